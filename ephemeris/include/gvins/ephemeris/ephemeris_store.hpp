@@ -1,0 +1,72 @@
+// Ephemeris store: keeps every broadcast record received (from RINEX or RTCM) and picks the right
+// one for a satellite and time.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "gvins/base/observation.hpp"
+#include "gvins/ephemeris/glonass_ephemeris.hpp"
+#include "gvins/ephemeris/ionosphere_parameters.hpp"
+#include "gvins/ephemeris/kepler_ephemeris.hpp"
+#include "gvins/ephemeris/rinex_nav.hpp"
+#include "gvins/ephemeris/satellite_state.hpp"
+
+namespace gvins {
+
+/// Selection policy knobs.
+struct EphemerisSelection {
+  bool allowUnhealthy = false;
+  /// Galileo: which message's clock to use (I/NAV: E1-E5b; F/NAV: E1-E5a). With `preferInav` the
+  /// store falls back to the other message type when the preferred one is missing.
+  bool preferGalileoInav = true;
+  /// Use a record whose transmission time (ttr) is after t only if t is within this many seconds
+  /// of toe (real-time processing never has records from the future; post-processing with a
+  /// nav file of the whole day may). Negative: never use records transmitted after t.
+  double futureTolerance = 7200.0;
+};
+
+class EphemerisStore {
+ public:
+  /// Adds a record; exact duplicates (same satellite, message, toe and issue of data) are ignored.
+  void add(const KeplerEphemeris& eph);
+  void add(const GlonassEphemeris& eph);
+  /// Adds all records and header parameters of a navigation file.
+  void add(const NavData& nav);
+
+  /// The record for a satellite at time t: within the system's validity window around toe
+  /// (per-system windows documented in the implementation, e.g. GPS the fit interval, GLONASS
+  /// +-15 min around tb), healthy unless allowed, newest issue of data, nearest toe.
+  /// nullptr if none.
+  const KeplerEphemeris* selectKepler(SatId sat, const GpsTime& t,
+                                      const EphemerisSelection& policy = {}) const;
+  const GlonassEphemeris* selectGlonass(SatId sat, const GpsTime& t,
+                                        const EphemerisSelection& policy = {}) const;
+
+  /// Satellite state at transmit time t from the selected record; std::nullopt when there is no
+  /// usable record.
+  std::optional<SatelliteState> satelliteState(SatId sat, const GpsTime& t,
+                                               const EphemerisSelection& policy = {}) const;
+  /// Group delay (s) for a pseudorange on `code` from the record selected at t (0 if none).
+  double groupDelay(SatId sat, ObsCode code, const GpsTime& t,
+                    const EphemerisSelection& policy = {}) const;
+
+  /// Satellites with at least one record.
+  std::vector<SatId> satellites() const;
+  std::size_t size() const;
+
+  IonosphereParameters& ionosphere() { return iono_; }
+  const IonosphereParameters& ionosphere() const { return iono_; }
+  /// GLONASS FDMA channels learned from the GLONASS records.
+  const GlonassChannels& glonassChannels() const { return channels_; }
+  std::optional<int> leapSeconds() const { return leapSeconds_; }
+
+ private:
+  std::vector<std::vector<KeplerEphemeris>> kepler_;   // indexed by satIndex, sorted by toe
+  std::vector<std::vector<GlonassEphemeris>> glonass_;
+  IonosphereParameters iono_;
+  GlonassChannels channels_;
+  std::optional<int> leapSeconds_;
+};
+
+}  // namespace gvins
