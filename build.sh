@@ -13,7 +13,7 @@ ROOT=$(pwd)
 JOBS=${JOBS:-$(nproc)}
 
 PACKAGES=(build-essential cmake ninja-build pkg-config
-          libeigen3-dev libsuitesparse-dev libopencv-dev libyaml-cpp-dev
+          zlib1g-dev libeigen3-dev libsuitesparse-dev libopencv-dev libyaml-cpp-dev
           libgtest-dev libgmock-dev libbenchmark-dev
           clang libclang-rt-14-dev rtklib)
 
