@@ -55,6 +55,15 @@ class EphemerisStore {
   std::vector<SatId> satellites() const;
   std::size_t size() const;
 
+  /// All Keplerian / GLONASS records of a satellite, sorted by toe (empty for none).
+  const std::vector<KeplerEphemeris>& keplerRecords(SatId sat) const;
+  const std::vector<GlonassEphemeris>& glonassRecords(SatId sat) const;
+
+  /// Half-width (s) of the window around toe in which a record is used; see the implementation
+  /// for the per-system values and their sources.
+  static double validityHalfWindow(const KeplerEphemeris& eph);
+  static double validityHalfWindow(const GlonassEphemeris& eph);
+
   IonosphereParameters& ionosphere() { return iono_; }
   const IonosphereParameters& ionosphere() const { return iono_; }
   /// GLONASS FDMA channels learned from the GLONASS records.

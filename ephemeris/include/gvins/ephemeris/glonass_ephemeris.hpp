@@ -28,4 +28,7 @@ struct GlonassEphemeris {
   double deltaTauN = 0.0;  ///< L1/L2 group delay difference, s
 };
 
+/// Whether the record allows use: health (Bn MSB / RINEX health flag) zero (GLONASS ICD 5.1, 4.4).
+bool isHealthy(const GlonassEphemeris& eph);
+
 }  // namespace gvins

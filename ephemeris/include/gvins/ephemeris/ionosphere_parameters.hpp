@@ -31,6 +31,7 @@ struct TimeSystemCorrection {
   double a1 = 0.0;                 ///< s/s
   double referenceTow = 0.0;       ///< s of week
   int referenceWeek = 0;           ///< week number as given in the file
+  double a2 = 0.0;                 ///< s/s^2 (RINEX 4 STO records; 0 in RINEX 2/3 headers)
 };
 
 /// Ionosphere parameters per source.

@@ -69,4 +69,17 @@ struct KeplerEphemeris {
   std::array<double, 2> tgd{0.0, 0.0};
 };
 
+/// Whether the record's health word allows use of the satellite for the signals the message serves:
+/// GPS all six LNAV health bits zero (IS-GPS-200N 20.3.3.3.1.4); QZSS the five bits other than
+/// the L1C/B flag (LSB) zero (IS-QZSS-PNT-005 4.1.2.3);
+/// Galileo I/NAV: E1-B and E5b DVS/HS bits zero, F/NAV: E5a DVS/HS bits zero (RINEX 3.04 table A8
+/// bit layout, OS SIS ICD 2.1 5.1.9.3); BeiDou SatH1 = 0 (BDS-SIS-ICD B1I 3.0 5.2.4.6).
+bool isHealthy(const KeplerEphemeris& eph);
+
+/// Galileo message type implied by a RINEX "data sources" bit field (RINEX 3.04 table A8):
+/// bit 9 (clock for E5b,E1) or bits 0/2 (I/NAV E1-B / E5b-I) mean I/NAV; bit 8 (clock for
+/// E5a,E1) or bit 1 (F/NAV E5a-I) mean F/NAV. Bit 9 wins over bit 8 when a writer sets both;
+/// an empty field (0) is taken as I/NAV, the message every Galileo receiver decodes.
+NavMessage galileoMessageFromDataSources(int dataSources);
+
 }  // namespace gvins

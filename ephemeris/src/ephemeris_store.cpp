@@ -1,0 +1,225 @@
+// Ephemeris store and record selection.
+//
+// Validity windows (half-widths around toe; a record is never used outside its window):
+//   GPS     half the fit interval (IS-GPS-200N 20.3.4.4 and table 20-XII): 2 h for the standard
+//           4 h fit (fit interval 0 or 4 in RINEX), 3 h when only the "> 4 h" flag (1) is given,
+//           otherwise fit/2 as written (6, 8, 14, 26 h fits after long uploads).
+//   QZSS    half the fit interval (IS-QZSS-PNT-005 4.1.2.7: flag 0 = 2 h, 1 = more than 2 h):
+//           1 h for flag 0, 2 h for flag 1, otherwise fit/2 as written.
+//   Galileo 4 h: the OS SIS ICD defines no fit interval; new IODnav batches come every 10 min
+//           and 4 h is the common maximum age of a batch (the value RTKLIB 2.4.3 also uses).
+//   BeiDou  2 h: D1/D2 ephemerides are refreshed every hour (BDS-SIS-ICD B1I 3.0 5.2.4.11, toe
+//           on the hour); one missed update is tolerated.
+//   GLONASS 30 min: tb is spaced 30, 45 or 60 min (ICD 5.1 4.4, word P1), so a record serves at
+//           most +-30 min around tb.
+// Among usable records the nearest toe wins; equal distances go to the newest transmission, then
+// the larger issue of data. Records whose transmission time is after t are used only within
+// EphemerisSelection::futureTolerance of toe.
+#include <algorithm>
+#include <cmath>
+
+#include "gvins/ephemeris/ephemeris_store.hpp"
+
+namespace gvins {
+namespace {
+
+constexpr double kHour = 3600.0;
+
+// Largest half window of any record of a system (bounds the scan of a satellite's records).
+double maxHalfWindow(System s) {
+  switch (s) {
+    case System::Gps:
+    case System::Qzss: return 13.0 * kHour;  // 26 h fit, the longest in IS-GPS-200N table 20-XII
+    case System::Galileo: return 4.0 * kHour;
+    case System::BeiDou: return 2.0 * kHour;
+    case System::Glonass: return 0.5 * kHour;
+    default: return 0.0;
+  }
+}
+
+bool sameKeplerRecord(const KeplerEphemeris& a, const KeplerEphemeris& b) {
+  return a.message == b.message && a.toe == b.toe && a.iode == b.iode && a.iodc == b.iodc;
+}
+
+// Whether a record transmitted at ttr may be used at t.
+bool transmittedInTime(const GpsTime& ttr, const GpsTime& toe, const GpsTime& t,
+                       const EphemerisSelection& policy) {
+  if (!(ttr > t)) return true;
+  if (policy.futureTolerance < 0.0) return false;
+  return std::fabs(t - toe) <= policy.futureTolerance;
+}
+
+const std::vector<KeplerEphemeris> kNoKepler;
+const std::vector<GlonassEphemeris> kNoGlonass;
+
+}  // namespace
+
+double EphemerisStore::validityHalfWindow(const KeplerEphemeris& eph) {
+  const double fit = eph.fitInterval;
+  switch (eph.sat.system) {
+    case System::Gps:
+      if (fit > 1.5) return 0.5 * fit * kHour;
+      return fit > 0.5 ? 3.0 * kHour : 2.0 * kHour;
+    case System::Qzss:
+      if (fit > 1.5) return 0.5 * fit * kHour;
+      return fit > 0.5 ? 2.0 * kHour : 1.0 * kHour;
+    default:
+      return maxHalfWindow(eph.sat.system);
+  }
+}
+
+double EphemerisStore::validityHalfWindow(const GlonassEphemeris&) { return 0.5 * kHour; }
+
+void EphemerisStore::add(const KeplerEphemeris& eph) {
+  if (!eph.sat.valid() || eph.sat.system == System::Glonass) return;
+  const int idx = satIndex(eph.sat);
+  if (kepler_.size() < static_cast<std::size_t>(numSatIndices())) kepler_.resize(numSatIndices());
+  auto& list = kepler_[idx];
+  auto it = std::lower_bound(list.begin(), list.end(), eph.toe,
+                             [](const KeplerEphemeris& e, const GpsTime& t) { return e.toe < t; });
+  for (auto j = it; j != list.end() && j->toe == eph.toe; ++j) {
+    if (sameKeplerRecord(*j, eph)) {
+      // The same data set seen again: keep the copy that was available first.
+      if (eph.ttr < j->ttr) *j = eph;
+      return;
+    }
+  }
+  list.insert(it, eph);
+}
+
+void EphemerisStore::add(const GlonassEphemeris& eph) {
+  if (!eph.sat.valid() || eph.sat.system != System::Glonass) return;
+  const int idx = satIndex(eph.sat);
+  if (glonass_.size() < static_cast<std::size_t>(numSatIndices())) glonass_.resize(numSatIndices());
+  auto& list = glonass_[idx];
+  auto it = std::lower_bound(list.begin(), list.end(), eph.toe,
+                             [](const GlonassEphemeris& e, const GpsTime& t) { return e.toe < t; });
+  for (auto j = it; j != list.end() && j->toe == eph.toe; ++j) {
+    if (j->position == eph.position && j->velocity == eph.velocity) {
+      if (eph.tof < j->tof) *j = eph;
+      return;
+    }
+  }
+  list.insert(it, eph);
+  if (eph.frequencyChannel >= -7 && eph.frequencyChannel <= 6) channels_.set(eph.sat.prn, eph.frequencyChannel);
+}
+
+void EphemerisStore::add(const NavData& nav) {
+  for (const auto& e : nav.kepler) add(e);
+  for (const auto& g : nav.glonass) add(g);
+  if (!iono_.gps) iono_.gps = nav.iono.gps;
+  if (!iono_.qzss) iono_.qzss = nav.iono.qzss;
+  if (!iono_.beidou) iono_.beidou = nav.iono.beidou;
+  if (!iono_.galileo) iono_.galileo = nav.iono.galileo;
+  if (!leapSeconds_) leapSeconds_ = nav.leapSeconds;
+}
+
+const KeplerEphemeris* EphemerisStore::selectKepler(SatId sat, const GpsTime& t,
+                                                    const EphemerisSelection& policy) const {
+  if (!sat.valid() || sat.system == System::Glonass || kepler_.empty()) return nullptr;
+  const auto& list = kepler_[satIndex(sat)];
+  if (list.empty()) return nullptr;
+  const double bound = maxHalfWindow(sat.system);
+
+  auto pick = [&](bool anyMessage, NavMessage wanted) -> const KeplerEphemeris* {
+    const KeplerEphemeris* best = nullptr;
+    double bestDt = 0.0;
+    auto it = std::lower_bound(list.begin(), list.end(), t - bound,
+                               [](const KeplerEphemeris& e, const GpsTime& x) { return e.toe < x; });
+    for (; it != list.end() && !(t + bound < it->toe); ++it) {
+      const KeplerEphemeris& e = *it;
+      if (!anyMessage && e.message != wanted) continue;
+      if (!policy.allowUnhealthy && !isHealthy(e)) continue;
+      const double dt = std::fabs(t - e.toe);
+      if (dt > validityHalfWindow(e)) continue;
+      if (!transmittedInTime(e.ttr, e.toe, t, policy)) continue;
+      if (best) {
+        if (dt > bestDt) continue;
+        if (dt == bestDt && (e.ttr < best->ttr || (e.ttr == best->ttr && e.iode <= best->iode))) continue;
+      }
+      best = &e;
+      bestDt = dt;
+    }
+    return best;
+  };
+
+  if (sat.system == System::Galileo) {
+    const NavMessage first = policy.preferGalileoInav ? NavMessage::GalileoInav : NavMessage::GalileoFnav;
+    const NavMessage second = policy.preferGalileoInav ? NavMessage::GalileoFnav : NavMessage::GalileoInav;
+    if (const auto* e = pick(false, first)) return e;
+    return pick(false, second);
+  }
+  return pick(true, NavMessage::GpsLnav);
+}
+
+const GlonassEphemeris* EphemerisStore::selectGlonass(SatId sat, const GpsTime& t,
+                                                      const EphemerisSelection& policy) const {
+  if (!sat.valid() || sat.system != System::Glonass || glonass_.empty()) return nullptr;
+  const auto& list = glonass_[satIndex(sat)];
+  const double bound = maxHalfWindow(System::Glonass);
+  const GlonassEphemeris* best = nullptr;
+  double bestDt = 0.0;
+  auto it = std::lower_bound(list.begin(), list.end(), t - bound,
+                             [](const GlonassEphemeris& e, const GpsTime& x) { return e.toe < x; });
+  for (; it != list.end() && !(t + bound < it->toe); ++it) {
+    const GlonassEphemeris& e = *it;
+    if (!policy.allowUnhealthy && !isHealthy(e)) continue;
+    const double dt = std::fabs(t - e.toe);
+    if (dt > validityHalfWindow(e)) continue;
+    if (!transmittedInTime(e.tof, e.toe, t, policy)) continue;
+    if (best && (dt > bestDt || (dt == bestDt && !(best->tof < e.tof)))) continue;
+    best = &e;
+    bestDt = dt;
+  }
+  return best;
+}
+
+std::optional<SatelliteState> EphemerisStore::satelliteState(SatId sat, const GpsTime& t,
+                                                             const EphemerisSelection& policy) const {
+  if (sat.system == System::Glonass) {
+    if (const auto* g = selectGlonass(sat, t, policy)) return glonassSatelliteState(*g, t);
+    return std::nullopt;
+  }
+  if (const auto* e = selectKepler(sat, t, policy)) return keplerSatelliteState(*e, t);
+  return std::nullopt;
+}
+
+double EphemerisStore::groupDelay(SatId sat, ObsCode code, const GpsTime& t,
+                                  const EphemerisSelection& policy) const {
+  if (sat.system == System::Glonass) {
+    const auto* g = selectGlonass(sat, t, policy);
+    return g ? broadcastGroupDelay(*g, code) : 0.0;
+  }
+  const auto* e = selectKepler(sat, t, policy);
+  return e ? broadcastGroupDelay(*e, code) : 0.0;
+}
+
+std::vector<SatId> EphemerisStore::satellites() const {
+  std::vector<SatId> out;
+  const int n = numSatIndices();
+  for (int i = 0; i < n; ++i) {
+    const bool k = i < static_cast<int>(kepler_.size()) && !kepler_[i].empty();
+    const bool g = i < static_cast<int>(glonass_.size()) && !glonass_[i].empty();
+    if (k || g) out.push_back(satFromIndex(i));
+  }
+  return out;
+}
+
+std::size_t EphemerisStore::size() const {
+  std::size_t n = 0;
+  for (const auto& l : kepler_) n += l.size();
+  for (const auto& l : glonass_) n += l.size();
+  return n;
+}
+
+const std::vector<KeplerEphemeris>& EphemerisStore::keplerRecords(SatId sat) const {
+  if (!sat.valid() || kepler_.empty()) return kNoKepler;
+  return kepler_[satIndex(sat)];
+}
+
+const std::vector<GlonassEphemeris>& EphemerisStore::glonassRecords(SatId sat) const {
+  if (!sat.valid() || glonass_.empty()) return kNoGlonass;
+  return glonass_[satIndex(sat)];
+}
+
+}  // namespace gvins
