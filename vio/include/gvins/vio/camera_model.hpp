@@ -24,6 +24,8 @@ struct CameraIntrinsics {
 class CameraModel {
  public:
   CameraModel() = default;
+  /// Throws std::invalid_argument for non-positive or non-finite focal lengths, non-finite
+  /// centre or distortion coefficients, or a negative image size.
   explicit CameraModel(const CameraIntrinsics& intrinsics);
 
   const CameraIntrinsics& intrinsics() const { return k_; }
@@ -41,7 +43,22 @@ class CameraModel {
   std::optional<Eigen::Vector2d> project(const Eigen::Vector3d& pointCamera,
                                          Eigen::Matrix<double, 2, 3>* jacobian = nullptr) const;
 
+  /// True if the pixel lies in [border, width-1-border] x [border, height-1-border]
+  /// (pixel centres at integer coordinates, OpenCV convention).
   bool inImage(const Eigen::Vector2d& pixel, double border = 0.0) const;
+
+  // Additions beyond the shared declaration (used by the front end and the filter).
+
+  /// Undistorted normalised -> distorted normalised coordinates (no focal length / centre).
+  /// Optional 2x2 Jacobian d distorted / d undistorted.
+  Eigen::Vector2d distort(const Eigen::Vector2d& normalized, Eigen::Matrix2d* jacobian = nullptr) const;
+  /// Distorted normalised -> undistorted normalised coordinates (inverse of distort()).
+  Eigen::Vector2d undistortNormalized(const Eigen::Vector2d& distorted) const;
+  /// As undistort(pixel), with the 2x2 Jacobian d normalised / d pixel (inverse of the
+  /// distortAndProject() Jacobian at the solution); used to map pixel noise to normalised noise.
+  Eigen::Vector2d undistort(const Eigen::Vector2d& pixel, Eigen::Matrix2d* jacobian) const;
+  /// Unit bearing vector in the camera frame of a distorted pixel.
+  Eigen::Vector3d bearing(const Eigen::Vector2d& pixel) const;
 
  private:
   CameraIntrinsics k_;
