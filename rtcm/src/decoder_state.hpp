@@ -1,0 +1,105 @@
+// Internal state of gvins::rtcm::Decoder, shared by the translation units that decode the
+// different message groups. Not installed.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <unordered_map>
+#include <vector>
+
+#include "gvins/rtcm/bit_reader.hpp"
+#include "gvins/rtcm/decoder.hpp"
+#include "gvins/rtcm/lock_time.hpp"
+
+namespace gvins::rtcm {
+
+/// Per satellite and signal tracking state.
+struct SignalTrack {
+  GpsTime last;                 ///< time of the last observation
+  std::int64_t lockMinMs = 0;   ///< lock-time lower bound at that observation
+  bool valid = false;
+  // Legacy messages only: accumulated phase-range rollover correction (cycles) and the last raw
+  // phase-range minus pseudorange difference (cycles).
+  double rolloverCycles = 0.0;
+  double lastRawDiffCycles = 0.0;
+  bool hasRawDiff = false;
+};
+
+struct Decoder::State {
+  DecoderOptions opt;
+  Framer framer;
+  DecoderStats stats;
+  std::deque<Decoded> out;
+  StationInfo station;
+  std::optional<StationPosition> stationPos;
+  GlonassChannels channels;
+  std::optional<GlonassCodePhaseBiases> biases;
+
+  GpsTime ref;               ///< reference time for resolving times of week/day
+  bool refAbsolute = false;  ///< from the options or learned from the stream
+
+  // Epoch assembly.
+  std::optional<ObsEpoch> open;
+  bool openHasOthers = false;  ///< the open epoch holds non-BeiDou systems
+  std::optional<GpsTime> lastClosed;
+  bool lastClosedHasOthers = false;
+
+  std::unordered_map<std::uint32_t, SignalTrack> tracks;
+  /// Last full rough range (ms) per satellite (satIndex) from MSM4-7, to resolve the whole
+  /// milliseconds that MSM1-3 leave out.
+  struct RangeTrack {
+    GpsTime t;
+    double ms = 0.0;
+    bool valid = false;
+  };
+  std::vector<RangeTrack> ranges = std::vector<RangeTrack>(static_cast<std::size_t>(numSatIndices()));
+
+  // The message being decoded (for error reports).
+  std::int64_t offset = 0;
+  int type = 0;
+};
+
+// ---- helpers shared by the decoding units ---------------------------------------------------
+
+/// Key of a satellite/signal pair in State::tracks.
+inline std::uint32_t trackKey(SatId sat, ObsCode code) {
+  return (static_cast<std::uint32_t>(satIndex(sat)) << 16) |
+         (static_cast<std::uint32_t>(static_cast<unsigned char>(code.band)) << 8) |
+         static_cast<unsigned char>(code.attr);
+}
+
+/// Loss-of-lock flag (RINEX LLI bit 0) of a signal observed at t with the given lock-time
+/// indicator; updates the track.
+std::uint8_t lossOfLock(Decoder::State& s, SatId sat, ObsCode code, const GpsTime& t,
+                        LockTimeKind kind, int indicator);
+
+/// Time of week (seconds) in GPST resolved near the reference.
+GpsTime resolveTow(const Decoder::State& s, double towSeconds);
+/// GLONASS time of day (Moscow time, seconds) resolved near the reference.
+GpsTime resolveGlonassTimeOfDay(const Decoder::State& s, double todSeconds);
+/// BeiDou MSM epoch time read as BDT (already converted to GPST): the GPST-stamping check of the
+/// Decoder file comment.
+GpsTime checkBeidouStamp(Decoder::State& s, const GpsTime& asBdt);
+/// Merges the satellites of one observation message into the epoch at t; `more` is the
+/// multiple-message / synchronous GNSS flag.
+void addObservations(Decoder::State& s, System system, const GpsTime& t, bool more,
+                     std::vector<SatObs>& sats);
+/// Moves the reference to an absolute time learned from the stream if the current reference is
+/// only the host clock.
+void learnAbsoluteTime(Decoder::State& s, const GpsTime& t);
+
+/// Message decoders (the reader is positioned after DF002). Each throws MessageError.
+void decodeLegacyGps(Decoder::State& s, BitReader& r, int type);
+void decodeLegacyGlonass(Decoder::State& s, BitReader& r, int type);
+void decodeMsm(Decoder::State& s, BitReader& r, System system, int msm);
+void decodeStationPosition(Decoder::State& s, BitReader& r, int type);
+void decodeAntenna(Decoder::State& s, BitReader& r, int type);
+void decodeGlonassBiases(Decoder::State& s, BitReader& r);
+void decodeGpsEphemeris(Decoder::State& s, BitReader& r);
+void decodeGlonassEphemeris(Decoder::State& s, BitReader& r);
+void decodeBeidouEphemeris(Decoder::State& s, BitReader& r);
+void decodeQzssEphemeris(Decoder::State& s, BitReader& r);
+void decodeGalileoEphemeris(Decoder::State& s, BitReader& r, bool inav);
+
+}  // namespace gvins::rtcm

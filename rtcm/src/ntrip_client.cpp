@@ -1,0 +1,199 @@
+#include "gvins/rtcm/ntrip_client.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+
+#include <fcntl.h>
+#include <netdb.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <sys/types.h>
+#include <unistd.h>
+
+namespace gvins::rtcm {
+namespace {
+
+using Kind = NtripError::Kind;
+using Clock = std::chrono::steady_clock;
+
+double secondsLeft(Clock::time_point deadline) {
+  return std::chrono::duration<double>(deadline - Clock::now()).count();
+}
+
+int pollMs(double seconds) {
+  if (seconds <= 0.0) return 0;
+  return static_cast<int>(std::min(seconds * 1000.0 + 1.0, 2.0e9));
+}
+
+}  // namespace
+
+NtripClient::NtripClient(NtripUrl url, NtripOptions options)
+    : url_(std::move(url)), opt_(std::move(options)), response_(url_.mountpoint) {}
+
+NtripClient::~NtripClient() { close(); }
+
+void NtripClient::close() {
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+}
+
+std::string NtripClient::request() const {
+  std::string r;
+  if (opt_.version == 1) {
+    r = "GET /" + url_.mountpoint + " HTTP/1.0\r\n";
+  } else {
+    r = "GET /" + url_.mountpoint + " HTTP/1.1\r\n";
+    r += "Host: " + url_.host + ":" + std::to_string(url_.port) + "\r\n";
+    r += "Ntrip-Version: Ntrip/2.0\r\n";
+  }
+  r += "User-Agent: " + opt_.userAgent + "\r\n";
+  if (!url_.user.empty() || !url_.password.empty()) {
+    r += "Authorization: Basic " + base64Encode(url_.user + ":" + url_.password) + "\r\n";
+  }
+  if (opt_.version != 1 && !opt_.gga.empty()) r += "Ntrip-GGA: " + opt_.gga + "\r\n";
+  if (opt_.version != 1) r += "Connection: close\r\n";
+  r += "\r\n";
+  if (opt_.version == 1 && !opt_.gga.empty()) r += opt_.gga + "\r\n";
+  return r;
+}
+
+void NtripClient::connect() {
+  close();
+  const std::string where = url_.host + ":" + std::to_string(url_.port);
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_STREAM;
+  addrinfo* res = nullptr;
+  const std::string port = std::to_string(url_.port);
+  const int gai = ::getaddrinfo(url_.host.c_str(), port.c_str(), &hints, &res);
+  if (gai != 0) throw NtripError(Kind::Resolve, "cannot resolve caster host '" + url_.host + "': " + gai_strerror(gai));
+
+  const Clock::time_point deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(opt_.connectTimeout));
+  int lastErr = 0;
+  bool timedOut = false;
+  for (addrinfo* a = res; a && fd_ < 0; a = a->ai_next) {
+    const int fd = ::socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC, a->ai_protocol);
+    if (fd < 0) {
+      lastErr = errno;
+      continue;
+    }
+    ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) | O_NONBLOCK);
+    int rc = ::connect(fd, a->ai_addr, a->ai_addrlen);
+    if (rc != 0 && errno == EINPROGRESS) {
+      pollfd p{fd, POLLOUT, 0};
+      rc = ::poll(&p, 1, pollMs(secondsLeft(deadline)));
+      if (rc == 0) {
+        timedOut = true;
+        ::close(fd);
+        continue;
+      }
+      int err = 0;
+      socklen_t len = sizeof err;
+      ::getsockopt(fd, SOL_SOCKET, SO_ERROR, &err, &len);
+      rc = err == 0 ? 0 : -1;
+      errno = err;
+    }
+    if (rc != 0) {
+      lastErr = errno;
+      ::close(fd);
+      continue;
+    }
+    fd_ = fd;
+  }
+  ::freeaddrinfo(res);
+  if (fd_ < 0) {
+    if (lastErr == ECONNREFUSED) throw NtripError(Kind::ConnectionRefused, "connection to caster " + where + " refused (nothing listens there)");
+    if (timedOut) throw NtripError(Kind::Timeout, "no connection to caster " + where + " within " + std::to_string(opt_.connectTimeout) + " s");
+    throw NtripError(Kind::Connection, "cannot connect to caster " + where + ": " + std::strerror(lastErr));
+  }
+
+  // Send the request.
+  const std::string req = request();
+  std::size_t sent = 0;
+  while (sent < req.size()) {
+    const ssize_t n = ::send(fd_, req.data() + sent, req.size() - sent, MSG_NOSIGNAL);
+    if (n > 0) {
+      sent += static_cast<std::size_t>(n);
+      continue;
+    }
+    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+      pollfd p{fd_, POLLOUT, 0};
+      if (::poll(&p, 1, pollMs(secondsLeft(deadline))) <= 0) {
+        close();
+        throw NtripError(Kind::Timeout, "caster " + where + " did not accept the request within " + std::to_string(opt_.connectTimeout) + " s");
+      }
+      continue;
+    }
+    const int e = errno;
+    close();
+    throw NtripError(Kind::Connection, "sending the request to " + where + " failed: " + std::strerror(e));
+  }
+
+  // Response header (stream bytes that follow it are kept).
+  try {
+    while (!response_.headerComplete()) {
+      const double left = secondsLeft(deadline);
+      if (left <= 0.0) throw NtripError(Kind::Timeout, "caster " + where + " sent no complete response within " + std::to_string(opt_.connectTimeout) + " s");
+      if (!receiveSome(pending_, left, "the response header")) {
+        response_.end();
+        throw NtripError(Kind::Connection, "caster " + where + " closed the connection after its header");
+      }
+    }
+  } catch (...) {
+    close();
+    throw;
+  }
+}
+
+bool NtripClient::receiveSome(std::vector<std::uint8_t>& payload, double timeout, const char* waitingFor) {
+  const Clock::time_point deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout));
+  std::uint8_t buf[16384];
+  for (;;) {
+    pollfd p{fd_, POLLIN, 0};
+    const int rc = ::poll(&p, 1, pollMs(secondsLeft(deadline)));
+    if (rc < 0 && errno == EINTR) continue;
+    if (rc == 0) {
+      throw NtripError(Kind::Timeout, "nothing received from " + url_.host + ":" + std::to_string(url_.port) +
+                                          " for " + std::to_string(timeout) + " s while waiting for " + waitingFor);
+    }
+    const ssize_t n = ::recv(fd_, buf, sizeof buf, 0);
+    if (n > 0) {
+      received_ += n;
+      response_.feed({buf, static_cast<std::size_t>(n)}, payload);
+      return true;
+    }
+    if (n == 0) return false;
+    if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) continue;
+    throw NtripError(Kind::Connection, std::string("receiving from the caster failed: ") + std::strerror(errno));
+  }
+}
+
+std::size_t NtripClient::read(std::vector<std::uint8_t>& out) {
+  if (!pending_.empty()) {
+    const std::size_t n = pending_.size();
+    out.insert(out.end(), pending_.begin(), pending_.end());
+    pending_.clear();
+    return n;
+  }
+  if (fd_ < 0 || ended_) return 0;
+  const Clock::time_point deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(opt_.readTimeout));
+  for (;;) {
+    const std::size_t before = out.size();
+    if (response_.finished()) {
+      ended_ = true;
+      return 0;
+    }
+    const double left = secondsLeft(deadline);
+    if (left <= 0.0) throw NtripError(Kind::Timeout, "no stream data from " + url_.display() + " for " + std::to_string(opt_.readTimeout) + " s");
+    if (!receiveSome(out, left, "stream data")) {
+      ended_ = true;
+      response_.end();
+      return out.size() - before;
+    }
+    if (out.size() > before) return out.size() - before;  // chunk framing alone gives nothing yet
+  }
+}
+
+}  // namespace gvins::rtcm

@@ -1,0 +1,474 @@
+// Decoder: RTKLIB's conversion of rtklib_testglo.rtcm3 observation by observation, the GMSD log
+// (MSM7 of four systems, GPS week rollover, BeiDou stamped in GPS time), every single-frame file,
+// malformed and hostile input.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <sstream>
+
+#include "gvins/base/parse_error.hpp"
+#include "gvins/rtcm/crc24q.hpp"
+#include "gvins/rtcm/decoder.hpp"
+#include "gvins/rtcm/encoder.hpp"
+#include "gvins/rtcm/message_types.hpp"
+#include "independent_frame_scan.hpp"
+
+namespace gvins::rtcm {
+namespace {
+
+using testing::dataDir;
+using testing::readBytes;
+
+struct Decoded {
+  std::vector<ObsEpoch> epochs;
+  std::vector<KeplerEphemeris> kepler;
+  std::vector<GlonassEphemeris> glonass;
+  std::vector<StationPosition> stations;
+  std::vector<AntennaDescriptor> antennas;
+  std::vector<ReceiverDescriptor> receivers;
+  std::vector<GlonassCodePhaseBiases> biases;
+};
+
+Decoded decodeAll(Decoder& dec, const std::vector<std::uint8_t>& d, std::size_t chunk = 4096) {
+  Decoded out;
+  auto drain = [&] {
+    while (auto it = dec.poll()) {
+      std::visit(
+          [&](auto&& v) {
+            using T = std::decay_t<decltype(v)>;
+            if constexpr (std::is_same_v<T, ObsEpoch>) out.epochs.push_back(v);
+            else if constexpr (std::is_same_v<T, KeplerEphemeris>) out.kepler.push_back(v);
+            else if constexpr (std::is_same_v<T, GlonassEphemeris>) out.glonass.push_back(v);
+            else if constexpr (std::is_same_v<T, StationPosition>) out.stations.push_back(v);
+            else if constexpr (std::is_same_v<T, AntennaDescriptor>) out.antennas.push_back(v);
+            else if constexpr (std::is_same_v<T, ReceiverDescriptor>) out.receivers.push_back(v);
+            else out.biases.push_back(v);
+          },
+          *it);
+    }
+  };
+  for (std::size_t i = 0; i < d.size(); i += chunk) {
+    dec.feed({d.data() + i, std::min(chunk, d.size() - i)});
+    drain();
+  }
+  dec.finish();
+  drain();
+  return out;
+}
+
+GpsTime date(int y, int m, int d) {
+  CalendarTime c;
+  c.year = y;
+  c.month = m;
+  c.day = d;
+  c.hour = 12;
+  return GpsTime::fromCalendar(c);
+}
+
+// ---- a minimal RINEX 3 observation parser for RTKLIB's reference file ----------------------
+
+struct RinexValue {
+  double value = 0.0;
+  int lli = 0;
+  bool present = false;
+};
+struct RinexEpoch {
+  GpsTime time;
+  std::map<std::string, std::vector<RinexValue>> sats;  // "G03" -> values in header type order
+};
+struct RinexObs {
+  std::map<char, std::vector<std::string>> types;  // 'G' -> {"C1C", "L1C", ...}
+  std::vector<RinexEpoch> epochs;
+};
+
+RinexObs readRtklibObs(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  RinexObs r;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.find("SYS / # / OBS TYPES") != std::string::npos) {
+      const char sys = line[0];
+      const int n = std::stoi(line.substr(3, 3));
+      for (int k = 0; k < n; ++k) r.types[sys].push_back(line.substr(7 + 4 * k, 3));
+    }
+    if (line.find("END OF HEADER") != std::string::npos) break;
+  }
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    if (line[0] == '>') {
+      CalendarTime c;
+      std::istringstream ss(line.substr(1));
+      ss >> c.year >> c.month >> c.day >> c.hour >> c.minute >> c.second;
+      r.epochs.push_back({GpsTime::fromCalendar(c), {}});
+      continue;
+    }
+    const std::string sat = line.substr(0, 3);
+    std::vector<RinexValue> vals;
+    for (std::size_t k = 0; k < r.types[line[0]].size(); ++k) {
+      RinexValue v;
+      const std::size_t pos = 3 + 16 * k;
+      if (pos + 14 <= line.size()) {
+        const std::string f = line.substr(pos, 14);
+        if (f.find_first_not_of(' ') != std::string::npos) {
+          v.value = std::stod(f);
+          v.present = true;
+        }
+        if (pos + 14 < line.size() && line[pos + 14] != ' ') v.lli = line[pos + 14] - '0';
+      }
+      vals.push_back(v);
+    }
+    r.epochs.back().sats[sat] = vals;
+  }
+  return r;
+}
+
+TEST(Decoder, TestgloMatchesRtklibObservationByObservation) {
+  const auto ref = readRtklibObs(dataDir() / "reference/rtklib-2.4.3/rtcm_testglo_convbin.obs");
+  ASSERT_EQ(ref.epochs.size(), 186u);
+  DecoderOptions opt;
+  opt.referenceTime = date(2009, 12, 18);
+  Decoder dec(opt);
+  const Decoded got = decodeAll(dec, readBytes(dataDir() / "rtcm/rtklib_testglo.rtcm3"));
+  ASSERT_EQ(got.epochs.size(), ref.epochs.size());
+
+  // Tolerances: the messages' resolution is 0.02 m for code and 0.0005 m for phase-range; both
+  // decoders compute the same numbers, so the RINEX rounding (0.001 m / cycle) dominates.
+  std::int64_t values = 0, lliSame = 0, lliCompared = 0;
+  double maxCode = 0, maxPhase = 0, maxSnr = 0;
+  for (std::size_t e = 0; e < ref.epochs.size(); ++e) {
+    const RinexEpoch& re = ref.epochs[e];
+    const ObsEpoch& oe = got.epochs[e];
+    ASSERT_EQ(oe.time, re.time) << e;
+    ASSERT_EQ(oe.sats.size(), re.sats.size()) << "epoch " << e;
+    for (const auto& [name, vals] : re.sats) {
+      const auto sat = SatId::parse(name);
+      ASSERT_TRUE(sat);
+      const SatObs* so = oe.find(*sat);
+      ASSERT_NE(so, nullptr) << name << " epoch " << e;
+      const auto& types = ref.types.at(name[0]);
+      std::size_t signalsSeen = 0;
+      for (std::size_t k = 0; k < types.size(); ++k) {
+        const ObsCode code(types[k][1], types[k][2]);
+        const SignalObs* s = so->find(code);
+        const RinexValue& v = vals[k];
+        if (!v.present) {
+          if (s) {
+            if (types[k][0] == 'S') {
+              EXPECT_FALSE(s->hasSnr()) << name << " " << types[k];
+            }
+            if (types[k][0] == 'L') {
+              EXPECT_FALSE(s->hasPhase()) << name << " " << types[k];
+            }
+          }
+          continue;
+        }
+        ASSERT_NE(s, nullptr) << name << " " << types[k] << " epoch " << e;
+        ++values;
+        switch (types[k][0]) {
+          case 'C':
+            ASSERT_TRUE(s->hasCode());
+            maxCode = std::max(maxCode, std::abs(s->pseudorange - v.value));
+            break;
+          case 'L':
+            ASSERT_TRUE(s->hasPhase());
+            maxPhase = std::max(maxPhase, std::abs(s->carrierPhase - v.value));
+            // RTKLIB's converter flags the first observation of every signal; compare later ones.
+            if (e > 0) {
+              ++lliCompared;
+              lliSame += (s->lli & 1) == (v.lli & 1);
+            }
+            break;
+          case 'S':
+            ASSERT_TRUE(s->hasSnr());
+            maxSnr = std::max(maxSnr, std::abs(s->snr - v.value));
+            break;
+        }
+        if (types[k][0] == 'C') ++signalsSeen;
+      }
+      EXPECT_EQ(signalsSeen, so->signals.size()) << name << " epoch " << e << ": same signals";
+    }
+  }
+  std::cerr << "testglo vs RTKLIB: " << values << " values, max |dC| " << maxCode << " m, max |dL| " << maxPhase
+            << " cycles, max |dS| " << maxSnr << " dB-Hz, LLI equal " << lliSame << "/" << lliCompared << "\n";
+  EXPECT_GT(values, 15000);
+  EXPECT_LE(maxCode, 0.0006);
+  EXPECT_LE(maxPhase, 0.0006);
+  EXPECT_LE(maxSnr, 1e-9);
+  EXPECT_EQ(lliSame, lliCompared);
+  EXPECT_EQ(dec.stats().malformed, 0);
+  EXPECT_EQ(dec.stats().epochs, 186);
+
+  // Station and GLONASS channels as in RTKLIB's header.
+  ASSERT_TRUE(dec.station().approxPosition);
+  EXPECT_NEAR(dec.station().approxPosition->x(), -3869297.5138, 1e-4);
+  EXPECT_NEAR(dec.station().approxPosition->y(), 3436571.3345, 1e-4);
+  EXPECT_NEAR(dec.station().approxPosition->z(), 3717369.3757, 1e-4);
+  // "GLONASS SLOT / FRQ #": R08 6, R13 -2, R14 -7, R15 0, R17 4, R23 3.
+  const std::pair<int, int> chans[] = {{8, 6}, {13, -2}, {14, -7}, {15, 0}, {17, 4}, {23, 3}};
+  for (auto [slot, k] : chans) EXPECT_EQ(dec.glonassChannels().get(slot), k) << slot;
+  EXPECT_EQ(got.kepler.size(), 19u);
+  EXPECT_EQ(got.glonass.size(), 19u);
+}
+
+TEST(Decoder, GmsdMsm7AcrossWeekRolloverWithBeidouInGpsTime) {
+  DecoderOptions opt;
+  opt.referenceTime = date(2012, 10, 13);
+  Decoder dec(opt);
+  const Decoded got = decodeAll(dec, readBytes(dataDir() / "rtcm/rtklib_GMSD7_20121014.rtcm3"), 1000);
+  const DecoderStats& st = dec.stats();
+  // 257 epochs of 1077+1087+1117+1127, each one epoch of four systems.
+  ASSERT_EQ(got.epochs.size(), 257u);
+  EXPECT_EQ(st.beidouGpstEpochs, 257);
+  EXPECT_EQ(st.malformed, 0);
+  const GpsTime first = got.epochs.front().time;
+  EXPECT_EQ(first.toString(0), "2012-10-13 23:59:44");
+  EXPECT_EQ(first.week(), 1709);
+  EXPECT_EQ(got.epochs.back().time.week(), 1710);  // crossed the week rollover (Sunday 00:00 GPST)
+  for (std::size_t i = 0; i < got.epochs.size(); ++i) {
+    const ObsEpoch& e = got.epochs[i];
+    EXPECT_DOUBLE_EQ(e.time - first, static_cast<double>(i)) << i;  // 1 Hz, continuous
+    int perSystem[kNumSystems] = {};
+    for (const SatObs& s : e.sats) ++perSystem[systemIndex(s.sat.system)];
+    EXPECT_GE(perSystem[systemIndex(System::Gps)], 10) << i;
+    EXPECT_GE(perSystem[systemIndex(System::Glonass)], 5) << i;
+    EXPECT_EQ(perSystem[systemIndex(System::Qzss)], 1) << i;
+    EXPECT_GE(perSystem[systemIndex(System::BeiDou)], 8) << i;
+  }
+  // Pseudoranges of all systems agree with each other: with the BeiDou epochs read as BDT instead
+  // the receiver clock would look 14 s different; here every pseudorange is a plausible range.
+  for (const ObsEpoch& e : got.epochs) {
+    for (const SatObs& s : e.sats) {
+      for (const SignalObs& g : s.signals) {
+        if (!g.hasCode()) continue;
+        EXPECT_GT(g.pseudorange, 1.9e7) << s.sat.str();
+        EXPECT_LT(g.pseudorange, 4.2e7) << s.sat.str();
+      }
+    }
+  }
+  // GLONASS channels from the MSM7 extended satellite information; receiver from 1033.
+  EXPECT_TRUE(dec.glonassChannels().get(13).has_value());
+  ASSERT_FALSE(got.receivers.empty());
+  EXPECT_EQ(got.receivers.front().type, "TRIMBLE NETR9");
+  EXPECT_EQ(got.kepler.size(), 15u);
+  EXPECT_EQ(got.glonass.size(), 16u);
+  // Truncated at the end of the file, nothing else lost.
+  EXPECT_EQ(st.framing.truncatedFrames, 1);
+  EXPECT_EQ(st.framing.crcFailures, 0);
+}
+
+TEST(Decoder, BeidouStampCheckLeavesCorrectBdtAlone) {
+  // Re-encode the GMSD epochs (our encoder stamps BeiDou in BDT): no correction must happen and
+  // the epochs must come out the same.
+  DecoderOptions opt;
+  opt.referenceTime = date(2012, 10, 13);
+  Decoder dec(opt);
+  const Decoded got = decodeAll(dec, readBytes(dataDir() / "rtcm/rtklib_GMSD7_20121014.rtcm3"));
+  Encoder enc;
+  enc.setGlonassChannels(dec.glonassChannels());
+  std::vector<std::uint8_t> stream;
+  for (const ObsEpoch& e : got.epochs) {
+    const auto f = enc.msm(e, 7);
+    stream.insert(stream.end(), f.begin(), f.end());
+  }
+  Decoder dec2(opt);
+  const Decoded again = decodeAll(dec2, stream);
+  EXPECT_EQ(dec2.stats().beidouGpstEpochs, 0);
+  ASSERT_EQ(again.epochs.size(), got.epochs.size());
+  for (std::size_t i = 0; i < got.epochs.size(); ++i) {
+    EXPECT_EQ(again.epochs[i].time, got.epochs[i].time);
+    EXPECT_EQ(again.epochs[i].sats.size(), got.epochs[i].sats.size());
+  }
+}
+
+TEST(Decoder, EverySingleFrameFileDecodesCleanly) {
+  DecoderOptions opt;
+  opt.referenceTime = date(2021, 1, 1);
+  std::int64_t decoded = 0, unsupported = 0;
+  for (const auto& path : testing::rtcmFiles()) {
+    SCOPED_TRACE(path.string());
+    opt.streamName = path.filename().string();
+    Decoder dec(opt);
+    const auto d = readBytes(path);
+    decodeAll(dec, d, 17);
+    EXPECT_EQ(dec.stats().malformed, 0);
+    for (const auto& issue : dec.stats().issues) ADD_FAILURE() << issue.what;
+    decoded += dec.stats().decoded;
+    unsupported += dec.stats().unsupported;
+    // Every good frame is either decoded or of a type this decoder does not decode.
+    std::int64_t frames = 0, notDecoded = 0;
+    for (const auto& [type, n] : dec.stats().messages) {
+      frames += n;
+      if (!isDecodedType(type)) notDecoded += n;
+    }
+    EXPECT_EQ(dec.stats().decoded + dec.stats().malformed, frames - notDecoded);
+  }
+  std::cerr << "decoded " << decoded << " messages, " << unsupported << " of types not decoded\n";
+}
+
+TEST(Decoder, StationAndDescriptorsFromSingleFrames) {
+  Decoder dec;
+  decodeAll(dec, readBytes(dataDir() / "rtcm/go-gnss_frames/1006_frame.bin"));
+  ASSERT_TRUE(dec.stationPosition());
+  const StationPosition& p = *dec.stationPosition();
+  EXPECT_EQ(p.messageType, 1006);
+  ASSERT_TRUE(p.antennaHeight);
+  // The marker is the ARP lowered by the antenna height.
+  EXPECT_NEAR((p.arp - *dec.station().approxPosition).norm(), *p.antennaHeight, 1e-6);
+  EXPECT_NEAR(p.arp.norm(), 6.37e6, 0.03e6);
+
+  Decoder d2;
+  decodeAll(d2, readBytes(dataDir() / "rtcm/go-gnss_frames/1033_frame.bin"));
+  // The frame's text fields (readable in a hex dump): no antenna descriptor, antenna serial
+  // "Unknown", receiver "SEPT POLARX5", firmware "5.2.0", receiver serial "3025123".
+  EXPECT_EQ(d2.station().antennaType, "");
+  EXPECT_EQ(d2.station().antennaNumber, "Unknown");
+  EXPECT_EQ(d2.station().receiverType, "SEPT POLARX5");
+  EXPECT_EQ(d2.station().receiverVersion, "5.2.0");
+  EXPECT_EQ(d2.station().receiverNumber, "3025123");
+}
+
+TEST(Decoder, GlonassBiases1230) {
+  Decoder dec;
+  const Decoded got = decodeAll(dec, readBytes(dataDir() / "rtcm/pyrtcm_pygpsdata-1230.bin"));
+  ASSERT_EQ(got.biases.size(), 5u);
+  for (const auto& b : got.biases) {
+    const int n = b.l1ca.has_value() + b.l1p.has_value() + b.l2ca.has_value() + b.l2p.has_value();
+    EXPECT_GT(n, 0);
+    for (const auto* v : {&b.l1ca, &b.l1p, &b.l2ca, &b.l2p}) {
+      if (*v) {
+        EXPECT_LT(std::abs(**v), 100.0);  // inter-frequency biases are metres, not kilometres
+      }
+    }
+  }
+}
+
+/// Builds a frame with a good CRC around an arbitrary payload.
+std::vector<std::uint8_t> frameOf(std::vector<std::uint8_t> payload) { return Encoder::frame(payload); }
+
+TEST(Decoder, MalformedMessagesAreReportedWithOffsetAndField) {
+  // A 1077 whose payload is cut in the middle of the signal data but carries a valid CRC.
+  auto full = readBytes(dataDir() / "rtcm/go-gnss_frames/1077_frame.bin");
+  std::vector<std::uint8_t> payload(full.begin() + 3, full.end() - 3);
+  payload.resize(payload.size() / 2);
+  std::vector<std::uint8_t> stream = readBytes(dataDir() / "rtcm/go-gnss_frames/1005_frame.bin");
+  const std::int64_t offset = static_cast<std::int64_t>(stream.size());
+  const auto bad = frameOf(payload);
+  stream.insert(stream.end(), bad.begin(), bad.end());
+  const auto tail = readBytes(dataDir() / "rtcm/go-gnss_frames/1019_frame.bin");
+  stream.insert(stream.end(), tail.begin(), tail.end());
+
+  DecoderOptions opt;
+  opt.streamName = "cut.rtcm3";
+  Decoder dec(opt);
+  const Decoded got = decodeAll(dec, stream);
+  EXPECT_EQ(dec.stats().malformed, 1);
+  ASSERT_EQ(dec.stats().issues.size(), 1u);
+  const DecodeIssue& is = dec.stats().issues[0];
+  EXPECT_EQ(is.offset, offset);
+  EXPECT_EQ(is.type, 1077);
+  EXPECT_EQ(is.field, "satellite and signal data");
+  EXPECT_NE(is.what.find("byte " + std::to_string(offset)), std::string::npos) << is.what;
+  EXPECT_NE(is.what.find("message too short"), std::string::npos) << is.what;
+  // The messages around it are decoded.
+  EXPECT_EQ(got.stations.size(), 1u);
+  EXPECT_EQ(got.kepler.size(), 1u);
+
+  // Strict mode throws ParseError naming the stream and the offset.
+  opt.strict = true;
+  Decoder strict(opt);
+  try {
+    strict.feed(stream);
+    FAIL() << "no exception";
+  } catch (const ParseError& e) {
+    EXPECT_EQ(e.file(), "cut.rtcm3");
+    EXPECT_EQ(e.line(), offset);
+    EXPECT_EQ(e.field(), "satellite and signal data");
+  }
+}
+
+TEST(Decoder, ImpossibleFieldValuesAreRejected) {
+  struct Case {
+    std::vector<std::uint8_t> payload;
+    std::string field;
+  };
+  // MSM header with 9 satellites x 8 signals (72 cells > 64).
+  std::vector<std::uint8_t> msm(40, 0);
+  msm[0] = 1077 >> 4;
+  msm[1] = static_cast<std::uint8_t>((1077 & 0xF) << 4);
+  // satellite mask starts at bit 73 (12+12+30+1+3+7+2+2+1+3); set 9 bits, signal mask 8 bits.
+  auto setBit = [&](std::vector<std::uint8_t>& p, int bit) { p[static_cast<std::size_t>(bit / 8)] |= static_cast<std::uint8_t>(0x80 >> (bit % 8)); };
+  for (int k = 0; k < 9; ++k) setBit(msm, 73 + k);
+  for (int k = 0; k < 8; ++k) setBit(msm, 73 + 64 + k);
+  // GPS ephemeris with satellite ID 0.
+  std::vector<std::uint8_t> eph(61, 0);
+  eph[0] = 1019 >> 4;
+  eph[1] = static_cast<std::uint8_t>((1019 & 0xF) << 4);
+  // 1004 with time of week beyond a week (all ones).
+  std::vector<std::uint8_t> legacy(8, 0xFF);
+  legacy[0] = 1004 >> 4;
+  legacy[1] = static_cast<std::uint8_t>(((1004 & 0xF) << 4) | 0xF);
+  const Case cases[] = {{msm, "DF396 cell mask"}, {eph, "DF009 satellite ID"}, {legacy, "DF004 GPS epoch time"}};
+  for (const Case& c : cases) {
+    Decoder dec;
+    dec.feed(frameOf(c.payload));
+    dec.finish();
+    ASSERT_EQ(dec.stats().issues.size(), 1u) << c.field;
+    EXPECT_EQ(dec.stats().issues[0].field, c.field);
+    EXPECT_FALSE(dec.poll().has_value());
+  }
+}
+
+TEST(Decoder, HostileStreamsNeverCrashOrHang) {
+  // Random bytes, random payloads behind valid CRCs, and valid frames with random bit flips
+  // re-sealed with a fresh CRC: the decoder must survive all of them and keep its memory bounded.
+  std::mt19937 rng(7);
+  std::vector<std::vector<std::uint8_t>> goods;
+  for (const auto& path : testing::rtcmFiles()) {
+    if (path.parent_path().filename() == "go-gnss_frames") goods.push_back(readBytes(path));
+  }
+  std::int64_t frames = 0, malformed = 0;
+  for (int round = 0; round < 300; ++round) {
+    std::vector<std::uint8_t> stream;
+    for (int k = 0; k < 20; ++k) {
+      const int kind = static_cast<int>(rng() % 3);
+      if (kind == 0) {
+        for (int j = 0, n = static_cast<int>(rng() % 64); j < n; ++j) stream.push_back(static_cast<std::uint8_t>(rng()));
+      } else {
+        const auto& g = goods[rng() % goods.size()];
+        std::vector<std::uint8_t> p(g.begin() + 3, g.end() - 3);
+        if (kind == 1) {
+          for (int j = 0, n = 1 + static_cast<int>(rng() % 8); j < n; ++j) {
+            p[2 + rng() % (p.size() - 2)] ^= static_cast<std::uint8_t>(1u << (rng() % 8));
+          }
+        } else {
+          p.resize(2 + rng() % (p.size() - 1));
+        }
+        const auto f = frameOf(p);
+        stream.insert(stream.end(), f.begin(), f.end());
+      }
+    }
+    DecoderOptions opt;
+    opt.referenceTime = date(2020, 6, 1);
+    Decoder dec(opt);
+    std::size_t pos = 0;
+    while (pos < stream.size()) {
+      const std::size_t n = std::min<std::size_t>(1 + rng() % 300, stream.size() - pos);
+      dec.feed({stream.data() + pos, n});
+      pos += n;
+      while (dec.poll()) {
+      }
+    }
+    dec.finish();
+    while (dec.poll()) {
+    }
+    frames += dec.stats().framing.frames;
+    malformed += dec.stats().malformed;
+    EXPECT_LE(dec.stats().issues.size(), opt.maxIssues);
+  }
+  std::cerr << "hostile streams: " << frames << " frames, " << malformed << " malformed\n";
+  EXPECT_GT(malformed, 100);
+}
+
+}  // namespace
+}  // namespace gvins::rtcm
