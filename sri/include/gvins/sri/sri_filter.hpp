@@ -1,0 +1,197 @@
+// Square-root inverse (SRI) filter over named state blocks — the estimation core of SRI-GVINS.
+//
+// The filter keeps an upper-triangular square-root information matrix R and a residual r: the
+// (error-state) information is Λ = RᵀR and the cost of an error δx about the current estimate x̂
+// is ‖R δx − r‖². It never forms a covariance (Wu et al. 2015, "A Square Root Inverse Filter for
+// Efficient Vision-aided Inertial Navigation on Mobile Devices"; Bierman 1977, "Factorization
+// Methods for Discrete Sequential Estimation"). The columns of R follow the order of the state
+// blocks (StateLayout); that order is also the elimination order:
+//   - marginalizing blocks that sit first costs nothing (their rows and columns are dropped);
+//   - measurement rows whose first non-zero column is c₀ only touch the columns ≥ c₀;
+//   - the covariance of the trailing blocks comes from the trailing block of R alone.
+// So put what will be marginalized first and what is new last, e.g. for the SRI-SWF
+//   [old IMU extra | SLAM features | clones (oldest first) | parameters | newest clone].
+//
+// Error-state conventions (block.hpp): vectors x = x̂ + δx; rotations R = R̂·Exp(δθ) (kRight,
+// default) or Exp(δθ)·R̂ (kLeft), chosen per block; poses [δθ; δp] with p = p̂ + δp.
+//
+// Minimal example (a 3-D position with a velocity, a GNSS-like position fix):
+//
+//   using namespace gvins::sri;
+//   SriFilter<double> f;
+//   BlockId p = f.addBlock(BlockSpec::vector("pos", 3),
+//                          BlockEstimate<double>::fromVector(Eigen::Vector3d(10, 0, 0)),
+//                          Prior<double>::stdDev(3, 30.0));
+//   BlockId v = f.addBlock(BlockSpec::vector("vel", 3), BlockEstimate<double>::zero(BlockKind::kVector, 3),
+//                          Prior<double>::uninformative());
+//   Measurement<double> z(3);
+//   z.jacobian(p, 3).setIdentity();
+//   z.residual() = fix - f.estimate(p).vector;   // z − h(x̂)
+//   z.whitenStdDev(0.02);
+//   if (auto chi2 = f.chiSquare(z); chi2 && chi2->value < 11.34) {  // 99 %, 3 dof
+//     f.update(z);
+//     f.correct();                                // x̂ ← x̂ ⊞ R⁻¹r, r ← 0
+//   }
+//   Eigen::MatrixXd P = f.covariance(std::vector{p});  // 3×3 marginal covariance
+//
+// Propagation (paper eq. (6)) is described by a Propagation object (propagation.hpp);
+// measurement rows by a Measurement (measurement.hpp), which also does null-space projection
+// of nuisance columns and QR compression. docs/sri_core.md has the derivations.
+//
+// Scalar is float or double (both compiled into gvins_sri).
+#pragma once
+
+#include <optional>
+#include <span>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "gvins/sri/block.hpp"
+#include "gvins/sri/block_estimate.hpp"
+#include "gvins/sri/measurement.hpp"
+#include "gvins/sri/prior.hpp"
+#include "gvins/sri/propagation.hpp"
+#include "gvins/sri/qr_update.hpp"
+#include "gvins/sri/state_layout.hpp"
+
+namespace gvins::sri {
+
+struct SriOptions {
+  /// Panel width of the blocked Householder update.
+  int panel = 24;
+  /// kAuto switches an update to Givens rotations when (largest entry of the new whitened rows)
+  /// / (smallest non-zero row of R that the rows meet) exceeds auto_givens_ratio_float (float) or
+  /// auto_givens_ratio_double (double). See docs/sri_core.md for the measurement behind these.
+  double auto_givens_ratio_float = 1e3;
+  double auto_givens_ratio_double = 1e10;
+  /// A diagonal entry |R_jj| ≤ zero_pivot × max|R_ii| counts as no information in solve()
+  /// (that error-state component is left at zero). 0: only exact zeros.
+  double zero_pivot = 0.0;
+};
+
+struct UpdateOptions {
+  RotationScheme scheme = RotationScheme::kAuto;
+};
+
+template <typename Scalar>
+struct UpdateResult {
+  Scalar chi2 = 0;  ///< Post-fit residual ‖e‖² of the rows, = innovation Mahalanobis distance.
+  int dof = 0;      ///< Rows (including rows removed by Measurement::compress).
+  RotationScheme scheme = RotationScheme::kBlockedHouseholder;  ///< Scheme used.
+};
+
+template <typename Scalar>
+struct ChiSquare {
+  Scalar value = 0;  ///< rᵀ (H P Hᵀ + Σ)⁻¹ r for the predicted residual r.
+  int dof = 0;
+};
+
+template <typename Scalar>
+class SriFilter {
+ public:
+  using Matrix = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
+  using Vector = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
+
+  explicit SriFilter(SriOptions options = {});
+
+  const SriOptions& options() const { return options_; }
+  const StateLayout& layout() const { return layout_; }
+  /// Error-state dimension.
+  int dim() const { return n_; }
+  /// Pre-allocates storage for a state of `dim` (the filter grows as needed otherwise).
+  void reserve(int dim);
+
+  // ---------------------------------------------------------------- state blocks
+  /// Adds a block with the given estimate and a prior centred at it. Throws
+  /// std::invalid_argument for an inconsistent spec, estimate or prior (e.g. covariance not
+  /// positive definite), std::out_of_range for an unknown placement anchor.
+  BlockId addBlock(const BlockSpec& spec, const BlockEstimate<Scalar>& estimate,
+                   const Prior<Scalar>& prior, Placement where = Placement::back());
+  /// Marginalizes blocks (Schur complement, exact in the linear-Gaussian case). Blocks at the
+  /// front are dropped for free; others are first moved to the front by re-triangularizing
+  /// (sweepColumnsToFront). Throws std::out_of_range for an unknown id.
+  void marginalize(std::span<const BlockId> ids);
+  void marginalize(BlockId id) { marginalize(std::span<const BlockId>(&id, 1)); }
+  /// Changes the order of the blocks (`order` lists every block once) and re-triangularizes
+  /// the columns after the unchanged prefix.
+  void reorder(std::span<const BlockId> order);
+
+  // ---------------------------------------------------------------- estimates
+  const BlockEstimate<Scalar>& estimate(BlockId id) const;
+  /// Moves the linearization point of a block, keeping the estimated distribution: r is adjusted
+  /// by −R δ with δ = value ⊟ old (first order for rotations).
+  void setEstimate(BlockId id, const BlockEstimate<Scalar>& value);
+
+  // ---------------------------------------------------------------- filter steps
+  /// Appends the propagation block row of the paper's eq. (6) for new blocks, re-triangularizes
+  /// and marginalizes the listed blocks. Returns the ids of the new blocks (in order added).
+  std::vector<BlockId> propagate(const Propagation<Scalar>& step);
+  /// Stacks the whitened rows [H r] under [R r] and re-triangularizes the columns from the first
+  /// one they touch (the paper's eq. (9)). The estimate is not moved; call correct() (or keep
+  /// stacking measurements first). Throws std::logic_error if the rows are not whitened or still
+  /// have nuisance columns, std::out_of_range for an unknown block.
+  UpdateResult<Scalar> update(const Measurement<Scalar>& m, const UpdateOptions& options = {});
+  /// Mahalanobis distance of a candidate measurement without forming a covariance (triangular
+  /// solve with the trailing block of R from the first touched column). nullopt if that block of
+  /// R is singular (part of the touched state has no information yet).
+  std::optional<ChiSquare<Scalar>> chiSquare(const Measurement<Scalar>& m) const;
+  /// Δx = R⁻¹ r by back-substitution. Components without information (zero pivots) get 0.
+  Vector solve() const;
+  /// x̂ ← x̂ ⊞ Δx with Δx = solve(), then r ← r − R Δx (= 0 when R is non-singular).
+  void correct();
+
+  // ---------------------------------------------------------------- covariance
+  /// Joint marginal covariance of the listed blocks, in the listed order: Y = R⁻ᵀ E on the
+  /// trailing part of R from the first listed block (forward substitution), P = YᵀY. Cheap for
+  /// blocks at the back. Throws std::domain_error if that part of R is singular.
+  Matrix covariance(std::span<const BlockId> ids) const;
+  /// Full covariance R⁻¹R⁻ᵀ (for tests and debugging; O(n³)).
+  Matrix fullCovariance() const;
+
+  // ---------------------------------------------------------------- raw access
+  /// R (n×n, zeros below the diagonal) and r, copied.
+  Matrix squareRootInformation() const;
+  Vector residual() const;
+  /// Views of the internal storage; entries below the diagonal of R are unspecified.
+  RowMatrixView<Scalar> rawR();
+  VectorView<Scalar> rawResidual();
+
+ private:
+  int position(BlockId id) const { return layout_.index(id); }
+  Scalar* rowPtr(int i) { return buf_.data() + static_cast<std::ptrdiff_t>(off_ + i) * cap_ + off_; }
+  const Scalar* rowPtr(int i) const {
+    return buf_.data() + static_cast<std::ptrdiff_t>(off_ + i) * cap_ + off_;
+  }
+  RowMatrixView<Scalar> view(int row, int col, int rows, int cols);
+  Eigen::Map<const RowMatrix<Scalar>, Eigen::Unaligned, Eigen::OuterStride<>> cview(int row, int col,
+                                                                                  int rows,
+                                                                                  int cols) const;
+  VectorView<Scalar> rview(int row, int rows) { return VectorView<Scalar>(rbuf_.data() + off_ + row, rows); }
+
+  /// Opens d zero rows/columns at column c (storage only).
+  void openColumns(int c, int d);
+  /// Storage is recentred/grown so that `need` columns fit with headroom.
+  void relocate(int need);
+  /// Drops rows [0, d) and columns [c, c+d) after sweepColumnsToFront(c, d, 0).
+  void dropFrontAfterSweep(int c, int d);
+  bool hasZeroPivot(int from) const;
+
+  SriOptions options_;
+  StateLayout layout_;
+  std::vector<BlockEstimate<Scalar>> estimates_;  // parallel to layout_.blocks()
+  RowMatrix<Scalar> buf_;                         // cap_ × cap_, R at (off_, off_)
+  Vector rbuf_;                                   // cap_, r at off_
+  int cap_ = 0;
+  int off_ = 0;
+  int n_ = 0;
+  // Update workspace.
+  RowMatrix<Scalar> work_;
+  Vector work_z_;
+  std::vector<int> lead_;
+};
+
+extern template class SriFilter<float>;
+extern template class SriFilter<double>;
+
+}  // namespace gvins::sri

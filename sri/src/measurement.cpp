@@ -1,0 +1,249 @@
+#include "gvins/sri/measurement.hpp"
+
+#include <stdexcept>
+#include <string>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <vector>
+
+#include "gvins/sri/qr_update.hpp"
+#include "gvins/sri/square_root.hpp"
+
+namespace gvins::sri {
+
+template <typename Scalar>
+void Measurement<Scalar>::reset(int rows) {
+  if (rows < 0) throw std::invalid_argument("sri::Measurement: negative row count");
+  H_.resize(rows, 0);
+  nuisance_.resize(rows, 0);
+  residual_ = Vector::Zero(rows);
+  blocks_.clear();
+  whitened_ = false;
+  discarded_chi2_ = 0;
+  discarded_rows_ = 0;
+}
+
+template <typename Scalar>
+Eigen::Block<typename Measurement<Scalar>::Matrix> Measurement<Scalar>::jacobian(BlockId id,
+                                                                                 int dim) {
+  if (!id.valid() || dim <= 0) {
+    throw std::invalid_argument("sri::Measurement::jacobian: invalid block id or dimension");
+  }
+  for (const Entry& e : blocks_) {
+    if (e.id == id) {
+      if (e.dim != dim) {
+        throw std::invalid_argument("sri::Measurement::jacobian: block " +
+                                    std::to_string(id.value) + " has dimension " +
+                                    std::to_string(e.dim) + ", not " + std::to_string(dim));
+      }
+      return H_.block(0, e.col, rows(), dim);
+    }
+  }
+  const int col = static_cast<int>(H_.cols());
+  H_.conservativeResize(Eigen::NoChange, col + dim);
+  H_.rightCols(dim).setZero();
+  blocks_.push_back({id, col, dim});
+  return H_.block(0, col, rows(), dim);
+}
+
+template <typename Scalar>
+Eigen::Block<typename Measurement<Scalar>::Matrix> Measurement<Scalar>::nuisance(int dim) {
+  if (dim <= 0) throw std::invalid_argument("sri::Measurement::nuisance: dimension must be > 0");
+  if (nuisance_.cols() != dim) {
+    if (nuisance_.cols() != 0) {
+      throw std::invalid_argument("sri::Measurement::nuisance: dimension changed");
+    }
+    nuisance_ = Matrix::Zero(rows(), dim);
+  }
+  return nuisance_.block(0, 0, rows(), dim);
+}
+
+template <typename Scalar>
+template <typename Op>
+void Measurement<Scalar>::transformRows(Op&& op) {
+  op(H_);
+  op(nuisance_);
+  op(residual_);
+}
+
+template <typename Scalar>
+void Measurement<Scalar>::whitenStdDev(Scalar sigma) {
+  if (!(sigma > Scalar(0))) throw std::invalid_argument("sri::Measurement: σ must be > 0");
+  const Scalar w = Scalar(1) / sigma;
+  transformRows([w](auto& m) { m *= w; });
+  whitened_ = true;
+}
+
+template <typename Scalar>
+void Measurement<Scalar>::whitenStdDevs(const Vector& sigmas) {
+  if (sigmas.size() != rows() || !(sigmas.array() > Scalar(0)).all()) {
+    throw std::invalid_argument("sri::Measurement: need rows() standard deviations > 0");
+  }
+  const Vector w = sigmas.cwiseInverse();
+  transformRows([&w](auto& m) { m = w.asDiagonal() * m; });
+  whitened_ = true;
+}
+
+template <typename Scalar>
+void Measurement<Scalar>::whitenCovariance(const Matrix& covariance) {
+  if (covariance.rows() != rows() || covariance.cols() != rows()) {
+    throw std::invalid_argument("sri::Measurement: covariance must be rows() × rows()");
+  }
+  const auto L = choleskyLower<Scalar>(covariance);
+  if (!L) throw std::invalid_argument("sri::Measurement: noise covariance is not positive definite");
+  // Rows ← L⁻¹ rows on [H nuisance r] at once.
+  const Eigen::Index p = H_.cols();
+  const Eigen::Index q = nuisance_.cols();
+  Matrix A(rows(), p + q + 1);
+  A << H_, nuisance_, residual_;
+  solveLowerInPlace<Scalar>(*L, A);
+  H_ = A.leftCols(p);
+  nuisance_ = A.middleCols(p, q);
+  residual_ = A.col(p + q);
+  whitened_ = true;
+}
+
+template <typename Scalar>
+void Measurement<Scalar>::whitenSqrtInformation(const Matrix& S) {
+  if (S.rows() != rows() || S.cols() != rows()) {
+    throw std::invalid_argument("sri::Measurement: square-root information must be rows() × rows()");
+  }
+  transformRows([&S](auto& m) { m = S * m; });
+  whitened_ = true;
+}
+
+template <typename Scalar>
+int Measurement<Scalar>::projectNuisance() {
+  if (!whitened_) throw std::logic_error("sri::Measurement::projectNuisance: whiten first");
+  const int q = nuisanceDim();
+  const int m = rows();
+  if (q == 0) return 0;
+  if (m <= q) {  // no information left about the state
+    reset(0);
+    whitened_ = true;
+    return m;
+  }
+  // Zero the nuisance column j below row j, from the bottom up, with rotations of adjacent rows;
+  // the rows j+1.. of the nuisance columns then span its left null space.
+  auto rotate = [](auto&& M, int a, int b, Scalar c, Scalar s) {
+    for (Eigen::Index col = 0; col < M.cols(); ++col) {
+      const Scalar x = M(a, col);
+      const Scalar y = M(b, col);
+      M(a, col) = c * x + s * y;
+      M(b, col) = c * y - s * x;
+    }
+  };
+  for (int j = 0; j < q; ++j) {
+    for (int i = m - 1; i > j; --i) {
+      const Scalar b = nuisance_(i, j);
+      if (b == Scalar(0)) continue;
+      const Scalar a = nuisance_(i - 1, j);
+      const Scalar rho = std::hypot(a, b);
+      const Scalar c = a / rho;
+      const Scalar s = b / rho;
+      rotate(nuisance_, i - 1, i, c, s);
+      rotate(H_, i - 1, i, c, s);
+      const Scalar x = residual_(i - 1);
+      const Scalar y = residual_(i);
+      residual_(i - 1) = c * x + s * y;
+      residual_(i) = c * y - s * x;
+    }
+  }
+  const int keep = m - q;
+  Matrix H = H_.bottomRows(keep);
+  Vector r = residual_.tail(keep);
+  H_ = std::move(H);
+  residual_ = std::move(r);
+  nuisance_.resize(keep, 0);
+  return q;
+}
+
+template <typename Scalar>
+int Measurement<Scalar>::compress() {
+  if (!whitened_) throw std::logic_error("sri::Measurement::compress: whiten first");
+  if (nuisanceDim() != 0) throw std::logic_error("sri::Measurement::compress: project nuisance first");
+  const int m = rows();
+  const int p = static_cast<int>(H_.cols());
+  if (m <= p) return 0;
+  // QR of [H r] as a stacked update onto an empty p×p factor (qr_update.hpp).
+  std::vector<int> lead(static_cast<std::size_t>(m));
+  std::vector<int> order(static_cast<std::size_t>(m));
+  for (int i = 0; i < m; ++i) {
+    int l = 0;
+    while (l < p && H_(i, l) == Scalar(0)) ++l;
+    lead[static_cast<std::size_t>(i)] = l;
+  }
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return lead[static_cast<std::size_t>(a)] < lead[static_cast<std::size_t>(b)];
+  });
+  RowMatrix<Scalar> W(m, p);
+  Vector z(m);
+  std::vector<int> sortedLead(static_cast<std::size_t>(m));
+  for (int s = 0; s < m; ++s) {
+    const int i = order[static_cast<std::size_t>(s)];
+    W.row(s) = H_.row(i);
+    z(s) = residual_(i);
+    sortedLead[static_cast<std::size_t>(s)] = lead[static_cast<std::size_t>(i)];
+  }
+  RowMatrix<Scalar> R = RowMatrix<Scalar>::Zero(p, p);
+  Vector r = Vector::Zero(p);
+  householderRowUpdate<Scalar>(RowMatrixView<Scalar>(R.data(), p, p, Eigen::OuterStride<>(p)),
+                               VectorView<Scalar>(r.data(), p),
+                               RowMatrixView<Scalar>(W.data(), m, p, Eigen::OuterStride<>(p)),
+                               VectorView<Scalar>(z.data(), m), sortedLead);
+  discarded_chi2_ += z.squaredNorm();
+  discarded_rows_ += m - p;
+  H_ = R.template triangularView<Eigen::Upper>();
+  residual_ = r;
+  nuisance_.resize(p, 0);
+  return m - p;
+}
+
+template <typename Scalar>
+void Measurement<Scalar>::stack(const Measurement& other) {
+  if (nuisanceDim() != 0 || other.nuisanceDim() != 0) {
+    throw std::logic_error("sri::Measurement::stack: project nuisance first");
+  }
+  if (rows() > 0 && other.rows() > 0 && whitened_ != other.whitened_) {
+    throw std::logic_error("sri::Measurement::stack: whitening state differs");
+  }
+  const int m0 = rows();
+  const int m1 = other.rows();
+  Matrix H = Matrix::Zero(m0 + m1, H_.cols());
+  H.topRows(m0) = H_;
+  std::vector<Entry> blocks = blocks_;
+  for (const Entry& e : other.blocks_) {
+    int col = -1;
+    for (const Entry& mine : blocks) {
+      if (mine.id == e.id) {
+        if (mine.dim != e.dim) throw std::invalid_argument("sri::Measurement::stack: dim mismatch");
+        col = mine.col;
+      }
+    }
+    if (col < 0) {
+      col = static_cast<int>(H.cols());
+      H.conservativeResize(Eigen::NoChange, col + e.dim);
+      H.rightCols(e.dim).setZero();
+      blocks.push_back({e.id, col, e.dim});
+    }
+    H.block(m0, col, m1, e.dim) = other.H_.block(0, e.col, m1, e.dim);
+  }
+  Vector r(m0 + m1);
+  r << residual_, other.residual_;
+  const bool white = m0 > 0 ? whitened_ : other.whitened_;
+  H_ = std::move(H);
+  residual_ = std::move(r);
+  blocks_ = std::move(blocks);
+  nuisance_.resize(m0 + m1, 0);
+  whitened_ = white;
+  discarded_chi2_ += other.discarded_chi2_;
+  discarded_rows_ += other.discarded_rows_;
+}
+
+template class Measurement<float>;
+template class Measurement<double>;
+
+}  // namespace gvins::sri

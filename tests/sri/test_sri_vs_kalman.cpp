@@ -1,0 +1,371 @@
+// The SRI filter against a textbook covariance Kalman filter on random linear-Gaussian problems
+// with block insertion anywhere, propagation (with and without a prediction residual),
+// updates, marginalization of blocks anywhere, reordering and corrections. In double the two
+// must agree to 1e-9 (relative); the float SRI must agree with the double SRI to ~1e-4.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <map>
+#include <random>
+#include <vector>
+
+#include "covariance_kf.hpp"
+#include "gvins/sri/sri_filter.hpp"
+
+namespace gvins::sri {
+namespace {
+
+using Md = Eigen::MatrixXd;
+using Vd = Eigen::VectorXd;
+
+template <typename S>
+Vd sriMean(const SriFilter<S>& f) {
+  Vd x(f.dim());
+  const auto dx = f.solve();
+  for (const BlockInfo& b : f.layout().blocks()) {
+    x.segment(b.offset, b.dim) = (f.estimate(b.id).vector + dx.segment(b.offset, b.dim)).template cast<double>();
+  }
+  return x;
+}
+
+double relErr(const Md& a, const Md& b) {
+  const double nb = std::max(b.norm(), 1e-300);
+  return (a - b).norm() / nb;
+}
+
+class Lockstep {
+ public:
+  explicit Lockstep(unsigned seed, RotationScheme scheme) : rng_(seed), scheme_(scheme) {}
+
+  double uni(double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng_); }
+  int pick(int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng_); }
+  Md randm(int r, int c) {
+    Md m(r, c);
+    for (int i = 0; i < r; ++i) {
+      for (int j = 0; j < c; ++j) m(i, j) = uni(-1, 1);
+    }
+    return m;
+  }
+  Md spd(int d, double smin, double smax) {
+    // Random orthogonal basis with standard deviations in [smin, smax].
+    Eigen::HouseholderQR<Md> qr(randm(d, d));
+    const Md Q = qr.householderQ();
+    Vd s(d);
+    for (int i = 0; i < d; ++i) s(i) = uni(smin, smax);
+    return Q * s.cwiseAbs2().asDiagonal() * Q.transpose();
+  }
+
+  int nblocks() const { return static_cast<int>(keys_.size()); }
+
+  template <typename S>
+  Placement placementFor(const std::map<std::uint64_t, BlockId>& ids, int index) const {
+    if (index >= nblocks()) return Placement::back();
+    return Placement::before(ids.at(keys_[static_cast<std::size_t>(index)]));
+  }
+
+  void addBlock() {
+    const int d = pick(1, 5);
+    const int index = pick(0, nblocks());
+    const Vd x0 = 3 * randm(d, 1);
+    const Md P0 = spd(d, 0.3, 3.0);
+    const std::uint64_t key = next_key_++;
+    kf_.addBlock(key, index, x0, P0);
+    const int type = pick(0, 2);
+    auto prior = [&](auto tag) {
+      using S = decltype(tag);
+      using Mat = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>;
+      if (type == 0) return Prior<S>::covariance(P0.cast<S>());
+      Eigen::LLT<Md> llt(P0);
+      Md Sq = Md::Identity(d, d);
+      llt.matrixL().solveInPlace(Sq);  // SᵀS = P0⁻¹ with S lower triangular
+      if (type == 1) return Prior<S>::sqrtInformation(Mat(Sq.cast<S>()));
+      // A non-square, non-triangular square root: [Q₁ S; 0] rotated.
+      Eigen::HouseholderQR<Md> qr(randm(d + 2, d + 2));
+      Md big = Md::Zero(d + 2, d);
+      big.topRows(d) = Sq;
+      return Prior<S>::sqrtInformation(Mat((Md(qr.householderQ()) * big).cast<S>()));
+    };
+    const Placement pd = placementFor<double>(idd_, index);
+    const Placement pf = placementFor<float>(idf_, index);
+    idd_[key] = sd_.addBlock(BlockSpec::vector("b", d), BlockEstimate<double>::fromVector(x0),
+                             prior(double{}), pd);
+    idf_[key] = sf_.addBlock(BlockSpec::vector("b", d),
+                             BlockEstimate<float>::fromVector(x0.cast<float>()), prior(float{}), pf);
+    keys_.insert(keys_.begin() + index, key);
+  }
+
+  void propagate() {
+    const int si = pick(0, nblocks() - 1);
+    const std::uint64_t src = keys_[static_cast<std::size_t>(si)];
+    const int ds = kf_.blockDim(src);
+    const int d = pick(0, 1) ? ds : pick(1, 5);
+    Md PhiS = 0.5 * randm(d, ds);
+    if (d == ds) PhiS += Md::Identity(d, d);
+    // Sometimes a second source block (e.g. a parameter entering the motion model).
+    std::uint64_t other = 0;
+    Md PhiO;
+    if (nblocks() > 1 && pick(0, 1)) {
+      do {
+        other = keys_[static_cast<std::size_t>(pick(0, nblocks() - 1))];
+      } while (other == src);
+      PhiO = 0.3 * randm(d, kf_.blockDim(other));
+    }
+    const Md Q = spd(d, 0.1, 1.0);
+    const bool marg = pick(0, 1) == 1;
+    const int where = pick(0, 3);  // 0,1: back, 2: right after src, 3: front
+    int index = nblocks();
+    if (where == 2) index = si + 1;
+    if (where == 3) index = 0;
+    const std::uint64_t key = next_key_++;
+    // Covariance filter.
+    Md Phi = Md::Zero(d, kf_.dim());
+    Phi.middleCols(kf_.offset(src), ds) = PhiS;
+    if (other) Phi.middleCols(kf_.offset(other), kf_.blockDim(other)) += PhiO;
+    const Vd xnew = Phi * kf_.x;
+    kf_.propagate(key, index, Phi, xnew, Q);
+    if (marg) kf_.marginalize(src);
+    // SRI filters: predicted estimate deliberately off by a random offset (tests e).
+    const Vd offset = 0.2 * randm(d, 1);
+    const bool sqrtNoise = pick(0, 1) == 1;
+    auto run = [&](auto& f, auto& ids) {
+      using S = typename std::decay_t<decltype(f)>::Vector::Scalar;
+      using Vec = Eigen::Matrix<S, Eigen::Dynamic, 1>;
+      using Mat = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>;
+      Vec fx = PhiS.cast<S>() * f.estimate(ids.at(src)).vector;
+      if (other) fx += PhiO.cast<S>() * f.estimate(ids.at(other)).vector;
+      const Vec predicted = fx + offset.cast<S>();
+      Propagation<S> p;
+      p.addNewBlock(BlockSpec::vector("p", d), BlockEstimate<S>::fromVector(predicted),
+                    index >= nblocks() ? Placement::back()
+                                       : Placement::before(ids.at(keys_[static_cast<std::size_t>(index)])));
+      p.setTransition(ids.at(src), PhiS.cast<S>());
+      if (other) p.setTransition(ids.at(other), PhiO.cast<S>());
+      if (sqrtNoise) {
+        Eigen::LLT<Md> llt(Q);
+        Md Sq = Md::Identity(d, d);
+        llt.matrixL().solveInPlace(Sq);
+        p.setNoiseSqrtInformation(Mat(Sq.cast<S>()));
+      } else {
+        p.setNoiseCovariance(Q.cast<S>());
+      }
+      p.setResidual(fx - predicted);
+      if (marg) p.marginalizeAfter(ids.at(src));
+      const auto newIds = f.propagate(p);
+      EXPECT_EQ(newIds.size(), 1u);
+      ids[key] = newIds.at(0);
+      if (marg) ids.erase(src);
+    };
+    run(sd_, idd_);
+    run(sf_, idf_);
+    keys_.insert(keys_.begin() + index, key);
+    if (marg) keys_.erase(std::find(keys_.begin(), keys_.end(), src));
+  }
+
+  void update() {
+    const int m = pick(1, 8);
+    // Touch 1–3 blocks, with a bias towards the back.
+    std::vector<std::uint64_t> touched;
+    const int nt = std::min(nblocks(), pick(1, 3));
+    while (static_cast<int>(touched.size()) < nt) {
+      const int i = pick(0, 1) ? pick(std::max(0, nblocks() - 3), nblocks() - 1) : pick(0, nblocks() - 1);
+      const std::uint64_t k = keys_[static_cast<std::size_t>(i)];
+      if (std::find(touched.begin(), touched.end(), k) == touched.end()) touched.push_back(k);
+    }
+    Md H = Md::Zero(m, kf_.dim());
+    std::vector<Md> Hb;
+    for (std::uint64_t k : touched) {
+      Hb.push_back(randm(m, kf_.blockDim(k)));
+      H.middleCols(kf_.offset(k), kf_.blockDim(k)) = Hb.back();
+    }
+    const bool full = pick(0, 1) == 1;
+    Md Rn = full ? spd(m, 0.2, 1.0) : Md(Vd::NullaryExpr(m, [&](Eigen::Index) {
+                                              return std::pow(uni(0.2, 1.0), 2);
+                                            }).asDiagonal());
+    const Vd z = H * kf_.x + 0.5 * randm(m, 1);
+    const double kfChi2 = kf_.update(H, z, Rn);
+    auto run = [&](auto& f, auto& ids, double tol) {
+      using S = typename std::decay_t<decltype(f)>::Vector::Scalar;
+      using Vec = Eigen::Matrix<S, Eigen::Dynamic, 1>;
+      Measurement<S> meas(m);
+      Vec pred = Vec::Zero(m);
+      for (std::size_t b = 0; b < touched.size(); ++b) {
+        const BlockId id = ids.at(touched[b]);
+        meas.jacobian(id, static_cast<int>(Hb[b].cols())) = Hb[b].cast<S>();
+        pred += Hb[b].cast<S>() * f.estimate(id).vector;
+      }
+      meas.residual() = z.cast<S>() - pred;
+      if (full) {
+        meas.whitenCovariance(Rn.cast<S>());
+      } else {
+        meas.whitenStdDevs(Rn.diagonal().cwiseSqrt().cast<S>());
+      }
+      const auto pre = f.chiSquare(meas);
+      EXPECT_TRUE(pre.has_value());
+      if (pre) {
+        EXPECT_NEAR(pre->value, kfChi2, tol * std::max(1.0, kfChi2));
+        EXPECT_EQ(pre->dof, m);
+      }
+      UpdateOptions opt;
+      opt.scheme = scheme_;
+      const auto res = f.update(meas, opt);
+      EXPECT_NEAR(res.chi2, kfChi2, tol * std::max(1.0, kfChi2));
+    };
+    run(sd_, idd_, 1e-9);
+    run(sf_, idf_, 1e-3);
+  }
+
+  void marginalize() {
+    if (nblocks() < 3) return;
+    std::vector<std::uint64_t> ks;
+    const int count = pick(1, 2);
+    while (static_cast<int>(ks.size()) < count) {
+      const std::uint64_t k = keys_[static_cast<std::size_t>(pick(0, nblocks() - 1))];
+      if (std::find(ks.begin(), ks.end(), k) == ks.end()) ks.push_back(k);
+    }
+    std::vector<BlockId> d;
+    std::vector<BlockId> f;
+    for (std::uint64_t k : ks) {
+      kf_.marginalize(k);
+      d.push_back(idd_.at(k));
+      f.push_back(idf_.at(k));
+      idd_.erase(k);
+      idf_.erase(k);
+      keys_.erase(std::find(keys_.begin(), keys_.end(), k));
+    }
+    sd_.marginalize(d);
+    sf_.marginalize(f);
+  }
+
+  void reorder() {
+    std::vector<std::uint64_t> ks = keys_;
+    if (pick(0, 1)) {
+      std::shuffle(ks.begin(), ks.end(), rng_);
+    } else {  // move one block to another place
+      const int from = pick(0, nblocks() - 1);
+      const std::uint64_t k = ks[static_cast<std::size_t>(from)];
+      ks.erase(ks.begin() + from);
+      ks.insert(ks.begin() + pick(0, static_cast<int>(ks.size())), k);
+    }
+    kf_.reorder(ks);
+    std::vector<BlockId> d;
+    std::vector<BlockId> f;
+    for (std::uint64_t k : ks) {
+      d.push_back(idd_.at(k));
+      f.push_back(idf_.at(k));
+    }
+    sd_.reorder(d);
+    sf_.reorder(f);
+    keys_ = ks;
+  }
+
+  void correct() {
+    sd_.correct();
+    sf_.correct();
+  }
+
+  /// Compares state, covariance and a random marginal covariance.
+  void check() {
+    ASSERT_EQ(sd_.dim(), kf_.dim());
+    ASSERT_EQ(sf_.dim(), kf_.dim());
+    for (int i = 0; i < nblocks(); ++i) {
+      ASSERT_EQ(sd_.layout().at(i).id, idd_.at(keys_[static_cast<std::size_t>(i)]));
+    }
+    const Vd xd = sriMean(sd_);
+    const Vd xf = sriMean(sf_);
+    const Md Pd = sd_.fullCovariance();
+    const Md Pf = sf_.fullCovariance().cast<double>();
+    max_double_x_ = std::max(max_double_x_, (xd - kf_.x).norm() / std::max(1.0, kf_.x.norm()));
+    max_double_p_ = std::max(max_double_p_, relErr(Pd, kf_.P));
+    max_float_x_ = std::max(max_float_x_, (xf - xd).norm() / std::max(1.0, xd.norm()));
+    max_float_p_ = std::max(max_float_p_, relErr(Pf, Pd));
+    // Marginal covariance of a random subset (order as listed).
+    if (nblocks() > 0) {
+      std::vector<std::uint64_t> ks;
+      const int count = std::min(nblocks(), pick(1, 3));
+      while (static_cast<int>(ks.size()) < count) {
+        const std::uint64_t k = keys_[static_cast<std::size_t>(pick(0, nblocks() - 1))];
+        if (std::find(ks.begin(), ks.end(), k) == ks.end()) ks.push_back(k);
+      }
+      std::vector<BlockId> ids;
+      std::vector<int> idx;
+      for (std::uint64_t k : ks) {
+        ids.push_back(idd_.at(k));
+        for (int q = 0; q < kf_.blockDim(k); ++q) idx.push_back(kf_.offset(k) + q);
+      }
+      const Md Pm = sd_.covariance(ids);
+      Md expect(idx.size(), idx.size());
+      for (std::size_t a = 0; a < idx.size(); ++a) {
+        for (std::size_t b = 0; b < idx.size(); ++b) expect(a, b) = kf_.P(idx[a], idx[b]);
+      }
+      max_double_p_ = std::max(max_double_p_, relErr(Pm, expect));
+    }
+  }
+
+  void run(int steps) {
+    for (int i = 0; i < 4; ++i) addBlock();
+    check();
+    for (int s = 0; s < steps && !::testing::Test::HasFatalFailure(); ++s) {
+      const int op = pick(0, 99);
+      if (kf_.dim() > 45) {
+        marginalize();
+      } else if (op < 15) {
+        addBlock();
+      } else if (op < 40) {
+        propagate();
+      } else if (op < 75) {
+        update();
+      } else if (op < 85) {
+        marginalize();
+      } else if (op < 92) {
+        reorder();
+      } else {
+        correct();
+      }
+      check();
+    }
+  }
+
+  double max_double_x_ = 0, max_double_p_ = 0, max_float_x_ = 0, max_float_p_ = 0;
+
+ private:
+  std::mt19937 rng_;
+  RotationScheme scheme_;
+  test::CovarianceKf<double> kf_;
+  SriFilter<double> sd_;
+  SriFilter<float> sf_;
+  std::vector<std::uint64_t> keys_;
+  std::map<std::uint64_t, BlockId> idd_, idf_;
+  std::uint64_t next_key_ = 1;
+};
+
+class SriVsKalman : public ::testing::TestWithParam<RotationScheme> {};
+
+TEST_P(SriVsKalman, RandomLinearGaussianProblems) {
+  double dx = 0, dp = 0, fx = 0, fp = 0;
+  for (unsigned seed = 1; seed <= 12; ++seed) {
+    Lockstep s(seed, GetParam());
+    s.run(80);
+    dx = std::max(dx, s.max_double_x_);
+    dp = std::max(dp, s.max_double_p_);
+    fx = std::max(fx, s.max_float_x_);
+    fp = std::max(fp, s.max_float_p_);
+  }
+  RecordProperty("max_rel_err_double_state", std::to_string(dx));
+  RecordProperty("max_rel_err_double_cov", std::to_string(dp));
+  RecordProperty("max_rel_err_float_state", std::to_string(fx));
+  RecordProperty("max_rel_err_float_cov", std::to_string(fp));
+  std::printf("double vs KF: state %.2e cov %.2e | float vs double: state %.2e cov %.2e\n", dx, dp,
+              fx, fp);
+  EXPECT_LT(dx, 1e-9);
+  EXPECT_LT(dp, 1e-9);
+  EXPECT_LT(fx, 1e-4);
+  EXPECT_LT(fp, 1e-4);
+}
+
+INSTANTIATE_TEST_SUITE_P(Schemes, SriVsKalman,
+                         ::testing::Values(RotationScheme::kAuto, RotationScheme::kBlockedHouseholder,
+                                           RotationScheme::kGivens));
+
+}  // namespace
+}  // namespace gvins::sri
