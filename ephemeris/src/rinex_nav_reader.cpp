@@ -548,7 +548,7 @@ void NavReader::readRinex4Body() {
     // The satellite field may be a bare system letter ("> STO E   IFNV").
     if (n < 3) throwParseError(w, "record type", "incomplete record line '" + line + "'");
     const std::string type(tok[0]), msg(tok[2]);
-    const std::string_view satText = tok[1];
+    const std::string satText(tok[1]);  // copied: `line` is reused below
     const std::string where = "line " + std::to_string(w.line) + ": ";
     if (!systemFromLetter(satText[0])) {
       throwParseError(w, "satellite system", "unknown satellite system in '" + line + "'");
@@ -599,9 +599,15 @@ void NavReader::readRinex4Body() {
     }
 
     // STO / ION / EOP: an epoch line "    yyyy mm dd hh mm ss" followed by data fields.
-    readContinuation(r, 1, 8, type, true);
+    readContinuation(r, 0, 0, type, true);
     const CalendarTime epoch = parseEpoch(column(r.text[0], 4, 19), at(r, 0));
+    auto need = [&](std::size_t lines, const char* field) {
+      if (r.text.size() < lines) {
+        throwParseError({in_.name(), r.number.back() + 1}, field, type + " record truncated");
+      }
+    };
     if (type == "STO") {
+      need(2, "STO transmission time");
       TimeSystemCorrection c;
       const std::string_view code = column(r.text[0], 24, 4);
       if (trim(code).size() != 4) throwParseError(at(r, 0), "STO time offset type", "missing offset type");
@@ -626,9 +632,7 @@ void NavReader::readRinex4Body() {
       const bool klob = ((sys == System::Gps || sys == System::Qzss) && (msg == "LNAV" || msg == "CNVX")) ||
                         (sys == System::BeiDou && msg == "D1D2");
       if (klob) {
-        if (r.text.size() < 3) {
-          throwParseError({in_.name(), r.number.back() + 1}, "ION beta", "Klobuchar ION record truncated");
-        }
+        need(3, "ION beta");
         KlobucharParameters k;
         k.alpha = {field(r, 0, 1, "ION alpha0"), field(r, 0, 2, "ION alpha1"), field(r, 0, 3, "ION alpha2"),
                    field(r, 1, 0, "ION alpha3")};
@@ -645,6 +649,7 @@ void NavReader::readRinex4Body() {
         skipRecord(where + "ION " + std::string(trim(satText)) + " " + msg + " skipped (model not used)");
       }
     } else if (type == "EOP") {
+      need(3, "EOP");
       for (std::size_t li = 0; li < r.text.size(); ++li) {
         for (int k = (li == 0 ? 1 : 0); k < 4; ++k) (void)field(r, li, k, "EOP");
       }

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "gvins/base/observation.hpp"
+#include "gvins/base/parse_error.hpp"
 #include "gvins/ephemeris/glonass_ephemeris.hpp"
 #include "gvins/ephemeris/ionosphere_parameters.hpp"
 #include "gvins/ephemeris/kepler_ephemeris.hpp"
