@@ -46,7 +46,7 @@ double gpsFitHours(bool flag, int iodc) {
   return 6.0;
 }
 
-// Orbit block shared by GPS/QZSS-style records after the caller has read the clock part.
+// Galileo and BeiDou times: full week numbers in the system's own count.
 void finishTimes(Decoder::State& s, KeplerEphemeris& e, int fullWeek, double toe, double toc,
                  bool gst, bool bdt) {
   auto at = [&](double sow) {
@@ -59,6 +59,21 @@ void finishTimes(Decoder::State& s, KeplerEphemeris& e, int fullWeek, double toe
   e.toeSeconds = toe;
   e.week = fullWeek;
   e.ttr = s.ref;
+}
+
+// GPS/QZSS LNAV times. DF076/DF452 is the week of transmission modulo 1024 (IS-GPS-200
+// 20.3.3.3.1.1); toe may lie in the next week when a record is sent before the rollover. The
+// transmission time is the reference (the time of reception) when that falls in the transmitted
+// week; otherwise (no usable reference) toe is taken to lie in the transmitted week and stands
+// for the transmission time.
+void lnavTimes(Decoder::State& s, KeplerEphemeris& e, int week10, double toe, double toc) {
+  const int week = resolveWeek(week10, 10, s.ref);
+  const GpsTime ttr = s.ref.week() == week ? s.ref : GpsTime::fromWeekTow(week, toe);
+  e.toe = nearWeek(GpsTime::fromWeekTow(week, toe), ttr);
+  e.toc = nearWeek(GpsTime::fromWeekTow(week, toc), e.toe);
+  e.toeSeconds = toe;
+  e.week = e.toe.week();
+  e.ttr = ttr;
 }
 
 void emit(Decoder::State& s, KeplerEphemeris&& e) {
@@ -105,10 +120,7 @@ void decodeGpsEphemeris(Decoder::State& s, BitReader& r) {
   e.sat = SatId(System::Gps, id);
   if (!e.sat.valid()) throw MessageError("DF009 satellite ID", "GPS satellite ID " + std::to_string(id) + " is not 1-32");
   if (toe >= kSecondsPerWeek || toc >= kSecondsPerWeek) throw MessageError("DF093 toe", "beyond a week");
-  // DF076 is the week modulo 1024; toe may belong to the next week at a week boundary.
-  const int week = resolveWeek(week10, 10, s.ref);
-  const GpsTime toeT = nearWeek(GpsTime::fromWeekTow(week, toe), s.ref);
-  finishTimes(s, e, toeT.week(), toe, toc, false, false);
+  lnavTimes(s, e, week10, toe, toc);
   emit(s, std::move(e));
 }
 
@@ -149,9 +161,7 @@ void decodeQzssEphemeris(Decoder::State& s, BitReader& r) {
   e.sat = SatId(System::Qzss, id);
   if (!e.sat.valid()) throw MessageError("DF429 QZSS satellite ID", "QZSS satellite ID " + std::to_string(id) + " is not 1-10");
   if (toe >= kSecondsPerWeek || toc >= kSecondsPerWeek) throw MessageError("DF442 toe", "beyond a week");
-  const int week = resolveWeek(week10, 10, s.ref);
-  const GpsTime toeT = nearWeek(GpsTime::fromWeekTow(week, toe), s.ref);
-  finishTimes(s, e, toeT.week(), toe, toc, false, false);
+  lnavTimes(s, e, week10, toe, toc);
   emit(s, std::move(e));
 }
 

@@ -30,6 +30,24 @@ double phaseCycles(Decoder::State& s, SatId sat, ObsCode code, double pr, double
   return pr / lambda + raw + tr.rolloverCycles;
 }
 
+// 1001/1003/1009/1011 carry the L1 pseudorange modulo one (GPS) or two (GLONASS)
+// light-milliseconds; 1002/1004/1010/1012 add the whole part (DF014/DF044). The phase is built on
+// the full pseudorange, so without the whole part neither can be delivered: it is taken from the
+// satellite's last full range if there is a recent one, else the satellite is dropped and
+// counted in DecoderStats::unresolvedRanges.
+bool wholeRange(Decoder::State& s, SatId sat, const GpsTime& t, bool extended, double unit, double& pr) {
+  if (extended) {
+    noteRange(s, sat, t, pr);
+    return true;
+  }
+  if (const auto full = resolveRange(s, sat, t, pr, unit)) {
+    pr = *full;
+    return true;
+  }
+  ++s.stats.unresolvedRanges;
+  return false;
+}
+
 }  // namespace
 
 void decodeLegacyGps(Decoder::State& s, BitReader& r, int type) {
@@ -79,7 +97,8 @@ void decodeLegacyGps(Decoder::State& s, BitReader& r, int type) {
     SatObs so;
     so.sat = sat;
     const bool sbas = sat.system == System::Sbas;
-    const double pr1 = static_cast<double>(pr1raw) * 0.02 + amb * kGpsPrAmbiguity;
+    double pr1 = static_cast<double>(pr1raw) * 0.02 + amb * kGpsPrAmbiguity;
+    if (!wholeRange(s, sat, t, ext, kGpsPrAmbiguity, pr1)) continue;
     {
       SignalObs o;
       o.code = ObsCode('1', (p1 && !sbas) ? 'P' : 'C');
@@ -157,7 +176,8 @@ void decodeLegacyGlonass(Decoder::State& s, BitReader& r, int type) {
     const std::optional<double> lam2 = carrierWavelength(System::Glonass, '2', k);
     SatObs so;
     so.sat = sat;
-    const double pr1 = static_cast<double>(pr1raw) * 0.02 + amb * kGlonassPrAmbiguity;
+    double pr1 = static_cast<double>(pr1raw) * 0.02 + amb * kGlonassPrAmbiguity;
+    if (!wholeRange(s, sat, t, ext, kGlonassPrAmbiguity, pr1)) continue;
     {
       SignalObs o;
       o.code = ObsCode('1', p1 ? 'P' : 'C');

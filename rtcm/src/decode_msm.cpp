@@ -112,14 +112,11 @@ void decodeMsm(Decoder::State& s, BitReader& r, System system, int msm) {
     bool roughOk = L.intMs ? intMs[i] != 255 : true;  // DF397 255: rough range invalid
     if (sat) {
       so.sat = *sat;
-      Decoder::State::RangeTrack& rt = s.ranges[static_cast<std::size_t>(satIndex(*sat))];
       if (L.intMs) {
         roughMs = intMs[i] + mod[i] * kP10;
-        if (roughOk) rt = {t, roughMs, true};
-      } else if (rt.valid && std::abs(t - rt.t) < 120.0) {
-        // MSM1-3: whole milliseconds from the last full range (ranges change < 1 ms in 2 min).
-        const double frac = mod[i] * kP10;
-        roughMs = frac + std::round(rt.ms - frac);
+        if (roughOk) noteRange(s, *sat, t, roughMs * kLightMs);
+      } else if (const auto full = resolveRange(s, *sat, t, mod[i] * kP10 * kLightMs, kLightMs)) {
+        roughMs = *full / kLightMs;  // MSM1-3: whole milliseconds from the last full range
       } else {
         roughOk = false;
       }

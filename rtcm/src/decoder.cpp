@@ -72,6 +72,31 @@ std::uint8_t lossOfLock(Decoder::State& s, SatId sat, ObsCode code, const GpsTim
   return lost ? 1 : 0;
 }
 
+void noteRange(Decoder::State& s, SatId sat, const GpsTime& t, double metres) {
+  s.ranges[static_cast<std::size_t>(satIndex(sat))] = {t, metres, true};
+}
+
+std::optional<double> resolveRange(const Decoder::State& s, SatId sat, const GpsTime& t, double modulo, double unit) {
+  const Decoder::State::RangeTrack& rt = s.ranges[static_cast<std::size_t>(satIndex(sat))];
+  if (!rt.valid || std::abs(t - rt.t) > 120.0) return std::nullopt;
+  return modulo + unit * std::round((rt.metres - modulo) / unit);
+}
+
+void mergeSignal(SatObs& so, const SignalObs& sig) {
+  SignalObs* have = so.find(sig.code);
+  if (!have) {
+    so.signals.push_back(sig);
+    return;
+  }
+  if (!have->hasCode() && sig.hasCode()) have->setCode(sig.pseudorange);
+  if (!have->hasPhase() && sig.hasPhase()) {
+    have->setPhase(sig.carrierPhase);
+    have->lli |= sig.lli;
+  }
+  if (!have->hasDoppler() && sig.hasDoppler()) have->setDoppler(sig.doppler);
+  if (!have->hasSnr() && sig.hasSnr()) have->setSnr(sig.snr);
+}
+
 GpsTime resolveTow(const Decoder::State& s, double towSeconds) {
   return nearestTow(towSeconds, s.ref);
 }
@@ -116,9 +141,7 @@ void addObservations(Decoder::State& s, System system, const GpsTime& t, bool mo
       s.open->sats.push_back(std::move(so));
       continue;
     }
-    for (SignalObs& sig : so.signals) {
-      if (!have->find(sig.code)) have->signals.push_back(sig);
-    }
+    for (const SignalObs& sig : so.signals) mergeSignal(*have, sig);
   }
   s.ref = t;
   if (!more) closeEpoch(s);

@@ -46,11 +46,11 @@ struct Decoder::State {
   bool lastClosedHasOthers = false;
 
   std::unordered_map<std::uint32_t, SignalTrack> tracks;
-  /// Last full rough range (ms) per satellite (satIndex) from MSM4-7, to resolve the whole
-  /// milliseconds that MSM1-3 leave out.
+  /// Last full range (m) per satellite (satIndex) from 1002/1004/1010/1012 and MSM4-7, to
+  /// resolve the whole milliseconds that 1001/1003/1009/1011 and MSM1-3 leave out.
   struct RangeTrack {
     GpsTime t;
-    double ms = 0.0;
+    double metres = 0.0;
     bool valid = false;
   };
   std::vector<RangeTrack> ranges = std::vector<RangeTrack>(static_cast<std::size_t>(numSatIndices()));
@@ -73,6 +73,16 @@ inline std::uint32_t trackKey(SatId sat, ObsCode code) {
 /// indicator; updates the track.
 std::uint8_t lossOfLock(Decoder::State& s, SatId sat, ObsCode code, const GpsTime& t,
                         LockTimeKind kind, int indicator);
+
+/// Records a full (unambiguous) range of a satellite at t.
+void noteRange(Decoder::State& s, SatId sat, const GpsTime& t, double metres);
+/// A range known modulo `unit` (m) made whole with the satellite's last full range (if within
+/// two minutes: ranges change by less than 200 km in that time, far less than the 300 km unit);
+/// std::nullopt if there is none.
+std::optional<double> resolveRange(const Decoder::State& s, SatId sat, const GpsTime& t, double modulo, double unit);
+/// Merges a signal into a satellite's list: a new code is appended, values missing from an
+/// existing entry are filled in.
+void mergeSignal(SatObs& so, const SignalObs& sig);
 
 /// Time of week (seconds) in GPST resolved near the reference.
 GpsTime resolveTow(const Decoder::State& s, double towSeconds);

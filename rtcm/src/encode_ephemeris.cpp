@@ -33,12 +33,20 @@ void gpsOrbit(BitWriter& w, const KeplerEphemeris& e, const char* crs, const cha
 
 double towOf(const GpsTime& t) { return t.tow(); }
 
+/// DF076/DF452: the week of transmission (IS-GPS-200 20.3.3.3.1.1), which differs from toe's
+/// week when a record for the next week is sent before the rollover. The transmission time is
+/// used when it is set and within half a week of toe.
+std::uint64_t lnavWeek(const KeplerEphemeris& e) {
+  const bool ttrUsable = e.ttr != GpsTime{} && std::abs(e.ttr - e.toe) < kSecondsPerWeek / 2;
+  return static_cast<std::uint64_t>((ttrUsable ? e.ttr : e.toe).week() % 1024);
+}
+
 std::vector<std::uint8_t> encodeGps(const KeplerEphemeris& e, int station) {
   (void)station;
   BitWriter w;
   w.u(12, 1019, "DF002 message number");
   w.u(6, e.sat.prn, "DF009 satellite ID");
-  w.u(10, static_cast<std::uint64_t>(e.toe.week() % 1024), "DF076 GPS week number");
+  w.u(10, lnavWeek(e), "DF076 GPS week number");
   w.u(4, static_cast<std::uint64_t>(uraIndex(e.ura)), "DF077 SV accuracy");
   w.u(2, static_cast<std::uint64_t>(e.codesOnL2), "DF078 code on L2");
   w.s(14, q(e.iDot / kSc, -43), "DF079 IDOT");
@@ -86,7 +94,7 @@ std::vector<std::uint8_t> encodeQzss(const KeplerEphemeris& e) {
   w.s(24, q(e.omegaDot / kSc, -43), "DF449 OMEGADOT");
   w.s(14, q(e.iDot / kSc, -43), "DF450 IDOT");
   w.u(2, static_cast<std::uint64_t>(e.codesOnL2), "DF451 codes on L2");
-  w.u(10, static_cast<std::uint64_t>(e.toe.week() % 1024), "DF452 week number");
+  w.u(10, lnavWeek(e), "DF452 week number");
   w.u(4, static_cast<std::uint64_t>(uraIndex(e.ura)), "DF453 URA");
   w.u(6, static_cast<std::uint64_t>(e.health), "DF454 SV health");
   w.s(8, q(e.tgd[0], -31), "DF455 TGD");

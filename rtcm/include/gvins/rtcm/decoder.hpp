@@ -88,8 +88,9 @@ struct DecoderStats {
                                          ///< because the FDMA channel was unknown
   std::int64_t unknownSatellites = 0;    ///< observation cells of satellites out of range
   std::int64_t unknownSignals = 0;       ///< MSM cells of reserved signal IDs
-  std::int64_t unresolvedRanges = 0;     ///< MSM1-3 cells dropped: whole milliseconds of the
-                                         ///< range unknown (no recent MSM4-7 of the satellite)
+  std::int64_t unresolvedRanges = 0;     ///< 1001/1003/1009/1011 satellites and MSM1-3 cells
+                                         ///< dropped: whole milliseconds of the range unknown
+                                         ///< (no recent full range of the satellite)
   std::int64_t ephemerides = 0;          ///< ephemeris records delivered
   std::optional<GpsTime> firstEpoch, lastEpoch;
   std::vector<DecodeIssue> issues;       ///< the first DecoderOptions::maxIssues malformed frames
