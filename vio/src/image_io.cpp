@@ -21,7 +21,7 @@ std::uint32_t be32(const std::uint8_t* p) {
 [[noreturn]] void fail(const std::string& name, const std::string& what) { throw ParseError(name, 0, "image", what); }
 
 void checkSize(const std::string& name, std::int64_t w, std::int64_t h, int ew, int eh) {
-  if (w <= 0 || h <= 0 || w * h > kMaxPixels) {
+  if (w <= 0 || h <= 0 || w > kMaxPixels || h > kMaxPixels || w * h > kMaxPixels) {
     fail(name, "implausible image size " + std::to_string(w) + "x" + std::to_string(h));
   }
   if ((ew > 0 && w != ew) || (eh > 0 && h != eh)) {

@@ -107,11 +107,14 @@ std::vector<double> doubleList(const YAML::Node& n, const Ctx& c, const std::str
 // A 4x4 rigid transform: EuRoC {rows: 4, cols: 4, data: [16]} or Kalibr nested 4x4 list.
 Eigen::Matrix4d transform(const YAML::Node& n, const Ctx& c, const std::string& field) {
   Eigen::Matrix4d T;
+  std::int64_t line = lineOf(n);  // where the numbers are, for value errors
   if (n.IsMap()) {
     const double rows = scalarDouble(child(n, "rows", c), c, field + ".rows");
     const double cols = scalarDouble(child(n, "cols", c), c, field + ".cols");
     if (rows != 4.0 || cols != 4.0) fail(c, lineOf(n), field, "expected rows: 4 and cols: 4");
-    const auto d = doubleList(child(n, "data", c), c, field + ".data", 16, 16);
+    const YAML::Node dn = child(n, "data", c);
+    line = lineOf(dn);
+    const auto d = doubleList(dn, c, field + ".data", 16, 16);
     for (int r = 0; r < 4; ++r) {
       for (int k = 0; k < 4; ++k) T(r, k) = d[static_cast<std::size_t>(4 * r + k)];
     }
@@ -126,12 +129,12 @@ Eigen::Matrix4d transform(const YAML::Node& n, const Ctx& c, const std::string& 
   }
   if (std::abs(T(3, 0)) > 1e-9 || std::abs(T(3, 1)) > 1e-9 || std::abs(T(3, 2)) > 1e-9 ||
       std::abs(T(3, 3) - 1.0) > 1e-9) {
-    fail(c, lineOf(n), field, "last row must be 0 0 0 1");
+    fail(c, line, field, "last row must be 0 0 0 1");
   }
   const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
   const double orthoErr = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   if (!(orthoErr < 1e-3) || !(R.determinant() > 0.0)) {
-    fail(c, lineOf(n), field, "rotation part is not a rotation matrix (orthonormality error " +
+    fail(c, line, field, "rotation part is not a rotation matrix (orthonormality error " +
                                   std::to_string(orthoErr) + ")");
   }
   // Remove the rounding of the printed coefficients.
