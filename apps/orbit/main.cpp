@@ -114,6 +114,7 @@ int main(int argc, char** argv) {
                 st->clockBias, st->clockDrift);
     ++perSystem[gvins::systemIndex(sat.system)];
   }
+  std::fflush(stdout);
   std::fprintf(stderr, "gvins-orbit: %s GPST, %zu records from %zu file(s), %zu skipped\n", t.toString(6).c_str(),
                store.size(), files.size(), skipped);
   std::fprintf(stderr, "  system   satellites\n");

@@ -14,7 +14,7 @@ bool isHealthy(const KeplerEphemeris& eph) {
       return (eph.health & 0x038) == 0;
     case NavMessage::QzssLnav:
       // The least significant of the six LNAV health bits flags the L1C/B signal
-      // (IS-QZSS-PNT-005 4.1.2.3); QZS-2/3/4 broadcast L1C/A with that bit set (health = 1) while
+      // (IS-QZSS-PNT-005, LNAV SV health); QZS-2/3/4 broadcast L1C/A with that bit set (health = 1) while
       // fully usable, so only the other five bits count.
       return (eph.health & 0x3E) == 0;
     default:

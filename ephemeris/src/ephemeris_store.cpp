@@ -1,15 +1,15 @@
 // Ephemeris store and record selection.
 //
 // Validity windows (half-widths around toe; a record is never used outside its window):
-//   GPS     half the fit interval (IS-GPS-200N 20.3.4.4 and table 20-XII): 2 h for the standard
+//   GPS     half the fit interval (IS-GPS-200N 20.3.3.4.3.1 and 20.3.4.4): 2 h for the standard
 //           4 h fit (fit interval 0 or 4 in RINEX), 3 h when only the "> 4 h" flag (1) is given,
 //           otherwise fit/2 as written (6, 8, 14, 26 h fits after long uploads).
-//   QZSS    half the fit interval (IS-QZSS-PNT-005 4.1.2.7: flag 0 = 2 h, 1 = more than 2 h):
+//   QZSS    half the fit interval (IS-QZSS 4.1.2.7, as RINEX 3.04 cites it: flag 0 = 2 h, 1 = more):
 //           1 h for flag 0, 2 h for flag 1, otherwise fit/2 as written.
 //   Galileo 4 h: the OS SIS ICD defines no fit interval; new IODnav batches come every 10 min
 //           and 4 h is the common maximum age of a batch (the value RTKLIB 2.4.3 also uses).
-//   BeiDou  2 h: D1/D2 ephemerides are refreshed every hour (BDS-SIS-ICD B1I 3.0 5.2.4.11, toe
-//           on the hour); one missed update is tolerated.
+//   BeiDou  2 h: the ICD defines no fit interval and D1/D2 ephemerides are refreshed every hour
+//           (toe on the hour in practice); one missed update is tolerated.
 //   GLONASS 30 min: tb is spaced 30, 45 or 60 min (ICD 5.1 4.4, word P1), so a record serves at
 //           most +-30 min around tb.
 // Among usable records the nearest toe wins; equal distances go to the newest transmission, then
@@ -29,7 +29,7 @@ constexpr double kHour = 3600.0;
 double maxHalfWindow(System s) {
   switch (s) {
     case System::Gps:
-    case System::Qzss: return 13.0 * kHour;  // 26 h fit, the longest in IS-GPS-200N table 20-XII
+    case System::Qzss: return 13.0 * kHour;  // 26 h fit, the longest in IS-GPS-200N 20.3.4.4
     case System::Galileo: return 4.0 * kHour;
     case System::BeiDou: return 2.0 * kHour;
     case System::Glonass: return 0.5 * kHour;

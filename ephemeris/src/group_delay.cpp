@@ -22,8 +22,8 @@ double broadcastGroupDelay(const KeplerEphemeris& eph, ObsCode code) {
     case NavMessage::QzssLnav: {
       // The LNAV clock refers to the L1/L2 P(Y) ionosphere-free combination; a single-frequency
       // user on band f removes (f1/f)^2 TGD (IS-GPS-200N 20.3.3.3.3.2; L5 and L1C without their
-      // inter-signal corrections, which LNAV does not carry). QZSS follows the same rule
-      // (IS-QZSS-PNT-005 5.1.2.1.2).
+      // inter-signal corrections, which LNAV does not carry). QZSS LNAV follows the same rule
+      // (IS-QZSS-PNT-005).
       const System sys = eph.sat.system;
       if (code.band == '1') return eph.tgd[0];
       if (code.band == '2' || code.band == '5') return gammaOf(sys, '1', code.band) * eph.tgd[0];
@@ -51,7 +51,7 @@ double broadcastGroupDelay(const KeplerEphemeris& eph, ObsCode code) {
     case NavMessage::BeiDouD1:
     case NavMessage::BeiDouD2:
       // D1/D2 clocks refer to B3I; TGD1 is the B1I and TGD2 the B2I delay relative to B3I
-      // (BDS-SIS-ICD B1I 3.0 5.2.4.10). B1I is band 2 (RINEX 3.03+; normalizeObsCode maps RINEX
+      // (BDS-SIS-ICD-B1I 3.0, 5.2.4 and 5.3.3). B1I is band 2 (RINEX 3.03+; normalizeObsCode maps RINEX
       // 3.02 codes), or the unambiguous 3.02 codes 1I/1Q; 1X/1D/1P are B1C, whose delay is only in
       // CNAV1. B2I is band 7 with I/Q/X (B2b, 7D/7P/7Z, has no D1/D2 delay).
       if (code.band == '2') return eph.tgd[0];

@@ -1,9 +1,10 @@
 // RINEX navigation reader: versions 2.10/2.11 (GPS "N", GLONASS "G", SBAS "H" and other
 // single-system files), 3.0x (single-system and mixed) and 4.0x (EPH/STO/ION/EOP records).
 //
-// Format references: RINEX 2.11 (Gurtner & Estey 2007) tables A3/A4/A10/A11; RINEX 3.04 (IGS/RTCM
-// 2018) tables A5-A16 (notably A6 GPS, A8 Galileo, A10 QZSS, A12 BDS, A13/A14 GLONASS); RINEX 3.05
-// (GLONASS fourth orbit line); RINEX 4.00 (2021) section 8 and tables A31-A40.
+// Format references: RINEX 2.10/2.11 (Gurtner & Estey) appendix tables for GPS and GLONASS
+// navigation files; RINEX 3.04 (IGS/RTCM 2018) appendix tables for the navigation header and the
+// GPS, Galileo (table A8, data sources), QZSS, BDS and GLONASS records; RINEX 3.05 (GLONASS fourth
+// orbit line); RINEX 4.00 (2021) EPH/STO/ION/EOP navigation records.
 #include <algorithm>
 #include <array>
 #include <cctype>
@@ -21,7 +22,6 @@ namespace gvins {
 namespace {
 
 constexpr double kWeek = 604800.0;
-constexpr double kHalfWeek = 302400.0;
 constexpr double kDay = 86400.0;
 
 // ---- numbers ---------------------------------------------------------------------------------
@@ -156,6 +156,7 @@ CalendarTime NavReader::parseEpoch(std::string_view text, const TextLocation& wh
 }
 
 std::optional<SatId> NavReader::recordSatellite(const std::string& line, const TextLocation& where) const {
+  if (trim(line).empty()) throwParseError(where, "satellite", "missing satellite and epoch line");
   if (rinex2_ && !std::isalpha(static_cast<unsigned char>(line[0]))) {
     const long prn = parseInt(column(line, 0, 2), where, "satellite number");
     SatId s(*fileSystem_, static_cast<int>(prn));

@@ -1,5 +1,5 @@
-// RINEX 3.04 mixed navigation writer (RINEX 3.04 tables A5 header, A6 GPS, A8 Galileo, A10 QZSS,
-// A12 BDS, A14 GLONASS records).
+// RINEX 3.04 mixed navigation writer (RINEX 3.04 appendix: navigation header and GPS, Galileo,
+// QZSS, BDS and GLONASS record layouts).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -13,7 +13,6 @@
 namespace gvins {
 namespace {
 
-constexpr double kWeekSeconds = 604800.0;
 
 // Fortran D19.12 written with an 'E' exponent; magnitudes outside the two-digit exponent range
 // are saturated (tiny values become 0) so that every field keeps its 19 columns.

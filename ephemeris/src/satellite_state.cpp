@@ -1,10 +1,10 @@
 // Satellite position, velocity and clock from broadcast ephemerides.
 //
-// Keplerian records: IS-GPS-200N table 20-IV (also used by QZSS, IS-QZSS-PNT-005 5.1.2; by Galileo,
-// OS SIS ICD 2.1 5.1.1 table 58; and by BeiDou MEO/IGSO, BDS-SIS-ICD B1I 3.0 5.2.4.12). BeiDou GEO
-// satellites are computed in an inertial-like frame and rotated by -5 deg about x and by the Earth
-// rotation since toe (BDS-SIS-ICD B1I 3.0 table 5-11). Velocities are the exact time derivatives of
-// these formulas (the broadcast harmonic corrections included), not finite differences.
+// Keplerian records: IS-GPS-200N table 20-IV (also used by QZSS, IS-QZSS-PNT-005; by Galileo, OS SIS
+// ICD 2.1 5.1.1; and by BeiDou MEO/IGSO, BDS-SIS-ICD-B1I 3.0 5.2.4). BeiDou GEO satellites are
+// computed in an inertial-like frame and rotated by -5 deg about x and by the Earth rotation since
+// toe (BDS-SIS-ICD-B1I 3.0 5.2.4, user algorithm for GEO satellites). Velocities are the exact time
+// derivatives of these formulas (the broadcast harmonic corrections included), not differences.
 //
 // GLONASS: fourth-order Runge-Kutta integration of the PZ-90 equations of motion with the J2 term
 // and the broadcast luni-solar accelerations held constant (GLONASS ICD ed. 5.1, appendix A.3.1.2).
@@ -33,7 +33,7 @@ KeplerConstants keplerConstants(System s) {
   }
 }
 
-// sin(-5 deg), cos(-5 deg): BeiDou GEO frame tilt (BDS-SIS-ICD B1I 3.0 table 5-11).
+// sin(-5 deg), cos(-5 deg): BeiDou GEO frame tilt (BDS-SIS-ICD-B1I 3.0, 5.2.4).
 const double kSinMinus5 = std::sin(-5.0 * constants::kDegToRad);
 const double kCosMinus5 = std::cos(-5.0 * constants::kDegToRad);
 
@@ -54,26 +54,34 @@ SatelliteState keplerSatelliteState(const KeplerEphemeris& eph, const GpsTime& t
   const double tk = t - eph.toe;
   const double tc = t - eph.toc;
 
-  // Mean motion and Kepler's equation (Newton's method; converges in 3-5 steps for GNSS orbits).
+  // Mean motion and Kepler's equation (Newton's method from E0 = M + e sin M). Newton converges
+  // quadratically: after a step of size d the error is about e d^2 / (2 (1 - e)), below 1e-19 rad
+  // once |d| < 1e-9, so that is where it stops (two or three steps for GNSS orbits).
   const double n = k.sqrtGm / (a * eph.sqrtA) + eph.deltaN;
   const double m = eph.m0 + n * tk;
-  double ecc = m;
+  double ecc = m + e * std::sin(m);
+  double sinE = std::sin(ecc), cosE = std::cos(ecc);
   for (int it = 0; it < 30; ++it) {
-    const double d = (ecc - e * std::sin(ecc) - m) / (1.0 - e * std::cos(ecc));
+    const double d = (ecc - e * sinE - m) / (1.0 - e * cosE);
     ecc -= d;
-    if (std::fabs(d) < 1e-14) break;
+    sinE = std::sin(ecc);
+    cosE = std::cos(ecc);
+    if (std::fabs(d) < 1e-9) break;
   }
-  const double sinE = std::sin(ecc), cosE = std::cos(ecc);
   const double oneMinusECosE = 1.0 - e * cosE;
   const double eDot = n / oneMinusECosE;
   const double sqrt1mE2 = std::sqrt(1.0 - e * e);
 
-  // Argument of latitude and second-harmonic corrections.
-  const double nu = std::atan2(sqrt1mE2 * sinE, cosE - e);
+  // True anomaly nu and argument of latitude phi = nu + omega, by their sines and cosines:
+  // sin nu = sqrt(1-e^2) sin E / (1 - e cos E), cos nu = (cos E - e) / (1 - e cos E).
+  const double sinNu = sqrt1mE2 * sinE / oneMinusECosE;
+  const double cosNu = (cosE - e) / oneMinusECosE;
+  const double sinW = std::sin(eph.omega), cosW = std::cos(eph.omega);
+  const double sinPhi = sinNu * cosW + cosNu * sinW;
+  const double cosPhi = cosNu * cosW - sinNu * sinW;
   const double nuDot = eDot * sqrt1mE2 / oneMinusECosE;
-  const double phi = nu + eph.omega;
-  const double s2 = std::sin(2.0 * phi), c2 = std::cos(2.0 * phi);
-  const double u = phi + eph.cus * s2 + eph.cuc * c2;
+  const double s2 = 2.0 * sinPhi * cosPhi, c2 = cosPhi * cosPhi - sinPhi * sinPhi;
+  const double du = eph.cus * s2 + eph.cuc * c2;
   const double r = a * oneMinusECosE + eph.crs * s2 + eph.crc * c2;
   const double inc = eph.i0 + eph.iDot * tk + eph.cis * s2 + eph.cic * c2;
   const double uDot = nuDot * (1.0 + 2.0 * (eph.cus * c2 - eph.cuc * s2));
@@ -81,7 +89,9 @@ SatelliteState keplerSatelliteState(const KeplerEphemeris& eph, const GpsTime& t
   const double incDot = eph.iDot + 2.0 * nuDot * (eph.cis * c2 - eph.cic * s2);
 
   // Position and velocity in the orbital plane.
-  const double su = std::sin(u), cu = std::cos(u);
+  // u = phi + du (du ~ 1e-5 rad).
+  const double sinDu = std::sin(du), cosDu = std::cos(du);
+  const double su = sinPhi * cosDu + cosPhi * sinDu, cu = cosPhi * cosDu - sinPhi * sinDu;
   const double xp = r * cu, yp = r * su;
   const double xpDot = rDot * cu - r * uDot * su;
   const double ypDot = rDot * su + r * uDot * cu;

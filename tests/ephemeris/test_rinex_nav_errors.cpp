@@ -194,6 +194,8 @@ TEST(RinexNavErrors, Rinex4Records) {
   expectError(header + "> EPH G05\n" + kGps, {4, "record type"});
   expectError(header + "> EPH G05 LNAV\n> EPH G05 LNAV\n" + kGps, {5, "SV / EPOCH / SV CLK"});
   expectError(header + kGps, {4, "record type"});
+  // Blank line where the satellite/epoch line belongs (found by fuzzing).
+  expectError(header + "> EPH G05 LNAV\n\n" + kGps.substr(kGps.find('\n') + 1), {5, "satellite"});
   // Satellite of the data line differs from the '>' line.
   expectError(header + "> EPH E05 INAV\n" + kGps, {5, "satellite"});
   // Truncated EPH record before the next '>' line.

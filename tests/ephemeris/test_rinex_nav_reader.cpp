@@ -330,3 +330,65 @@ TEST(RinexNavReader, MergeKeepsFirstHeaderValues) {
   EXPECT_EQ(a.kepler.size(), n + b.kepler.size());
   EXPECT_DOUBLE_EQ(a.iono.gps->alpha[0], alpha0);
 }
+
+TEST(RinexNavReader, Rinex305GlonassFourthLineAndRecordAfterIt) {
+  const std::string text =
+      "     3.05           N: GNSS NAV DATA    M: MIXED            RINEX VERSION / TYPE\n"
+      "    18                                                      LEAP SECONDS\n"
+      "                                                            END OF HEADER\n"
+      "R01 2022 10 05 00 15 00 1.574866473675e-05 0.000000000000e+00 2.592300000000e+05\n"
+      "    -6.686352539062e+03 3.702297210693e-01 9.313225746155e-10 0.000000000000e+00\n"
+      "    -1.537300634766e+04-2.607774734497e+00 9.313225746155e-10 1.000000000000e+00\n"
+      "     1.922300781250e+04-1.955271720886e+00-2.793967723846e-09 0.000000000000e+00\n"
+      "     1.790000000000e+02 8.381903171539e-09 1.500000000000e+01 3.000000000000e+00\n"
+      "R02 2022 10 05 00 15 00 1.574866473675e-05 0.000000000000e+00 2.592300000000e+05\n"
+      "    -6.686352539062e+03 3.702297210693e-01 9.313225746155e-10 0.000000000000e+00\n"
+      "    -1.537300634766e+04-2.607774734497e+00 9.313225746155e-10-4.000000000000e+00\n"
+      "     1.922300781250e+04-1.955271720886e+00-2.793967723846e-09 0.000000000000e+00\n";
+  const NavData nav = parseRinexNav(text, "v305.rnx");
+  ASSERT_EQ(nav.glonass.size(), 2u);
+  EXPECT_DOUBLE_EQ(nav.glonass[0].deltaTauN, 8.381903171539e-09);
+  EXPECT_DOUBLE_EQ(nav.glonass[0].accuracy, 0.0);  // F_T = 15: not given
+  EXPECT_EQ(nav.glonass[1].frequencyChannel, -4);
+  EXPECT_EQ(nav.glonass[1].deltaTauN, 0.0);  // three-line record (3.04 style) accepted too
+}
+
+TEST(RinexNavReader, Rinex2OtherSingleSystemFiles) {
+  // SBAS (file type H): records are skipped with a reason, three orbit lines each.
+  const std::string sbas =
+      "     2.11           H: GEO NAV MSG DATA                     RINEX VERSION / TYPE\n"
+      "                                                            END OF HEADER\n"
+      "20 09 12 18 23 07 28.0 0.000000000000D+00 0.000000000000D+00 3.395520000000D+05\n"
+      "    4.073740000000D+04 0.000000000000D+00 0.000000000000D+00 0.000000000000D+00\n"
+      "    0.000000000000D+00 0.000000000000D+00 0.000000000000D+00 3.200000000000D+01\n"
+      "    0.000000000000D+00 0.000000000000D+00 0.000000000000D+00 0.000000000000D+00\n"
+      "27 09 12 18 23 07 28.0 0.000000000000D+00 0.000000000000D+00 3.395520000000D+05\n"
+      "    4.073740000000D+04 0.000000000000D+00 0.000000000000D+00 0.000000000000D+00\n"
+      "    0.000000000000D+00 0.000000000000D+00 0.000000000000D+00 3.200000000000D+01\n"
+      "    0.000000000000D+00 0.000000000000D+00 0.000000000000D+00 0.000000000000D+00\n";
+  const NavData s = parseRinexNav(sbas, "sbas.09h");
+  EXPECT_TRUE(s.kepler.empty());
+  ASSERT_EQ(s.skipped.size(), 2u);
+  EXPECT_NE(s.skipped[0].find("S20 SBAS"), std::string::npos);
+  EXPECT_NE(s.skipped[1].find("line 7"), std::string::npos);
+  // A RINEX 2 file of another system whose records start with the satellite letter (the RINEX 3
+  // first-line layout, as RINEX 2.12 Galileo files and RTKLIB's reader have it).
+  const std::string gal =
+      "     2.12           N: GNSS NAV DATA    E: GALILEO          RINEX VERSION / TYPE\n"
+      "                                                            END OF HEADER\n"
+      "E12 2024 06 24 08 20 00-1.095227780752D-03-1.594457899046D-11 0.000000000000D+00\n"
+      "    6.700000000000D+01 1.359062500000D+02 2.740828452221D-09 1.818462909708D+00\n"
+      "    6.115064024925D-06 4.236079985276D-04 7.338821887970D-07 5.440608266830D+03\n"
+      "    1.164000000000D+05-3.539025783539D-08 1.566556240144D+00 5.587935447693D-09\n"
+      "    9.967372953892D-01 3.393125000000D+02 8.146038365252D-01-5.710952169795D-09\n"
+      "    8.214627886510D-11 5.170000000000D+02 2.320000000000D+03\n"
+      "    3.120000000000D+00 0.000000000000D+00-8.614733815193D-09-8.847564458847D-09\n"
+      "    1.170650000000D+05\n";
+  const NavData g = parseRinexNav(gal, "gal.24l");
+  ASSERT_EQ(g.kepler.size(), 1u);
+  EXPECT_EQ(g.kepler[0].sat, SatId(System::Galileo, 12));
+  EXPECT_EQ(g.kepler[0].message, NavMessage::GalileoInav);
+  EXPECT_DOUBLE_EQ(g.kepler[0].sqrtA, 5.440608266830e+03);
+  EXPECT_DOUBLE_EQ(g.kepler[0].tgd[1], -8.847564458847e-09);
+  EXPECT_EQ(g.kepler[0].toe, gpst(2024, 6, 24, 8, 20, 0));
+}

@@ -71,9 +71,9 @@ struct KeplerEphemeris {
 
 /// Whether the record's health word allows use of the satellite for the signals the message serves:
 /// GPS all six LNAV health bits zero (IS-GPS-200N 20.3.3.3.1.4); QZSS the five bits other than
-/// the L1C/B flag (LSB) zero (IS-QZSS-PNT-005 4.1.2.3);
+/// the L1C/B flag (LSB) zero (IS-QZSS-PNT-005, LNAV SV health);
 /// Galileo I/NAV: E1-B and E5b DVS/HS bits zero, F/NAV: E5a DVS/HS bits zero (RINEX 3.04 table A8
-/// bit layout, OS SIS ICD 2.1 5.1.9.3); BeiDou SatH1 = 0 (BDS-SIS-ICD B1I 3.0 5.2.4.6).
+/// bit layout, OS SIS ICD 2.1 5.1.9.3); BeiDou SatH1 = 0 (BDS-SIS-ICD-B1I 3.0, 5.2.4).
 bool isHealthy(const KeplerEphemeris& eph);
 
 /// Galileo message type implied by a RINEX "data sources" bit field (RINEX 3.04 table A8):
