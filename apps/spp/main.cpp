@@ -1,0 +1,364 @@
+// gvins-spp: single point positioning (and Doppler velocity) from RINEX observation and
+// navigation files, written as an RTKLIB-compatible .pos file.
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "gvins/base/constants.hpp"
+#include "gvins/base/geodetic.hpp"
+#include "gvins/base/parse_error.hpp"
+#include "gvins/base/rinex_obs_reader.hpp"
+#include "gvins/ephemeris/ephemeris_store.hpp"
+#include "gvins/ephemeris/rinex_nav.hpp"
+#include "gvins/gnss/accuracy_statistics.hpp"
+#include "gvins/gnss/pos_writer.hpp"
+#include "gvins/gnss/spp.hpp"
+#include "gvins/gnss/spp_config.hpp"
+
+namespace {
+
+const char* kUsage =
+    "usage: gvins-spp [options] -o OUT.pos OBS NAV [NAV...]\n"
+    "\n"
+    "Single point positioning from RINEX observations (2.10/2.11, 3.0x; plain or .gz) and\n"
+    "broadcast navigation files (RINEX 2/3/4, merged). Writes one RTKLIB-style .pos row per\n"
+    "solved epoch, prints progress and a summary to stderr.\n"
+    "\n"
+    "  -o FILE            output .pos file ('-' for stdout); required\n"
+    "  --config F.yaml    options from the 'spp:' section of a YAML file (see docs); command-line\n"
+    "                     options given after it override it\n"
+    "  --systems GRECJ    systems to use (G GPS, R GLONASS, E Galileo, C BeiDou, J QZSS, S SBAS,\n"
+    "                     I NavIC); default GRECJ\n"
+    "  --elmask DEG       elevation mask, degrees (default 15)\n"
+    "  --snrmask DBHZ     C/N0 mask, dB-Hz (default 0 = off)\n"
+    "  --freq N           bands per system, 1-3 (default 1); with 2 or 3 and --iono dual-frequency\n"
+    "                     ionosphere-free pseudoranges are formed where two bands exist\n"
+    "  --iono MODEL       off | broadcast | dual-frequency (default broadcast: Klobuchar, BeiDou's\n"
+    "                     own parameters for BeiDou)\n"
+    "  --tropo MODEL      off | saastamoinen (default; Niell mapping)\n"
+    "  --no-fde           no fault detection and exclusion\n"
+    "  --no-velocity      no Doppler velocity (velocity columns are zeros)\n"
+    "  --xyz              ECEF x/y/z columns instead of latitude/longitude/height\n"
+    "  --time-decimals N  decimals of the time column (default 3)\n"
+    "  --truth X,Y,Z      true antenna position (ECEF, m): adds an accuracy table (east/north/up\n"
+    "                     mean, std, RMS, horizontal/vertical RMS, 95 %, max; velocity errors are\n"
+    "                     taken against zero, i.e. a static receiver)\n"
+    "  --truth-llh LAT,LON,H   the same as latitude, longitude (deg) and ellipsoidal height (m)\n"
+    "  --strict           stop at the first malformed epoch (default: skip it and count it)\n"
+    "  -q, --quiet        no progress line\n"
+    "  -h, --help         this text\n";
+
+struct Args {
+  std::string config;
+  std::string out;
+  std::vector<std::string> inputs;
+  std::optional<std::string> systems;
+  std::optional<double> elmask, snrmask;
+  std::optional<int> freq;
+  std::optional<std::string> iono, tropo;
+  bool noFde = false, noVelocity = false, xyz = false, strict = false, quiet = false;
+  int timeDecimals = 3;
+  std::optional<Eigen::Vector3d> truth;
+};
+
+[[noreturn]] void usageError(const std::string& msg) {
+  std::fprintf(stderr, "gvins-spp: %s (see --help)\n", msg.c_str());
+  std::exit(2);
+}
+
+bool parseTriple(const std::string& s, double v[3]) {
+  char extra = 0;
+  return std::sscanf(s.c_str(), "%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &extra) == 3 && std::isfinite(v[0]) &&
+         std::isfinite(v[1]) && std::isfinite(v[2]);
+}
+
+double parseNumber(const std::string& opt, const std::string& s) {
+  char* end = nullptr;
+  const double v = std::strtod(s.c_str(), &end);
+  if (end == s.c_str() || *end != '\0' || !std::isfinite(v)) usageError(opt + " needs a number, not '" + s + "'");
+  return v;
+}
+
+Args parseArgs(int argc, char** argv) {
+  Args a;
+  auto value = [&](int& i, const std::string& opt) -> std::string {
+    if (i + 1 >= argc) usageError(opt + " needs a value");
+    return argv[++i];
+  };
+  for (int i = 1; i < argc; ++i) {
+    const std::string o = argv[i];
+    if (o == "-h" || o == "--help") {
+      std::fputs(kUsage, stdout);
+      std::exit(0);
+    } else if (o == "-o") {
+      a.out = value(i, o);
+    } else if (o == "--config") {
+      a.config = value(i, o);
+    } else if (o == "--systems") {
+      a.systems = value(i, o);
+    } else if (o == "--elmask") {
+      a.elmask = parseNumber(o, value(i, o));
+      if (*a.elmask < -10.0 || *a.elmask > 90.0) usageError("--elmask must be within -10..90 degrees");
+    } else if (o == "--snrmask") {
+      a.snrmask = parseNumber(o, value(i, o));
+    } else if (o == "--freq") {
+      const double f = parseNumber(o, value(i, o));
+      if (f != 1.0 && f != 2.0 && f != 3.0) usageError("--freq must be 1, 2 or 3");
+      a.freq = static_cast<int>(f);
+    } else if (o == "--iono") {
+      a.iono = value(i, o);
+    } else if (o == "--tropo") {
+      a.tropo = value(i, o);
+    } else if (o == "--no-fde") {
+      a.noFde = true;
+    } else if (o == "--no-velocity") {
+      a.noVelocity = true;
+    } else if (o == "--xyz") {
+      a.xyz = true;
+    } else if (o == "--time-decimals") {
+      const double d = parseNumber(o, value(i, o));
+      if (d < 0 || d > 9 || d != std::floor(d)) usageError("--time-decimals must be 0..9");
+      a.timeDecimals = static_cast<int>(d);
+    } else if (o == "--truth" || o == "--truth-llh") {
+      double v[3];
+      const std::string s = value(i, o);
+      if (!parseTriple(s, v)) usageError(o + " needs three comma-separated numbers, not '" + s + "'");
+      if (o == "--truth") {
+        a.truth = Eigen::Vector3d(v[0], v[1], v[2]);
+      } else {
+        if (std::abs(v[0]) > 90.0 || std::abs(v[1]) > 360.0) usageError("--truth-llh latitude/longitude out of range");
+        a.truth = gvins::geodeticToEcef(gvins::geodeticFromDegrees(v[0], v[1], v[2]));
+      }
+    } else if (o == "--strict") {
+      a.strict = true;
+    } else if (o == "-q" || o == "--quiet") {
+      a.quiet = true;
+    } else if (o.size() > 1 && o[0] == '-') {
+      usageError("unknown option '" + o + "'");
+    } else {
+      a.inputs.push_back(o);
+    }
+  }
+  if (a.out.empty()) usageError("no output file (-o OUT.pos)");
+  if (a.inputs.size() < 2) usageError("need an observation file and at least one navigation file");
+  return a;
+}
+
+std::string ionoName(gvins::IonosphereOption o) {
+  switch (o) {
+    case gvins::IonosphereOption::Off: return "off";
+    case gvins::IonosphereOption::Broadcast: return "broadcast";
+    case gvins::IonosphereOption::DualFrequency: return "dual-frequency";
+  }
+  return "?";
+}
+
+std::string systemsText(const gvins::SppConfig& c) {
+  std::string s;
+  for (int i = 0; i < gvins::kNumSystems; ++i) {
+    if (c.systems[i]) s += gvins::systemLetter(static_cast<gvins::System>(i));
+  }
+  return s;
+}
+
+void printError(const gvins::ParseError& e) { std::fprintf(stderr, "gvins-spp: error: %s\n", e.what()); }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace gvins;
+  const Args args = parseArgs(argc, argv);
+  const auto wall0 = std::chrono::steady_clock::now();
+
+  // Configuration: defaults, YAML, command line.
+  SppConfig cfg;
+  try {
+    if (!args.config.empty()) cfg = loadSppConfig(args.config, cfg);
+  } catch (const ParseError& e) {
+    printError(e);
+    return 2;
+  }
+  try {
+    if (args.systems) cfg.systems = parseSystemLetters(*args.systems);
+  } catch (const std::invalid_argument& e) {
+    usageError(std::string("--systems: ") + e.what());
+  }
+  if (args.elmask) cfg.elevationMask = *args.elmask * constants::kDegToRad;
+  if (args.snrmask) cfg.snrMask = *args.snrmask;
+  if (args.freq) cfg.frequencies = *args.freq;
+  if (args.iono) {
+    if (*args.iono == "off") cfg.ionosphere = IonosphereOption::Off;
+    else if (*args.iono == "broadcast") cfg.ionosphere = IonosphereOption::Broadcast;
+    else if (*args.iono == "dual-frequency") cfg.ionosphere = IonosphereOption::DualFrequency;
+    else usageError("--iono must be off, broadcast or dual-frequency");
+  }
+  if (args.tropo) {
+    if (*args.tropo == "off") cfg.troposphere = TroposphereOption::Off;
+    else if (*args.tropo == "saastamoinen") cfg.troposphere = TroposphereOption::Saastamoinen;
+    else usageError("--tropo must be off or saastamoinen");
+  }
+  if (args.noFde) cfg.faultExclusion.enabled = false;
+  if (args.noVelocity) cfg.velocity = false;
+
+  // Navigation data.
+  EphemerisStore nav;
+  try {
+    for (std::size_t i = 1; i < args.inputs.size(); ++i) nav.add(readRinexNav(args.inputs[i]));
+  } catch (const ParseError& e) {
+    printError(e);
+    return 1;
+  }
+  if (nav.size() == 0) {
+    std::fprintf(stderr, "gvins-spp: error: no usable ephemeris in the navigation files\n");
+    return 1;
+  }
+
+  // Observations.
+  std::optional<RinexObsReader> obs;
+  RinexObsReaderOptions ropt;
+  ropt.skipBadEpochs = !args.strict;
+  try {
+    obs.emplace(args.inputs[0], ropt);
+  } catch (const ParseError& e) {
+    printError(e);
+    return 1;
+  }
+  const RinexObsHeader& hdr = obs->header();
+
+  SppSolver solver(nav, cfg);
+  solver.setGlonassChannels(hdr.glonassChannels);
+  if (hdr.station.approxPosition) solver.setInitialPosition(*hdr.station.approxPosition);
+
+  std::ofstream file;
+  std::ostream* out = &std::cout;
+  if (args.out != "-") {
+    file.open(args.out);
+    if (!file) {
+      std::fprintf(stderr, "gvins-spp: error: cannot create '%s'\n", args.out.c_str());
+      return 1;
+    }
+    out = &file;
+  }
+  PosWriterOptions popt;
+  popt.coordinates = args.xyz ? PosCoordinates::Xyz : PosCoordinates::Llh;
+  popt.velocity = true;
+  popt.timeDecimals = args.timeDecimals;
+  popt.program = "SRI-GVINS gvins-spp";
+  for (const auto& f : args.inputs) popt.headerFields.emplace_back("inp file", f);
+  popt.headerFields.emplace_back("pos mode", "single");
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "%.1f deg", cfg.elevationMask * constants::kRadToDeg);
+  popt.headerFields.emplace_back("elev mask", buf);
+  popt.headerFields.emplace_back("ionos opt", ionoName(cfg.ionosphere));
+  popt.headerFields.emplace_back("tropo opt", cfg.troposphere == TroposphereOption::Off ? "off" : "saastamoinen+niell");
+  popt.headerFields.emplace_back("navi sys", systemsText(cfg));
+  std::snprintf(buf, sizeof buf, "%d", cfg.frequencies);
+  popt.headerFields.emplace_back("freqs", buf);
+  PosWriter writer(*out, popt);
+
+  std::optional<AccuracyStatistics> stats;
+  if (args.truth) stats.emplace(*args.truth);
+
+  // Processing loop.
+  std::map<SppStatus, long> statusCount;
+  std::map<SatId, long> excludedCount;
+  std::array<long, 8> useCount{};
+  long epochs = 0, solutions = 0, velocities = 0, testFailed = 0;
+  double satSum = 0.0;
+  const bool tty = isatty(fileno(stderr));
+  auto lastProgress = wall0;
+  const double span = hdr.firstObs && hdr.lastObs ? *hdr.lastObs - *hdr.firstObs : 0.0;
+  int exitCode = 0;
+  ObsEpoch epoch;
+  for (;;) {
+    try {
+      if (!obs->next(epoch)) break;
+    } catch (const ParseError& e) {
+      printError(e);
+      exitCode = 1;
+      break;
+    }
+    ++epochs;
+    const SppSolution sol = solver.solve(epoch);
+    ++statusCount[sol.status];
+    for (const auto& s : sol.satellites) ++useCount[static_cast<int>(s.use)];
+    for (const auto& s : sol.excluded) ++excludedCount[s];
+    if (sol.valid()) {
+      ++solutions;
+      if (sol.status == SppStatus::TestFailed) ++testFailed;
+      satSum += sol.numSatellites;
+      if (sol.velocity.valid) ++velocities;
+      writer.write(sol.toPositionSolution());
+      if (stats) {
+        stats->addPosition(sol.position);
+        if (sol.velocity.valid) stats->addVelocity(sol.velocity.velocity);
+      }
+    }
+    if (!args.quiet) {
+      const auto now = std::chrono::steady_clock::now();
+      if (now - lastProgress > std::chrono::milliseconds(tty ? 200 : 5000)) {
+        lastProgress = now;
+        std::string pct;
+        if (span > 0.0 && hdr.firstObs) {
+          std::snprintf(buf, sizeof buf, " %5.1f%%", 100.0 * std::clamp((epoch.time - *hdr.firstObs) / span, 0.0, 1.0));
+          pct = buf;
+        }
+        std::fprintf(stderr, "%s%s epoch %ld %s solutions %ld%s", tty ? "\r" : "", epoch.time.toString(1).c_str(),
+                     epochs, pct.c_str(), solutions, tty ? "   " : "\n");
+        std::fflush(stderr);
+      }
+    }
+  }
+  writer.finish();
+  if (file.is_open()) {
+    file.close();
+    if (!file) {
+      std::fprintf(stderr, "gvins-spp: error: writing '%s' failed\n", args.out.c_str());
+      exitCode = 1;
+    }
+  }
+  if (!args.quiet && tty) std::fprintf(stderr, "\r%60s\r", "");
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+
+  // Summary.
+  const auto& rs = obs->stats();
+  std::fprintf(stderr, "gvins-spp summary (%s)\n", args.inputs[0].c_str());
+  std::fprintf(stderr, "  epochs read            %8ld\n", epochs);
+  std::fprintf(stderr, "  solutions              %8ld (%.1f %%)\n", solutions, epochs ? 100.0 * solutions / epochs : 0.0);
+  std::fprintf(stderr, "    residual test failed %8ld (kept, flagged)\n", testFailed);
+  std::fprintf(stderr, "  velocity solutions     %8ld\n", velocities);
+  std::fprintf(stderr, "  mean satellites used   %8.1f\n", solutions ? satSum / solutions : 0.0);
+  for (const auto& [st, n] : statusCount) {
+    if (st != SppStatus::Ok && st != SppStatus::TestFailed) std::fprintf(stderr, "  no solution: %-22s %6ld\n", toString(st), n);
+  }
+  static const char* kUse[] = {"used", "system disabled", "no signal", "low C/N0", "no ephemeris", "below mask", "excluded"};
+  std::fprintf(stderr, "  satellite-epochs:");
+  for (int i = 0; i < 7; ++i) {
+    if (useCount[i]) std::fprintf(stderr, " %s %ld;", kUse[i], useCount[i]);
+  }
+  std::fprintf(stderr, "\n");
+  if (!excludedCount.empty()) {
+    std::fprintf(stderr, "  excluded by FDE:");
+    for (const auto& [s, n] : excludedCount) std::fprintf(stderr, " %s x%ld", s.str().c_str(), n);
+    std::fprintf(stderr, "\n");
+  }
+  if (rs.skippedEpochs || rs.skippedSatellites || rs.specialRecords || rs.emptyEpochs) {
+    std::fprintf(stderr, "  input: %lld malformed epochs skipped, %lld satellite records skipped, %lld event records, %lld empty epochs\n",
+                 static_cast<long long>(rs.skippedEpochs), static_cast<long long>(rs.skippedSatellites),
+                 static_cast<long long>(rs.specialRecords), static_cast<long long>(rs.emptyEpochs));
+    for (const auto& m : rs.messages) std::fprintf(stderr, "    %s\n", m.c_str());
+  }
+  std::fprintf(stderr, "  time                   %8.3f s (%.0f epochs/s)\n", wall, wall > 0 ? epochs / wall : 0.0);
+  if (stats) std::fputs(stats->table().c_str(), stderr);
+  if (solutions == 0 && exitCode == 0) exitCode = 3;
+  return exitCode;
+}

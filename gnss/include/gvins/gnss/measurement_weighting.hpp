@@ -1,0 +1,36 @@
+// Measurement standard deviations of pseudoranges and Doppler range rates as functions of
+// elevation and carrier-to-noise density.
+#pragma once
+
+#include <array>
+
+#include "gvins/base/satellite.hpp"
+
+namespace gvins {
+
+enum class WeightingScheme {
+  Elevation,     ///< sigma^2 = f_sys^2 (a^2 + b^2 / sin^2 el)
+  Snr,           ///< sigma^2 = f_sys^2 (a^2 + b^2) 10^((C0 - C/N0) / 10)
+  ElevationSnr,  ///< sigma^2 = f_sys^2 (a^2 10^((C0 - C/N0) / 10) + b^2 / sin^2 el)
+};
+
+/// The elevation model is the common "a + b / sin(el)" form in variance (e.g. Eueler & Goad 1991,
+/// Bull. Geod. 65); the C/N0 model follows the SIGMA-epsilon idea of Hartinger & Brunner (1999,
+/// GPS Solutions 2(4)): variance proportional to 10^(-C/N0 / 10), here normalised to equal a^2 + b^2
+/// at the reference C/N0 C0. Without a C/N0 value the C/N0 schemes fall back to the elevation model.
+struct MeasurementWeighting {
+  WeightingScheme scheme = WeightingScheme::Elevation;
+  double a = 0.3;                ///< m, elevation-independent part (pseudorange)
+  double b = 0.3;                ///< m, elevation-dependent part (pseudorange)
+  double snrReference = 45.0;    ///< dB-Hz, C0
+  double dopplerSigma = 0.05;    ///< m/s, range-rate sigma at zenith / reference C/N0
+  /// Per-system factor f_sys (index systemIndex): GLONASS FDMA codes and SBAS are noisier.
+  std::array<double, kNumSystems> systemFactor{1.0, 1.5, 1.0, 1.0, 1.0, 3.0, 1.5};
+
+  /// Pseudorange variance (m^2) for a system, elevation (rad) and C/N0 (dB-Hz, <= 0: unknown).
+  double codeVariance(System sys, double elevation, double snr) const;
+  /// Range-rate variance ((m/s)^2) from Doppler, same shape with dopplerSigma for sqrt(a^2+b^2).
+  double dopplerVariance(System sys, double elevation, double snr) const;
+};
+
+}  // namespace gvins

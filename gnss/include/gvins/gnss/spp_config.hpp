@@ -1,0 +1,128 @@
+// Options of single point positioning and their YAML form.
+#pragma once
+
+#include <array>
+#include <string>
+#include <string_view>
+
+#include "gvins/base/constants.hpp"
+#include "gvins/base/satellite.hpp"
+#include "gvins/ephemeris/ephemeris_store.hpp"
+#include "gvins/gnss/fault_exclusion.hpp"
+#include "gvins/gnss/measurement_weighting.hpp"
+
+namespace gvins {
+
+enum class IonosphereOption {
+  Off,
+  Broadcast,      ///< Klobuchar (GPS/QZSS parameters; BeiDou's for BeiDou), scaled per frequency
+  DualFrequency,  ///< ionosphere-free pseudoranges where two bands exist, Broadcast otherwise
+};
+
+enum class TroposphereOption { Off, Saastamoinen };
+
+/// Robust re-weighting of pseudoranges after fault exclusion (IGG-III equivalent weights).
+struct RobustEstimation {
+  bool enabled = true;
+  double k0 = 2.0;          ///< standardised residual (in robust scales) that keeps full weight
+  double k1 = 5.0;          ///< beyond it the weight is ~0
+  double minScale = 0.5;    ///< floor of the robust scale (units of the a-priori sigmas)
+  int maxIterations = 8;
+};
+
+/// A common correction to the broadcast ionosphere model's zenith delay, estimated with the
+/// position from the elevation dependence of the residuals (partial: the model's obliquity
+/// factor), constrained by a prior of `priorFraction` of the modelled zenith delay.
+struct IonosphereEstimation {
+  bool enabled = true;
+  double priorFraction = 1.0;
+  double minPriorSigma = 0.3;  ///< m
+};
+
+struct SppConfig {
+  /// Systems used (index systemIndex). Default: GPS, GLONASS, Galileo, BeiDou, QZSS.
+  std::array<bool, kNumSystems> systems{true, true, true, true, true, false, false};
+  double elevationMask = 15.0 * constants::kDegToRad;  ///< rad
+  double snrMask = 0.0;                                ///< dB-Hz; 0 = off
+  /// Bands per system in order of preference (RINEX band digits): the first available is the
+  /// primary; with `frequencies` >= 2 the next available one forms the ionosphere-free pair.
+  std::array<std::string, kNumSystems> bands{"125", "12", "157", "276", "125", "15", "59"};
+  int frequencies = 1;  ///< 1, 2 or 3 bands considered per system
+  IonosphereOption ionosphere = IonosphereOption::Broadcast;
+  TroposphereOption troposphere = TroposphereOption::Saastamoinen;
+  /// Surface meteorology of the Saastamoinen model: a latitude/season climatology (RTCA DO-229)
+  /// or the standard atmosphere with `relativeHumidity`.
+  bool climatologicalMeteo = false;
+  double relativeHumidity = 0.5;  ///< of the standard atmosphere
+  MeasurementWeighting weighting;
+  /// Error budget added to the measurement variance: broadcast-ionosphere residual as a fraction
+  /// of the model delay, troposphere residual at zenith (m, mapped), and the orbit/clock error.
+  double ionosphereModelError = 0.5;
+  double troposphereZenithError = 0.1;
+  /// Satellite-specific range error (m) per system that is neither noise nor atmosphere: broadcast
+  /// orbit and clock errors (signal-in-space range error) following the multi-GNSS assessment of
+  /// Montenbruck, Steigenberger & Hauschild (2018, Adv. Space Res. 61(12)): GPS ~0.6 m, Galileo
+  /// ~0.3 m, BeiDou ~1 m, QZSS ~0.6 m. GLONASS FDMA pseudoranges add receiver-dependent
+  /// inter-frequency code biases of metres per frequency channel (e.g. Wanninger 2012, GPS
+  /// Solutions 16(4)), hence 5 m. The broadcast URA/SISA is an upper bound rather than a sigma
+  /// (Galileo's "3.12 m" SISA is typical) and replaces the nominal value only when it exceeds
+  /// `ephemerisAlarmAccuracy` (a satellite flagged as degraded).
+  std::array<double, kNumSystems> ephemerisError{0.6, 5.0, 0.3, 1.0, 0.6, 2.0, 2.0};
+  double ephemerisAlarmAccuracy = 10.0;
+  FaultExclusionOptions faultExclusion;
+  RobustEstimation robust;
+  IonosphereEstimation ionosphereEstimation;
+  double maxGdop = 30.0;
+  /// Inter-system clock biases: a prior from earlier epochs keeps systems with one or two
+  /// satellites useful; sigma of the prior (m) and random-walk noise (m^2/s). 0 disables.
+  double isbPriorSigma = 2.0;
+  double isbRandomWalk = 0.01;
+  /// QZSS pseudoranges use the GPS receiver clock (QZSST is steered to GPST; same signals)
+  /// instead of a clock of their own.
+  bool qzssUsesGpsClock = true;
+  int maxIterations = 10;
+  bool velocity = true;  ///< estimate velocity and clock drift from Doppler
+  EphemerisSelection ephemeris;
+
+  bool useSystem(System s) const { return systems[systemIndex(s)]; }
+};
+
+/// Parses "GRECJ"-style system letters; throws std::invalid_argument naming a bad letter.
+std::array<bool, kNumSystems> parseSystemLetters(std::string_view letters);
+
+/// Reads options from YAML (yaml-cpp). The options live under a top-level `spp:` map (other
+/// top-level keys are left to other tools); every key under it must be known. Missing keys keep
+/// `base`'s values. Errors (syntax, unknown key, wrong type, value out of range) throw ParseError
+/// naming the file, the line and the key.
+///
+///   spp:
+///     systems: GRECJ              # letters of G R E C J S I
+///     elevation_mask_deg: 15
+///     snr_mask_dbhz: 0
+///     frequencies: 1              # 1..3
+///     bands: {G: "125", E: "157", C: "276"}
+///     ionosphere: broadcast       # off | broadcast | dual-frequency
+///     troposphere: saastamoinen   # off | saastamoinen
+///     meteo: climatology          # climatology (RTCA DO-229 table) | standard
+///     relative_humidity: 0.5      # standard atmosphere only
+///     weighting: {scheme: elevation, a_m: 0.3, b_m: 0.3, snr_reference_dbhz: 45,
+///                 doppler_sigma_mps: 0.05, system_factor: {R: 1.5}}
+///     ionosphere_model_error: 0.5
+///     troposphere_zenith_error_m: 0.1
+///     ephemeris_error_m: {G: 0.6, R: 5.0, E: 0.3, C: 1.0, J: 0.6}
+///     ephemeris_alarm_accuracy_m: 10
+///     fault_exclusion: {enabled: true, false_alarm_probability: 0.001, max_exclusions: 6,
+///                       max_candidates: 10, min_redundancy: 1}
+///     robust: {enabled: true, k0: 2.0, k1: 5.0, min_scale: 0.5, max_iterations: 8}
+///     ionosphere_estimation: {enabled: true, prior_fraction: 1.0, min_prior_sigma_m: 0.3}
+///     max_gdop: 30
+///     isb_prior_sigma_m: 2
+///     isb_random_walk_m2ps: 0.01
+///     qzss_gps_clock: true
+///     max_iterations: 10
+///     velocity: true
+///     allow_unhealthy: false
+SppConfig loadSppConfig(const std::string& path, const SppConfig& base = {});
+SppConfig parseSppConfig(std::string_view yaml, std::string_view name, const SppConfig& base = {});
+
+}  // namespace gvins

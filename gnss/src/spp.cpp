@@ -1,0 +1,688 @@
+// Single point positioning. Observation equation for a pseudorange P of satellite s on the
+// system clock of constellation k:
+//   P = |r_s(t_tx) - r| + sagnac + c dt_k - c (dt_s - gd_s) + I + T + e,
+// with the transmit time t_tx = t_rx - P/c - dt_s (independent of the receiver clock), the
+// satellite position in the ECEF frame of t_tx and the Earth rotation during the signal travel
+// applied as the Sagnac range term. Solved by Gauss-Newton iterations of weighted least squares.
+#include "gvins/gnss/spp.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Cholesky>
+
+#include "gvins/base/constants.hpp"
+#include "gvins/base/geodetic.hpp"
+#include "gvins/gnss/ionosphere_free.hpp"
+#include "gvins/gnss/klobuchar.hpp"
+#include "gvins/gnss/meteo_climatology.hpp"
+#include "gvins/gnss/niell_mapping.hpp"
+#include "gvins/gnss/saastamoinen.hpp"
+#include "gvins/gnss/sagnac.hpp"
+
+namespace gvins {
+
+namespace {
+constexpr double kC = constants::kSpeedOfLight;
+constexpr int kMaxUnknowns = 4 + kNumSystems;  // position, clocks, zenith ionosphere
+using MatN = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxUnknowns, kMaxUnknowns>;
+using VecN = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxUnknowns, 1>;
+
+/// Whether an ECEF position is near the Earth's surface (-1000 km .. +1000 km from the ellipsoid
+/// sphere approximation), i.e. converged enough for elevations and atmospheric models.
+bool nearSurface(const Eigen::Vector3d& x) {
+  const double r = x.norm();
+  return r > 5.3e6 && r < 7.4e6;
+}
+}  // namespace
+
+const char* toString(SppStatus s) {
+  switch (s) {
+    case SppStatus::Ok: return "ok";
+    case SppStatus::NoObservations: return "no observations";
+    case SppStatus::NotEnoughSatellites: return "not enough satellites";
+    case SppStatus::NoConvergence: return "no convergence";
+    case SppStatus::GdopTooLarge: return "GDOP too large";
+    case SppStatus::TestFailed: return "residual test failed";
+  }
+  return "?";
+}
+
+PositionSolution SppSolution::toPositionSolution() const {
+  PositionSolution p;
+  p.time = solutionTime;
+  p.quality = valid() ? SolutionQuality::Single : SolutionQuality::None;
+  p.position = position;
+  p.positionCovariance = positionCovariance;
+  p.numSatellites = numSatellites;
+  if (velocity.valid) {
+    p.velocity = velocity.velocity;
+    p.velocityCovariance = velocity.covariance;
+  }
+  return p;
+}
+
+struct SppSolver::Measurement {
+  SatId sat;
+  int sys = 0;
+  int result = 0;  // index into SppSolution::satellites
+  double pseudorange = 0.0;
+  double frequency = 0.0;  // of the primary signal (ionosphere scaling)
+  bool ionosphereFree = false;
+  double noiseFactor = 1.0;
+  double snr = 0.0;
+  SatelliteState state;
+  double satClock = 0.0;  // s, clock bias minus group delay
+  // Doppler
+  bool hasDoppler = false;
+  double rangeRate = 0.0;
+  // Model values of the last iteration.
+  AzEl azel{0.0, 0.5 * constants::kPi};
+  double iono = 0.0, tropo = 0.0, variance = 1.0;
+  bool active = true;  // above the mask in the last iteration
+  double inflation = 1.0;  // variance factor from robust re-weighting
+  double ionoMap = 0.0;    // partial of the delay w.r.t. a zenith L1 ionosphere correction
+};
+
+SppSolver::SppSolver(const EphemerisStore& nav, SppConfig config) : nav_(nav), config_(std::move(config)) {}
+
+void SppSolver::setGlonassChannels(const GlonassChannels& channels) { channels_ = channels; }
+void SppSolver::setInitialPosition(const Eigen::Vector3d& ecef) { initial_ = ecef; }
+void SppSolver::reset() {
+  last_.reset();
+  isb_ = {};
+}
+
+bool SppSolver::gatherMeasurements(const ObsEpoch& epoch, SppSolution& sol, std::vector<Measurement>& meas) {
+  const SppConfig& cfg = config_;
+  for (const SatObs& so : epoch.sats) {
+    SatelliteResidual r;
+    r.sat = so.sat;
+    const int result = static_cast<int>(sol.satellites.size());
+    sol.satellites.push_back(r);
+    SatelliteResidual& out = sol.satellites.back();
+    if (!cfg.useSystem(so.sat.system) || !so.sat.valid()) {
+      out.use = SatelliteUse::SystemDisabled;
+      continue;
+    }
+    const int sys = systemIndex(so.sat.system);
+    std::optional<int> channel;
+    if (so.sat.system == System::Glonass) {
+      channel = channels_.get(so.sat.prn);
+      if (!channel) channel = nav_.glonassChannels().get(so.sat.prn);
+    }
+    // Bands considered, in order of preference.
+    const std::string& bands = cfg.bands[sys];
+    const std::size_t nb = std::min<std::size_t>(bands.size(), static_cast<std::size_t>(std::clamp(cfg.frequencies, 1, 3)));
+    const SignalObs* s1 = nullptr;
+    const SignalObs* s2 = nullptr;
+    double f1 = 0.0, f2 = 0.0;
+    for (std::size_t i = 0; i < nb; ++i) {
+      const SignalObs* s = so.bestOnBand(bands[i], SignalObs::kCode);
+      if (!s || !(s->pseudorange > 1e6 && s->pseudorange < 1e8)) continue;
+      const auto f = carrierFrequency(so.sat.system, bands[i], channel);
+      if (!f) continue;
+      if (!s1) {
+        s1 = s;
+        f1 = *f;
+      } else if (!s2) {
+        s2 = s;
+        f2 = *f;
+        break;
+      }
+    }
+    if (!s1) {
+      out.use = SatelliteUse::NoSignal;
+      continue;
+    }
+    if (cfg.snrMask > 0.0 && s1->hasSnr() && s1->snr < cfg.snrMask) {
+      out.use = SatelliteUse::LowSnr;
+      continue;
+    }
+    Measurement m;
+    m.sat = so.sat;
+    // Clock group: QZSS time is steered to GPST and its L1/L2/L5 signals share GPS's
+    // (IS-QZSS-PNT-005, 3.2.1), so QZSS can use the GPS receiver clock instead of its own.
+    m.sys = so.sat.system == System::Qzss && cfg.qzssUsesGpsClock ? systemIndex(System::Gps) : sys;
+    m.result = result;
+    m.frequency = f1;
+    m.snr = s1->hasSnr() ? s1->snr : 0.0;
+    m.pseudorange = s1->pseudorange;
+    IonosphereFreeCoefficients ifc;
+    if (cfg.ionosphere == IonosphereOption::DualFrequency && s2) {
+      ifc = ionosphereFreeCoefficients(f1, f2);
+      m.pseudorange = ifc.a1 * s1->pseudorange + ifc.a2 * s2->pseudorange;
+      m.ionosphereFree = true;
+      m.noiseFactor = ifc.noiseFactor();
+    }
+    // Transmit time: t_rx - P/c - dt_s, with dt_s evaluated at the first approximation.
+    GpsTime ttx = epoch.time - m.pseudorange / kC;
+    auto st = nav_.satelliteState(so.sat, ttx, cfg.ephemeris);
+    if (!st) {
+      out.use = SatelliteUse::NoEphemeris;
+      continue;
+    }
+    // Move the state by -dt_s (|dt_s| < 1 ms): a first-order step is exact to < 1e-6 m, since the
+    // orbital acceleration (< 1 m/s^2) contributes a*dt^2/2.
+    const double dts = st->clockBias;
+    ttx -= dts;
+    st->position -= st->velocity * dts;
+    st->clockBias -= st->clockDrift * dts;
+    if (std::abs(dts) > 0.01) st = nav_.satelliteState(so.sat, ttx, cfg.ephemeris);  // implausible clock
+    if (!st || (!st->healthy && !cfg.ephemeris.allowUnhealthy) || !st->position.allFinite() ||
+        st->position.norm() < 1e7) {
+      out.use = SatelliteUse::NoEphemeris;
+      continue;
+    }
+    m.state = *st;
+    double gd = nav_.groupDelay(so.sat, s1->code, ttx, cfg.ephemeris);
+    if (m.ionosphereFree) gd = ifc.a1 * gd + ifc.a2 * nav_.groupDelay(so.sat, s2->code, ttx, cfg.ephemeris);
+    m.satClock = st->clockBias - gd;
+    // Doppler: the primary signal's, else any signal with a known wavelength.
+    const SignalObs* d = s1->hasDoppler() ? s1 : nullptr;
+    double fd = f1;
+    if (!d) {
+      for (const auto& s : so.signals) {
+        if (!s.hasDoppler()) continue;
+        const auto f = carrierFrequency(so.sat.system, s.code.band, channel);
+        if (f) {
+          d = &s;
+          fd = *f;
+          break;
+        }
+      }
+    }
+    if (d && std::abs(d->doppler) < 1e5) {
+      m.hasDoppler = true;
+      m.rangeRate = -kC / fd * d->doppler;
+    }
+    out.ionosphereFree = m.ionosphereFree;
+    meas.push_back(m);
+  }
+  return !meas.empty();
+}
+
+namespace {
+
+/// Per-epoch constant parts of the models (time-dependent only).
+struct EpochModel {
+  double dayOfYear = 0.0;
+};
+
+/// A weighted least-squares fit of the measurements flagged in `use`.
+struct LsqResult {
+  bool ok = false;
+  VecN x;     // state increment or state
+  MatN cov;   // (H^T W H)^-1
+  double chi2 = 0.0;
+  int nObs = 0;
+  int nUnknowns = 0;
+  std::vector<double> normResidual;
+};
+
+}  // namespace
+
+SppSolution SppSolver::solve(const ObsEpoch& epoch) {
+  SppSolution sol;
+  sol.time = epoch.time;
+  sol.solutionTime = epoch.time;
+  const SppConfig& cfg = config_;
+  std::vector<Measurement> meas;
+  meas.reserve(epoch.sats.size());
+  if (!gatherMeasurements(epoch, sol, meas)) {
+    sol.status = SppStatus::NoObservations;
+    return sol;
+  }
+  const int n = static_cast<int>(meas.size());
+
+  // Starting point: last solution within 10 minutes, else the a-priori position, else the centre.
+  Eigen::Vector3d x0 = Eigen::Vector3d::Zero();
+  if (last_ && std::abs(epoch.time - lastTime_) < 600.0) x0 = *last_;
+  else if (initial_) x0 = *initial_;
+
+  const CalendarTime cal = epoch.time.toCalendar();
+  const double doy = dayOfYear(cal.year, cal.month, cal.day) + (cal.hour + cal.minute / 60.0 + cal.second / 3600.0) / 24.0;
+  const IonosphereParameters& ionoPar = nav_.ionosphere();
+  // Zenith ionosphere correction to the broadcast model as an extra unknown (with a prior).
+  const bool estIono = cfg.ionosphereEstimation.enabled && cfg.ionosphere != IonosphereOption::Off && ionoPar.gps.has_value();
+  double ionoPriorVar = 1.0;
+
+  // Updates az/el, atmospheric delays, variances and the mask flag of every measurement at x.
+  auto updateModels = [&](const Eigen::Vector3d& x) {
+    const bool surface = nearSurface(x);
+    Geodetic g;
+    SurfaceMeteo meteo;
+    double zhd = 0.0, zwd = 0.0;
+    if (surface) {
+      g = ecefToGeodetic(x);
+      if (cfg.troposphere == TroposphereOption::Saastamoinen && g.height > -500.0 && g.height < 20000.0) {
+        meteo = cfg.climatologicalMeteo ? climatologicalMeteo(g.lat, g.height, doy)
+                                        : standardAtmosphere(g.height, cfg.relativeHumidity);
+        zhd = saastamoinenZenithHydrostatic(meteo.pressure, g.lat, g.height);
+        zwd = saastamoinenZenithWet(meteo.temperature, meteo.waterVapour);
+      }
+    }
+    if (surface && estIono && ionoPar.gps) {
+      const double iz = klobucharDelayL1(*ionoPar.gps, g, AzEl{0.0, 0.5 * constants::kPi}, epoch.time);
+      ionoPriorVar = std::pow(std::max(cfg.ionosphereEstimation.priorFraction * iz, cfg.ionosphereEstimation.minPriorSigma), 2);
+    }
+    for (Measurement& m : meas) {
+      m.iono = 0.0;
+      m.tropo = 0.0;
+      double ionoVar = 0.0, tropoVar = 0.0;
+      m.ionoMap = 0.0;
+      if (surface) {
+        m.azel = azimuthElevation(g, x, m.state.position);
+        m.active = m.azel.elevation >= cfg.elevationMask;
+        if (zhd > 0.0) {
+          const MappingFactors mf = niellMapping(g, m.azel.elevation, doy);
+          m.tropo = zhd * mf.hydrostatic + zwd * mf.wet;
+          const double e = cfg.troposphereZenithError * mf.hydrostatic;
+          tropoVar = e * e;
+        }
+        if (!m.ionosphereFree && cfg.ionosphere != IonosphereOption::Off) {
+          const System s = m.sat.system;
+          const double fL1 = *carrierFrequency(System::Gps, '1');
+          if (s == System::BeiDou && ionoPar.beidou) {
+            m.iono = beidouKlobucharDelayB1I(*ionoPar.beidou, g, m.azel, epoch.time) *
+                     ionosphereFrequencyScale(*carrierFrequency(System::BeiDou, '2'), m.frequency);
+          } else if (s == System::Qzss && ionoPar.qzss) {
+            m.iono = klobucharDelayL1(*ionoPar.qzss, g, m.azel, epoch.time) * ionosphereFrequencyScale(fL1, m.frequency);
+          } else if (ionoPar.gps) {
+            m.iono = klobucharDelayL1(*ionoPar.gps, g, m.azel, epoch.time) * ionosphereFrequencyScale(fL1, m.frequency);
+          } else if (ionoPar.qzss) {
+            m.iono = klobucharDelayL1(*ionoPar.qzss, g, m.azel, epoch.time) * ionosphereFrequencyScale(fL1, m.frequency);
+          }
+          const double e = cfg.ionosphereModelError * m.iono;
+          ionoVar = e * e;
+          if (m.iono == 0.0) ionoVar = 25.0;  // no model available: ~5 m slant delay unaccounted
+          // Obliquity of the broadcast model (IS-GPS-200N 20.3.3.5.2.5) scaled to the frequency.
+          const double el = m.azel.elevation / constants::kPi;
+          m.ionoMap = (1.0 + 16.0 * std::pow(0.53 - el, 3.0)) * ionosphereFrequencyScale(fL1, m.frequency);
+        }
+      } else {
+        m.azel = AzEl{0.0, 0.5 * constants::kPi};
+        m.active = true;
+      }
+      double var = cfg.weighting.codeVariance(m.sat.system, m.azel.elevation, m.snr) * m.noiseFactor * m.noiseFactor;
+      var += ionoVar + tropoVar;
+      double eph = cfg.ephemerisError[systemIndex(m.sat.system)];
+      if (m.state.accuracy > cfg.ephemerisAlarmAccuracy && cfg.ephemerisAlarmAccuracy > 0.0) {
+        eph = std::max(eph, std::min(m.state.accuracy, 1000.0));
+      }
+      var += eph * eph;
+      m.variance = var * m.inflation;
+    }
+  };
+
+  // Clock columns for the systems with active measurements.
+  std::array<int, kNumSystems> col{};
+  std::vector<int> colSystems;
+  auto assignColumns = [&](const std::vector<char>& use) {
+    col.fill(-1);
+    colSystems.clear();
+    for (int i = 0; i < n; ++i) {
+      if (!use[i]) continue;
+      if (col[meas[i].sys] < 0) {
+        col[meas[i].sys] = static_cast<int>(colSystems.size());
+        colSystems.push_back(meas[i].sys);
+      }
+    }
+  };
+  // Reference clock: GPS when present, else the system with the most measurements.
+  auto referenceSystem = [&](const std::vector<char>& use) {
+    if (col[systemIndex(System::Gps)] >= 0) return systemIndex(System::Gps);
+    std::array<int, kNumSystems> cnt{};
+    for (int i = 0; i < n; ++i) cnt[meas[i].sys] += use[i] ? 1 : 0;
+    return static_cast<int>(std::max_element(cnt.begin(), cnt.end()) - cnt.begin());
+  };
+
+  // One Gauss-Newton step at state (x, clocks) using the frozen model values.
+  // Returns the increment and the statistics of the linearisation point.
+  auto lsqStep = [&](const Eigen::Vector3d& x, const VecN& clk, double ion, const std::vector<char>& use,
+                     bool wantResiduals) {
+    LsqResult r;
+    const int nc = static_cast<int>(colSystems.size());
+    const int m = 3 + nc + (estIono ? 1 : 0);
+    r.nUnknowns = m;
+    MatN N = MatN::Zero(m, m);
+    VecN b = VecN::Zero(m);
+    Eigen::Matrix<double, kMaxUnknowns, 1> h;
+    std::vector<std::pair<Eigen::Matrix<double, kMaxUnknowns, 1>, double>> rows;  // for residual normalisation
+    std::vector<double> resid(wantResiduals ? n : 0, 0.0);
+    double chi2 = 0.0;
+    int nobs = 0;
+    for (int i = 0; i < n; ++i) {
+      if (!use[i]) continue;
+      const Measurement& mm = meas[i];
+      const Eigen::Vector3d d = mm.state.position - x;
+      const double rho = d.norm();
+      const Eigen::Vector3d e = d / rho;
+      const int c = col[mm.sys];
+      const double pred = rho + sagnacRangeCorrection(mm.state.position, x) + clk[c] - kC * mm.satClock + mm.iono +
+                          mm.ionoMap * ion + mm.tropo;
+      const double v = mm.pseudorange - pred;
+      const double w = 1.0 / mm.variance;
+      h.setZero();
+      h.head<3>() = -e;
+      h[3 + c] = 1.0;
+      if (estIono) h[3 + nc] = mm.ionoMap;
+      N.noalias() += w * h.head(m) * h.head(m).transpose();
+      b.noalias() += w * v * h.head(m);
+      chi2 += w * v * v;
+      ++nobs;
+      if (wantResiduals) {
+        resid[i] = v;
+        rows.emplace_back(h, mm.variance);
+      }
+    }
+    // Inter-system bias priors: clk_s - clk_ref = isb_s - isb_ref.
+    const int ref = referenceSystem(use);
+    const bool refKnown = ref == systemIndex(System::Gps) || isb_[ref].known;
+    if (cfg.isbPriorSigma > 0.0 && refKnown) {
+      for (int s : colSystems) {
+        if (s == ref || !isb_[s].known) continue;
+        const double dt = std::abs(epoch.time - isb_[s].time);
+        double var = isb_[s].variance + cfg.isbRandomWalk * dt;
+        double target = isb_[s].value;
+        if (ref != systemIndex(System::Gps)) {
+          var += isb_[ref].variance + cfg.isbRandomWalk * std::abs(epoch.time - isb_[ref].time);
+          target -= isb_[ref].value;
+        }
+        var = std::max(var, cfg.isbPriorSigma * cfg.isbPriorSigma);
+        const double v = target - (clk[col[s]] - clk[col[ref]]);
+        const double w = 1.0 / var;
+        h.setZero();
+        h[3 + col[s]] = 1.0;
+        h[3 + col[ref]] = -1.0;
+        N.noalias() += w * h.head(m) * h.head(m).transpose();
+        b.noalias() += w * v * h.head(m);
+        chi2 += w * v * v;
+        ++nobs;
+      }
+    }
+    if (estIono) {
+      const double v = -ion;
+      const double w = 1.0 / ionoPriorVar;
+      h.setZero();
+      h[3 + nc] = 1.0;
+      N.noalias() += w * h.head(m) * h.head(m).transpose();
+      b.noalias() += w * v * h.head(m);
+      chi2 += w * v * v;
+      ++nobs;
+    }
+    r.nObs = nobs;
+    r.chi2 = chi2;
+    if (nobs < m) return r;
+    Eigen::LDLT<MatN> ldlt(N);
+    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().array() > 1e-12 * N.diagonal().maxCoeff()).all()) return r;
+    r.x = ldlt.solve(b);
+    r.cov = ldlt.solve(MatN::Identity(m, m));
+    if (!r.x.allFinite() || !r.cov.allFinite()) return r;
+    r.ok = true;
+    if (wantResiduals) {
+      // Normalised post-fit residuals of the linearised problem: v_post = v - H dx,
+      // var(v_post) = sigma^2 - h Q h^T.
+      r.normResidual.assign(n, 0.0);
+      int k = 0;
+      for (int i = 0; i < n; ++i) {
+        if (!use[i]) continue;
+        const auto& [hr, var] = rows[k++];
+        const double post = resid[i] - hr.head(m).dot(r.x);
+        const double q = var - hr.head(m).dot(r.cov * hr.head(m));
+        r.normResidual[i] = std::abs(post) / std::sqrt(std::max(q, 1e-6 * var));
+      }
+    }
+    return r;
+  };
+
+  // Full iteration to convergence for a subset; models are refreshed when `refresh` is set.
+  Eigen::Vector3d x = x0;
+  VecN clk;
+  LsqResult last;
+  auto iterate = [&](std::vector<char>& use, bool refresh, int maxIter, Eigen::Vector3d& xs, VecN& clks, double& ion) {
+    LsqResult res;
+    bool converged = false;
+    int it = 0;
+    std::vector<char> active(n);
+    for (; it < maxIter; ++it) {
+      if (refresh) updateModels(xs);
+      for (int i = 0; i < n; ++i) active[i] = use[i] && meas[i].active;
+      // Keep clock estimates of systems that stay; new systems start at 0 m.
+      std::array<double, kNumSystems> prev{};
+      std::array<bool, kNumSystems> had{};
+      for (std::size_t c = 0; c < colSystems.size(); ++c) {
+        if (static_cast<int>(c) < clks.size()) {
+          prev[colSystems[c]] = clks[static_cast<int>(c)];
+          had[colSystems[c]] = true;
+        }
+      }
+      assignColumns(active);
+      clks = VecN::Zero(static_cast<int>(colSystems.size()));
+      for (std::size_t c = 0; c < colSystems.size(); ++c) {
+        if (had[colSystems[c]]) clks[static_cast<int>(c)] = prev[colSystems[c]];
+      }
+      res = lsqStep(xs, clks, ion, active, false);
+      if (!res.ok) break;
+      const int ncol = static_cast<int>(colSystems.size());
+      xs += res.x.head<3>();
+      clks += res.x.segment(3, ncol);
+      if (estIono) ion += res.x[3 + ncol];
+      if (res.x.head<3>().norm() < 1e-4 && (nearSurface(xs) || !refresh)) {
+        converged = true;
+        ++it;
+        break;
+      }
+    }
+    sol.iterations += it;
+    if (!res.ok) return res;
+    // Statistics at the converged point.
+    res = lsqStep(xs, clks, ion, active, true);
+    res.ok = res.ok && converged;
+    use = active;
+    return res;
+  };
+
+  std::vector<char> use(n, 1);
+  colSystems.clear();
+  clk = VecN();
+  const int maxIter = std::max(cfg.maxIterations, 4) + (nearSurface(x0) ? 0 : 8);
+  double ion = 0.0;
+  last = iterate(use, true, maxIter, x, clk, ion);
+  auto statusForFailure = [&](const LsqResult& r) {
+    return r.nObs < r.nUnknowns ? SppStatus::NotEnoughSatellites : SppStatus::NoConvergence;
+  };
+  if (!last.ok) {
+    sol.status = statusForFailure(last);
+    for (int i = 0; i < n; ++i) {
+      if (!meas[i].active) sol.satellites[meas[i].result].use = SatelliteUse::BelowMask;
+    }
+    return sol;
+  }
+  for (int i = 0; i < n; ++i) {
+    if (!use[i] && !meas[i].active) sol.satellites[meas[i].result].use = SatelliteUse::BelowMask;
+  }
+
+  // Fault detection and exclusion with frozen models (geometry re-linearised in each fit).
+  const Eigen::Vector3d xConv = x;
+  const VecN clkConv = clk;
+  const double ionConv = ion;
+  const std::vector<int> colsConv = colSystems;
+  auto subsetFit = [&](const std::vector<char>& u) {
+    SubsetFit f;
+    Eigen::Vector3d xs = xConv;
+    VecN cs = clkConv;
+    double is = ionConv;
+    colSystems = colsConv;
+    std::vector<char> uu = u;
+    // A few iterations suffice from the converged point.
+    LsqResult r = iterate(uu, false, 5, xs, cs, is);
+    f.ok = r.ok;
+    f.chi2 = r.chi2;
+    f.dof = r.nObs - r.nUnknowns;
+    f.normalizedResidual = std::move(r.normResidual);
+    return f;
+  };
+  FaultExclusionResult fde;
+  {
+    SubsetFit f0;
+    f0.ok = true;
+    f0.chi2 = last.chi2;
+    f0.dof = last.nObs - last.nUnknowns;
+    f0.normalizedResidual = last.normResidual;
+    bool first = true;
+    auto fitFn = [&](const std::vector<char>& u) {
+      if (first) {
+        first = false;
+        return f0;
+      }
+      return subsetFit(u);
+    };
+    fde = detectAndExclude(use, fitFn, cfg.faultExclusion);
+  }
+  for (int i : fde.excluded) {
+    sol.satellites[meas[i].result].use = SatelliteUse::Excluded;
+    sol.excluded.push_back(meas[i].sat);
+  }
+  x = xConv;
+  clk = clkConv;
+  ion = ionConv;
+  colSystems = colsConv;
+  if (!fde.excluded.empty()) {
+    // Final solution on the remaining measurements with the full models.
+    last = iterate(use, true, std::max(cfg.maxIterations, 4), x, clk, ion);
+    if (!last.ok) {
+      sol.status = statusForFailure(last);
+      return sol;
+    }
+  } else {
+    // `use` already holds the active set; recompute the final statistics at x.
+    assignColumns(use);
+    last = lsqStep(x, clk, ion, use, true);
+  }
+  sol.chi2 = last.chi2;
+  sol.dof = last.nObs - last.nUnknowns;
+  sol.testPassed = sol.dof < 1 || sol.chi2 <= globalTestThreshold(sol.dof, cfg.faultExclusion.falseAlarmProbability);
+
+  // Robust re-weighting (IGG-III, Yang et al. 2002, J. Geodesy 76: equivalent weights from
+  // standardised residuals): measurements that disagree with the rest by more than k0 robust
+  // scales lose weight progressively, beyond k1 almost all of it. The scale is the median
+  // absolute standardised residual (x 1.4826), floored so that consistent data keep full weight.
+  const RobustEstimation& rb = cfg.robust;
+  if (rb.enabled && sol.dof >= 2) {
+    for (int it = 0; it < rb.maxIterations; ++it) {
+      std::vector<double> u;
+      for (int i = 0; i < n; ++i) {
+        if (use[i]) u.push_back(last.normResidual[i] * std::sqrt(meas[i].inflation));
+      }
+      std::nth_element(u.begin(), u.begin() + static_cast<long>(u.size() / 2), u.end());
+      const double scale = std::max(1.4826 * u[u.size() / 2], rb.minScale);
+      bool changed = false;
+      for (int i = 0; i < n; ++i) {
+        if (!use[i]) continue;
+        const double z = last.normResidual[i] * std::sqrt(meas[i].inflation) / scale;
+        double w = 1.0;
+        if (z > rb.k1) w = 1e-4;
+        else if (z > rb.k0) w = std::max(1e-4, rb.k0 / z * std::pow((rb.k1 - z) / (rb.k1 - rb.k0), 2));
+        const double infl = 1.0 / w;
+        if (std::abs(infl - meas[i].inflation) > 0.05 * meas[i].inflation) changed = true;
+        meas[i].variance *= infl / meas[i].inflation;
+        meas[i].inflation = infl;
+      }
+      if (!changed) break;
+      std::vector<char> u2 = use;
+      const LsqResult rr = iterate(u2, false, 5, x, clk, ion);
+      if (!rr.ok) break;
+      last = rr;
+    }
+  }
+
+  // Outputs.
+  sol.position = x;
+  sol.positionCovariance = last.cov.topLeftCorner<3, 3>();
+  for (std::size_t c = 0; c < colSystems.size(); ++c) {
+    sol.clockBias[colSystems[c]] = clk[static_cast<int>(c)];
+    sol.clockBiasVariance[colSystems[c]] = last.cov(3 + static_cast<int>(c), 3 + static_cast<int>(c));
+  }
+  const int gi = systemIndex(System::Gps), ji = systemIndex(System::Qzss);
+  if (cfg.qzssUsesGpsClock && sol.clockBias[gi]) {
+    sol.clockBias[ji] = sol.clockBias[gi];
+    sol.clockBiasVariance[ji] = sol.clockBiasVariance[gi];
+  }
+  if (estIono) sol.ionosphereCorrection = ion;
+  const int ref = referenceSystem(use);
+  if (col[ref] >= 0) sol.solutionTime = epoch.time - clk[col[ref]] / kC;
+  std::vector<Eigen::Vector3d> losEnu;
+  std::vector<int> clockIdx;
+  const Geodetic g = ecefToGeodetic(x);
+  const Eigen::Matrix3d rEnu = ecefToEnuRotation(g.lat, g.lon);
+  for (int i = 0; i < n; ++i) {
+    SatelliteResidual& out = sol.satellites[meas[i].result];
+    const Measurement& m = meas[i];
+    out.azel = m.azel;
+    out.sigma = std::sqrt(m.variance / m.inflation);
+    out.weightFactor = 1.0 / m.inflation;
+    const double rho = (m.state.position - x).norm() + sagnacRangeCorrection(m.state.position, x);
+    const double c = col[m.sys] >= 0 ? clk[col[m.sys]] : 0.0;
+    out.residual = m.pseudorange - (rho + c - kC * m.satClock + m.iono + m.ionoMap * ion + m.tropo);
+    if (!use[i]) continue;
+    out.use = SatelliteUse::Used;
+    ++sol.numSatellites;
+    losEnu.push_back(rEnu * (m.state.position - x).normalized());
+    clockIdx.push_back(col[m.sys]);
+  }
+  sol.dop = computeDop(losEnu, clockIdx, static_cast<int>(colSystems.size()));
+  if (!sol.dop.valid || sol.dop.gdop > cfg.maxGdop) {
+    sol.status = SppStatus::GdopTooLarge;
+    return sol;
+  }
+  sol.status = sol.testPassed ? SppStatus::Ok : SppStatus::TestFailed;
+
+  // Inter-system biases for the next epochs (from epochs that pass the test, relative to GPS).
+  if (sol.testPassed) {
+    Eigen::MatrixXd cov = last.cov;
+    updateIsb(sol, cov, colSystems);
+  }
+  last_ = x;
+  lastTime_ = epoch.time;
+
+  // Doppler velocity.
+  if (cfg.velocity) {
+    std::vector<RangeRateMeasurement> rr;
+    for (int i = 0; i < n; ++i) {
+      const Measurement& m = meas[i];
+      if (!use[i] || !m.hasDoppler) continue;
+      RangeRateMeasurement d;
+      d.sat = m.sat;
+      d.satPosition = m.state.position;
+      d.satVelocity = m.state.velocity;
+      d.satClockDrift = m.state.clockDrift;
+      d.rangeRate = m.rangeRate;
+      d.variance = cfg.weighting.dopplerVariance(m.sat.system, m.azel.elevation, m.snr);
+      rr.push_back(d);
+    }
+    if (rr.size() >= 4) sol.velocity = solveDopplerVelocity(rr, x, cfg.faultExclusion);
+  }
+  return sol;
+}
+
+void SppSolver::updateIsb(const SppSolution& sol, const Eigen::MatrixXd& cov, const std::vector<int>& clockSystems) {
+  const int g = systemIndex(System::Gps);
+  int cg = -1;
+  for (std::size_t c = 0; c < clockSystems.size(); ++c) {
+    if (clockSystems[c] == g) cg = static_cast<int>(c);
+  }
+  if (cg < 0) return;
+  for (std::size_t c = 0; c < clockSystems.size(); ++c) {
+    const int s = clockSystems[c];
+    if (s == g) continue;
+    const int i = 3 + static_cast<int>(c), j = 3 + cg;
+    Isb& b = isb_[s];
+    b.known = true;
+    b.value = *sol.clockBias[s] - *sol.clockBias[g];
+    b.variance = std::max(cov(i, i) + cov(j, j) - 2.0 * cov(i, j), 0.0);
+    b.time = sol.time;
+  }
+}
+
+}  // namespace gvins

@@ -1,0 +1,257 @@
+#include "gvins/gnss/spp_config.hpp"
+
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include <yaml-cpp/yaml.h>
+
+#include "gvins/base/parse_error.hpp"
+
+namespace gvins {
+
+std::array<bool, kNumSystems> parseSystemLetters(std::string_view letters) {
+  std::array<bool, kNumSystems> out{};
+  for (char c : letters) {
+    if (c == ',' || c == ' ') continue;
+    const auto s = systemFromLetter(static_cast<char>(std::toupper(static_cast<unsigned char>(c))));
+    if (!s) throw std::invalid_argument(std::string("unknown system letter '") + c + "' (use G R E C J S I)");
+    out[systemIndex(*s)] = true;
+  }
+  return out;
+}
+
+namespace {
+
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const YAML::Node& n, const std::string& key, const std::string& what) const {
+    const auto m = n.Mark();
+    throw ParseError(file_, m.line >= 0 ? m.line + 1 : 0, key, what);
+  }
+
+  template <class T>
+  T get(const YAML::Node& n, const std::string& key) const {
+    try {
+      return n.as<T>();
+    } catch (const YAML::Exception&) {
+      fail(n, key, "wrong type for '" + key + "'");
+    }
+  }
+
+  double number(const YAML::Node& n, const std::string& key, double lo, double hi) const {
+    if (!n.IsScalar()) fail(n, key, "'" + key + "' must be a number");
+    const double v = get<double>(n, key);
+    if (!(v >= lo && v <= hi)) {
+      std::ostringstream os;
+      os << "'" << key << "' = " << v << " is outside [" << lo << ", " << hi << "]";
+      fail(n, key, os.str());
+    }
+    return v;
+  }
+  int integer(const YAML::Node& n, const std::string& key, int lo, int hi) const {
+    if (!n.IsScalar()) fail(n, key, "'" + key + "' must be an integer");
+    const int v = get<int>(n, key);
+    if (v < lo || v > hi) {
+      fail(n, key, "'" + key + "' = " + std::to_string(v) + " is outside [" + std::to_string(lo) + ", " +
+                       std::to_string(hi) + "]");
+    }
+    return v;
+  }
+  bool boolean(const YAML::Node& n, const std::string& key) const {
+    if (!n.IsScalar()) fail(n, key, "'" + key + "' must be true or false");
+    return get<bool>(n, key);
+  }
+  std::string text(const YAML::Node& n, const std::string& key) const {
+    if (!n.IsScalar()) fail(n, key, "'" + key + "' must be a string");
+    return get<std::string>(n, key);
+  }
+  /// Iterates a map, rejecting keys not in `known`.
+  template <class F>
+  void map(const YAML::Node& n, const std::string& where, const std::set<std::string>& known, F&& f) const {
+    if (!n.IsMap()) fail(n, where, "'" + where + "' must be a map");
+    for (auto it = n.begin(); it != n.end(); ++it) {
+      const std::string k = it->first.as<std::string>();
+      const std::string full = where.empty() ? k : where + "." + k;
+      if (!known.count(k)) fail(it->first, full, "unknown key '" + full + "'");
+      f(k, full, it->second);
+    }
+  }
+  /// Map keyed by system letter.
+  template <class F>
+  void perSystem(const YAML::Node& n, const std::string& where, F&& f) const {
+    if (!n.IsMap()) fail(n, where, "'" + where + "' must be a map of system letters");
+    for (auto it = n.begin(); it != n.end(); ++it) {
+      const std::string k = it->first.as<std::string>();
+      const auto s = k.size() == 1 ? systemFromLetter(k[0]) : std::nullopt;
+      if (!s) fail(it->first, where + "." + k, "unknown system '" + k + "' (use G R E C J S I)");
+      f(*s, where + "." + k, it->second);
+    }
+  }
+
+ private:
+  std::string file_;
+};
+
+void apply(const Reader& r, const YAML::Node& spp, SppConfig& c) {
+  static const std::set<std::string> kKeys = {
+      "systems", "elevation_mask_deg", "snr_mask_dbhz", "frequencies", "bands", "ionosphere", "troposphere",
+      "relative_humidity", "meteo", "weighting", "ionosphere_model_error", "troposphere_zenith_error_m",
+      "ephemeris_error_m", "ephemeris_alarm_accuracy_m", "fault_exclusion", "robust", "ionosphere_estimation", "max_gdop", "isb_prior_sigma_m", "isb_random_walk_m2ps", "qzss_gps_clock",
+      "max_iterations", "velocity", "allow_unhealthy"};
+  r.map(spp, "spp", kKeys, [&](const std::string& k, const std::string& full, const YAML::Node& v) {
+    if (k == "systems") {
+      try {
+        c.systems = parseSystemLetters(r.text(v, full));
+      } catch (const std::invalid_argument& e) {
+        r.fail(v, full, e.what());
+      }
+    } else if (k == "elevation_mask_deg") {
+      c.elevationMask = r.number(v, full, -10.0, 90.0) * constants::kDegToRad;
+    } else if (k == "snr_mask_dbhz") {
+      c.snrMask = r.number(v, full, 0.0, 100.0);
+    } else if (k == "frequencies") {
+      c.frequencies = r.integer(v, full, 1, 3);
+    } else if (k == "bands") {
+      r.perSystem(v, full, [&](System s, const std::string& f2, const YAML::Node& b) {
+        const std::string bands = r.text(b, f2);
+        if (bands.empty()) r.fail(b, f2, "empty band list");
+        for (char ch : bands) {
+          if (!isKnownBand(s, ch) && !(s == System::Glonass && (ch == '1' || ch == '2'))) {
+            r.fail(b, f2, std::string("band '") + ch + "' does not exist for " + std::string(systemName(s)));
+          }
+        }
+        c.bands[systemIndex(s)] = bands;
+      });
+    } else if (k == "ionosphere") {
+      const std::string t = r.text(v, full);
+      if (t == "off") c.ionosphere = IonosphereOption::Off;
+      else if (t == "broadcast") c.ionosphere = IonosphereOption::Broadcast;
+      else if (t == "dual-frequency") c.ionosphere = IonosphereOption::DualFrequency;
+      else r.fail(v, full, "'" + full + "' must be off, broadcast or dual-frequency, not '" + t + "'");
+    } else if (k == "troposphere") {
+      const std::string t = r.text(v, full);
+      if (t == "off") c.troposphere = TroposphereOption::Off;
+      else if (t == "saastamoinen") c.troposphere = TroposphereOption::Saastamoinen;
+      else r.fail(v, full, "'" + full + "' must be off or saastamoinen, not '" + t + "'");
+    } else if (k == "meteo") {
+      const std::string t = r.text(v, full);
+      if (t == "climatology") c.climatologicalMeteo = true;
+      else if (t == "standard") c.climatologicalMeteo = false;
+      else r.fail(v, full, "'" + full + "' must be climatology or standard, not '" + t + "'");
+    } else if (k == "relative_humidity") {
+      c.relativeHumidity = r.number(v, full, 0.0, 1.0);
+    } else if (k == "weighting") {
+      static const std::set<std::string> kW = {"scheme", "a_m", "b_m", "snr_reference_dbhz", "doppler_sigma_mps",
+                                               "system_factor"};
+      r.map(v, full, kW, [&](const std::string& wk, const std::string& wf, const YAML::Node& wv) {
+        if (wk == "scheme") {
+          const std::string t = r.text(wv, wf);
+          if (t == "elevation") c.weighting.scheme = WeightingScheme::Elevation;
+          else if (t == "snr") c.weighting.scheme = WeightingScheme::Snr;
+          else if (t == "elevation-snr") c.weighting.scheme = WeightingScheme::ElevationSnr;
+          else r.fail(wv, wf, "'" + wf + "' must be elevation, snr or elevation-snr, not '" + t + "'");
+        } else if (wk == "a_m") {
+          c.weighting.a = r.number(wv, wf, 0.0, 1000.0);
+        } else if (wk == "b_m") {
+          c.weighting.b = r.number(wv, wf, 0.0, 1000.0);
+        } else if (wk == "snr_reference_dbhz") {
+          c.weighting.snrReference = r.number(wv, wf, 0.0, 100.0);
+        } else if (wk == "doppler_sigma_mps") {
+          c.weighting.dopplerSigma = r.number(wv, wf, 1e-6, 1000.0);
+        } else {
+          r.perSystem(wv, wf, [&](System s, const std::string& f2, const YAML::Node& b) {
+            c.weighting.systemFactor[systemIndex(s)] = r.number(b, f2, 0.01, 1000.0);
+          });
+        }
+      });
+      if (c.weighting.a <= 0.0 && c.weighting.b <= 0.0) r.fail(v, full, "weighting a_m and b_m cannot both be 0");
+    } else if (k == "ionosphere_model_error") {
+      c.ionosphereModelError = r.number(v, full, 0.0, 10.0);
+    } else if (k == "troposphere_zenith_error_m") {
+      c.troposphereZenithError = r.number(v, full, 0.0, 10.0);
+    } else if (k == "ephemeris_error_m") {
+      r.perSystem(v, full, [&](System s, const std::string& f2, const YAML::Node& b) {
+        c.ephemerisError[systemIndex(s)] = r.number(b, f2, 0.0, 1000.0);
+      });
+    } else if (k == "ephemeris_alarm_accuracy_m") {
+      c.ephemerisAlarmAccuracy = r.number(v, full, 0.0, 1e6);
+    } else if (k == "fault_exclusion") {
+      static const std::set<std::string> kF = {"enabled", "false_alarm_probability", "max_exclusions",
+                                               "max_candidates", "min_redundancy"};
+      r.map(v, full, kF, [&](const std::string& fk, const std::string& ff, const YAML::Node& fv) {
+        if (fk == "enabled") c.faultExclusion.enabled = r.boolean(fv, ff);
+        else if (fk == "false_alarm_probability") c.faultExclusion.falseAlarmProbability = r.number(fv, ff, 1e-12, 0.5);
+        else if (fk == "max_exclusions") c.faultExclusion.maxExclusions = r.integer(fv, ff, 0, 100);
+        else if (fk == "max_candidates") c.faultExclusion.maxCandidates = r.integer(fv, ff, 0, 1000);
+        else c.faultExclusion.minRedundancy = r.integer(fv, ff, 0, 100);
+      });
+    } else if (k == "robust") {
+      static const std::set<std::string> kR = {"enabled", "k0", "k1", "min_scale", "max_iterations"};
+      r.map(v, full, kR, [&](const std::string& rk, const std::string& rf, const YAML::Node& rv) {
+        if (rk == "enabled") c.robust.enabled = r.boolean(rv, rf);
+        else if (rk == "k0") c.robust.k0 = r.number(rv, rf, 0.1, 100.0);
+        else if (rk == "k1") c.robust.k1 = r.number(rv, rf, 0.2, 1000.0);
+        else if (rk == "min_scale") c.robust.minScale = r.number(rv, rf, 0.0, 100.0);
+        else c.robust.maxIterations = r.integer(rv, rf, 1, 100);
+      });
+      if (c.robust.k1 <= c.robust.k0) r.fail(v, full, "robust.k1 must be larger than robust.k0");
+    } else if (k == "ionosphere_estimation") {
+      static const std::set<std::string> kI = {"enabled", "prior_fraction", "min_prior_sigma_m"};
+      r.map(v, full, kI, [&](const std::string& ik, const std::string& iff, const YAML::Node& iv) {
+        if (ik == "enabled") c.ionosphereEstimation.enabled = r.boolean(iv, iff);
+        else if (ik == "prior_fraction") c.ionosphereEstimation.priorFraction = r.number(iv, iff, 0.0, 10.0);
+        else c.ionosphereEstimation.minPriorSigma = r.number(iv, iff, 0.001, 100.0);
+      });
+    } else if (k == "max_gdop") {
+      c.maxGdop = r.number(v, full, 1.0, 1e6);
+    } else if (k == "isb_prior_sigma_m") {
+      c.isbPriorSigma = r.number(v, full, 0.0, 1e6);
+    } else if (k == "isb_random_walk_m2ps") {
+      c.isbRandomWalk = r.number(v, full, 0.0, 1e6);
+    } else if (k == "qzss_gps_clock") {
+      c.qzssUsesGpsClock = r.boolean(v, full);
+    } else if (k == "max_iterations") {
+      c.maxIterations = r.integer(v, full, 1, 100);
+    } else if (k == "velocity") {
+      c.velocity = r.boolean(v, full);
+    } else if (k == "allow_unhealthy") {
+      c.ephemeris.allowUnhealthy = r.boolean(v, full);
+    }
+  });
+}
+
+}  // namespace
+
+SppConfig parseSppConfig(std::string_view yaml, std::string_view name, const SppConfig& base) {
+  SppConfig c = base;
+  const Reader r{std::string(name)};
+  YAML::Node root;
+  try {
+    root = YAML::Load(std::string(yaml));
+  } catch (const YAML::ParserException& e) {
+    throw ParseError(std::string(name), e.mark.line >= 0 ? e.mark.line + 1 : 0, "YAML", e.msg);
+  } catch (const YAML::Exception& e) {
+    throw ParseError(std::string(name), e.mark.line >= 0 ? e.mark.line + 1 : 0, "YAML", e.msg);
+  }
+  if (root.IsNull()) return c;  // empty file: defaults
+  if (!root.IsMap()) r.fail(root, "", "the configuration must be a map with an 'spp' section");
+  const YAML::Node spp = root["spp"];
+  if (!spp) return c;
+  if (spp.IsNull()) return c;
+  apply(r, spp, c);
+  return c;
+}
+
+SppConfig loadSppConfig(const std::string& path, const SppConfig& base) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw ParseError(path, 0, "", "cannot open configuration file");
+  std::ostringstream ss;
+  ss << f.rdbuf();
+  return parseSppConfig(ss.str(), path, base);
+}
+
+}  // namespace gvins
