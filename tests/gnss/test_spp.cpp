@@ -1,0 +1,476 @@
+// Single point positioning and Doppler velocity: simulation truth (exact Earth-rotation geometry,
+// injected faults, noise statistics, finite-difference Doppler), real data against surveyed truth
+// with RTKLIB's accuracy as the bar, and degenerate epochs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include <Eigen/Cholesky>
+
+#include "gvins/base/constants.hpp"
+#include "gvins/base/geodetic.hpp"
+#include "gvins/base/local_frame.hpp"
+#include "gvins/base/rinex_obs_reader.hpp"
+#include "gvins/ephemeris/rinex_nav.hpp"
+#include "gvins/gnss/accuracy_statistics.hpp"
+#include "gvins/gnss/klobuchar.hpp"
+#include "gvins/gnss/pos_reader.hpp"
+#include "gvins/gnss/sagnac.hpp"
+#include "gvins/gnss/spp.hpp"
+#include "gvins/gnss/troposphere.hpp"
+
+using namespace gvins;
+
+namespace {
+
+const std::string kData = GVINS_TEST_DATA;
+constexpr double kC = constants::kSpeedOfLight;
+
+const EphemerisStore& nagoyaNav() {
+  static const EphemerisStore store = [] {
+    EphemerisStore s;
+    s.add(readRinexNav(kData + "/gnss/nagoya_static_2024/base.nav.gz"));
+    return s;
+  }();
+  return store;
+}
+
+struct SimOptions {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  std::array<double, kNumSystems> clock{};  ///< receiver clock per system, m
+  double drift = 0.0;                       ///< receiver clock drift, m/s
+  bool atmosphere = false;                  ///< add Klobuchar + Saastamoinen delays
+  double noise = 0.0;                       ///< pseudorange noise sigma (x1.5 for GLONASS), m
+  std::mt19937* rng = nullptr;
+};
+
+/// Exact pseudorange at receiver time tag `tag` for a receiver moving linearly from the truth
+/// position: transmit time found by iterating the light time with the satellite position rotated
+/// into the receive-time frame (no Sagnac approximation).
+std::optional<double> exactPseudorange(const EphemerisStore& nav, SatId sat, const GpsTime& tag, const SimOptions& o,
+                                       double dtFromEpoch, ObsCode code, double* elevation) {
+  const double clk = o.clock[systemIndex(sat.system)] + o.drift * dtFromEpoch;
+  const Eigen::Vector3d r = o.position + o.velocity * dtFromEpoch;
+  const GpsTime tTrue = tag - clk / kC;
+  double tau = 0.075;
+  std::optional<SatelliteState> st;
+  Eigen::Vector3d rs;
+  for (int i = 0; i < 6; ++i) {
+    st = nav.satelliteState(sat, tTrue - tau);
+    if (!st) return std::nullopt;
+    rs = rotateEarth(st->position, tau);
+    tau = (rs - r).norm() / kC;
+  }
+  const AzEl ae = azimuthElevation(r, rs);
+  if (elevation) *elevation = ae.elevation;
+  double p = (rs - r).norm() + clk - kC * (st->clockBias - nav.groupDelay(sat, code, tTrue - tau));
+  if (o.atmosphere) {
+    const Geodetic g = ecefToGeodetic(r);
+    // First-order ionosphere scales with 1/f^2 from L1 to the signal's carrier.
+    const double fL1 = *carrierFrequency(System::Gps, '1');
+    std::optional<int> ch;
+    if (sat.system == System::Glonass) ch = nav.glonassChannels().get(sat.prn);
+    const double f = *carrierFrequency(sat.system, code.band, ch);
+    p += klobucharDelayL1(*nav.ionosphere().gps, g, ae, tag) * (fL1 / f) * (fL1 / f);
+    p += slantTroposphereDelay(g, ae.elevation, tag, 0.5).slant;
+  }
+  return p;
+}
+
+/// Simulated L1/B1I pseudoranges (and Doppler from a central difference of exact ranges) of
+/// every satellite with an ephemeris above 5 degrees.
+ObsEpoch simulate(const EphemerisStore& nav, const GpsTime& t, const SimOptions& o) {
+  ObsEpoch e;
+  e.time = t;
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  for (SatId sat : nav.satellites()) {
+    if (sat.system == System::Sbas || sat.system == System::Navic) continue;
+    std::optional<int> ch;
+    if (sat.system == System::Glonass) {
+      ch = nav.glonassChannels().get(sat.prn);
+      if (!ch) continue;
+    }
+    const char band = primaryBand(sat.system);
+    const ObsCode code(band, sat.system == System::BeiDou ? 'I' : 'C');
+    double el = 0.0;
+    const auto p = exactPseudorange(nav, sat, t, o, 0.0, code, &el);
+    if (!p || el < 5.0 * constants::kDegToRad) continue;
+    const double h = 0.01;
+    const auto pp = exactPseudorange(nav, sat, t + h, o, h, code, nullptr);
+    const auto pm = exactPseudorange(nav, sat, t - h, o, -h, code, nullptr);
+    if (!pp || !pm) continue;
+    SignalObs s{code};
+    double noise = 0.0;
+    if (o.noise > 0.0 && o.rng) noise = o.noise * (sat.system == System::Glonass ? 1.5 : 1.0) * gauss(*o.rng);
+    s.setCode(*p + noise);
+    const double lambda = *carrierWavelength(sat.system, band, ch);
+    s.setDoppler(-((*pp - *pm) / (2 * h)) / lambda);
+    s.setSnr(45.0);
+    e.add(sat).signals.push_back(s);
+  }
+  return e;
+}
+
+SppConfig plainConfig() {
+  SppConfig c;
+  c.ionosphere = IonosphereOption::Off;
+  c.troposphere = TroposphereOption::Off;
+  c.elevationMask = 5.0 * constants::kDegToRad;
+  return c;
+}
+
+const Eigen::Vector3d kNagoyaRover = geodeticToEcef(geodeticFromDegrees(35.13469901, 136.97757549, 104.8626));
+const GpsTime kNagoyaTime = GpsTime::fromCalendar({2024, 6, 24, 8, 22, 0.0});
+
+}  // namespace
+
+TEST(Spp, RecoversSimulatedPositionAndClocksFromTheEarthCentre) {
+  SimOptions o;
+  o.position = kNagoyaRover;
+  o.clock = {1234.5, 1250.0, 1220.0, 1300.0, 1234.5, 0.0, 0.0};
+  const ObsEpoch e = simulate(nagoyaNav(), kNagoyaTime, o);
+  ASSERT_GT(e.sats.size(), 25u);
+  SppSolver solver(nagoyaNav(), plainConfig());  // no initial position: starts at the centre
+  const SppSolution s = solver.solve(e);
+  ASSERT_EQ(s.status, SppStatus::Ok) << toString(s.status);
+  EXPECT_LT((s.position - o.position).norm(), 0.01);
+  EXPECT_NEAR(*s.clockBias[systemIndex(System::Gps)], 1234.5, 0.01);
+  EXPECT_NEAR(*s.clockBias[systemIndex(System::Glonass)], 1250.0, 0.01);
+  EXPECT_NEAR(*s.clockBias[systemIndex(System::Galileo)], 1220.0, 0.01);
+  EXPECT_NEAR(*s.clockBias[systemIndex(System::BeiDou)], 1300.0, 0.01);
+  EXPECT_TRUE(s.testPassed);
+  EXPECT_TRUE(s.excluded.empty());
+  EXPECT_TRUE(s.dop.valid);
+  EXPECT_LT(s.dop.pdop, 3.0);
+  // The solution time is the time tag minus the GPS receiver clock.
+  EXPECT_NEAR(s.solutionTime - e.time, -1234.5 / kC, 1e-9);
+  // Doppler: velocity 0, drift 0 -> recovered to well below a mm/s.
+  ASSERT_TRUE(s.velocity.valid);
+  EXPECT_LT(s.velocity.velocity.norm(), 3e-3);
+}
+
+TEST(Spp, RecoversPositionWithAtmosphereAndEstimatesNoIonosphereCorrection) {
+  SimOptions o;
+  o.position = kNagoyaRover;
+  o.clock = {-50.0, -40.0, -45.0, -60.0, -50.0, 0.0, 0.0};
+  o.atmosphere = true;
+  const ObsEpoch e = simulate(nagoyaNav(), kNagoyaTime, o);
+  SppConfig c;  // defaults: Klobuchar, Saastamoinen (standard atmosphere, RH 0.5), 15 deg mask
+  SppSolver solver(nagoyaNav(), c);
+  const SppSolution s = solver.solve(e);
+  ASSERT_TRUE(s.valid());
+  EXPECT_LT((s.position - o.position).norm(), 0.02);
+  ASSERT_TRUE(s.ionosphereCorrection);
+  EXPECT_NEAR(*s.ionosphereCorrection, 0.0, 0.01);
+  for (const auto& r : s.satellites) {
+    if (r.use == SatelliteUse::Used) {
+      EXPECT_NEAR(r.residual, 0.0, 0.02) << r.sat.str();
+    }
+    if (r.use == SatelliteUse::BelowMask) {
+      EXPECT_LT(r.azel.elevation, c.elevationMask);
+    }
+  }
+}
+
+TEST(Spp, FaultDetectionExcludesABiasedSatellite) {
+  SimOptions o;
+  o.position = kNagoyaRover;
+  ObsEpoch e = simulate(nagoyaNav(), kNagoyaTime, o);
+  // A 60 m error on one GPS and a 25 m error on one Galileo pseudorange.
+  SatId badG, badE;
+  for (auto& so : e.sats) {
+    if (so.sat.system == System::Gps && badG.prn == 0) {
+      badG = so.sat;
+      so.signals[0].pseudorange += 60.0;
+    } else if (so.sat.system == System::Galileo && badE.prn == 0) {
+      badE = so.sat;
+      so.signals[0].pseudorange += 25.0;
+    }
+  }
+  SppConfig c = plainConfig();
+  c.robust.enabled = false;  // exclusion alone
+  SppSolver solver(nagoyaNav(), c);
+  const SppSolution s = solver.solve(e);
+  ASSERT_TRUE(s.valid());
+  ASSERT_EQ(s.excluded.size(), 2u);
+  EXPECT_TRUE((s.excluded[0] == badG && s.excluded[1] == badE) || (s.excluded[0] == badE && s.excluded[1] == badG));
+  EXPECT_TRUE(s.testPassed);
+  EXPECT_LT((s.position - o.position).norm(), 0.01);
+  int excludedFlags = 0;
+  for (const auto& r : s.satellites) excludedFlags += r.use == SatelliteUse::Excluded;
+  EXPECT_EQ(excludedFlags, 2);
+  // Without FDE the solution is pulled by metres.
+  c.faultExclusion.enabled = false;
+  SppSolver plain(nagoyaNav(), c);
+  const SppSolution bad = plain.solve(e);
+  EXPECT_GT((bad.position - o.position).norm(), 1.0);
+  EXPECT_FALSE(bad.testPassed);
+  EXPECT_EQ(bad.status, SppStatus::TestFailed);
+}
+
+TEST(Spp, RobustWeightingSurvivesSeveralMultipathLikeErrors) {
+  SimOptions o;
+  o.position = kNagoyaRover;
+  std::mt19937 rng(7);
+  o.rng = &rng;
+  o.noise = 0.3;
+  ObsEpoch e = simulate(nagoyaNav(), kNagoyaTime, o);
+  // Five satellites with 8-20 m positive errors (NLOS reception is always late).
+  int k = 0;
+  for (auto& so : e.sats) {
+    if (k < 5 && (so.sat.prn % 3 == 0)) {
+      so.signals[0].pseudorange += 8.0 + 3.0 * k;
+      ++k;
+    }
+  }
+  ASSERT_EQ(k, 5);
+  SppConfig c = plainConfig();
+  SppSolver solver(nagoyaNav(), c);
+  const SppSolution s = solver.solve(e);
+  ASSERT_TRUE(s.valid());
+  EXPECT_LT((s.position - o.position).norm(), 1.0);
+  c.faultExclusion.enabled = false;
+  c.robust.enabled = false;
+  const SppSolution plain = SppSolver(nagoyaNav(), c).solve(e);
+  EXPECT_GT((plain.position - o.position).norm(), 1.5 * (s.position - o.position).norm());
+}
+
+TEST(Spp, CovarianceIsConsistentWithSimulatedNoise) {
+  // With the noise model equal to the simulation (sigma 0.3 m, GLONASS x1.5, no other error
+  // terms) the normalised estimation error squared averages to 3 (chi-square, 3 dof).
+  SppConfig c = plainConfig();
+  c.weighting.a = 0.3;
+  c.weighting.b = 0.0;
+  c.ephemerisError.fill(0.0);
+  c.faultExclusion.enabled = false;
+  c.robust.enabled = false;
+  c.isbPriorSigma = 0.0;
+  c.velocity = false;
+  SimOptions o;
+  o.position = kNagoyaRover;
+  o.noise = 0.3;
+  std::mt19937 rng(42);
+  o.rng = &rng;
+  const int trials = 300;
+  double nees = 0.0;
+  for (int i = 0; i < trials; ++i) {
+    const ObsEpoch e = simulate(nagoyaNav(), kNagoyaTime + i * 10.0, o);
+    SppSolver solver(nagoyaNav(), c);
+    solver.setInitialPosition(kNagoyaRover);
+    const SppSolution s = solver.solve(e);
+    ASSERT_TRUE(s.valid());
+    const Eigen::Vector3d d = s.position - o.position;
+    nees += d.dot(s.positionCovariance.ldlt().solve(d));
+  }
+  nees /= trials;
+  // Mean of 300 chi-square(3) draws: 3 +- 0.14 (1 sigma).
+  EXPECT_NEAR(nees, 3.0, 0.5);
+}
+
+TEST(Spp, DopplerVelocityAndClockDriftFromFiniteDifferenceRanges) {
+  SimOptions o;
+  o.position = kNagoyaRover;
+  o.velocity = Eigen::Vector3d(12.3, -4.5, 0.7);
+  o.drift = 35.0;  // m/s (~117 ns/s)
+  o.clock = {100.0, 110.0, 90.0, 120.0, 100.0, 0.0, 0.0};
+  const ObsEpoch e = simulate(nagoyaNav(), kNagoyaTime, o);
+  SppSolver solver(nagoyaNav(), plainConfig());
+  const SppSolution s = solver.solve(e);
+  ASSERT_TRUE(s.valid());
+  ASSERT_TRUE(s.velocity.valid);
+  EXPECT_LT((s.velocity.velocity - o.velocity).norm(), 2e-3);
+  EXPECT_NEAR(s.velocity.clockDrift, 35.0, 2e-3);
+  EXPECT_GT(s.velocity.numMeasurements, 25);
+  EXPECT_TRUE(s.velocity.excluded.empty());
+  // A wrong Doppler on one satellite is excluded.
+  ObsEpoch bad = e;
+  bad.sats[3].signals[0].doppler += 50.0;  // ~10 m/s
+  const SppSolution sb = SppSolver(nagoyaNav(), plainConfig()).solve(bad);
+  ASSERT_TRUE(sb.velocity.valid);
+  ASSERT_EQ(sb.velocity.excluded.size(), 1u);
+  EXPECT_EQ(sb.velocity.excluded[0], bad.sats[3].sat);
+  EXPECT_LT((sb.velocity.velocity - o.velocity).norm(), 5e-3);
+}
+
+TEST(Spp, SubsetsOfSystemsAndTwoFrequencies) {
+  SimOptions o;
+  o.position = kNagoyaRover;
+  o.clock = {10.0, 20.0, 30.0, 40.0, 10.0, 0.0, 0.0};
+  ObsEpoch e = simulate(nagoyaNav(), kNagoyaTime, o);
+  for (const char* systems : {"G", "E", "C", "R", "GE", "GC"}) {
+    SppConfig c = plainConfig();
+    c.systems = parseSystemLetters(systems);
+    const SppSolution s = SppSolver(nagoyaNav(), c).solve(e);
+    ASSERT_TRUE(s.valid()) << systems << " " << toString(s.status);
+    EXPECT_LT((s.position - o.position).norm(), 0.02) << systems;
+    for (int i = 0; i < kNumSystems; ++i) {
+      if (i != systemIndex(System::Qzss)) {
+        EXPECT_EQ(s.clockBias[i].has_value(), c.systems[i]) << systems << i;
+      }
+    }
+  }
+  // Dual-frequency ionosphere-free: add L2/E5a/B3I pseudoranges with a first-order ionosphere of
+  // 2 m times 1/sin(elevation) on the primary band; the IF combination must remove it.
+  ObsEpoch d = e;
+  for (auto& so : d.sats) {
+    if (so.sat.system == System::Glonass) continue;
+    const auto st = nagoyaNav().satelliteState(so.sat, d.time - 0.07);
+    const double iono = 2.0 / std::sin(azimuthElevation(o.position, st->position).elevation);
+    const System sys = so.sat.system;
+    const char b1 = primaryBand(sys);
+    const char b2 = sys == System::Galileo ? '5' : sys == System::BeiDou ? '6' : '2';
+    const double f1 = *carrierFrequency(sys, b1), f2 = *carrierFrequency(sys, b2);
+    SignalObs& s1 = so.signals[0];
+    SignalObs s2{ObsCode(b2, sys == System::Gps ? 'W' : sys == System::Galileo ? 'Q' : sys == System::BeiDou ? 'I' : 'L')};
+    // Remove the primary group delay, apply each band's own.
+    const double gd1 = nagoyaNav().groupDelay(so.sat, s1.code, d.time);
+    const double gd2 = nagoyaNav().groupDelay(so.sat, s2.code, d.time);
+    const double geom = s1.pseudorange - kC * gd1;
+    s1.pseudorange = geom + kC * gd1 + iono;
+    s2.setCode(geom + kC * gd2 + iono * (f1 / f2) * (f1 / f2));
+    so.signals.push_back(s2);
+  }
+  SppConfig c = plainConfig();
+  c.systems = parseSystemLetters("GEJ");
+  c.frequencies = 2;
+  c.ionosphere = IonosphereOption::DualFrequency;
+  const SppSolution s = SppSolver(nagoyaNav(), c).solve(d);
+  ASSERT_TRUE(s.valid());
+  EXPECT_LT((s.position - o.position).norm(), 0.05);
+  int ifCount = 0;
+  for (const auto& r : s.satellites) ifCount += r.use == SatelliteUse::Used && r.ionosphereFree;
+  EXPECT_GT(ifCount, 15);
+  // Single frequency on the same data is off by metres.
+  c.frequencies = 1;
+  const SppSolution s1 = SppSolver(nagoyaNav(), c).solve(d);
+  EXPECT_GT((s1.position - o.position).norm(), 2.0);
+}
+
+TEST(Spp, DegenerateEpochsGiveStatusesNotCrashes) {
+  SppSolver solver(nagoyaNav());
+  ObsEpoch empty;
+  empty.time = kNagoyaTime;
+  EXPECT_EQ(solver.solve(empty).status, SppStatus::NoObservations);
+  // No ephemeris at this time (ten years later).
+  SimOptions o;
+  o.position = kNagoyaRover;
+  ObsEpoch e = simulate(nagoyaNav(), kNagoyaTime, o);
+  ObsEpoch late = e;
+  late.time = kNagoyaTime + 10 * 365.25 * 86400.0;
+  const SppSolution sl = solver.solve(late);
+  EXPECT_EQ(sl.status, SppStatus::NoObservations);
+  for (const auto& r : sl.satellites) EXPECT_EQ(r.use, SatelliteUse::NoEphemeris);
+  // Three GPS satellites only.
+  ObsEpoch three;
+  three.time = e.time;
+  for (const auto& so : e.sats) {
+    if (so.sat.system == System::Gps && three.sats.size() < 3) three.sats.push_back(so);
+  }
+  SppConfig c = plainConfig();
+  EXPECT_EQ(SppSolver(nagoyaNav(), c).solve(three).status, SppStatus::NotEnoughSatellites);
+  // Garbage values: NaN / zero / negative pseudoranges are not used.
+  ObsEpoch junk = e;
+  junk.sats[0].signals[0].pseudorange = std::nan("");
+  junk.sats[1].signals[0].pseudorange = 0.0;
+  junk.sats[2].signals[0].pseudorange = -2e7;
+  const SppSolution sj = SppSolver(nagoyaNav(), c).solve(junk);
+  EXPECT_TRUE(sj.valid());
+  EXPECT_EQ(sj.satellites[0].use, SatelliteUse::NoSignal);
+  EXPECT_LT((sj.position - o.position).norm(), 0.02);
+}
+
+// ---- real data ----------------------------------------------------------------------------------
+
+namespace {
+struct RealRun {
+  AccuracySummary position, velocity;
+  long epochs = 0, solutions = 0;
+};
+
+RealRun runReal(const std::string& obs, const std::vector<std::string>& navs, const Eigen::Vector3d& truth,
+                const SppConfig& cfg = {}) {
+  EphemerisStore nav;
+  for (const auto& n : navs) nav.add(readRinexNav(n));
+  RinexObsReader r(obs);
+  SppSolver solver(nav, cfg);
+  solver.setGlonassChannels(r.header().glonassChannels);
+  if (r.header().station.approxPosition) solver.setInitialPosition(*r.header().station.approxPosition);
+  AccuracyStatistics st(truth);
+  RealRun out;
+  ObsEpoch e;
+  while (r.next(e)) {
+    ++out.epochs;
+    const SppSolution s = solver.solve(e);
+    if (!s.valid()) continue;
+    ++out.solutions;
+    st.addPosition(s.position);
+    if (s.velocity.valid) st.addVelocity(s.velocity.velocity);
+  }
+  out.position = st.position();
+  out.velocity = st.velocity();
+  return out;
+}
+
+AccuracySummary rtklibAccuracy(const std::string& pos, const Eigen::Vector3d& truth) {
+  AccuracyStatistics st(truth);
+  for (const auto& s : readPosFile(pos).solutions) st.addPosition(s.position);
+  return st.position();
+}
+}  // namespace
+
+// Settings like reference/rtklib-2.4.3/conf/spp.conf: L1, 15 deg mask, Klobuchar, Saastamoinen,
+// all five systems present. RTKLIB's numbers are recomputed from its stored .pos with our own
+// statistics (cross-check of the 2.52/0.93 m quoted in the data README).
+TEST(SppRealData, NagoyaRoverBeatsRtklibAndDopplerVelocityIsCentimetric) {
+  const Eigen::Vector3d truth = kNagoyaRover;
+  const AccuracySummary rtk = rtklibAccuracy(kData + "/reference/rtklib-2.4.3/nagoya_rover_spp.pos", truth);
+  EXPECT_NEAR(rtk.horizontalRms, 2.52, 0.005);
+  EXPECT_NEAR(rtk.verticalRms, 0.93, 0.006);
+  EXPECT_EQ(rtk.count, 301);
+  const RealRun ours = runReal(kData + "/gnss/nagoya_static_2024/rover.obs.gz",
+                               {kData + "/gnss/nagoya_static_2024/base.nav.gz"}, truth);
+  EXPECT_EQ(ours.epochs, 301);
+  EXPECT_EQ(ours.solutions, 301);
+  EXPECT_LE(ours.position.horizontalRms, rtk.horizontalRms);
+  EXPECT_LE(ours.position.verticalRms, rtk.verticalRms);
+  EXPECT_EQ(ours.velocity.count, 301);
+  EXPECT_LE(ours.velocity.horizontalRms, 0.01);
+  EXPECT_LE(ours.velocity.verticalRms, 0.02);
+  std::printf("nagoya: ours H %.3f V %.3f m, RTKLIB H %.3f V %.3f m; velocity H %.4f V %.4f m/s\n",
+              ours.position.horizontalRms, ours.position.verticalRms, rtk.horizontalRms, rtk.verticalRms,
+              ours.velocity.horizontalRms, ours.velocity.verticalRms);
+}
+
+TEST(SppRealData, KamakuraBeatsRtklib) {
+  const Eigen::Vector3d truth(-3962108.673, 3381309.574, 3668678.638);
+  const AccuracySummary rtk = rtklibAccuracy(kData + "/reference/rtklib-2.4.3/kamakura_sept078_spp.pos", truth);
+  EXPECT_NEAR(rtk.horizontalRms, 0.29, 0.005);
+  EXPECT_NEAR(rtk.verticalRms, 1.44, 0.005);
+  const RealRun ours = runReal(kData + "/gnss/kamakura_static_2021/SEPT078M.21O.gz",
+                               {kData + "/gnss/kamakura_static_2021/SEPT078M.21P.gz"}, truth);
+  EXPECT_EQ(ours.epochs, 900);
+  EXPECT_EQ(ours.solutions, 900);
+  EXPECT_LE(ours.position.horizontalRms, rtk.horizontalRms);
+  EXPECT_LE(ours.position.verticalRms, rtk.verticalRms);
+  EXPECT_EQ(ours.velocity.count, 0);  // the file has no Doppler
+  std::printf("kamakura: ours H %.3f V %.3f m, RTKLIB H %.3f V %.3f m\n", ours.position.horizontalRms,
+              ours.position.verticalRms, rtk.horizontalRms, rtk.verticalRms);
+}
+
+TEST(SppRealData, GeonetRinex2GpsOnlyMatchesRtklib) {
+  // RINEX 2.10, GPS only, 30 s, no Doppler; truth: the header position of 0759 (RTKLIB's static RTK
+  // agrees with it to 0.12 m east / 0.12 m up, see the data README). Five epochs have too poor a
+  // geometry at a 15 deg mask (GDOP > 30); RTKLIB rejects the same five.
+  const Eigen::Vector3d marker(-3976219.5082, 3382372.5671, 3652512.9849);
+  const AccuracySummary rtk = rtklibAccuracy(kData + "/reference/rtklib-2.4.3/geonet_0759_spp.pos", marker);
+  const RealRun ours = runReal(kData + "/gnss/geonet_0759_3040_2005/07590920.05o.gz",
+                               {kData + "/gnss/geonet_0759_3040_2005/07590920.05n.gz"}, marker);
+  EXPECT_EQ(ours.epochs, 120);
+  EXPECT_EQ(ours.solutions, rtk.count);
+  EXPECT_LE(ours.position.horizontalRms, rtk.horizontalRms + 0.1);
+  EXPECT_LE(ours.position.verticalRms, rtk.verticalRms + 0.1);
+  std::printf("geonet 0759: ours H %.3f V %.3f m, RTKLIB H %.3f V %.3f m\n", ours.position.horizontalRms,
+              ours.position.verticalRms, rtk.horizontalRms, rtk.verticalRms);
+}

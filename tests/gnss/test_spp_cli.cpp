@@ -1,0 +1,123 @@
+// gvins-spp end to end: output layout, summary, accuracy table, options and error handling.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "gvins/base/geodetic.hpp"
+#include "gvins/gnss/accuracy_statistics.hpp"
+#include "gvins/gnss/pos_reader.hpp"
+
+namespace {
+const std::string kData = GVINS_TEST_DATA;
+const std::string kBin = std::string(GVINS_BIN_DIR) + "/gvins-spp";
+
+struct CliRun {
+  int code = -1;
+  std::string err;
+};
+
+CliRun run(const std::string& args) {
+  const std::string errFile = std::filesystem::temp_directory_path() / ("gvins_spp_cli_" + std::to_string(::getpid()) + ".err");
+  const int rc = std::system((kBin + " " + args + " 2>" + errFile + " >/dev/null").c_str());
+  CliRun r;
+  r.code = WEXITSTATUS(rc);
+  std::ifstream f(errFile);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  r.err = ss.str();
+  std::filesystem::remove(errFile);
+  return r;
+}
+
+std::string tmp(const std::string& name) {
+  return (std::filesystem::temp_directory_path() / ("gvins_spp_cli_" + std::to_string(::getpid()) + "_" + name)).string();
+}
+}  // namespace
+
+TEST(SppCli, NagoyaWithTruthWritesPosAndAccuracyTable) {
+  const std::string out = tmp("n.pos");
+  const CliRun r = run("-q --truth-llh 35.13469901,136.97757549,104.8626 -o " + out + " " + kData +
+                    "/gnss/nagoya_static_2024/rover.obs.gz " + kData + "/gnss/nagoya_static_2024/base.nav.gz");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("epochs read                 301"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("solutions                   301"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("position error vs truth (301 epochs, m)"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("velocity error vs truth"), std::string::npos) << r.err;
+  const gvins::PosFile f = gvins::readPosFile(out);
+  EXPECT_FALSE(f.ecef);
+  ASSERT_EQ(f.solutions.size(), 301u);
+  // The file's positions give the same horizontal RMS as the tool's table (to print resolution).
+  gvins::AccuracyStatistics st(gvins::geodeticToEcef(gvins::geodeticFromDegrees(35.13469901, 136.97757549, 104.8626)));
+  for (const auto& s : f.solutions) st.addPosition(s.position);
+  char expect[64];
+  std::snprintf(expect, sizeof expect, "%10.3f", st.position().horizontalRms);
+  EXPECT_NE(r.err.find(expect), std::string::npos) << expect << "\n" << r.err;
+  std::filesystem::remove(out);
+}
+
+TEST(SppCli, XyzLayoutOptionsAndConfig) {
+  const std::string out = tmp("g.pos"), cfg = tmp("c.yaml");
+  std::ofstream(cfg) << "spp:\n  systems: GE\n  velocity: false\n";
+  const CliRun r = run("-q --config " + cfg + " --elmask 10 --xyz --time-decimals 1 -o " + out + " " + kData +
+                    "/gnss/kamakura_static_2021/SEPT078M.21O.gz " + kData + "/gnss/kamakura_static_2021/SEPT078M.21P.gz");
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream f(out);
+  std::string line, header;
+  int rows = 0;
+  while (std::getline(f, line)) {
+    if (line.rfind("%  GPST", 0) == 0) header = line;
+    if (!line.empty() && line[0] != '%') ++rows;
+    if (rows == 1 && line[0] != '%') {
+      EXPECT_EQ(line.substr(0, 21), "2021/03/19 12:00:00.0");
+    }
+  }
+  EXPECT_EQ(rows, 900);
+  EXPECT_NE(header.find("x-ecef(m)"), std::string::npos);
+  EXPECT_NE(header.find("vx(m/s)"), std::string::npos);
+  std::filesystem::remove(out);
+  std::filesystem::remove(cfg);
+}
+
+TEST(SppCli, BadArgumentsAndBadFiles) {
+  EXPECT_EQ(run("").code, 2);
+  EXPECT_EQ(run("-o x.pos onlyone.obs").code, 2);
+  EXPECT_EQ(run("--elmask abc -o x.pos a b").code, 2);
+  EXPECT_EQ(run("--systems GX -o x.pos a b").code, 2);
+  EXPECT_EQ(run("--frobnicate -o x.pos a b").code, 2);
+  const CliRun missing = run("-o " + tmp("m.pos") + " /nonexistent.obs " + kData + "/gnss/nagoya_static_2024/base.nav.gz");
+  EXPECT_EQ(missing.code, 1);
+  EXPECT_NE(missing.err.find("/nonexistent.obs"), std::string::npos);
+  // A navigation file given as observations: clear error naming the file and line 1.
+  const CliRun swapped = run("-o " + tmp("s.pos") + " " + kData + "/gnss/nagoya_static_2024/base.nav.gz " + kData +
+                          "/gnss/nagoya_static_2024/base.nav.gz");
+  EXPECT_EQ(swapped.code, 1);
+  EXPECT_NE(swapped.err.find("base.nav.gz:1"), std::string::npos) << swapped.err;
+  EXPECT_NE(swapped.err.find("not an observation file"), std::string::npos) << swapped.err;
+  // Truncated observation file: earlier epochs are solved, the broken epoch is skipped and counted.
+  const std::string cut = tmp("cut.obs");
+  {
+    std::ofstream o(cut);
+    std::string l;
+    FILE* p = popen(("gzip -dc " + kData + "/gnss/nagoya_static_2024/rover.obs.gz | head -n 400").c_str(), "r");
+    char buf[4096];
+    while (fgets(buf, sizeof buf, p)) o << buf;
+    pclose(p);
+    o << "G05  2061";  // cut mid-record
+  }
+  const CliRun trunc = run("-q -o " + tmp("t.pos") + " " + cut + " " + kData + "/gnss/nagoya_static_2024/base.nav.gz");
+  EXPECT_EQ(trunc.code, 0) << trunc.err;
+  EXPECT_NE(trunc.err.find("1 malformed epochs skipped"), std::string::npos) << trunc.err;
+  const CliRun strict = run("-q --strict -o " + tmp("t.pos") + " " + cut + " " + kData + "/gnss/nagoya_static_2024/base.nav.gz");
+  EXPECT_EQ(strict.code, 1);
+  EXPECT_NE(strict.err.find(cut), std::string::npos) << strict.err;
+  // Observations without any matching ephemeris: runs, no solution, exit code 3.
+  const CliRun noeph = run("-q -o " + tmp("e.pos") + " " + kData + "/gnss/kamakura_static_2021/SEPT078M.21O.gz " + kData +
+                        "/gnss/nagoya_static_2024/base.nav.gz");
+  EXPECT_EQ(noeph.code, 3) << noeph.err;
+  EXPECT_NE(noeph.err.find("no ephemeris"), std::string::npos) << noeph.err;
+  for (const char* n : {"m.pos", "s.pos", "cut.obs", "t.pos", "e.pos"}) std::filesystem::remove(tmp(n));
+}
