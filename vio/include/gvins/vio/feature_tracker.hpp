@@ -1,0 +1,90 @@
+// Temporal feature tracking in one camera: image pyramids, pyramidal Lucas-Kanade optical flow
+// (Bouguet, "Pyramidal implementation of the Lucas Kanade feature tracker", 2000, as implemented
+// by OpenCV) with a forward-backward consistency check, fundamental-matrix RANSAC on undistorted
+// points (Hartley & Zisserman, ch. 11) and grid detection of new corners; features carry ids and
+// track lengths.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core/mat.hpp>
+#include <opencv2/core/types.hpp>
+
+#include "gvins/vio/camera_model.hpp"
+#include "gvins/vio/feature_detector.hpp"
+#include "gvins/vio/feature_frame.hpp"
+
+namespace gvins::vio {
+
+struct KltParams {
+  int window = 21;                    ///< square window side, pixels
+  int levels = 3;                     ///< pyramid levels above the full image
+  int iterations = 30;
+  double epsilon = 0.01;              ///< pixels
+  double maxForwardBackward = 0.5;    ///< pixels between the start and the back-tracked point
+  int border = 5;                     ///< tracked points closer to the edge are dropped
+};
+
+/// An image with its Lucas-Kanade pyramid (levels with precomputed derivatives). Build a new
+/// object for every image: the front end keeps the previous one alive.
+class ImagePyramid {
+ public:
+  ImagePyramid() = default;
+  ImagePyramid(const cv::Mat& gray, const KltParams& params);
+  const cv::Mat& image() const { return image_; }
+  const std::vector<cv::Mat>& levels() const { return levels_; }
+  bool empty() const { return image_.empty(); }
+
+ private:
+  cv::Mat image_;
+  std::vector<cv::Mat> levels_;
+};
+
+/// Lucas-Kanade from `from` to `to` for `pts`. If `useGuess`, `out` holds initial positions in
+/// `to` (same size as pts); otherwise it is overwritten. status[i] = 1 if tracked forward, back
+/// to within maxForwardBackward of pts[i], and inside the border of `to`.
+void trackKlt(const ImagePyramid& from, const ImagePyramid& to, const std::vector<cv::Point2f>& pts,
+              std::vector<cv::Point2f>& out, std::vector<unsigned char>& status, const KltParams& params,
+              bool useGuess);
+
+struct FeatureTrackerConfig {
+  GridDetectorConfig grid;
+  KltParams klt;
+  bool ransac = true;
+  double ransacThreshold = 1.0;    ///< pixels at the camera's focal length, on undistorted points
+  double ransacConfidence = 0.99;
+};
+
+/// Tracks the features of one camera from image to image.
+class FeatureTracker {
+ public:
+  FeatureTracker(const CameraModel& camera, const FeatureTrackerConfig& config);
+
+  /// Tracks the current features into `image`, removes outliers, then tops up with new corners.
+  /// R_cur_prev (optional) rotates previous-camera-frame vectors into the current camera frame
+  /// (e.g. from the gyro); tracks then start at the rotation-predicted pixels.
+  void process(const ImagePyramid& image, const Eigen::Matrix3d* R_cur_prev = nullptr,
+               FrontendTiming* timing = nullptr);
+
+  const std::vector<cv::Point2f>& points() const { return pts_; }
+  /// Position of each feature in the previous image (new features: their current position).
+  const std::vector<cv::Point2f>& previousPoints() const { return prevPts_; }
+  const std::vector<std::uint64_t>& ids() const { return ids_; }
+  const std::vector<int>& trackLengths() const { return lengths_; }
+  const CameraModel& camera() const { return cam_; }
+  const FeatureTrackerConfig& config() const { return cfg_; }
+
+ private:
+  CameraModel cam_;
+  FeatureTrackerConfig cfg_;
+  GridDetector detector_;
+  ImagePyramid prev_;
+  std::vector<cv::Point2f> pts_, prevPts_;
+  std::vector<std::uint64_t> ids_;
+  std::vector<int> lengths_;
+  std::uint64_t nextId_ = 0;
+};
+
+}  // namespace gvins::vio

@@ -1,0 +1,147 @@
+#include "gvins/vio/frontend.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <unordered_map>
+
+#include <Eigen/LU>
+#include <opencv2/imgproc.hpp>
+
+namespace gvins::vio {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+Eigen::Matrix4d inverse(const Eigen::Matrix4d& T) {
+  Eigen::Matrix4d I = Eigen::Matrix4d::Identity();
+  I.topLeftCorner<3, 3>() = T.topLeftCorner<3, 3>().transpose();
+  I.topRightCorner<3, 1>() = -T.topLeftCorner<3, 3>().transpose() * T.topRightCorner<3, 1>();
+  return I;
+}
+void checkImage(const cv::Mat& img, const CameraModel& cam, const char* which) {
+  const auto& k = cam.intrinsics();
+  if (img.type() != CV_8UC1 || img.cols != k.width || img.rows != k.height) {
+    throw std::invalid_argument(std::string("StereoFrontend: ") + which + " image must be 8-bit gray " +
+                                std::to_string(k.width) + "x" + std::to_string(k.height));
+  }
+}
+}  // namespace
+
+struct StereoFrontend::Impl {
+  static FrontendConfig shared(FrontendConfig c) {
+    c.stereo.klt.window = c.tracker.klt.window;
+    c.stereo.klt.levels = c.tracker.klt.levels;
+    return c;
+  }
+  FrontendConfig cfg;
+  FeatureTracker tracker;
+  std::optional<CameraModel> cam1;
+  std::optional<StereoMatcher> matcher;
+  cv::Ptr<cv::CLAHE> clahe;
+  std::uint64_t frames = 0;
+  // Last cam1 pixel of each stereo-matched feature, for the next prediction.
+  std::unordered_map<std::uint64_t, cv::Point2f> lastStereo;
+  double medianDepth;
+
+  Impl(const FrontendConfig& c, const CameraCalibration& c0, const CameraCalibration* c1)
+      : cfg(shared(c)), tracker(CameraModel(c0.intrinsics), cfg.tracker), medianDepth(c.stereo.defaultDepth) {
+    if (c1) {
+      cam1.emplace(c1->intrinsics);
+      // x_c1 = T_C1B T_BC0 x_c0.
+      matcher.emplace(tracker.camera(), *cam1, inverse(c1->T_BS) * c0.T_BS, cfg.stereo);
+    }
+    if (c.equalize == Equalization::Clahe) clahe = cv::createCLAHE(3.0, cv::Size(8, 8));
+  }
+};
+
+StereoFrontend::StereoFrontend(const FrontendConfig& config, const CameraCalibration& cam0, const CameraCalibration* cam1)
+    : impl_(std::make_unique<Impl>(config, cam0, cam1)) {}
+StereoFrontend::~StereoFrontend() = default;
+StereoFrontend::StereoFrontend(StereoFrontend&&) noexcept = default;
+StereoFrontend& StereoFrontend::operator=(StereoFrontend&&) noexcept = default;
+
+const CameraModel& StereoFrontend::camera(int i) const {
+  if (i == 0) return impl_->tracker.camera();
+  if (i == 1 && impl_->cam1) return *impl_->cam1;
+  throw std::out_of_range("StereoFrontend::camera");
+}
+
+bool StereoFrontend::stereo() const { return impl_->matcher.has_value() && impl_->cfg.useStereo; }
+
+FeatureFrame StereoFrontend::process(std::int64_t t_ns, const cv::Mat& leftIn, const cv::Mat& rightIn,
+                                     const Eigen::Matrix3d* R_cur_prev) {
+  Impl& s = *impl_;
+  const auto tStart = Clock::now();
+  FeatureFrame out;
+  out.t_ns = t_ns;
+  out.index = s.frames++;
+  const CameraModel& cam0 = s.tracker.camera();
+  checkImage(leftIn, cam0, "cam0");
+  const bool doStereo = stereo() && !rightIn.empty();
+  if (doStereo) checkImage(rightIn, *s.cam1, "cam1");
+
+  auto t0 = Clock::now();
+  cv::Mat left = leftIn, right = rightIn;
+  if (s.cfg.equalize == Equalization::Clahe) {
+    s.clahe->apply(leftIn, left);
+    if (doStereo) s.clahe->apply(rightIn, right);
+  } else if (s.cfg.equalize == Equalization::Histogram) {
+    cv::equalizeHist(leftIn, left);
+    if (doStereo) cv::equalizeHist(rightIn, right);
+  }
+  const ImagePyramid leftPyr(left, s.cfg.tracker.klt);
+  ImagePyramid rightPyr;
+  if (doStereo) rightPyr = ImagePyramid(right, s.cfg.tracker.klt);
+  out.timing.pyramid = msSince(t0);
+
+  s.tracker.process(leftPyr, R_cur_prev, &out.timing);
+  const auto& pts = s.tracker.points();
+  const auto& prevPts = s.tracker.previousPoints();
+  const auto& ids = s.tracker.ids();
+  const auto& lengths = s.tracker.trackLengths();
+
+  out.features.resize(pts.size());
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    FeatureObservation& f = out.features[i];
+    f.id = ids[i];
+    f.trackLength = lengths[i];
+    f.pixel0 = {pts[i].x, pts[i].y};
+    f.normalized0 = cam0.undistort(f.pixel0);
+  }
+
+  if (doStereo) {
+    t0 = Clock::now();
+    // Start from last frame's right pixel moved by the left motion, or from the median depth.
+    std::vector<cv::Point2f> rightPts(pts.size(), cv::Point2f(std::nanf(""), 0.f));
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      const auto it = s.lastStereo.find(ids[i]);
+      if (it != s.lastStereo.end() && lengths[i] > 1) rightPts[i] = it->second + (pts[i] - prevPts[i]);
+    }
+    std::vector<unsigned char> status;
+    s.matcher->match(leftPyr, rightPyr, pts, rightPts, status, s.medianDepth);
+    s.lastStereo.clear();
+    std::vector<double> depths;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      if (!status[i]) continue;
+      FeatureObservation& f = out.features[i];
+      f.stereo = true;
+      f.pixel1 = {rightPts[i].x, rightPts[i].y};
+      f.normalized1 = s.cam1->undistort(f.pixel1);
+      s.lastStereo.emplace(ids[i], rightPts[i]);
+      if (const auto z = s.matcher->depth(f.normalized0, f.normalized1)) depths.push_back(*z);
+    }
+    if (!depths.empty()) {
+      std::nth_element(depths.begin(), depths.begin() + static_cast<long>(depths.size() / 2), depths.end());
+      s.medianDepth = depths[depths.size() / 2];
+    }
+    out.timing.stereo = msSince(t0);
+  }
+  out.timing.total = msSince(tStart);
+  return out;
+}
+
+}  // namespace gvins::vio
