@@ -2,27 +2,40 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <vector>
 
 namespace gvins::sri {
 
 namespace {
 
-/// Householder reflector H = I − τ v vᵀ, v = [1; x̃], with H [α; x] = [β; 0]
-/// (the convention of LAPACK's xLARFG). On return alpha = β and x = x̃. Scaled to avoid
-/// overflow/underflow of the squared norm.
-template <typename Scalar, typename Vec>
-Scalar makeReflector(Scalar& alpha, Vec&& x) {
-  if (x.size() == 0) return Scalar(0);
-  const Scalar xmax = x.cwiseAbs().maxCoeff();
-  if (xmax == Scalar(0)) return Scalar(0);
-  const Scalar scale = std::max(xmax, std::abs(alpha));
-  const Scalar inv = Scalar(1) / scale;
-  const Scalar a = alpha * inv;
-  const Scalar norm = scale * std::sqrt(a * a + (x * inv).squaredNorm());
+/// Householder reflector H = I − τ v vᵀ, v = [1; x̃], with H [α; x] = [β; 0] (the convention of
+/// LAPACK's xLARFG), for a contiguous x[0..n). On return alpha = β and x = x̃. The norm is
+/// scaled when the squares could under- or overflow.
+template <typename Scalar>
+Scalar makeReflectorRaw(Scalar& alpha, Scalar* x, int n) {
+  Scalar ss = 0;
+  for (int i = 0; i < n; ++i) ss += x[i] * x[i];
+  if (ss == Scalar(0)) return Scalar(0);
+  Scalar norm;
+  // Unscaled unless the squares may have lost precision to underflow or overflowed.
+  constexpr Scalar kSmall = std::numeric_limits<Scalar>::min() / std::numeric_limits<Scalar>::epsilon();
+  constexpr Scalar kBig = std::numeric_limits<Scalar>::max() / Scalar(4);
+  if (ss > kSmall && ss < kBig && alpha * alpha < kBig) {
+    norm = std::sqrt(alpha * alpha + ss);
+  } else {
+    Scalar xmax = std::abs(alpha);
+    for (int i = 0; i < n; ++i) xmax = std::max(xmax, std::abs(x[i]));
+    const Scalar inv = Scalar(1) / xmax;
+    Scalar sc = (alpha * inv) * (alpha * inv);
+    for (int i = 0; i < n; ++i) sc += (x[i] * inv) * (x[i] * inv);
+    norm = xmax * std::sqrt(sc);
+  }
   const Scalar beta = alpha >= Scalar(0) ? -norm : norm;
   const Scalar tau = (beta - alpha) / beta;
-  x *= Scalar(1) / (alpha - beta);
+  const Scalar scale = Scalar(1) / (alpha - beta);
+  for (int i = 0; i < n; ++i) x[i] *= scale;
   alpha = beta;
   return tau;
 }
@@ -51,144 +64,390 @@ inline Scalar makeGivens(Scalar a, Scalar b, Scalar& c, Scalar& s) {
   return rho;
 }
 
-/// x ← c·x + s·y, y ← c·y − s·x over n contiguous entries.
+#if defined(__GNUC__) || defined(__clang__)
+#define GVINS_SRI_VECTOR_EXT 1
+/// 16-byte SIMD vector of Scalar (GCC/Clang vector extension; SSE2 on x86-64 by default, wider
+/// registers are combined from these when the target allows).
 template <typename Scalar>
-inline void rotateRows(Scalar* __restrict x, Scalar* __restrict y, int n, Scalar c, Scalar s) {
-  for (int t = 0; t < n; ++t) {
-    const Scalar xv = x[t];
-    const Scalar yv = y[t];
-    x[t] = c * xv + s * yv;
-    y[t] = c * yv - s * xv;
+struct Simd {
+  typedef Scalar type __attribute__((vector_size(16)));
+  static constexpr int kLanes = 16 / static_cast<int>(sizeof(Scalar));
+  static type load(const Scalar* p) {
+    type v;
+    std::memcpy(&v, p, sizeof(v));
+    return v;
+  }
+  static void store(Scalar* p, type v) { std::memcpy(p, &v, sizeof(v)); }
+  static type broadcast(Scalar s) { return type{} + s; }
+};
+#endif
+
+/// Qᵀ = I − V Tᵀ Vᵀ of P reflectors (V = [I_P; V_W]) applied to the columns [t0, len) of the P
+/// pivot rows x[p] of R and of the a rows of W (row i at w0 + i·ws): Z = X + V_Wᵀ W,
+/// Z ← Tᵀ Z, X −= Z, W −= V_W Z. V_W(i, p) = v[p·a + i] (column-major); T is P×P upper
+/// triangular, column-major.
+template <typename Scalar, int P>
+void applyReflectorsScalar(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a, int t0, int len,
+                           const Scalar* v, const Scalar* T) {
+  for (; t0 < len; ++t0) {
+    Scalar zr[P];
+    for (int p = 0; p < P; ++p) zr[p] = x[p][t0];
+    for (int i = 0; i < a; ++i) {
+      const Scalar wv = w0[i * ws + t0];
+      for (int p = 0; p < P; ++p) zr[p] += v[p * a + i] * wv;
+    }
+    for (int p = P - 1; p >= 0; --p) {
+      Scalar acc = T[p * P + p] * zr[p];
+      for (int q = 0; q < p; ++q) acc += T[p * P + q] * zr[q];
+      zr[p] = acc;
+    }
+    for (int p = 0; p < P; ++p) x[p][t0] -= zr[p];
+    for (int i = 0; i < a; ++i) {
+      Scalar acc = 0;
+      for (int p = 0; p < P; ++p) acc += v[p * a + i] * zr[p];
+      w0[i * ws + t0] -= acc;
+    }
   }
 }
+
+/// As applyReflectorsScalar on [0, len), register-blocked: per chunk of 2 SIMD vectors the P
+/// rows of Z stay in registers while the rows of W stream through twice. vb holds V_W(i, p)
+/// broadcast to full vectors at vb[i·P + p] (SSE2 has no cheap broadcast from memory).
+template <typename Scalar, int P>
+void applyReflectors(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a, int len,
+                     const Scalar* v, [[maybe_unused]] const void* vb, const Scalar* T) {
+  int t0 = 0;
+#ifdef GVINS_SRI_VECTOR_EXT
+  using V = Simd<Scalar>;
+  using Vec = typename V::type;
+  constexpr int L = V::kLanes;
+  const Vec* vv = static_cast<const Vec*>(vb);
+  for (; t0 + 2 * L <= len; t0 += 2 * L) {
+    Vec z0[P];
+    Vec z1[P];
+    for (int p = 0; p < P; ++p) {
+      z0[p] = V::load(x[p] + t0);
+      z1[p] = V::load(x[p] + t0 + L);
+    }
+    for (int i = 0; i < a; ++i) {
+      const Scalar* wi = w0 + i * ws + t0;
+      const Vec a0 = V::load(wi);
+      const Vec a1 = V::load(wi + L);
+      for (int p = 0; p < P; ++p) {
+        const Vec vp = vv[i * P + p];
+        z0[p] += vp * a0;
+        z1[p] += vp * a1;
+      }
+    }
+    for (int p = P - 1; p >= 0; --p) {  // Z ← Tᵀ Z (Tᵀ lower triangular)
+      const Vec tpp = V::broadcast(T[p * P + p]);
+      Vec acc0 = tpp * z0[p];
+      Vec acc1 = tpp * z1[p];
+      for (int q = 0; q < p; ++q) {
+        const Vec tq = V::broadcast(T[p * P + q]);
+        acc0 += tq * z0[q];
+        acc1 += tq * z1[q];
+      }
+      z0[p] = acc0;
+      z1[p] = acc1;
+    }
+    for (int p = 0; p < P; ++p) {
+      V::store(x[p] + t0, V::load(x[p] + t0) - z0[p]);
+      V::store(x[p] + t0 + L, V::load(x[p] + t0 + L) - z1[p]);
+    }
+    for (int i = 0; i < a; ++i) {
+      Scalar* wi = w0 + i * ws + t0;
+      Vec a0 = V::load(wi);
+      Vec a1 = V::load(wi + L);
+      for (int p = 0; p < P; ++p) {
+        const Vec vp = vv[i * P + p];
+        a0 -= vp * z0[p];
+        a1 -= vp * z1[p];
+      }
+      V::store(wi, a0);
+      V::store(wi + L, a1);
+    }
+  }
+#endif
+  applyReflectorsScalar<Scalar, P>(x, w0, ws, a, t0, len, v, T);
+}
+
+/// Columns (reflectors) per panel of the Householder update. Four reflectors × two SIMD vectors
+/// fill 8 of the 16 SSE registers with the panel's Z; measured faster at n = 150…400 than wider
+/// panels whose trailing update goes through Eigen's matrix products (docs/sri_core.md).
+constexpr int kFusedPanel = 4;
 
 }  // namespace
 
 template <typename Scalar>
 void householderRowUpdate(RowMatrixView<Scalar> R, VectorView<Scalar> r, RowMatrixView<Scalar> W,
-                          VectorView<Scalar> z, std::span<const int> lead, int panel) {
-  using Matrix = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
-  using RowMat = RowMatrix<Scalar>;
-  using Vector = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
+                          VectorView<Scalar> z, std::span<const int> lead) {
   const int k = static_cast<int>(R.rows());
   const int m = static_cast<int>(W.rows());
   if (m == 0 || k == 0 || lead.empty() || lead[0] >= k) return;
-  panel = std::max(1, std::min(panel, k));
-
-  Matrix T = Matrix::Zero(panel, panel);
-  RowMat Y(panel, k);
-  RowMat Y2(panel, k);
-  Vector tau(panel);
-  Vector tmp(panel);
-  Eigen::Matrix<Scalar, 1, Eigen::Dynamic> wv(panel);
-
-  int a = 0;  // active rows: lead < end of panel
+  const std::ptrdiff_t ws = W.outerStride();
+  // Narrow panels: the panel's columns of W are copied to a contiguous column-major block,
+  // its reflectors broadcast to SIMD vectors for the register-blocked kernel.
+  std::vector<Scalar> vc(static_cast<std::size_t>(kFusedPanel * m));
+#ifdef GVINS_SRI_VECTOR_EXT
+  std::vector<typename Simd<Scalar>::type> vb(static_cast<std::size_t>(kFusedPanel * m));
+  void* vbp = vb.data();
+#else
+  void* vbp = nullptr;
+#endif
+  int a = 0;  // active rows: lead < end of the panel
   for (int j0 = lead[0]; j0 < k;) {
-    const int jb = std::min(panel, k - j0);
-    while (a < m && lead[static_cast<std::size_t>(a)] < j0 + jb) ++a;
-    if (a == 0) {  // cannot happen (lead[0] < k), kept for safety
-      j0 += jb;
-      continue;
-    }
-    // --- Panel factorization (unblocked), columns j0 .. j0+jb−1.
-    for (int jj = 0; jj < jb; ++jj) {
-      const int j = j0 + jj;
-      auto v = W.col(j).head(a);
-      tau(jj) = makeReflector<Scalar>(R(j, j), v);
-      const int ncols = jb - jj - 1;
-      if (tau(jj) != Scalar(0) && ncols > 0) {
-        auto Rrow = R.row(j).segment(j + 1, ncols);
-        auto Wb = W.block(0, j + 1, a, ncols);
-        auto w = wv.head(ncols);
-        w.noalias() = v.transpose() * Wb;
-        w += Rrow;
-        Rrow -= tau(jj) * w;
-        Wb.noalias() -= (tau(jj) * v) * w;
-      }
-    }
-    auto V = W.block(0, j0, a, jb);
-    // --- T of the compact WY form Q = H_1 ⋯ H_jb = I − V T Vᵀ, V = [I; V_W].
-    auto Tb = T.topLeftCorner(jb, jb);
-    Tb.setZero();
-    for (int jj = 0; jj < jb; ++jj) {
-      Tb(jj, jj) = tau(jj);
-      if (jj > 0 && tau(jj) != Scalar(0)) {
-        auto t = tmp.head(jj);
-        t.noalias() = V.leftCols(jj).transpose() * V.col(jj);
-        t *= -tau(jj);
-        Tb.col(jj).head(jj).noalias() =
-            Tb.topLeftCorner(jj, jj).template triangularView<Eigen::Upper>() * t;
-      }
-    }
-    // --- Apply Qᵀ = I − V Tᵀ Vᵀ to the trailing columns and to the right-hand side.
-    const int c1 = j0 + jb;
-    const int nt = k - c1;
-    if (nt > 0) {
-      auto CA = R.block(j0, c1, jb, nt);
-      auto CB = W.block(0, c1, a, nt);
-      auto Yb = Y.topLeftCorner(jb, nt);
-      auto Y2b = Y2.topLeftCorner(jb, nt);
-      Yb.noalias() = V.transpose() * CB;
-      Yb += CA;
-      Y2b.noalias() = Tb.transpose().template triangularView<Eigen::Lower>() * Yb;
-      CA -= Y2b;
-      CB.noalias() -= V * Y2b;
-    }
     {
-      auto y = tmp.head(jb);
-      y.noalias() = V.transpose() * z.head(a);
-      y += r.segment(j0, jb);
-      Vector y2 = Tb.transpose().template triangularView<Eigen::Lower>() * y;
-      r.segment(j0, jb) -= y2;
-      z.head(a).noalias() -= V * y2;
+      const int jb = std::min(kFusedPanel, k - j0);
+      while (a < m && lead[static_cast<std::size_t>(a)] < j0 + jb) ++a;
+      Scalar* V = vc.data();
+      for (int i = 0; i < a; ++i) {
+        const Scalar* wi = &W(i, j0);
+        for (int p = 0; p < jb; ++p) V[p * a + i] = wi[p];
+      }
+      Scalar tauv[kFusedPanel];
+      for (int jj = 0; jj < jb; ++jj) {
+        const int j = j0 + jj;
+        Scalar* v = V + jj * a;
+        const Scalar t = makeReflectorRaw<Scalar>(R(j, j), v, a);
+        tauv[jj] = t;
+        if (t == Scalar(0)) continue;
+        for (int c = jj + 1; c < jb; ++c) {
+          Scalar* vcol = V + c * a;
+          Scalar dot = R(j, j0 + c);
+          for (int i = 0; i < a; ++i) dot += v[i] * vcol[i];
+          dot *= t;
+          R(j, j0 + c) -= dot;
+          for (int i = 0; i < a; ++i) vcol[i] -= dot * v[i];
+        }
+      }
+      // T (column-major jb×jb): T_{1:q−1,q} = −τ_q T_{1:q−1,1:q−1} V_Wᵀ v_q.
+      Scalar Tc[kFusedPanel * kFusedPanel] = {};
+      for (int q = 0; q < jb; ++q) {
+        Tc[q * jb + q] = tauv[q];
+        if (tauv[q] == Scalar(0)) continue;
+        Scalar g[kFusedPanel];
+        for (int p = 0; p < q; ++p) {
+          Scalar d = 0;
+          for (int i = 0; i < a; ++i) d += V[p * a + i] * V[q * a + i];
+          g[p] = -tauv[q] * d;
+        }
+        for (int p = 0; p < q; ++p) {
+          Scalar acc = 0;
+          for (int l = p; l < q; ++l) acc += Tc[l * jb + p] * g[l];
+          Tc[q * jb + p] = acc;
+        }
+      }
+#ifdef GVINS_SRI_VECTOR_EXT
+      auto* vbv = static_cast<typename Simd<Scalar>::type*>(vbp);
+      for (int i = 0; i < a; ++i) {
+        for (int p = 0; p < jb; ++p) vbv[i * jb + p] = Simd<Scalar>::broadcast(V[p * a + i]);
+      }
+#endif
+      const int c1 = j0 + jb;
+      const int nt = k - c1;
+      Scalar* x[kFusedPanel];
+      Scalar* xr[kFusedPanel];
+      for (int p = 0; p < jb; ++p) {
+        x[p] = &R(j0 + p, 0) + c1;
+        xr[p] = r.data() + j0 + p;
+      }
+      Scalar* w0 = &W(0, 0) + c1;
+      switch (jb) {
+        case 4:
+          applyReflectors<Scalar, 4>(x, w0, ws, a, nt, V, vbp, Tc);
+          applyReflectorsScalar<Scalar, 4>(xr, z.data(), 1, a, 0, 1, V, Tc);
+          break;
+        case 3:
+          applyReflectors<Scalar, 3>(x, w0, ws, a, nt, V, vbp, Tc);
+          applyReflectorsScalar<Scalar, 3>(xr, z.data(), 1, a, 0, 1, V, Tc);
+          break;
+        case 2:
+          applyReflectors<Scalar, 2>(x, w0, ws, a, nt, V, vbp, Tc);
+          applyReflectorsScalar<Scalar, 2>(xr, z.data(), 1, a, 0, 1, V, Tc);
+          break;
+        default:
+          applyReflectors<Scalar, 1>(x, w0, ws, a, nt, V, vbp, Tc);
+          applyReflectorsScalar<Scalar, 1>(xr, z.data(), 1, a, 0, 1, V, Tc);
+          break;
+      }
+      j0 += jb;
     }
-    j0 += jb;
   }
 }
+
+namespace {
+
+template <typename Scalar, int P>
+void chainRotationsScalar(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a, int t0, int len,
+                          const Scalar* C, const Scalar* S, int ld) {
+  for (; t0 < len; ++t0) {
+    Scalar xr[P];
+    for (int p = 0; p < P; ++p) xr[p] = x[p][t0];
+    for (int i = 0; i < a; ++i) {
+      Scalar wv = w0[i * ws + t0];
+      for (int p = 0; p < P; ++p) {
+        const Scalar c = C[p * ld + i];
+        const Scalar sn = S[p * ld + i];
+        const Scalar xv = xr[p];
+        xr[p] = c * xv + sn * wv;
+        wv = c * wv - sn * xv;
+      }
+      w0[i * ws + t0] = wv;
+    }
+    for (int p = 0; p < P; ++p) x[p][t0] = xr[p];
+  }
+}
+
+/// Applies, on the columns [0, len) of P pivot rows x[p] and of the a rows of W (row stride
+/// ws), the rotations of P consecutive columns: for every row i of W and p = 0..P−1 in turn,
+/// (x_p, w_i) ← (c x_p + s w_i, c w_i − s x_p) with (c, s) = (C[p·ld + i], S[p·ld + i]).
+/// This order is a valid reordering of "all rotations of column p, then of column p+1": two
+/// rotations that do not share a row commute. The pivot rows of a chunk of 2 SIMD vectors stay
+/// in registers while the rows of W stream through once (register blocking). cb, sb hold the
+/// same c, s broadcast to SIMD vectors at [i·P + p].
+template <typename Scalar, int P>
+void chainRotations(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a, int len,
+                    const Scalar* C, const Scalar* S, int ld, [[maybe_unused]] const void* cb,
+                    [[maybe_unused]] const void* sb) {
+  int t0 = 0;
+#ifdef GVINS_SRI_VECTOR_EXT
+  using V = Simd<Scalar>;
+  using Vec = typename V::type;
+  constexpr int L = V::kLanes;
+  for (; t0 + 2 * L <= len; t0 += 2 * L) {
+    Vec x0[P];
+    Vec x1[P];
+    for (int p = 0; p < P; ++p) {
+      x0[p] = V::load(x[p] + t0);
+      x1[p] = V::load(x[p] + t0 + L);
+    }
+    for (int i = 0; i < a; ++i) {
+      Scalar* wi = w0 + i * ws + t0;
+      Vec w0v = V::load(wi);
+      Vec w1v = V::load(wi + L);
+      for (int p = 0; p < P; ++p) {
+        const Vec c = static_cast<const Vec*>(cb)[i * P + p];
+        const Vec sn = static_cast<const Vec*>(sb)[i * P + p];
+        const Vec a0 = x0[p];
+        const Vec a1 = x1[p];
+        x0[p] = c * a0 + sn * w0v;
+        x1[p] = c * a1 + sn * w1v;
+        w0v = c * w0v - sn * a0;
+        w1v = c * w1v - sn * a1;
+      }
+      V::store(wi, w0v);
+      V::store(wi + L, w1v);
+    }
+    for (int p = 0; p < P; ++p) {
+      V::store(x[p] + t0, x0[p]);
+      V::store(x[p] + t0 + L, x1[p]);
+    }
+  }
+#endif
+  chainRotationsScalar<Scalar, P>(x, w0, ws, a, t0, len, C, S, ld);
+}
+
+/// Columns handled per pass by the Givens update.
+constexpr int kGivensPanel = 4;
+
+}  // namespace
 
 template <typename Scalar>
 void givensRowUpdate(RowMatrixView<Scalar> R, VectorView<Scalar> r, RowMatrixView<Scalar> W,
                      VectorView<Scalar> z, std::span<const int> lead) {
+  constexpr int P = kGivensPanel;
   const int k = static_cast<int>(R.rows());
   const int m = static_cast<int>(W.rows());
   if (m == 0 || k == 0 || lead.empty() || lead[0] >= k) return;
-  std::vector<int> rows;
-  std::vector<Scalar> cs;
-  std::vector<Scalar> sn;
-  rows.reserve(static_cast<std::size_t>(m));
-  cs.reserve(static_cast<std::size_t>(m));
-  sn.reserve(static_cast<std::size_t>(m));
+  // Rotation (c, s) of panel column p with row i of W at C[p·m + i], S[p·m + i] (and broadcast
+  // at cb[i·P + p], sb[i·P + p]); the panel's columns of W are copied to the column-major vc.
+  std::vector<Scalar> C(static_cast<std::size_t>(P * m));
+  std::vector<Scalar> S(static_cast<std::size_t>(P * m));
+  std::vector<Scalar> vc(static_cast<std::size_t>(P * m));
+#ifdef GVINS_SRI_VECTOR_EXT
+  using Vec = typename Simd<Scalar>::type;
+  std::vector<Vec> cbv(static_cast<std::size_t>(P * m));
+  std::vector<Vec> sbv(static_cast<std::size_t>(P * m));
+#endif
+  const std::ptrdiff_t ws = W.outerStride();
   int a = 0;
-  for (int j = lead[0]; j < k; ++j) {
-    while (a < m && lead[static_cast<std::size_t>(a)] <= j) ++a;
-    rows.clear();
-    cs.clear();
-    sn.clear();
-    Scalar p = R(j, j);
+  for (int j0 = lead[0]; j0 < k; j0 += P) {
+    const int pw = std::min(P, k - j0);
+    while (a < m && lead[static_cast<std::size_t>(a)] < j0 + pw) ++a;
+    const int pend = j0 + pw;
+    Scalar* V = vc.data();
     for (int i = 0; i < a; ++i) {
-      const Scalar w = W(i, j);
-      if (w == Scalar(0)) continue;
-      Scalar c;
-      Scalar s;
-      p = makeGivens(p, w, c, s);
-      W(i, j) = Scalar(0);
-      rows.push_back(i);
-      cs.push_back(c);
-      sn.push_back(s);
+      const Scalar* wi = &W(i, 0) + j0;
+      for (int q = 0; q < pw; ++q) V[q * a + i] = wi[q];
     }
-    if (rows.empty()) continue;
-    R(j, j) = p;
-    const int len = k - j - 1;
-    Scalar* prow = &R(j, j) + 1;
-    Scalar rj = r(j);
-    for (std::size_t q = 0; q < rows.size(); ++q) {
-      const int i = rows[q];
-      if (len > 0) rotateRows(prow, &W(i, j) + 1, len, cs[q], sn[q]);
-      const Scalar zi = z(i);
-      z(i) = cs[q] * zi - sn[q] * rj;
-      rj = cs[q] * rj + sn[q] * zi;
+    // Panel: the rotations of each column, applied at once to the rest of the panel.
+    for (int q = 0; q < pw; ++q) {
+      Scalar* cq = C.data() + static_cast<std::ptrdiff_t>(q) * m;
+      Scalar* sq = S.data() + static_cast<std::ptrdiff_t>(q) * m;
+      const int j = j0 + q;
+      Scalar piv = R(j, j);
+      Scalar* rj = &R(j, 0);
+      const Scalar* vq = V + q * a;
+      for (int i = 0; i < a; ++i) {
+        const Scalar wv = vq[i];
+        if (wv == Scalar(0)) {
+          cq[i] = Scalar(1);
+          sq[i] = Scalar(0);
+          continue;
+        }
+        Scalar c;
+        Scalar sn;
+        piv = makeGivens(piv, wv, c, sn);
+        cq[i] = c;
+        sq[i] = sn;
+        for (int col = q + 1; col < pw; ++col) {
+          const Scalar xv = rj[j0 + col];
+          const Scalar yv = V[col * a + i];
+          rj[j0 + col] = c * xv + sn * yv;
+          V[col * a + i] = c * yv - sn * xv;
+        }
+      }
+      R(j, j) = piv;
     }
-    r(j) = rj;
+    // Trailing columns, all panel rotations in one pass.
+    const int len = k - pend;
+    if (len > 0) {
+      Scalar* x[P];
+      for (int q = 0; q < pw; ++q) x[q] = &R(j0 + q, 0) + pend;
+      Scalar* w0 = &W(0, 0) + pend;
+#ifdef GVINS_SRI_VECTOR_EXT
+      for (int i = 0; i < a; ++i) {
+        for (int q = 0; q < pw; ++q) {
+          cbv[static_cast<std::size_t>(i * pw + q)] = Simd<Scalar>::broadcast(C[q * m + i]);
+          sbv[static_cast<std::size_t>(i * pw + q)] = Simd<Scalar>::broadcast(S[q * m + i]);
+        }
+      }
+      const void* cb = cbv.data();
+      const void* sb = sbv.data();
+#else
+      const void* cb = nullptr;
+      const void* sb = nullptr;
+#endif
+      switch (pw) {
+        case 4: chainRotations<Scalar, 4>(x, w0, ws, a, len, C.data(), S.data(), m, cb, sb); break;
+        case 3: chainRotations<Scalar, 3>(x, w0, ws, a, len, C.data(), S.data(), m, cb, sb); break;
+        case 2: chainRotations<Scalar, 2>(x, w0, ws, a, len, C.data(), S.data(), m, cb, sb); break;
+        default: chainRotations<Scalar, 1>(x, w0, ws, a, len, C.data(), S.data(), m, cb, sb); break;
+      }
+    }
+    // Right-hand side.
+    for (int q = 0; q < pw; ++q) {
+      const Scalar* cq = C.data() + static_cast<std::ptrdiff_t>(q) * m;
+      const Scalar* sq = S.data() + static_cast<std::ptrdiff_t>(q) * m;
+      Scalar rv = r(j0 + q);
+      for (int i = 0; i < a; ++i) {
+        const Scalar zi = z(i);
+        z(i) = cq[i] * zi - sq[i] * rv;
+        rv = cq[i] * rv + sq[i] * zi;
+      }
+      r(j0 + q) = rv;
+    }
   }
 }
 
@@ -265,7 +524,7 @@ void sweepColumnsToFront(RowMatrixView<Scalar> R, VectorView<Scalar> r, int c, i
 
 #define GVINS_SRI_INSTANTIATE(S)                                                              \
   template void householderRowUpdate<S>(RowMatrixView<S>, VectorView<S>, RowMatrixView<S>,    \
-                                        VectorView<S>, std::span<const int>, int);            \
+                                        VectorView<S>, std::span<const int>);                 \
   template void givensRowUpdate<S>(RowMatrixView<S>, VectorView<S>, RowMatrixView<S>,         \
                                    VectorView<S>, std::span<const int>);                      \
   template void sweepColumnsToFront<S>(RowMatrixView<S>, VectorView<S>, int, int, int);

@@ -43,9 +43,7 @@ Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic> priorFactor(const Prior<Sc
 }  // namespace
 
 template <typename Scalar>
-SriFilter<Scalar>::SriFilter(SriOptions options) : options_(options) {
-  if (options_.panel < 1) options_.panel = 1;
-}
+SriFilter<Scalar>::SriFilter(SriOptions options) : options_(options) {}
 
 template <typename Scalar>
 RowMatrixView<Scalar> SriFilter<Scalar>::view(int row, int col, int rows, int cols) {
@@ -279,7 +277,7 @@ void SriFilter<Scalar>::reorder(std::span<const BlockId> order) {
     rt.setZero();
     householderRowUpdate<Scalar>(Rt, rt,
                                  RowMatrixView<Scalar>(W.data(), k, k, Eigen::OuterStride<>(k)),
-                                 VectorView<Scalar>(z.data(), k), sortedLead, options_.panel);
+                                 VectorView<Scalar>(z.data(), k), sortedLead);
   }
   layout_ = std::move(next);
   estimates_ = std::move(est);
@@ -441,8 +439,7 @@ UpdateResult<Scalar> SriFilter<Scalar>::update(const Measurement<Scalar>& m,
     if (scheme == RotationScheme::kGivens) {
       givensRowUpdate<Scalar>(view(c0, c0, k, k), rview(c0, k), W, z, lead_);
     } else {
-      householderRowUpdate<Scalar>(view(c0, c0, k, k), rview(c0, k), W, z, lead_,
-                                   options_.panel);
+      householderRowUpdate<Scalar>(view(c0, c0, k, k), rview(c0, k), W, z, lead_);
     }
   }
   result.chi2 = z.squaredNorm() + m.discardedChiSquare();
@@ -498,7 +495,7 @@ std::optional<ChiSquare<Scalar>> SriFilter<Scalar>::chiSquare(const Measurement<
         RowMatrixView<Scalar>(U.data(), rows, rows, Eigen::OuterStride<>(rows)),
         VectorView<Scalar>(ru.data(), rows),
         RowMatrixView<Scalar>(W.data(), k, rows, Eigen::OuterStride<>(rows)),
-        VectorView<Scalar>(zw.data(), k), lead, options_.panel);
+        VectorView<Scalar>(zw.data(), k), lead);
     U.transpose().template triangularView<Eigen::Lower>().solveInPlace(zp);
   }
   out.value = zp.squaredNorm() + m.discardedChiSquare();

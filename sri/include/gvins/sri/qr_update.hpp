@@ -6,11 +6,12 @@
 //
 // Kernels:
 // - householderRowUpdate: QR of [R r; W z] where R (k×k) is upper triangular and the rows of W
-//   are sorted by their first non-zero column ("lead"). Blocked Householder with the compact WY
-//   representation Q = I − V T Vᵀ (Schreiber & Van Loan 1989), specialised to the
-//   triangular-over-pentagonal structure (V = [I; V_W], as in LAPACK's xTPQRT): a reflector for
-//   column j only involves row j of R and the rows of W whose lead is ≤ j, and the trailing
-//   columns are updated with two matrix products per panel.
+//   are sorted by their first non-zero column ("lead"). Householder reflectors in the compact WY
+//   form Q = I − V T Vᵀ (Schreiber & Van Loan 1989) specialised to the triangular-over-
+//   pentagonal structure (V = [I; V_W], as in LAPACK's xTPQRT): a reflector for column j only
+//   involves row j of R and the rows of W whose lead is ≤ j. Panels of 4 reflectors are applied
+//   to the trailing columns by a register-blocked SIMD kernel (one pass over W per panel for
+//   Z = X + V_Wᵀ W, one for W −= V_W TᵀZ).
 // - givensRowUpdate: the same factorization with Givens rotations between row j of R and each
 //   active row of W. About 1.5× the flops of Householder and no level-3 operations, but each
 //   rotation only combines two rows with coefficients c, s ∈ [−1, 1]; light rows are never
@@ -47,14 +48,15 @@ enum class RotationScheme : unsigned char {
 /// - R: k×k upper triangular (entries below the diagonal must be zero), r: k.
 /// - W: m×k, z: m. Rows sorted so that lead[i] (first column that may be non-zero in row i;
 ///   k for an all-zero row) is non-decreasing.
-/// On return R, r hold R', r'; W is overwritten (its columns hold Householder vectors) and z
-/// holds the post-update residuals: ‖z‖² is the rows' contribution to the least-squares cost,
-/// i.e. the chi-square of the update (see sri_filter.hpp). `panel` is the block size.
+/// On return R, r hold R', r'; the contents of W are unspecified and z holds the post-update
+/// residuals: ‖z‖² is the rows' contribution to the least-squares cost,
+/// i.e. the chi-square of the update (see sri_filter.hpp).
 template <typename Scalar>
 void householderRowUpdate(RowMatrixView<Scalar> R, VectorView<Scalar> r, RowMatrixView<Scalar> W,
-                          VectorView<Scalar> z, std::span<const int> lead, int panel = 24);
+                          VectorView<Scalar> z, std::span<const int> lead);
 
-/// Same factorization as householderRowUpdate with Givens rotations; on return W is zero.
+/// Same factorization as householderRowUpdate with Givens rotations (panels of 4 columns whose
+/// rotations are applied to the trailing columns in one register-blocked pass).
 template <typename Scalar>
 void givensRowUpdate(RowMatrixView<Scalar> R, VectorView<Scalar> r, RowMatrixView<Scalar> W,
                      VectorView<Scalar> z, std::span<const int> lead);
@@ -71,10 +73,10 @@ void sweepColumnsToFront(RowMatrixView<Scalar> R, VectorView<Scalar> r, int c, i
 
 extern template void householderRowUpdate<float>(RowMatrixView<float>, VectorView<float>,
                                                  RowMatrixView<float>, VectorView<float>,
-                                                 std::span<const int>, int);
+                                                 std::span<const int>);
 extern template void householderRowUpdate<double>(RowMatrixView<double>, VectorView<double>,
                                                   RowMatrixView<double>, VectorView<double>,
-                                                  std::span<const int>, int);
+                                                  std::span<const int>);
 extern template void givensRowUpdate<float>(RowMatrixView<float>, VectorView<float>,
                                             RowMatrixView<float>, VectorView<float>,
                                             std::span<const int>);

@@ -58,8 +58,6 @@
 namespace gvins::sri {
 
 struct SriOptions {
-  /// Panel width of the blocked Householder update.
-  int panel = 24;
   /// kAuto switches an update to Givens rotations when (largest entry of the new whitened rows)
   /// / (smallest non-zero row of R that the rows meet) exceeds auto_givens_ratio_float (float) or
   /// auto_givens_ratio_double (double). See docs/sri_core.md for the measurement behind these.

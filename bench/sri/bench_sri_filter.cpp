@@ -1,0 +1,220 @@
+// Speed of the SRI core on sliding-window states of n = 150/300/400 with m = 40/60 new rows
+// (vio_window.hpp), in float and double:
+//   Update          SriFilter::update (blocked Householder, rows scattered and sorted by lead)
+//   UpdateGivens    the same with Givens rotations (the row-wise stable path)
+//   DenseQR         Eigen::HouseholderQR of the whole stack [R r; W z], (n+m) × (n+1)
+//   EkfUpdate       covariance-form EKF update of the same rows (P Hᵀ on the touched columns,
+//                   S, Cholesky, P ← P − K (P Hᵀ)ᵀ)
+//   MargOldestClone SriFilter::marginalize of the oldest clone, paper order (after the features)
+//                   or clones-first order (a free prefix drop); a new clone is appended each
+//                   iteration to keep n constant (included in the time)
+//   MargDenseQR     the naive alternative: permute the clone first and HouseholderQR all of R
+//   EkfMarg         covariance form: delete the clone's rows and columns of P
+//   Solve           back-substitution R Δx = r
+#include <benchmark/benchmark.h>
+
+#include <deque>
+
+#include <Eigen/Cholesky>
+#include <Eigen/QR>
+
+#include "vio_window.hpp"
+
+namespace gvins::sri::bench {
+namespace {
+
+template <typename S>
+void BM_Update(benchmark::State& state) {
+  Window<S> w;
+  buildWindow(w, windowFor(static_cast<int>(state.range(0))), Order::kPaper);
+  const Measurement<S> z = vioRows(w, static_cast<int>(state.range(1)));
+  UpdateOptions opt;
+  opt.scheme = RotationScheme::kBlockedHouseholder;
+  for (auto _ : state) {
+    auto res = w.filter.update(z, opt);
+    benchmark::DoNotOptimize(res);
+  }
+}
+
+template <typename S>
+void BM_UpdateGivens(benchmark::State& state) {
+  Window<S> w;
+  buildWindow(w, windowFor(static_cast<int>(state.range(0))), Order::kPaper);
+  const Measurement<S> z = vioRows(w, static_cast<int>(state.range(1)));
+  UpdateOptions opt;
+  opt.scheme = RotationScheme::kGivens;
+  for (auto _ : state) {
+    auto res = w.filter.update(z, opt);
+    benchmark::DoNotOptimize(res);
+  }
+}
+
+template <typename S>
+void BM_DenseQR(benchmark::State& state) {
+  using Mat = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>;
+  Window<S> w;
+  buildWindow(w, windowFor(static_cast<int>(state.range(0))), Order::kPaper);
+  const Measurement<S> z = vioRows(w, static_cast<int>(state.range(1)));
+  const int n = w.filter.dim();
+  const int m = z.rows();
+  Mat A = Mat::Zero(n + m, n + 1);
+  A.topLeftCorner(n, n) = w.filter.squareRootInformation();
+  A.topRightCorner(n, 1) = w.filter.residual();
+  A.bottomLeftCorner(m, n) = denseRows(w.filter, z);
+  A.bottomRightCorner(m, 1) = z.residual();
+  Mat B(n + m, n + 1);
+  Eigen::HouseholderQR<Mat> qr(n + m, n + 1);
+  for (auto _ : state) {
+    B = A;
+    qr.compute(B);
+    benchmark::DoNotOptimize(qr.matrixQR().data());
+  }
+}
+
+template <typename S>
+void BM_EkfUpdate(benchmark::State& state) {
+  using Mat = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>;
+  using Vec = Eigen::Matrix<S, Eigen::Dynamic, 1>;
+  Window<S> w;
+  buildWindow(w, windowFor(static_cast<int>(state.range(0))), Order::kPaper);
+  const Measurement<S> z = vioRows(w, static_cast<int>(state.range(1)));
+  const int n = w.filter.dim();
+  const int m = z.rows();
+  const Mat P0 = w.filter.fullCovariance();
+  const Mat H = denseRows(w.filter, z);
+  int c0 = n;
+  for (int j = 0; j < n && c0 == n; ++j) {
+    if (!H.col(j).isZero(0)) c0 = j;
+  }
+  const int k = n - c0;
+  const Mat Ht = H.rightCols(k);
+  Mat P = P0;
+  Vec x = Vec::Zero(n);
+  Mat PHt(n, m);
+  Mat Sm(m, m);
+  Mat K(n, m);
+  const Vec r = z.residual();
+  for (auto _ : state) {
+    PHt.noalias() = P.rightCols(k) * Ht.transpose();
+    Sm.noalias() = Ht * PHt.bottomRows(k);
+    Sm.diagonal().array() += S(1);
+    Eigen::LLT<Mat> llt(Sm);
+    K = llt.solve(PHt.transpose()).transpose();
+    x.noalias() += K * r;
+    P.noalias() -= K * PHt.transpose();
+    benchmark::DoNotOptimize(P.data());
+    state.PauseTiming();
+    P = P0;  // keep it positive definite
+    state.ResumeTiming();
+  }
+}
+
+template <typename S>
+void BM_MargOldestClone(benchmark::State& state) {
+  Window<S> w;
+  const Order order = state.range(1) == 0 ? Order::kPaper : Order::kClonesFirst;
+  buildWindow(w, windowFor(static_cast<int>(state.range(0))), order);
+  std::deque<BlockId> clones(w.clones.begin(), w.clones.end());
+  const Prior<S> prior = Prior<S>::stdDev(6, S(1));
+  const auto zero = BlockEstimate<S>::zero(BlockKind::kPose, 6);
+  for (auto _ : state) {
+    w.filter.marginalize(clones.front());
+    clones.pop_front();
+    // Keep n constant: a new clone after the last one.
+    clones.push_back(w.filter.addBlock(BlockSpec::pose("clone"), zero, prior,
+                                       Placement::after(clones.back())));
+  }
+}
+
+template <typename S>
+void BM_MargDenseQR(benchmark::State& state) {
+  using Mat = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>;
+  Window<S> w;
+  buildWindow(w, windowFor(static_cast<int>(state.range(0))), Order::kPaper);
+  const int n = w.filter.dim();
+  const BlockInfo& c = w.filter.layout().block(w.clones.front());
+  const Mat R = w.filter.squareRootInformation();
+  // Columns [clone | everything else | r].
+  Mat A(n, n + 1);
+  A.leftCols(c.dim) = R.middleCols(c.offset, c.dim);
+  A.middleCols(c.dim, c.offset) = R.leftCols(c.offset);
+  A.middleCols(c.offset + c.dim, n - c.offset - c.dim) = R.rightCols(n - c.offset - c.dim);
+  A.col(n) = w.filter.residual();
+  Mat B(n, n + 1);
+  Eigen::HouseholderQR<Mat> qr(n, n + 1);
+  for (auto _ : state) {
+    B = A;
+    qr.compute(B);
+    benchmark::DoNotOptimize(qr.matrixQR().data());
+  }
+}
+
+template <typename S>
+void BM_EkfMarg(benchmark::State& state) {
+  using Mat = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic>;
+  Window<S> w;
+  buildWindow(w, windowFor(static_cast<int>(state.range(0))), Order::kPaper);
+  const int n = w.filter.dim();
+  const BlockInfo& c = w.filter.layout().block(w.clones.front());
+  const Mat P = w.filter.fullCovariance();
+  Mat Q(n - 6, n - 6);
+  const int o = c.offset;
+  const int t = n - o - 6;
+  for (auto _ : state) {
+    Q.topLeftCorner(o, o) = P.topLeftCorner(o, o);
+    Q.topRightCorner(o, t) = P.topRightCorner(o, t);
+    Q.bottomLeftCorner(t, o) = P.bottomLeftCorner(t, o);
+    Q.bottomRightCorner(t, t) = P.bottomRightCorner(t, t);
+    benchmark::DoNotOptimize(Q.data());
+  }
+}
+
+template <typename S>
+void BM_Solve(benchmark::State& state) {
+  Window<S> w;
+  buildWindow(w, windowFor(static_cast<int>(state.range(0))), Order::kPaper);
+  w.filter.rawResidual().setOnes();
+  for (auto _ : state) {
+    auto dx = w.filter.solve();
+    benchmark::DoNotOptimize(dx.data());
+  }
+}
+
+void sizes(benchmark::internal::Benchmark* b) {
+  for (int n : {150, 300, 400}) {
+    for (int m : {40, 60}) b->Args({n, m});
+  }
+  b->Unit(benchmark::kMicrosecond);
+}
+void margSizes(benchmark::internal::Benchmark* b) {
+  for (int n : {150, 300, 400}) {
+    for (int order : {0, 1}) b->Args({n, order});
+  }
+  b->Unit(benchmark::kMicrosecond);
+}
+void nSizes(benchmark::internal::Benchmark* b) {
+  for (int n : {150, 300, 400}) b->Args({n});
+  b->Unit(benchmark::kMicrosecond);
+}
+
+BENCHMARK(BM_Update<double>)->Apply(sizes);
+BENCHMARK(BM_Update<float>)->Apply(sizes);
+BENCHMARK(BM_UpdateGivens<double>)->Apply(sizes);
+BENCHMARK(BM_UpdateGivens<float>)->Apply(sizes);
+BENCHMARK(BM_DenseQR<double>)->Apply(sizes);
+BENCHMARK(BM_DenseQR<float>)->Apply(sizes);
+BENCHMARK(BM_EkfUpdate<double>)->Apply(sizes);
+BENCHMARK(BM_EkfUpdate<float>)->Apply(sizes);
+BENCHMARK(BM_MargOldestClone<double>)->Apply(margSizes);
+BENCHMARK(BM_MargOldestClone<float>)->Apply(margSizes);
+BENCHMARK(BM_MargDenseQR<double>)->Apply(nSizes);
+BENCHMARK(BM_MargDenseQR<float>)->Apply(nSizes);
+BENCHMARK(BM_EkfMarg<double>)->Apply(nSizes);
+BENCHMARK(BM_EkfMarg<float>)->Apply(nSizes);
+BENCHMARK(BM_Solve<double>)->Apply(nSizes);
+BENCHMARK(BM_Solve<float>)->Apply(nSizes);
+
+}  // namespace
+}  // namespace gvins::sri::bench
+
+BENCHMARK_MAIN();
