@@ -72,7 +72,8 @@ void BM_GlonassRk4(benchmark::State& state) {
 }
 BENCHMARK(BM_GlonassRk4)->Arg(60)->Arg(300)->Arg(900)->Arg(1800);
 
-// Store: selection of the record and state, per satellite in view of the file's epoch.
+// Store: selection of the record and state, per satellite of the file (79, of which 66 have a
+// usable record at 08:20; the others cost only the failed selection).
 void BM_StoreSatelliteState(benchmark::State& state) {
   EphemerisStore store;
   store.add(nav());
@@ -86,7 +87,7 @@ void BM_StoreSatelliteState(benchmark::State& state) {
     benchmark::DoNotOptimize(st);
     if (++i == sats.size()) {
       i = 0;
-      dt += 1.0;
+      dt = dt >= 299.0 ? 0.0 : dt + 1.0;  // 08:20-08:25, the span of the nagoya observations
     }
   }
   state.SetItemsProcessed(state.iterations());
