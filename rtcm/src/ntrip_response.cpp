@@ -231,6 +231,9 @@ void NtripResponse::end() {
                                              ? "caster closed the connection without answering"
                                              : "caster closed the connection inside its status line");
     case State::Headers:
+      // Some casters (RTKLIB's) send only the status line of an error and close.
+      if (status_ != 200 && status_ != 0) finishHeaders();
+      if (sourceTableType_) failSourceTable();
       throw NtripError(Kind::Connection, "caster closed the connection inside its response header");
     case State::SourceTable:
       failSourceTable();

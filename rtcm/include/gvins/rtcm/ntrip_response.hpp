@@ -29,7 +29,11 @@ class NtripResponse {
   /// incomplete header, a source table, a chunk cut short).
   void end();
 
-  bool headerComplete() const { return state_ >= State::Raw && state_ != State::SourceTable; }
+  /// The caster accepted the request: the stream may follow (after "ICY 200 OK" optional header
+  /// lines are still recognised and stripped when stream bytes arrive).
+  bool headerComplete() const {
+    return state_ == State::IcyHeaders || (state_ >= State::Raw && state_ != State::SourceTable);
+  }
   /// First line of the response ("ICY 200 OK", "HTTP/1.1 200 OK").
   const std::string& statusLine() const { return statusLine_; }
   bool chunked() const { return chunked_; }

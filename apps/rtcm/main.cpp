@@ -1,0 +1,47 @@
+// gvins-rtcm: RTCM 3 streams from files, pipes and NTRIP casters.
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "gvins/base/parse_error.hpp"
+#include "gvins/rtcm/ntrip_error.hpp"
+#include "stream_summary.hpp"
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: gvins-rtcm <command> ...\n"
+    "  info FILE|- [--date YYYY-MM-DD]\n"
+    "      one row per message type (type, count, description), time span, station, CRC failures\n"
+    "  to-rinex FILE|- --date YYYY-MM-DD -o PREFIX [--interval S]\n"
+    "      writes PREFIX.obs (RINEX 3.04 observations) and PREFIX.nav (RINEX 3.04 navigation)\n"
+    "  ntrip URL -o FILE|- [--duration S] [--frames N] [--version 1|2] [--timeout S] [--gga NMEA]\n"
+    "      records an NTRIP stream; URL = ntrip://user:pass@host:port/MOUNT\n";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace gvins::rtcm_app;
+  if (argc < 2 || std::string(argv[1]) == "-h" || std::string(argv[1]) == "--help") {
+    std::cerr << kUsage;
+    return argc < 2 ? 2 : 0;
+  }
+  const std::string cmd = argv[1];
+  const std::vector<std::string> args(argv + 2, argv + argc);
+  try {
+    if (cmd == "info") return runInfo(args);
+    if (cmd == "to-rinex") return runToRinex(args);
+    if (cmd == "ntrip") return runNtrip(args);
+    throw UsageError("unknown command '" + cmd + "'");
+  } catch (const UsageError& e) {
+    std::cerr << "gvins-rtcm: " << e.what() << "\n" << kUsage;
+    return 2;
+  } catch (const gvins::rtcm::NtripError& e) {
+    std::cerr << "\ngvins-rtcm: NTRIP: " << e.what() << "\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "gvins-rtcm: " << e.what() << "\n";
+    return 1;
+  }
+}

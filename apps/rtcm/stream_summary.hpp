@@ -1,0 +1,47 @@
+// Shared pieces of the gvins-rtcm commands: input reading, reference time, the summary table.
+#pragma once
+
+#include <cstdio>
+#include <optional>
+#include <ostream>
+#include <string>
+
+#include "gvins/base/gnss_time.hpp"
+#include "gvins/rtcm/decoder.hpp"
+
+namespace gvins::rtcm_app {
+
+/// Thrown for command-line mistakes; main prints it with the usage hint and exits with 2.
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// "YYYY-MM-DD" to 12:00 GPST of that day; throws UsageError.
+GpsTime parseDate(const std::string& text);
+
+/// Opens FILE or "-" (stdin); throws std::runtime_error naming the file.
+std::FILE* openInput(const std::string& path);
+
+/// Reference time for a file: the --date option, else the first absolute time found in the file
+/// (1020 with N4, 1042, 1045/1046), else nullopt (the decoder then uses the host clock).
+/// Prints what it chose to stderr.
+std::optional<GpsTime> referenceFor(const std::string& path, const std::optional<GpsTime>& date);
+
+/// Feeds a whole input through the decoder in chunks; `onItem` gets every decoded item.
+template <class F>
+void decodeAll(std::FILE* in, rtcm::Decoder& dec, F&& onItem) {
+  std::vector<std::uint8_t> buf(1 << 16);
+  for (;;) {
+    const std::size_t n = std::fread(buf.data(), 1, buf.size(), in);
+    if (n > 0) dec.feed({buf.data(), n});
+    while (auto item = dec.poll()) onItem(*item);
+    if (n < buf.size()) break;
+  }
+  dec.finish();
+  while (auto item = dec.poll()) onItem(*item);
+}
+
+/// Per-message table, time span, station, ephemerides, errors.
+void printSummary(std::ostream& out, const rtcm::Decoder& dec, const std::string& name);
+
+}  // namespace gvins::rtcm_app

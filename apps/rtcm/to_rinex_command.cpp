@@ -1,0 +1,167 @@
+// gvins-rtcm to-rinex FILE|- --date YYYY-MM-DD -o PREFIX
+// Two passes over the stream (stdin is spooled to a temporary file first): the first collects
+// the observation types, station description, GLONASS channels and epoch span for the header,
+// the second writes PREFIX.obs (RINEX 3.04) epoch by epoch; PREFIX.nav (RINEX 3.04) holds every
+// distinct ephemeris record.
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <tuple>
+
+#include "commands.hpp"
+#include "gvins/base/rinex_obs_writer.hpp"
+#include "gvins/ephemeris/rinex_nav.hpp"
+#include "stream_summary.hpp"
+
+namespace gvins::rtcm_app {
+namespace {
+
+/// Opens the input for a second reading: a file again, or stdin spooled to a temporary file.
+std::FILE* reopenable(const std::string& path) {
+  if (path != "-") return openInput(path);
+  std::FILE* tmp = std::tmpfile();
+  if (!tmp) throw std::runtime_error(std::string("cannot create a temporary file: ") + std::strerror(errno));
+  std::vector<char> buf(1 << 16);
+  std::size_t n;
+  while ((n = std::fread(buf.data(), 1, buf.size(), stdin)) > 0) std::fwrite(buf.data(), 1, n, tmp);
+  std::rewind(tmp);
+  return tmp;
+}
+
+/// Header column order: by band, attribute, then C L D S.
+void sortTypes(RinexObsHeader& h) {
+  auto rank = [](ObsType t) { return t == ObsType::Code ? 0 : t == ObsType::Phase ? 1 : t == ObsType::Doppler ? 2 : 3; };
+  for (auto& list : h.obsTypes) {
+    std::stable_sort(list.begin(), list.end(), [&](const ObsDescriptor& a, const ObsDescriptor& b) {
+      return std::make_tuple(a.code.band, a.code.attr, rank(a.type)) < std::make_tuple(b.code.band, b.code.attr, rank(b.type));
+    });
+  }
+}
+
+/// Adds b's satellites/signals into a (same epoch time delivered twice).
+void mergeEpoch(ObsEpoch& a, const ObsEpoch& b) {
+  for (const SatObs& s : b.sats) {
+    SatObs& t = a.add(s.sat);
+    for (const SignalObs& g : s.signals) {
+      if (!t.find(g.code)) t.signals.push_back(g);
+    }
+  }
+}
+
+}  // namespace
+
+int runToRinex(const std::vector<std::string>& args) {
+  std::string path, prefix;
+  std::optional<GpsTime> date;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == "--date" && i + 1 < args.size()) date = parseDate(args[++i]);
+    else if (args[i] == "-o" && i + 1 < args.size()) prefix = args[++i];
+    else if (args[i].size() > 1 && args[i][0] == '-') throw UsageError("to-rinex: unknown option '" + args[i] + "'");
+    else if (path.empty()) path = args[i];
+    else throw UsageError("to-rinex: more than one input");
+  }
+  if (path.empty()) throw UsageError("to-rinex: no input (FILE or -)");
+  if (!date) throw UsageError("to-rinex: --date YYYY-MM-DD is required (RTCM times carry no date)");
+  if (prefix.empty()) throw UsageError("to-rinex: no output prefix (-o PREFIX)");
+
+  std::FILE* in = reopenable(path);
+  rtcm::DecoderOptions opt;
+  opt.referenceTime = date;
+  opt.streamName = path;
+
+  // Pass 1: header contents, ephemerides.
+  RinexObsHeader header;
+  NavData nav;
+  std::map<std::tuple<int, int, std::int64_t, int>, bool> seen;  // sat index, message, toe, iode
+  std::map<std::int64_t, int> spacing;  // epoch spacing in ms -> count
+  std::optional<GpsTime> first, last, prev;
+  std::int64_t epochs = 0;
+  rtcm::Decoder scan(opt);
+  decodeAll(in, scan, [&](const rtcm::Decoded& item) {
+    if (const auto* e = std::get_if<ObsEpoch>(&item)) {
+      header.addTypesFrom(*e);
+      if (prev && e->time > *prev) ++spacing[std::llround((e->time - *prev) * 1000.0)];
+      if (!prev || e->time != *prev) ++epochs;
+      if (!first || e->time < *first) first = e->time;
+      if (!last || e->time > *last) last = e->time;
+      prev = e->time;
+    } else if (const auto* k = std::get_if<KeplerEphemeris>(&item)) {
+      const auto key = std::make_tuple(satIndex(k->sat), static_cast<int>(k->message), k->toe.wholeSeconds(), k->iode);
+      if (!seen[key]) nav.kepler.push_back(*k);
+      seen[key] = true;
+    } else if (const auto* g = std::get_if<GlonassEphemeris>(&item)) {
+      const auto key = std::make_tuple(satIndex(g->sat), -1, g->toe.wholeSeconds(), g->iode);
+      if (!seen[key]) nav.glonass.push_back(*g);
+      seen[key] = true;
+    }
+  });
+  sortTypes(header);
+  header.station = scan.station();
+  if (header.station.markerName.empty()) header.station.markerName = std::filesystem::path(path == "-" ? "RTCM" : path).stem().string();
+  header.glonassChannels = scan.glonassChannels();
+  header.firstObs = first;
+  header.lastObs = last;
+  if (!spacing.empty()) {
+    header.interval = static_cast<double>(std::max_element(spacing.begin(), spacing.end(), [](const auto& a, const auto& b) {
+                                            return a.second < b.second;
+                                          })->first) * 1e-3;
+  }
+  if (first) header.leapSeconds = leapSecondsAtGpst(*first);
+  header.signalStrengthUnit = "DBHZ";
+  header.comments.push_back("converted from RTCM 3 by gvins-rtcm (SRI-GVINS)");
+  if (scan.stats().beidouGpstEpochs > 0) {
+    header.comments.push_back("BeiDou MSM epochs stamped in GPST read as GPST: " + std::to_string(scan.stats().beidouGpstEpochs));
+  }
+  if (const auto& b = scan.glonassBiases()) {
+    const std::pair<const char*, std::optional<double>> biases[] = {{"C1C", b->l1ca}, {"C1P", b->l1p}, {"C2C", b->l2ca}, {"C2P", b->l2p}};
+    for (const auto& [code, value] : biases) header.glonassBiases.push_back({*ObsDescriptor::parse(code), value});
+  }
+
+  // Pass 2: observations.
+  std::rewind(in);
+  const std::string obsPath = prefix + ".obs";
+  std::ofstream obs(obsPath);
+  if (!obs) throw std::runtime_error("cannot create '" + obsPath + "'");
+  RinexObsWriter writer(obs, header, "gvins-rtcm");
+  rtcm::Decoder dec(opt);
+  std::optional<ObsEpoch> pending;
+  decodeAll(in, dec, [&](const rtcm::Decoded& item) {
+    const auto* e = std::get_if<ObsEpoch>(&item);
+    if (!e) return;
+    if (pending && pending->time == e->time) {
+      mergeEpoch(*pending, *e);
+      return;
+    }
+    if (pending) writer.write(*pending);
+    pending = *e;
+  });
+  if (pending) writer.write(*pending);
+  writer.finish();
+  obs.close();
+  if (in != stdin) std::fclose(in);
+
+  // Navigation file.
+  std::sort(nav.kepler.begin(), nav.kepler.end(), [](const KeplerEphemeris& a, const KeplerEphemeris& b) {
+    return std::make_tuple(a.sat, a.toe) < std::make_tuple(b.sat, b.toe);
+  });
+  std::sort(nav.glonass.begin(), nav.glonass.end(), [](const GlonassEphemeris& a, const GlonassEphemeris& b) {
+    return std::make_tuple(a.sat, a.toe) < std::make_tuple(b.sat, b.toe);
+  });
+  if (first) nav.leapSeconds = leapSecondsAtGpst(*first);
+  const std::string navPath = prefix + ".nav";
+  std::ofstream navOut(navPath);
+  if (!navOut) throw std::runtime_error("cannot create '" + navPath + "'");
+  writeRinexNav(navOut, nav, "gvins-rtcm");
+
+  std::cerr << "wrote " << obsPath << " (" << writer.epochsWritten() << " epochs";
+  if (writer.droppedValues() > 0) std::cerr << ", " << writer.droppedValues() << " values not representable";
+  std::cerr << ") and " << navPath << " (" << nav.kepler.size() << " Keplerian + " << nav.glonass.size()
+            << " GLONASS records)\n";
+  printSummary(std::cerr, dec, path == "-" ? "<stdin>" : path);
+  return 0;
+}
+
+}  // namespace gvins::rtcm_app
