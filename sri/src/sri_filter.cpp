@@ -412,8 +412,12 @@ UpdateResult<Scalar> SriFilter<Scalar>::update(const Measurement<Scalar>& m,
     z(s) = m.residual()(i);
     lead_[static_cast<std::size_t>(s)] = rowLead[static_cast<std::size_t>(i)] - c0;
     for (int b = 0; b < nb; ++b) {
+      // Columns of the block before c0 are zero in every row by the definition of c0.
       const auto J = m.jacobianAt(b);
-      W.row(s).segment(boff[static_cast<std::size_t>(b)] - c0, J.cols()) = J.row(i);
+      const int o = boff[static_cast<std::size_t>(b)];
+      const int skip = std::max(0, c0 - o);
+      const int len = static_cast<int>(J.cols()) - skip;
+      if (len > 0) W.row(s).segment(o + skip - c0, len) = J.row(i).tail(len);
     }
   }
   // Rotation scheme.

@@ -1,0 +1,318 @@
+// Measurement rows: whitening, null-space projection of nuisance columns (against the Schur
+// complement and against "feature as a state, then marginalized"), QR compression, stacking,
+// the chi-square test, uninformative priors and partially observed states, setEstimate.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <stdexcept>
+#include <vector>
+
+#include <Eigen/Cholesky>
+#include <Eigen/QR>
+
+#include "gvins/sri/sri_filter.hpp"
+
+namespace gvins::sri {
+namespace {
+
+using Md = Eigen::MatrixXd;
+using Vd = Eigen::VectorXd;
+
+Md randm(std::mt19937& rng, int r, int c) {
+  std::normal_distribution<double> g(0.0, 1.0);
+  Md m(r, c);
+  for (int i = 0; i < r; ++i) {
+    for (int j = 0; j < c; ++j) m(i, j) = g(rng);
+  }
+  return m;
+}
+
+TEST(Measurement, WhiteningVariants) {
+  std::mt19937 rng(1);
+  const int m = 4;
+  const Md H = randm(rng, m, 3);
+  const Vd r = randm(rng, m, 1);
+  const Md A = randm(rng, m, m);
+  const Md Sigma = A * A.transpose() + 0.5 * Md::Identity(m, m);
+  const Md Info = Sigma.inverse();
+  const BlockId id{7};
+  Measurement<double> z(m);
+  EXPECT_FALSE(z.isWhitened());
+  z.jacobian(id, 3) = H;
+  z.residual() = r;
+  z.whitenCovariance(Sigma);
+  EXPECT_TRUE(z.isWhitened());
+  const Md Hw = z.jacobianAt(0);
+  EXPECT_LT((Hw.transpose() * Hw - H.transpose() * Info * H).norm(), 1e-10);
+  EXPECT_LT((Hw.transpose() * z.residual() - H.transpose() * Info * r).norm(), 1e-10);
+  EXPECT_NEAR(z.residual().squaredNorm(), r.dot(Info * r), 1e-10);
+  // Square-root information S with SᵀS = Σ⁻¹.
+  Measurement<double> z2(m);
+  z2.jacobian(id, 3) = H;
+  z2.residual() = r;
+  Eigen::LLT<Md> llt(Info);
+  z2.whitenSqrtInformation(llt.matrixU());
+  EXPECT_LT((Md(z2.jacobianAt(0)).transpose() * z2.jacobianAt(0) - Hw.transpose() * Hw).norm(), 1e-10);
+  // Standard deviations.
+  Measurement<double> z3(m);
+  z3.jacobian(id, 3) = H;
+  z3.whitenStdDevs(Vd::Constant(m, 2.0));
+  EXPECT_LT((Md(z3.jacobianAt(0)) - H / 2).norm(), 1e-15);
+  EXPECT_THROW(z3.whitenStdDevs(Vd::Constant(m, -1.0)), std::invalid_argument);
+  EXPECT_THROW(z3.whitenCovariance(-Sigma), std::invalid_argument);
+  EXPECT_THROW(z3.jacobian(id, 2), std::invalid_argument);  // dimension changed
+}
+
+TEST(Measurement, NullSpaceProjectionEqualsSchurComplement) {
+  std::mt19937 rng(2);
+  const int m = 10;
+  const Md Hc1 = randm(rng, m, 6);
+  const Md Hc2 = randm(rng, m, 6);
+  const Md Hf = randm(rng, m, 3);
+  const Vd r = randm(rng, m, 1);
+  Measurement<double> z(m);
+  z.jacobian(BlockId{1}, 6) = Hc1;
+  z.jacobian(BlockId{2}, 6) = Hc2;
+  z.nuisance(3) = Hf;
+  z.residual() = r;
+  EXPECT_THROW(z.projectNuisance(), std::logic_error);  // not whitened yet
+  z.setWhitened();
+  EXPECT_EQ(z.projectNuisance(), 3);
+  EXPECT_EQ(z.rows(), m - 3);
+  EXPECT_EQ(z.nuisanceDim(), 0);
+  Md Hx(m, 12);
+  Hx << Hc1, Hc2;
+  // I − H_f (H_fᵀH_f)⁻¹ H_fᵀ: the orthogonal projector onto the left null space of H_f.
+  const Md Pn = Md::Identity(m, m) - Hf * (Hf.transpose() * Hf).inverse() * Hf.transpose();
+  const Md Hp = z.stackedJacobian();
+  EXPECT_LT((Hp.transpose() * Hp - Hx.transpose() * Pn * Hx).norm(), 1e-10);
+  EXPECT_LT((Hp.transpose() * z.residual() - Hx.transpose() * Pn * r).norm(), 1e-10);
+  EXPECT_NEAR(z.residual().squaredNorm(), r.dot(Pn * r), 1e-10);
+}
+
+// MSCKF equivalence: updating with the projected rows equals adding the feature as a state with
+// no prior information, updating with the full rows and marginalizing the feature.
+TEST(Measurement, ProjectionEqualsFeatureStateMarginalized) {
+  std::mt19937 rng(3);
+  const int m = 8;
+  auto makeFilter = [&](SriFilter<double>& f, std::vector<BlockId>& ids) {
+    std::mt19937 r2(9);
+    for (int i = 0; i < 3; ++i) {
+      ids.push_back(f.addBlock(BlockSpec::pose("c"), BlockEstimate<double>::zero(BlockKind::kPose, 6),
+                               Prior<double>::sqrtInformation(randm(r2, 9, 6))));
+    }
+  };
+  SriFilter<double> a;
+  SriFilter<double> b;
+  std::vector<BlockId> ia;
+  std::vector<BlockId> ib;
+  makeFilter(a, ia);
+  makeFilter(b, ib);
+  std::vector<Md> Hc;
+  for (int i = 0; i < 3; ++i) Hc.push_back(randm(rng, m, 6));
+  const Md Hf = randm(rng, m, 3);
+  const Vd r = randm(rng, m, 1);
+  Measurement<double> za(m);
+  for (int i = 0; i < 3; ++i) za.jacobian(ia[static_cast<std::size_t>(i)], 6) = Hc[static_cast<std::size_t>(i)];
+  za.nuisance(3) = Hf;
+  za.residual() = r;
+  za.whitenStdDev(0.7);
+  EXPECT_THROW(a.update(za), std::logic_error);  // nuisance still there
+  za.projectNuisance();
+  const auto ra = a.update(za);
+  const BlockId feat = b.addBlock(BlockSpec::vector("f", 3), BlockEstimate<double>::zero(BlockKind::kVector, 3),
+                                  Prior<double>::uninformative(), Placement::front());
+  Measurement<double> zb(m);
+  for (int i = 0; i < 3; ++i) zb.jacobian(ib[static_cast<std::size_t>(i)], 6) = Hc[static_cast<std::size_t>(i)];
+  zb.jacobian(feat, 3) = Hf;
+  zb.residual() = r;
+  zb.whitenStdDev(0.7);
+  const auto rb = b.update(zb);
+  b.marginalize(feat);
+  EXPECT_NEAR(ra.chi2, rb.chi2, 1e-10);
+  EXPECT_LT((a.fullCovariance() - b.fullCovariance()).norm(), 1e-10 * b.fullCovariance().norm());
+  EXPECT_LT((a.solve() - b.solve()).norm(), 1e-10);
+}
+
+TEST(Measurement, CompressionKeepsInformationAndChiSquare) {
+  std::mt19937 rng(4);
+  const int m = 40;
+  SriFilter<double> f1;
+  SriFilter<double> f2;
+  std::vector<BlockId> ids1;
+  std::vector<BlockId> ids2;
+  for (int i = 0; i < 3; ++i) {
+    ids1.push_back(f1.addBlock(BlockSpec::vector("x", 4), BlockEstimate<double>::zero(BlockKind::kVector, 4),
+                               Prior<double>::stdDev(4, 2.0)));
+    ids2.push_back(f2.addBlock(BlockSpec::vector("x", 4), BlockEstimate<double>::zero(BlockKind::kVector, 4),
+                               Prior<double>::stdDev(4, 2.0)));
+  }
+  // A tall stack built from two measurements (stack matches blocks by id), on 2 of 3 blocks.
+  const Md H0 = randm(rng, m / 2, 4), H1 = randm(rng, m / 2, 4), H2 = randm(rng, m / 2, 4);
+  const Vd r0 = randm(rng, m / 2, 1), r1 = randm(rng, m / 2, 1);
+  auto build = [&](const std::vector<BlockId>& ids) {
+    Measurement<double> a(m / 2);
+    a.jacobian(ids[1], 4) = H0;
+    a.jacobian(ids[2], 4) = H1;
+    a.residual() = r0;
+    a.whitenStdDev(0.5);
+    Measurement<double> b(m / 2);
+    b.jacobian(ids[2], 4) = H2;  // other order, one block only
+    b.residual() = r1;
+    b.whitenStdDev(0.5);
+    a.stack(b);
+    return a;
+  };
+  Measurement<double> full = build(ids1);
+  Measurement<double> small = build(ids2);
+  EXPECT_EQ(full.rows(), m);
+  EXPECT_EQ(small.compress(), m - 8);
+  EXPECT_EQ(small.rows(), 8);
+  EXPECT_EQ(small.discardedRows(), m - 8);
+  const Md Hf = full.stackedJacobian();
+  const Md Hs = small.stackedJacobian();
+  EXPECT_LT((Hs.transpose() * Hs - Hf.transpose() * Hf).norm(), 1e-10);
+  EXPECT_LT((Hs.transpose() * small.residual() - Hf.transpose() * full.residual()).norm(), 1e-10);
+  EXPECT_NEAR(small.residual().squaredNorm() + small.discardedChiSquare(), full.residual().squaredNorm(), 1e-10);
+  const auto pre = f2.chiSquare(small);
+  ASSERT_TRUE(pre.has_value());
+  const auto c1 = f1.update(full);
+  const auto c2 = f2.update(small);
+  EXPECT_NEAR(c1.chi2, c2.chi2, 1e-9);
+  EXPECT_NEAR(pre->value, c1.chi2, 1e-9);
+  EXPECT_EQ(c1.dof, m);
+  EXPECT_EQ(c2.dof, m);
+  EXPECT_EQ(pre->dof, m);
+  EXPECT_LT((f1.fullCovariance() - f2.fullCovariance()).norm(), 1e-12);
+  EXPECT_LT((f1.solve() - f2.solve()).norm(), 1e-12);
+}
+
+TEST(Measurement, ChiSquareAgainstCovarianceFormula) {
+  std::mt19937 rng(5);
+  SriFilter<double> f;
+  std::vector<BlockId> ids;
+  for (int i = 0; i < 4; ++i) {
+    ids.push_back(f.addBlock(BlockSpec::vector("x", 3), BlockEstimate<double>::zero(BlockKind::kVector, 3),
+                             Prior<double>::sqrtInformation(randm(rng, 5, 3))));
+  }
+  // A prior offset (r ≠ 0): the predicted residual must account for it.
+  f.rawResidual() = randm(rng, 12, 1);
+  const Md P = f.fullCovariance();
+  const Vd mean = f.solve();
+  Measurement<double> z(5);
+  const Md H1 = randm(rng, 5, 3), H3 = randm(rng, 5, 3);
+  z.jacobian(ids[1], 3) = H1;
+  z.jacobian(ids[3], 3) = H3;
+  z.residual() = randm(rng, 5, 1);
+  z.whitenStdDev(0.3);
+  Md H = Md::Zero(5, 12);
+  H.middleCols(3, 3) = H1 / 0.3;
+  H.middleCols(9, 3) = H3 / 0.3;
+  const Vd nu = z.residual() - H * mean;
+  const Md S = H * P * H.transpose() + Md::Identity(5, 5);
+  const double expect = nu.dot(S.ldlt().solve(nu));
+  const auto c = f.chiSquare(z);
+  ASSERT_TRUE(c.has_value());
+  EXPECT_NEAR(c->value, expect, 1e-10 * expect);
+  EXPECT_EQ(c->dof, 5);
+  const auto u = f.update(z);
+  EXPECT_NEAR(u.chi2, expect, 1e-10 * expect);
+  // Rows that touch nothing: χ² is ‖r‖² and R does not change.
+  const Md R0 = f.squareRootInformation();
+  Measurement<double> none(2);
+  none.jacobian(ids[0], 3).setZero();
+  none.residual() = Vd::Constant(2, 3.0);
+  none.setWhitened();
+  EXPECT_NEAR(f.chiSquare(none)->value, 18.0, 1e-12);
+  EXPECT_NEAR(f.update(none).chi2, 18.0, 1e-12);
+  EXPECT_EQ(f.squareRootInformation(), R0);
+}
+
+TEST(Measurement, ErrorsAreReported) {
+  SriFilter<double> f;
+  const BlockId x = f.addBlock(BlockSpec::vector("x", 2), BlockEstimate<double>::zero(BlockKind::kVector, 2),
+                               Prior<double>::stdDev(2, 1.0));
+  Measurement<double> z(1);
+  z.jacobian(x, 2).setOnes();
+  EXPECT_THROW(f.update(z), std::logic_error);  // not whitened
+  z.setWhitened();
+  Measurement<double> unknown(1);
+  unknown.jacobian(BlockId{12345}, 2).setOnes();
+  unknown.setWhitened();
+  EXPECT_THROW(f.update(unknown), std::out_of_range);
+  Measurement<double> wrongDim(1);
+  wrongDim.jacobian(x, 3).setOnes();
+  wrongDim.setWhitened();
+  EXPECT_THROW(f.update(wrongDim), std::invalid_argument);
+  EXPECT_THROW(f.addBlock(BlockSpec::vector("y", 2), BlockEstimate<double>::zero(BlockKind::kVector, 3),
+                          Prior<double>::stdDev(2, 1.0)),
+               std::invalid_argument);
+  EXPECT_THROW(f.addBlock(BlockSpec::vector("y", 2), BlockEstimate<double>::zero(BlockKind::kVector, 2),
+                          Prior<double>::covariance(-Md::Identity(2, 2))),
+               std::invalid_argument);
+  EXPECT_THROW(f.addBlock(BlockSpec::vector("y", 2), BlockEstimate<double>::zero(BlockKind::kVector, 2),
+                          Prior<double>::stdDev(2, 1.0), Placement::after(BlockId{999})),
+               std::out_of_range);
+  EXPECT_EQ(f.dim(), 2);  // failed additions left nothing behind
+}
+
+// Uninformative priors: the update is then ordinary weighted least squares; unobserved
+// components are reported, not invented.
+TEST(Measurement, UninformativePriorGivesLeastSquares) {
+  std::mt19937 rng(6);
+  SriFilter<double> f;
+  const BlockId a = f.addBlock(BlockSpec::vector("a", 3), BlockEstimate<double>::fromVector(Eigen::Vector3d(1, 1, 1)),
+                               Prior<double>::uninformative());
+  const BlockId b = f.addBlock(BlockSpec::vector("b", 2), BlockEstimate<double>::zero(BlockKind::kVector, 2),
+                               Prior<double>::uninformative());
+  // Before any measurement: nothing is known.
+  Measurement<double> probe(1);
+  probe.jacobian(a, 3).setOnes();
+  probe.setWhitened();
+  EXPECT_FALSE(f.chiSquare(probe).has_value());
+  EXPECT_THROW(f.covariance(std::vector<BlockId>{a}), std::domain_error);
+  // Observe only a (6 rows): b stays unobserved.
+  const Md H = randm(rng, 6, 3);
+  const Vd y = randm(rng, 6, 1);
+  Measurement<double> z(6);
+  z.jacobian(a, 3) = H;
+  z.residual() = y - H * Eigen::Vector3d(1, 1, 1);
+  z.whitenStdDev(0.2);
+  f.update(z);
+  EXPECT_THROW(f.covariance(std::vector<BlockId>{b}), std::domain_error);
+  f.correct();
+  const Vd ls = H.colPivHouseholderQr().solve(y);
+  EXPECT_LT((f.estimate(a).vector - ls).norm(), 1e-12);
+  EXPECT_EQ(f.estimate(b).vector, Eigen::Vector2d::Zero());  // left alone
+  // Marginal covariance of a: (HᵀH/σ²)⁻¹.
+  const Md Pa = (H.transpose() * H / 0.04).inverse();
+  // b has no information; a's block of R is invertible on its own because a comes first.
+  const Md R = f.squareRootInformation();
+  const Md Ra = R.topLeftCorner(3, 3);
+  EXPECT_LT(((Ra.transpose() * Ra).inverse() - Pa).norm(), 1e-12);
+}
+
+TEST(Measurement, SetEstimateKeepsTheDistribution) {
+  std::mt19937 rng(7);
+  SriFilter<double> f;
+  const BlockId p = f.addBlock(BlockSpec::pose("T"), BlockEstimate<double>::zero(BlockKind::kPose, 6),
+                               Prior<double>::sqrtInformation(randm(rng, 8, 6)));
+  const BlockId v = f.addBlock(BlockSpec::vector("v", 3), BlockEstimate<double>::fromVector(Eigen::Vector3d(1, 2, 3)),
+                               Prior<double>::sqrtInformation(randm(rng, 4, 3)));
+  Measurement<double> z(4);
+  z.jacobian(p, 6) = randm(rng, 4, 6);
+  z.jacobian(v, 3) = randm(rng, 4, 3);
+  z.residual() = randm(rng, 4, 1);
+  z.setWhitened();
+  f.update(z);
+  const Vd mean = f.solve();
+  const Vd vMean = f.estimate(v).vector + mean.tail(3);
+  const Md P = f.fullCovariance();
+  f.setEstimate(v, BlockEstimate<double>::fromVector(Eigen::Vector3d(-4, 0.5, 9)));
+  EXPECT_LT((f.estimate(v).vector + f.solve().tail(3) - vMean).norm(), 1e-12);
+  EXPECT_LT((f.solve().head(6) - mean.head(6)).norm(), 1e-12);
+  EXPECT_LT((f.fullCovariance() - P).norm(), 1e-12);
+}
+
+}  // namespace
+}  // namespace gvins::sri
