@@ -57,9 +57,13 @@ std::uint8_t lossOfLock(Decoder::State& s, SatId sat, ObsCode code, const GpsTim
     } else if (dt < 0.0) {
       lost = true;  // time went backwards: nothing can be assumed about continuity
     }
+  } else if (s.lastClosed && t - *s.lastClosed > 0.0) {
+    // First observation of a signal in a running stream (a rising satellite, a new signal): its
+    // phase starts a new ambiguity for every user, so it is flagged whatever the lock time says.
+    lost = true;
   } else {
-    // First observation of the signal: a lock shorter than the indicator's first step has just
-    // started.
+    // First epoch of the stream: only a lock shorter than the indicator's first step is known to
+    // have just started.
     lost = minMs == 0;
   }
   tr.last = t;

@@ -3,14 +3,18 @@
 // malformed and hostile input.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
 #include <random>
+#include <set>
 #include <sstream>
 
 #include "gvins/base/parse_error.hpp"
+#include "gvins/base/rinex_obs_reader.hpp"
 #include "gvins/rtcm/crc24q.hpp"
 #include "gvins/rtcm/decoder.hpp"
 #include "gvins/rtcm/encoder.hpp"
+#include "gvins/rtcm/framer.hpp"
 #include "gvins/rtcm/message_types.hpp"
 #include "independent_frame_scan.hpp"
 
@@ -255,6 +259,119 @@ TEST(Decoder, GmsdMsm7AcrossWeekRolloverWithBeidouInGpsTime) {
   // Truncated at the end of the file, nothing else lost.
   EXPECT_EQ(st.framing.truncatedFrames, 1);
   EXPECT_EQ(st.framing.crcFailures, 0);
+}
+
+TEST(Decoder, GmsdBeidouMatchesRtklib14SecondsApart) {
+  // RTKLIB converts only the BeiDou part of this log and stamps it 14 s late (it reads the GPS
+  // time of week in the BeiDou messages as BDT). Its values must equal ours at time - 14 s.
+  RinexObsReader ref((dataDir() / "reference/rtklib-2.4.3/rtcm_gmsd_convbin.obs.gz").string());
+  DecoderOptions opt;
+  opt.referenceTime = date(2012, 10, 13);
+  Decoder dec(opt);
+  const Decoded got = decodeAll(dec, readBytes(dataDir() / "rtcm/rtklib_GMSD7_20121014.rtcm3"));
+  std::map<std::int64_t, const ObsEpoch*> byTime;
+  for (const ObsEpoch& e : got.epochs) byTime[e.time.wholeSeconds()] = &e;
+  ObsEpoch r;
+  int epochs = 0;
+  std::int64_t values = 0, lliCompared = 0, lliGapOnlyOurs = 0;
+  double maxC = 0, maxL = 0, maxD = 0, maxS = 0;
+  std::set<std::uint32_t> prevSignals;
+  auto trackKey = [](SatId sat, ObsCode c) { return static_cast<std::uint32_t>(satIndex(sat) * 65536 + c.band * 256 + c.attr); };
+  while (ref.next(r)) {
+    std::set<std::uint32_t> signals;
+    const auto it = byTime.find((r.time - 14.0).wholeSeconds());
+    ASSERT_NE(it, byTime.end()) << r.time.toString();
+    const ObsEpoch& e = *it->second;
+    int bds = 0;
+    for (const SatObs& s : e.sats) bds += s.sat.system == System::BeiDou;
+    ASSERT_EQ(bds, static_cast<int>(r.sats.size())) << r.time.toString();
+    for (const SatObs& rs : r.sats) {
+      const SatObs* os = e.find(rs.sat);
+      ASSERT_NE(os, nullptr) << rs.sat.str();
+      ASSERT_EQ(os->signals.size(), rs.signals.size()) << rs.sat.str();
+      for (const SignalObs& rg : rs.signals) {
+        const SignalObs* og = os->find(rg.code);
+        ASSERT_NE(og, nullptr) << rs.sat.str() << " " << rg.code.str();
+        EXPECT_EQ(og->present, rg.present) << rs.sat.str() << " " << rg.code.str();
+        if (rg.hasCode()) maxC = std::max(maxC, std::abs(og->pseudorange - rg.pseudorange));
+        if (rg.hasPhase()) maxL = std::max(maxL, std::abs(og->carrierPhase - rg.carrierPhase));
+        if (rg.hasDoppler()) maxD = std::max(maxD, std::abs(og->doppler - rg.doppler));
+        if (rg.hasSnr()) maxS = std::max(maxS, std::abs(og->snr - rg.snr));
+        if (epochs > 0 && rg.hasPhase()) {
+          ++lliCompared;
+          if ((og->lli & 1) != (rg.lli & 1)) {
+            // RTKLIB flags a slip only when the indicator decreases; after a gap longer than the
+            // lock time the indicator can repeat. Every disagreement must be such a gap, flagged
+            // by us.
+            const bool gap = !prevSignals.count(trackKey(rs.sat, rg.code));
+            EXPECT_TRUE(gap && (og->lli & 1)) << rs.sat.str() << " " << rg.code.str() << " " << r.time.toString();
+            ++lliGapOnlyOurs;
+          }
+        }
+        signals.insert(trackKey(rs.sat, rg.code));
+        values += std::popcount(rg.present);
+      }
+    }
+    prevSignals = std::move(signals);
+    ++epochs;
+  }
+  std::cerr << "GMSD BeiDou vs RTKLIB (14 s apart): " << epochs << " epochs, " << values << " values, max |dC| " << maxC
+            << " m, |dL| " << maxL << " cycles, |dD| " << maxD << " Hz, |dS| " << maxS << " dB-Hz; LLI equal "
+            << lliCompared - lliGapOnlyOurs << "/" << lliCompared << " (others: re-acquisition after a gap)\n";
+  EXPECT_EQ(epochs, 257);
+  EXPECT_LE(lliGapOnlyOurs, 10);
+  EXPECT_LE(maxC, 0.0006);  // RINEX rounding (0.001)
+  EXPECT_LE(maxL, 0.0006);
+  EXPECT_LE(maxD, 0.001);  // RINEX rounding and RTKLIB's own wavelength arithmetic
+  // RTKLIB writes C/N0 rounded to 0.25 dB-Hz (its internal unit); MSM7 has 1/16 dB-Hz.
+  EXPECT_LE(maxS, 0.125 + 1e-9);
+}
+
+TEST(Decoder, StreamThatNeverClearsTheMultipleMessageBit) {
+  // Set DF393 on every MSM frame of the GMSD log (re-sealing the CRC): epochs must still come out,
+  // each closed by the next epoch's first message (the last one at the end of the stream), and be
+  // the same as those of the original log.
+  const auto bytes = readBytes(dataDir() / "rtcm/rtklib_GMSD7_20121014.rtcm3");
+  std::vector<std::uint8_t> patched;
+  Framer fr;
+  fr.feed(bytes);
+  Frame f;
+  int set = 0;
+  while (fr.next(f)) {
+    std::vector<std::uint8_t> p(f.payload.begin(), f.payload.end());
+    if (msmKind(f.type())) {
+      set += (p[6] & 0x02) == 0;
+      p[6] |= 0x02;  // DF393 is bit 54
+    }
+    const auto framed = Encoder::frame(p);
+    patched.insert(patched.end(), framed.begin(), framed.end());
+  }
+  ASSERT_EQ(set, 257);  // the last message of each epoch had it cleared
+  DecoderOptions opt;
+  opt.referenceTime = date(2012, 10, 13);
+  Decoder a(opt), b(opt);
+  const Decoded orig = decodeAll(a, bytes);
+  // Feed all but the end: the epoch in progress stays open until the stream ends.
+  b.feed(patched);
+  std::vector<ObsEpoch> got;
+  while (auto item = b.poll()) {
+    if (auto* e = std::get_if<ObsEpoch>(&*item)) got.push_back(*e);
+  }
+  EXPECT_EQ(got.size(), 256u);
+  b.finish();
+  while (auto item = b.poll()) {
+    if (auto* e = std::get_if<ObsEpoch>(&*item)) got.push_back(*e);
+  }
+  ASSERT_EQ(got.size(), orig.epochs.size());
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    EXPECT_EQ(got[i].time, orig.epochs[i].time);
+    ASSERT_EQ(got[i].sats.size(), orig.epochs[i].sats.size());
+    for (std::size_t k = 0; k < got[i].sats.size(); ++k) {
+      EXPECT_EQ(got[i].sats[k].sat, orig.epochs[i].sats[k].sat);
+      EXPECT_EQ(got[i].sats[k].signals.size(), orig.epochs[i].sats[k].signals.size());
+    }
+  }
+  EXPECT_EQ(b.stats().beidouGpstEpochs, 257);
 }
 
 TEST(Decoder, BeidouStampCheckLeavesCorrectBdtAlone) {

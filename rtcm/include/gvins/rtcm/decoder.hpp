@@ -7,7 +7,10 @@
 // announces more; an epoch is also closed when a message with a different time arrives, so a
 // stream that never clears the bit still yields epochs (one epoch late). Lock-time indicators
 // become RINEX loss-of-lock flags (bit 0) per satellite and signal, the MSM half-cycle flag becomes
-// bit 1. Legacy phase-range rollovers of +-1500 cycles (RTCM 10403.3, DF012 note) are undone.
+// bit 1. A signal is flagged when its lock-time indicator decreases, when the indicator's upper
+// bound is not longer than the time since the signal's last observation (re-acquired after a
+// gap), and at its first observation in a running stream (not in the stream's first epoch,
+// where only a zero lock time is flagged). Legacy phase-range rollovers of +-1500 cycles (RTCM 10403.3, DF012 note) are undone.
 //
 // Time. Times of week (GPS, Galileo, QZSS, SBAS; BeiDou BDT = GPST - 14 s), GLONASS times of day
 // (Moscow time) and truncated week numbers are resolved to the instant nearest a reference time.
