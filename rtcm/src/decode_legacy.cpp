@@ -18,7 +18,7 @@ constexpr std::int64_t kInvalidPrDiff = -8192;        // DF017/DF047: 0x2000
 // field (RTCM 10403.3, DF012 note).
 double phaseCycles(Decoder::State& s, SatId sat, ObsCode code, double pr, double diffMetres,
                    double lambda) {
-  SignalTrack& tr = s.tracks[trackKey(sat, code)];
+  SignalTrack& tr = track(s, sat, code);
   const double raw = diffMetres / lambda;
   if (tr.hasRawDiff) {
     const double jump = raw - tr.lastRawDiffCycles;

@@ -46,7 +46,7 @@ void closeEpoch(Decoder::State& s) {
 
 std::uint8_t lossOfLock(Decoder::State& s, SatId sat, ObsCode code, const GpsTime& t,
                         LockTimeKind kind, int indicator) {
-  SignalTrack& tr = s.tracks[trackKey(sat, code)];
+  SignalTrack& tr = track(s, sat, code);
   const std::int64_t minMs = lockTimeMinMs(kind, indicator);
   const std::int64_t maxMs = lockTimeMaxMs(kind, indicator);
   bool lost = false;

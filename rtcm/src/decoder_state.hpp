@@ -5,7 +5,6 @@
 #include <cstdint>
 #include <deque>
 #include <optional>
-#include <unordered_map>
 #include <vector>
 
 #include "gvins/rtcm/bit_reader.hpp"
@@ -45,7 +44,9 @@ struct Decoder::State {
   std::optional<GpsTime> lastClosed;
   bool lastClosedHasOthers = false;
 
-  std::unordered_map<std::uint32_t, SignalTrack> tracks;
+  /// Per satellite (satIndex) the tracks of its signals: a handful each, searched linearly.
+  std::vector<std::vector<std::pair<ObsCode, SignalTrack>>> tracks =
+      std::vector<std::vector<std::pair<ObsCode, SignalTrack>>>(static_cast<std::size_t>(numSatIndices()));
   /// Last full range (m) per satellite (satIndex) from 1002/1004/1010/1012 and MSM4-7, to
   /// resolve the whole milliseconds that 1001/1003/1009/1011 and MSM1-3 leave out.
   struct RangeTrack {
@@ -62,11 +63,13 @@ struct Decoder::State {
 
 // ---- helpers shared by the decoding units ---------------------------------------------------
 
-/// Key of a satellite/signal pair in State::tracks.
-inline std::uint32_t trackKey(SatId sat, ObsCode code) {
-  return (static_cast<std::uint32_t>(satIndex(sat)) << 16) |
-         (static_cast<std::uint32_t>(static_cast<unsigned char>(code.band)) << 8) |
-         static_cast<unsigned char>(code.attr);
+/// The track of a satellite's signal (created on first use).
+inline SignalTrack& track(Decoder::State& s, SatId sat, ObsCode code) {
+  auto& list = s.tracks[static_cast<std::size_t>(satIndex(sat))];
+  for (auto& [c, t] : list) {
+    if (c == code) return t;
+  }
+  return list.emplace_back(code, SignalTrack{}).second;
 }
 
 /// Loss-of-lock flag (RINEX LLI bit 0) of a signal observed at t with the given lock-time

@@ -2,7 +2,9 @@
 // payload, never past its end: reading beyond the payload throws MessageError naming the field.
 #pragma once
 
+#include <bit>
 #include <cstddef>
+#include <cstring>
 #include <cstdint>
 #include <span>
 
@@ -65,7 +67,8 @@ class BitReader {
     std::uint64_t w = 0;
     const std::size_t n = data_.size();
     if (byte + 8 <= n) {
-      for (int k = 0; k < 8; ++k) w = (w << 8) | data_[byte + static_cast<std::size_t>(k)];
+      std::memcpy(&w, data_.data() + byte, 8);
+      if constexpr (std::endian::native == std::endian::little) w = __builtin_bswap64(w);
     } else {
       for (std::size_t k = 0; k < 8; ++k) w = (w << 8) | (byte + k < n ? data_[byte + k] : 0u);
     }
