@@ -61,6 +61,10 @@ std::string NtripClient::request() const {
 
 void NtripClient::connect() {
   close();
+  // A fresh exchange (connect() also reconnects after a dropped stream).
+  response_ = NtripResponse(url_.mountpoint);
+  pending_.clear();
+  ended_ = false;
   const std::string where = url_.host + ":" + std::to_string(url_.port);
   addrinfo hints{};
   hints.ai_family = AF_UNSPEC;

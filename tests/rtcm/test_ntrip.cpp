@@ -168,9 +168,9 @@ TEST(NtripResponse, ErrorsAreClassified) {
 
 class ScriptedCaster {
  public:
-  /// Accepts one connection, reads the request, then sends `reply` (unless empty) and closes
-  /// after `holdSeconds`.
-  ScriptedCaster(std::vector<std::uint8_t> reply, double holdSeconds = 0.0) {
+  /// Accepts `connections` connections one after the other; on each reads the request, sends
+  /// `reply` (unless empty) and closes after `holdSeconds`.
+  ScriptedCaster(std::vector<std::uint8_t> reply, double holdSeconds = 0.0, int connections = 1) {
     fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
     sockaddr_in a{};
     a.sin_family = AF_INET;
@@ -180,8 +180,26 @@ class ScriptedCaster {
     socklen_t len = sizeof a;
     ::getsockname(fd_, reinterpret_cast<sockaddr*>(&a), &len);
     port_ = ntohs(a.sin_port);
-    ::listen(fd_, 1);
-    thread_ = std::thread([this, reply = std::move(reply), holdSeconds] {
+    ::listen(fd_, 4);
+    thread_ = std::thread([this, reply = std::move(reply), holdSeconds, connections] {
+      for (int k = 0; k < connections; ++k) serve(reply, holdSeconds);
+    });
+  }
+
+  ~ScriptedCaster() {
+    ::shutdown(fd_, SHUT_RDWR);
+    ::close(fd_);
+    if (thread_.joinable()) thread_.join();
+  }
+  int port() const { return port_; }
+  std::string request() {
+    if (thread_.joinable()) thread_.join();
+    return request_;
+  }
+
+ private:
+  void serve(const std::vector<std::uint8_t>& reply, double holdSeconds) {
+    {
       const int c = ::accept(fd_, nullptr, nullptr);
       if (c < 0) return;
       char buf[4096];
@@ -200,20 +218,9 @@ class ScriptedCaster {
       }
       std::this_thread::sleep_for(std::chrono::duration<double>(holdSeconds));
       ::close(c);
-    });
-  }
-  ~ScriptedCaster() {
-    ::shutdown(fd_, SHUT_RDWR);
-    ::close(fd_);
-    if (thread_.joinable()) thread_.join();
-  }
-  int port() const { return port_; }
-  std::string request() {
-    if (thread_.joinable()) thread_.join();
-    return request_;
+    }
   }
 
- private:
   int fd_ = -1;
   int port_ = 0;
   std::thread thread_;
@@ -265,6 +272,20 @@ TEST(NtripClient, Ntrip1RequestAndIcyAnswer) {
   const std::string req = caster.request();
   EXPECT_EQ(req.rfind("GET /TG HTTP/1.0\r\n", 0), 0u) << req;
   EXPECT_EQ(req.find("Ntrip-Version"), std::string::npos);
+
+}
+
+TEST(NtripClient, ReconnectsAfterTheStreamEnds) {
+  const auto data = readBytes(dataDir() / "rtcm/rtklib_testglo.rtcm3");
+  auto reply = bytesOf("ICY 200 OK\r\n");
+  reply.insert(reply.end(), data.begin(), data.end());
+  ScriptedCaster caster(reply, 0.0, 2);
+  NtripClient c(NtripUrl::parse("ntrip://u:p@127.0.0.1:" + std::to_string(caster.port()) + "/TG"));
+  for (int session = 0; session < 2; ++session) {
+    c.connect();
+    Decoder dec;
+    EXPECT_EQ(receiveAll(c, dec), 429) << "session " << session;
+  }
 }
 
 TEST(NtripClient, TimeoutsAndRefusedConnections) {

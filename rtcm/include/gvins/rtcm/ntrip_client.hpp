@@ -34,7 +34,8 @@ class NtripClient {
   NtripClient& operator=(const NtripClient&) = delete;
 
   /// Connects, sends the request and reads the response header. Stream bytes that arrived with
-  /// the header are kept for the first read(). Throws NtripError.
+  /// the header are kept for the first read(). Throws NtripError. Calling it again reconnects
+  /// (e.g. after read() returned 0 or threw because the caster dropped the stream).
   void connect();
   /// Appends stream bytes to `out`, waiting up to readTimeout for at least one; returns how many
   /// were appended, 0 when the caster ended the stream. Throws NtripError (Timeout, Connection,
