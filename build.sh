@@ -69,8 +69,9 @@ case "$cmd" in
     install_deps
     secs=${1:-20}
     dir=${BUILD_DIR:-build-fuzz}
-    CXX=clang++ CC=clang configure_build "$dir" -DGVINS_FUZZ=ON -DGVINS_BUILD_TESTS=OFF \
-      -DGVINS_BUILD_BENCH=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo
+    CXX=clang++ CC=clang configure_build "$dir" -DGVINS_FUZZ=ON -DGVINS_BUILD_BENCH=OFF \
+      -DCMAKE_BUILD_TYPE=RelWithDebInfo
+    ls "$dir"/fuzz/fuzz_* >/dev/null 2>&1 || { echo "no fuzz targets were built" >&2; exit 1; }
     for f in "$dir"/fuzz/fuzz_*; do
       [ -x "$f" ] || continue
       name=$(basename "$f")

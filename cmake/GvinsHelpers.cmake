@@ -44,6 +44,9 @@ endfunction()
 # reachable through the GVINS_TEST_DATA environment variable and compile definition.
 function(gvins_add_test)
   cmake_parse_arguments(A "" "NAME;TIMEOUT" "SOURCES;DEPS;LABELS" ${ARGN})
+  if(GVINS_FUZZ)
+    return()  # fuzzing builds contain only fuzz targets
+  endif()
   add_executable(${A_NAME} ${A_SOURCES})
   target_link_libraries(${A_NAME} PRIVATE ${A_DEPS} GTest::gtest GTest::gtest_main)
   target_compile_options(${A_NAME} PRIVATE ${GVINS_WARNINGS})
