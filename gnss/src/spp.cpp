@@ -248,7 +248,12 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
   double ionoPriorVar = 1.0;
 
   // Updates az/el, atmospheric delays, variances and the mask flag of every measurement at x.
+  // Model values change by < 1 mm when the position moves by less than a metre (elevations by
+  // < 2e-7 rad), so they are refreshed only after larger moves.
+  std::optional<Eigen::Vector3d> modelPoint;
   auto updateModels = [&](const Eigen::Vector3d& x) {
+    if (modelPoint && (x - *modelPoint).norm() < 0.5) return;
+    modelPoint = x;
     const bool surface = nearSurface(x);
     Geodetic g;
     SurfaceMeteo meteo;
@@ -339,14 +344,25 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
 
   // One Gauss-Newton step at state (x, clocks) using the frozen model values.
   // Returns the increment and the statistics of the linearisation point.
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, Eigen::Dynamic, kMaxUnknowns> Hw;
+  Eigen::VectorXd vw;
   auto lsqStep = [&](const Eigen::Vector3d& x, const VecN& clk, double ion, const std::vector<char>& use,
                      bool wantResiduals) {
     LsqResult r;
     const int nc = static_cast<int>(colSystems.size());
     const int m = 3 + nc + (estIono ? 1 : 0);
     r.nUnknowns = m;
-    MatN N = MatN::Zero(m, m);
-    VecN b = VecN::Zero(m);
+    // Rows of the whitened design matrix sqrt(w) h and observations sqrt(w) v; the normal
+    // equations are formed once from them (one matrix product instead of rank-1 updates).
+    Hw.resize(n + kNumSystems + 1, m);
+    vw.resize(n + kNumSystems + 1);
+    int row = 0;
+    auto addRow = [&](const Eigen::Matrix<double, kMaxUnknowns, 1>& hh, double v, double w) {
+      const double sw = std::sqrt(w);
+      Hw.row(row) = sw * hh.head(m).transpose();
+      vw[row] = sw * v;
+      ++row;
+    };
     Eigen::Matrix<double, kMaxUnknowns, 1> h;
     std::vector<std::pair<Eigen::Matrix<double, kMaxUnknowns, 1>, double>> rows;  // for residual normalisation
     std::vector<double> resid(wantResiduals ? n : 0, 0.0);
@@ -367,8 +383,7 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
       h.head<3>() = -e;
       h[3 + c] = 1.0;
       if (estIono) h[3 + nc] = mm.ionoMap;
-      N.noalias() += w * h.head(m) * h.head(m).transpose();
-      b.noalias() += w * v * h.head(m);
+      addRow(h, v, w);
       chi2 += w * v * v;
       ++nobs;
       if (wantResiduals) {
@@ -395,8 +410,7 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
         h.setZero();
         h[3 + col[s]] = 1.0;
         h[3 + col[ref]] = -1.0;
-        N.noalias() += w * h.head(m) * h.head(m).transpose();
-        b.noalias() += w * v * h.head(m);
+        addRow(h, v, w);
         chi2 += w * v * v;
         ++nobs;
       }
@@ -406,14 +420,16 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
       const double w = 1.0 / ionoPriorVar;
       h.setZero();
       h[3 + nc] = 1.0;
-      N.noalias() += w * h.head(m) * h.head(m).transpose();
-      b.noalias() += w * v * h.head(m);
+      addRow(h, v, w);
       chi2 += w * v * v;
       ++nobs;
     }
     r.nObs = nobs;
     r.chi2 = chi2;
     if (nobs < m) return r;
+    MatN N(m, m);
+    N.noalias() = Hw.topRows(row).transpose() * Hw.topRows(row);
+    const VecN b = Hw.topRows(row).transpose() * vw.head(row);
     Eigen::LDLT<MatN> ldlt(N);
     if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().array() > 1e-12 * N.diagonal().maxCoeff()).all()) return r;
     r.x = ldlt.solve(b);
@@ -590,9 +606,15 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
         meas[i].inflation = infl;
       }
       if (!changed) break;
-      std::vector<char> u2 = use;
-      const LsqResult rr = iterate(u2, false, 5, x, clk, ion);
+      // The geometry moves by far less than a metre between passes: one Gauss-Newton step from
+      // the current point is converged, and its post-fit residuals drive the next pass.
+      const LsqResult rr = lsqStep(x, clk, ion, use, true);
       if (!rr.ok) break;
+      const int ncol = static_cast<int>(colSystems.size());
+      x += rr.x.head<3>();
+      clk += rr.x.segment(3, ncol);
+      if (estIono) ion += rr.x[3 + ncol];
+      ++sol.iterations;
       last = rr;
     }
   }

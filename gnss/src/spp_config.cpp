@@ -69,12 +69,16 @@ class Reader {
     if (!n.IsScalar()) fail(n, key, "'" + key + "' must be a string");
     return get<std::string>(n, key);
   }
+  std::string key(const YAML::Node& k, const std::string& where) const {
+    if (!k.IsScalar()) fail(k, where, "keys of '" + where + "' must be plain names");
+    return k.Scalar();
+  }
   /// Iterates a map, rejecting keys not in `known`.
   template <class F>
   void map(const YAML::Node& n, const std::string& where, const std::set<std::string>& known, F&& f) const {
     if (!n.IsMap()) fail(n, where, "'" + where + "' must be a map");
     for (auto it = n.begin(); it != n.end(); ++it) {
-      const std::string k = it->first.as<std::string>();
+      const std::string k = key(it->first, where);
       const std::string full = where.empty() ? k : where + "." + k;
       if (!known.count(k)) fail(it->first, full, "unknown key '" + full + "'");
       f(k, full, it->second);
@@ -85,7 +89,7 @@ class Reader {
   void perSystem(const YAML::Node& n, const std::string& where, F&& f) const {
     if (!n.IsMap()) fail(n, where, "'" + where + "' must be a map of system letters");
     for (auto it = n.begin(); it != n.end(); ++it) {
-      const std::string k = it->first.as<std::string>();
+      const std::string k = key(it->first, where);
       const auto s = k.size() == 1 ? systemFromLetter(k[0]) : std::nullopt;
       if (!s) fail(it->first, where + "." + k, "unknown system '" + k + "' (use G R E C J S I)");
       f(*s, where + "." + k, it->second);
@@ -239,10 +243,14 @@ SppConfig parseSppConfig(std::string_view yaml, std::string_view name, const Spp
   }
   if (root.IsNull()) return c;  // empty file: defaults
   if (!root.IsMap()) r.fail(root, "", "the configuration must be a map with an 'spp' section");
-  const YAML::Node spp = root["spp"];
-  if (!spp) return c;
-  if (spp.IsNull()) return c;
-  apply(r, spp, c);
+  try {
+    const YAML::Node spp = root["spp"];
+    if (!spp || spp.IsNull()) return c;
+    apply(r, spp, c);
+  } catch (const YAML::Exception& e) {
+    // Anything yaml-cpp itself rejects while walking the document (odd keys, aliases...).
+    throw ParseError(std::string(name), e.mark.line >= 0 ? e.mark.line + 1 : 0, "YAML", e.msg);
+  }
   return c;
 }
 

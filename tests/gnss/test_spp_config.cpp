@@ -69,6 +69,25 @@ TEST(SppConfig, ParsesEveryKey) {
   EXPECT_EQ(parseSppConfig("spp:\n  max_gdop: 5\n", "b.yaml", c).frequencies, 2);
 }
 
+// The example file shipped with gvins-spp parses and equals the built-in defaults.
+TEST(SppConfig, ShippedExampleIsTheDefaults) {
+  const SppConfig c = loadSppConfig(std::string(GVINS_SOURCE_DIR) + "/apps/spp/spp.yaml");
+  const SppConfig d;
+  EXPECT_EQ(c.systems, d.systems);
+  EXPECT_EQ(c.elevationMask, d.elevationMask);
+  EXPECT_EQ(c.bands, d.bands);
+  EXPECT_EQ(c.frequencies, d.frequencies);
+  EXPECT_EQ(c.ionosphere, d.ionosphere);
+  EXPECT_EQ(c.climatologicalMeteo, d.climatologicalMeteo);
+  EXPECT_EQ(c.weighting.systemFactor, d.weighting.systemFactor);
+  EXPECT_EQ(c.ephemerisError, d.ephemerisError);
+  EXPECT_EQ(c.faultExclusion.falseAlarmProbability, d.faultExclusion.falseAlarmProbability);
+  EXPECT_EQ(c.robust.k1, d.robust.k1);
+  EXPECT_EQ(c.ionosphereEstimation.priorFraction, d.ionosphereEstimation.priorFraction);
+  EXPECT_EQ(c.isbPriorSigma, d.isbPriorSigma);
+  EXPECT_EQ(c.qzssUsesGpsClock, d.qzssUsesGpsClock);
+}
+
 namespace {
 void expectError(const std::string& yaml, std::int64_t line, const std::string& key, const std::string& what) {
   try {
@@ -98,6 +117,7 @@ TEST(SppConfig, ErrorsNameFileLineAndKey) {
   expectError("spp: [1, 2\n", 2, "YAML", "");
   expectError("- a\n- b\n", 1, "", "map");
   expectError("spp:\n  weighting: 3\n", 2, "spp.weighting", "must be a map");
+  expectError("spp:\n  weighting: { {R: 2}}\n", 2, "spp.weighting", "plain names");  // found by fuzzing
   try {
     loadSppConfig("/nonexistent/spp.yaml");
     FAIL();

@@ -27,7 +27,7 @@ struct RobustEstimation {
   double k0 = 2.0;          ///< standardised residual (in robust scales) that keeps full weight
   double k1 = 5.0;          ///< beyond it the weight is ~0
   double minScale = 0.5;    ///< floor of the robust scale (units of the a-priori sigmas)
-  int maxIterations = 8;
+  int maxIterations = 3;
 };
 
 /// A common correction to the broadcast ionosphere model's zenith delay, estimated with the
@@ -113,7 +113,7 @@ std::array<bool, kNumSystems> parseSystemLetters(std::string_view letters);
 ///     ephemeris_alarm_accuracy_m: 10
 ///     fault_exclusion: {enabled: true, false_alarm_probability: 0.001, max_exclusions: 6,
 ///                       max_candidates: 10, min_redundancy: 1}
-///     robust: {enabled: true, k0: 2.0, k1: 5.0, min_scale: 0.5, max_iterations: 8}
+///     robust: {enabled: true, k0: 2.0, k1: 5.0, min_scale: 0.5, max_iterations: 3}
 ///     ionosphere_estimation: {enabled: true, prior_fraction: 1.0, min_prior_sigma_m: 0.3}
 ///     max_gdop: 30
 ///     isb_prior_sigma_m: 2
