@@ -42,6 +42,7 @@ void decodeMsm(Decoder::State& s, BitReader& r, System system, int msm) {
   const Layout L = layoutOf(msm);
   r.skip(12, "DF003 reference station ID");
   GpsTime t;
+  bool beidouAsBdt = false;
   if (system == System::Glonass) {
     const int dow = static_cast<int>(r.u(3, "DF416 GLONASS day of week"));
     const std::uint64_t tod = r.u(27, "DF034 GLONASS epoch time");
@@ -52,7 +53,7 @@ void decodeMsm(Decoder::State& s, BitReader& r, System system, int msm) {
     const std::uint64_t tow = r.u(30, system == System::BeiDou ? "DF427 BeiDou epoch time" : "DF004 epoch time");
     if (tow >= 604800000u) throw MessageError("epoch time", "time of week " + std::to_string(tow) + " ms is beyond a week");
     if (system == System::BeiDou) {
-      t = checkBeidouStamp(s, resolveTow(s, static_cast<double>(tow) * 1e-3 - kBdtMinusGpst));
+      t = checkBeidouStamp(s, resolveTow(s, static_cast<double>(tow) * 1e-3 - kBdtMinusGpst), beidouAsBdt);
     } else {
       t = resolveTow(s, static_cast<double>(tow) * 1e-3);
     }
@@ -160,7 +161,7 @@ void decodeMsm(Decoder::State& s, BitReader& r, System system, int msm) {
     }
     if (sat && !so.signals.empty()) sats.push_back(std::move(so));
   }
-  addObservations(s, system, t, more, sats);
+  addObservations(s, system, t, more, sats, beidouAsBdt);
 }
 
 }  // namespace gvins::rtcm

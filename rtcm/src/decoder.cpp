@@ -116,27 +116,45 @@ GpsTime resolveGlonassTimeOfDay(const Decoder::State& s, double todSeconds) {
   return s.ref + d;
 }
 
-GpsTime checkBeidouStamp(Decoder::State& s, const GpsTime& asBdt) {
+GpsTime checkBeidouStamp(Decoder::State& s, const GpsTime& asBdt, bool& asBdtKept) {
+  asBdtKept = false;
   const GpsTime asGpst = asBdt + kBdtMinusGpst;  // the same TOW read as GPST
   auto matches = [&](const GpsTime& t) {
     if (s.open && s.openHasOthers && std::abs(t - s.open->time) < 1e-3) return true;
     return !s.open && s.lastClosed && s.lastClosedHasOthers && std::abs(t - *s.lastClosed) < 1e-3;
   };
-  if (!matches(asBdt) && matches(asGpst)) {
+  const bool bdt = matches(asBdt), gpst = matches(asGpst);
+  if (bdt) s.beidouInGpst = false;
+  if (gpst && !bdt) s.beidouInGpst = true;
+  // Once seen, the stamping is assumed for BeiDou messages that have no other epoch to compare
+  // with (e.g. sent before the other systems' messages of their epoch).
+  if ((gpst && !bdt) || (!bdt && s.beidouInGpst)) {
     ++s.stats.beidouGpstEpochs;
     return asGpst;
   }
+  asBdtKept = true;
   return asBdt;
 }
 
 void addObservations(Decoder::State& s, System system, const GpsTime& t, bool more,
-                     std::vector<SatObs>& sats) {
+                     std::vector<SatObs>& sats, bool beidouAsBdt) {
+  // A BeiDou-only epoch read as BDT that lies exactly 14 s after the first other system's
+  // message: the BeiDou time was GPST (its message came first in the epoch). Retime it.
+  if (system != System::BeiDou && s.open && !s.openHasOthers && s.openBeidouAsBdt > 0 &&
+      std::abs(s.open->time + kBdtMinusGpst - t) < 1e-3) {
+    s.open->time = t;
+    s.beidouInGpst = true;
+    s.stats.beidouGpstEpochs += s.openBeidouAsBdt;
+    s.openBeidouAsBdt = 0;
+  }
   if (s.open && std::abs(t - s.open->time) > kSameEpoch) closeEpoch(s);
   if (!s.open) {
     s.open.emplace();
     s.open->time = t;
     s.openHasOthers = false;
+    s.openBeidouAsBdt = 0;
   }
+  if (system == System::BeiDou && beidouAsBdt) ++s.openBeidouAsBdt;
   if (system != System::BeiDou) s.openHasOthers = true;
   for (SatObs& so : sats) {
     if (so.signals.empty()) continue;

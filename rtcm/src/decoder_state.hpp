@@ -43,6 +43,8 @@ struct Decoder::State {
   bool openHasOthers = false;  ///< the open epoch holds non-BeiDou systems
   std::optional<GpsTime> lastClosed;
   bool lastClosedHasOthers = false;
+  bool beidouInGpst = false;  ///< the stream was seen stamping BeiDou MSM in GPST
+  int openBeidouAsBdt = 0;    ///< BeiDou MSM messages in the open epoch read as BDT
 
   /// Per satellite (satIndex) the tracks of its signals: a handful each, searched linearly.
   std::vector<std::vector<std::pair<ObsCode, SignalTrack>>> tracks =
@@ -92,12 +94,12 @@ GpsTime resolveTow(const Decoder::State& s, double towSeconds);
 /// GLONASS time of day (Moscow time, seconds) resolved near the reference.
 GpsTime resolveGlonassTimeOfDay(const Decoder::State& s, double todSeconds);
 /// BeiDou MSM epoch time read as BDT (already converted to GPST): the GPST-stamping check of the
-/// Decoder file comment.
-GpsTime checkBeidouStamp(Decoder::State& s, const GpsTime& asBdt);
+/// Decoder file comment. `asBdtKept` tells whether the BDT reading was kept.
+GpsTime checkBeidouStamp(Decoder::State& s, const GpsTime& asBdt, bool& asBdtKept);
 /// Merges the satellites of one observation message into the epoch at t; `more` is the
 /// multiple-message / synchronous GNSS flag.
 void addObservations(Decoder::State& s, System system, const GpsTime& t, bool more,
-                     std::vector<SatObs>& sats);
+                     std::vector<SatObs>& sats, bool beidouAsBdt = false);
 /// Moves the reference to an absolute time learned from the stream if the current reference is
 /// only the host clock.
 void learnAbsoluteTime(Decoder::State& s, const GpsTime& t);

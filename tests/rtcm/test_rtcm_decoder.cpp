@@ -374,6 +374,61 @@ TEST(Decoder, StreamThatNeverClearsTheMultipleMessageBit) {
   EXPECT_EQ(b.stats().beidouGpstEpochs, 257);
 }
 
+TEST(Decoder, BeidouStampedInGpsTimeSentFirstInItsEpoch) {
+  // Reorder the GMSD log so that each epoch's 1127 comes before the other MSM messages (with its
+  // multiple-message bit set): every BeiDou message must still join its epoch.
+  const auto bytes = readBytes(dataDir() / "rtcm/rtklib_GMSD7_20121014.rtcm3");
+  std::vector<std::uint8_t> reordered, held;
+  Framer fr;
+  fr.feed(bytes);
+  Frame f;
+  while (fr.next(f)) {
+    std::vector<std::uint8_t> p(f.payload.begin(), f.payload.end());
+    const int t = f.type();
+    if (t == 1077) held.clear();
+    if (t == 1077 || t == 1087 || t == 1117) {
+      const auto framed = Encoder::frame(p);
+      held.insert(held.end(), framed.begin(), framed.end());
+      continue;
+    }
+    if (t == 1127) {
+      p[6] |= 0x02;  // more messages follow now
+      const auto framed = Encoder::frame(p);
+      reordered.insert(reordered.end(), framed.begin(), framed.end());
+      // The last of the others now closes the epoch.
+      Framer inner;
+      inner.feed(held);
+      Frame g;
+      std::vector<std::vector<std::uint8_t>> others;
+      while (inner.next(g)) others.emplace_back(g.payload.begin(), g.payload.end());
+      others.back()[6] &= static_cast<std::uint8_t>(~0x02u);
+      for (const auto& o : others) {
+        const auto fo = Encoder::frame(o);
+        reordered.insert(reordered.end(), fo.begin(), fo.end());
+      }
+      held.clear();
+      continue;
+    }
+    const auto framed = Encoder::frame(p);
+    reordered.insert(reordered.end(), framed.begin(), framed.end());
+  }
+  DecoderOptions opt;
+  opt.referenceTime = date(2012, 10, 13);
+  Decoder dec(opt);
+  const Decoded got = decodeAll(dec, reordered);
+  // The open BeiDou-only epoch is retimed when the other systems' messages arrive 14 s earlier;
+  // from then on the stamping is known.
+  ASSERT_EQ(got.epochs.size(), 257u);
+  EXPECT_EQ(dec.stats().beidouGpstEpochs, 257);
+  int merged = 0;
+  for (const ObsEpoch& e : got.epochs) {
+    bool bds = false, others = false;
+    for (const SatObs& s : e.sats) (s.sat.system == System::BeiDou ? bds : others) = true;
+    merged += bds && others;
+  }
+  EXPECT_EQ(merged, 257);
+}
+
 TEST(Decoder, BeidouStampCheckLeavesCorrectBdtAlone) {
   // Re-encode the GMSD epochs (our encoder stamps BeiDou in BDT): no correction must happen and
   // the epochs must come out the same.

@@ -25,7 +25,11 @@
 // exactly 14 s after the epoch of the other systems it belongs to. The decoder therefore checks
 // every BeiDou MSM time against the open (or just closed) epoch of the other systems: if reading
 // it as GPST makes the two coincide (within 1 ms) while reading it as BDT does not, it is read as
-// GPST, merged into that epoch and counted in DecoderStats::beidouGpstEpochs.
+// GPST, merged into that epoch and counted in DecoderStats::beidouGpstEpochs. If the BeiDou
+// message comes first in its epoch, the BeiDou-only epoch it opened (read as BDT) is retimed when
+// the other systems' messages arrive exactly 14 s earlier. Once seen, GPST stamping is assumed for
+// BeiDou messages that have no epoch of another system to compare with (until a BeiDou time
+// matches as BDT again), so the order of messages within an epoch does not matter.
 //
 // Errors. Frames with bad CRCs are skipped by the framer and counted. A frame with a good CRC but
 // impossible content (too short for its satellite/cell counts, out-of-range fields) is skipped and
