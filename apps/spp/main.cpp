@@ -20,6 +20,7 @@
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "gvins/gnss/accuracy_statistics.hpp"
+#include "gvins/gnss/pos_reader.hpp"
 #include "gvins/gnss/pos_writer.hpp"
 #include "gvins/gnss/spp.hpp"
 #include "gvins/gnss/spp_config.hpp"
@@ -28,6 +29,7 @@ namespace {
 
 const char* kUsage =
     "usage: gvins-spp [options] -o OUT.pos OBS NAV [NAV...]\n"
+    "       gvins-spp --score FILE.pos --truth X,Y,Z | --truth-llh LAT,LON,H\n"
     "\n"
     "Single point positioning from RINEX observations (2.10/2.11, 3.0x; plain or .gz) and\n"
     "broadcast navigation files (RINEX 2/3/4, merged). Writes one RTKLIB-style .pos row per\n"
@@ -54,12 +56,15 @@ const char* kUsage =
     "                     taken against zero, i.e. a static receiver)\n"
     "  --truth-llh LAT,LON,H   the same as latitude, longitude (deg) and ellipsoidal height (m)\n"
     "  --strict           stop at the first malformed epoch (default: skip it and count it)\n"
+    "  --score FILE.pos   only print the accuracy table of an existing .pos file (ours or RTKLIB's,\n"
+    "                     geodetic or ECEF layout) against --truth / --truth-llh\n"
     "  -q, --quiet        no progress line\n"
     "  -h, --help         this text\n";
 
 struct Args {
   std::string config;
   std::string out;
+  std::string score;
   std::vector<std::string> inputs;
   std::optional<std::string> systems;
   std::optional<double> elmask, snrmask;
@@ -138,6 +143,8 @@ Args parseArgs(int argc, char** argv) {
         if (std::abs(v[0]) > 90.0 || std::abs(v[1]) > 360.0) usageError("--truth-llh latitude/longitude out of range");
         a.truth = gvins::geodeticToEcef(gvins::geodeticFromDegrees(v[0], v[1], v[2]));
       }
+    } else if (o == "--score") {
+      a.score = value(i, o);
     } else if (o == "--strict") {
       a.strict = true;
     } else if (o == "-q" || o == "--quiet") {
@@ -147,6 +154,10 @@ Args parseArgs(int argc, char** argv) {
     } else {
       a.inputs.push_back(o);
     }
+  }
+  if (!a.score.empty()) {
+    if (!a.truth) usageError("--score needs --truth or --truth-llh");
+    return a;
   }
   if (a.out.empty()) usageError("no output file (-o OUT.pos)");
   if (a.inputs.size() < 2) usageError("need an observation file and at least one navigation file");
@@ -178,6 +189,22 @@ int main(int argc, char** argv) {
   using namespace gvins;
   const Args args = parseArgs(argc, argv);
   const auto wall0 = std::chrono::steady_clock::now();
+  if (!args.score.empty()) {
+    try {
+      const PosFile f = readPosFile(args.score);
+      AccuracyStatistics st(*args.truth);
+      for (const auto& s : f.solutions) {
+        st.addPosition(s.position);
+        if (s.velocity) st.addVelocity(*s.velocity);
+      }
+      std::fprintf(stderr, "gvins-spp score (%s, %zu solutions)\n", args.score.c_str(), f.solutions.size());
+      std::fputs(st.table().c_str(), stderr);
+      return f.solutions.empty() ? 3 : 0;
+    } catch (const ParseError& e) {
+      printError(e);
+      return 1;
+    }
+  }
 
   // Configuration: defaults, YAML, command line.
   SppConfig cfg;

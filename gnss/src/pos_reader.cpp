@@ -121,6 +121,8 @@ PosFile parse(LineReader& in) {
         V(2, 0) = V(0, 2) = sq(cr[2]);
       }
     }
+    // RTKLIB (and our writer) print zeros in the velocity columns of epochs without a velocity.
+    if (hasVel && vel.isZero(0.0) && V.isZero(0.0)) hasVel = false;
     if (!std::isfinite(P.sum()) || !std::isfinite(V.sum()) || !vel.allFinite()) {
       throwParseError(w, "row", "non-finite value");
     }

@@ -82,6 +82,15 @@ TEST(SppCli, XyzLayoutOptionsAndConfig) {
   std::filesystem::remove(cfg);
 }
 
+TEST(SppCli, ScoresAnExistingPosFile) {
+  // RTKLIB's kamakura solution scored by the tool: the 0.29/1.44 m quoted in the data README.
+  const CliRun r = run("--score " + kData + "/reference/rtklib-2.4.3/kamakura_sept078_spp.pos --truth -3962108.673,3381309.574,3668678.638");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("     0.287      1.437"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("velocity error"), std::string::npos) << r.err;
+  EXPECT_EQ(run("--score x.pos").code, 2);  // needs a truth
+}
+
 TEST(SppCli, BadArgumentsAndBadFiles) {
   EXPECT_EQ(run("").code, 2);
   EXPECT_EQ(run("-o x.pos onlyone.obs").code, 2);

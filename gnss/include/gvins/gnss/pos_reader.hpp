@@ -1,6 +1,7 @@
 // Reader of RTKLIB-compatible solution files (.pos) in either coordinate layout: geodetic
 // ("latitude(deg) longitude(deg) height(m)" with optional n/e/u sd and velocity columns) or ECEF
-// ("x-ecef(m) ..."), GPST times as "yyyy/mm/dd hh:mm:ss.sss" or "week tow". Used to compare our
+// ("x-ecef(m) ..."), GPST times as "yyyy/mm/dd hh:mm:ss.sss" or "week tow". Velocity columns that
+// are all zero, values and sd alike, mean "no velocity" (RTKLIB's convention). Used to compare our
 // solutions with RTKLIB's and to evaluate any stored result against a truth.
 #pragma once
 
