@@ -20,10 +20,13 @@ constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8
 /// Plain fixed-point decimal ("  -1234.567") without exponent. The digits form an integer below
 /// 2^53, so mantissa / 10^k is the correctly rounded value (same result as strtod). Returns false
 /// for anything else, blank included; the caller then falls back to the general parser.
-bool fastDecimal(std::string_view s, double& out) {
+enum class Fast { Blank, Value, Other };
+
+Fast fastDecimal(std::string_view s, double& out) {
   std::size_t i = 0;
   const std::size_t n = s.size();
   while (i < n && s[i] == ' ') ++i;
+  if (i == n) return Fast::Blank;
   bool neg = false;
   if (i < n && (s[i] == '-' || s[i] == '+')) {
     neg = s[i] == '-';
@@ -35,25 +38,25 @@ bool fastDecimal(std::string_view s, double& out) {
   for (; i < n; ++i) {
     const char c = s[i];
     if (c >= '0' && c <= '9') {
-      if (++digits > 17) return false;
+      if (++digits > 17) return Fast::Other;
       m = m * 10 + static_cast<unsigned>(c - '0');
       if (dot) ++frac;
     } else if (c == '.' && !dot) {
       dot = true;
     } else if (c == ' ') {
       for (; i < n; ++i) {
-        if (s[i] != ' ') return false;
+        if (s[i] != ' ') return Fast::Other;
       }
       break;
     } else {
-      return false;
+      return Fast::Other;
     }
   }
-  if (digits == 0 || m > (std::uint64_t{1} << 53)) return false;
+  if (digits == 0 || m > (std::uint64_t{1} << 53)) return Fast::Other;
   double v = static_cast<double>(m);
   if (frac) v /= kPow10[frac];
   out = neg ? -v : v;
-  return true;
+  return Fast::Value;
 }
 
 bool isBlank(std::string_view s) {
@@ -505,8 +508,10 @@ void RinexObsReader::Impl::readSatValues(std::string_view l, std::size_t start, 
     const std::string_view field = l.substr(pos, 16);
     const std::string_view num = field.substr(0, std::min<std::size_t>(14, field.size()));
     double v;
-    if (!fastDecimal(num, v)) {
-      if (isBlank(num)) continue;
+    const Fast f = fastDecimal(num, v);
+    if (f == Fast::Blank) continue;
+    if (f == Fast::Other) {
+      if (isBlank(num)) continue;  // e.g. a trailing '\r'
       const std::string name = so.sat.str() + " " + ObsDescriptor(col.type, lay.codes[col.signal]).str();
       v = parseDouble(num, where(), name);
     }
@@ -690,7 +695,15 @@ bool RinexObsReader::Impl::readEpoch(ObsEpoch& e) {
                                        std::to_string(nsat) + " announced");
       }
       const std::string_view idText = column(line, 0, 3);
-      const auto id = SatId::parse(idText);
+      std::optional<SatId> id;
+      if (idText.size() == 3 && idText[1] >= '0' && idText[1] <= '9' && idText[2] >= '0' && idText[2] <= '9') {
+        if (const auto sys = systemFromLetter(idText[0])) {
+          const SatId q(*sys, (idText[1] - '0') * 10 + (idText[2] - '0'));
+          if (q.valid()) id = q;
+        }
+      } else {
+        id = SatId::parse(idText);
+      }
       if (!id || (!idText.empty() && idText[0] == ' ')) {
         skipSat(idText, "unknown system or satellite number");
         continue;
