@@ -157,26 +157,32 @@ bool SppSolver::gatherMeasurements(const ObsEpoch& epoch, SppSolution& sol, std:
     }
     // Transmit time: t_rx - P/c - dt_s, with dt_s evaluated at the first approximation.
     GpsTime ttx = epoch.time - m.pseudorange / kC;
-    auto st = nav_.satelliteState(so.sat, ttx, cfg.ephemeris);
-    if (!st) {
+    // One record selection per satellite for the state and the group delays.
+    const GlonassEphemeris* ge = nullptr;
+    const KeplerEphemeris* ke = nullptr;
+    if (so.sat.system == System::Glonass) ge = nav_.selectGlonass(so.sat, ttx, cfg.ephemeris);
+    else ke = nav_.selectKepler(so.sat, ttx, cfg.ephemeris);
+    if (!ge && !ke) {
       out.use = SatelliteUse::NoEphemeris;
       continue;
     }
+    std::optional<SatelliteState> st = ge ? glonassSatelliteState(*ge, ttx) : keplerSatelliteState(*ke, ttx);
     // Move the state by -dt_s (|dt_s| < 1 ms): a first-order step is exact to < 1e-6 m, since the
     // orbital acceleration (< 1 m/s^2) contributes a*dt^2/2.
     const double dts = st->clockBias;
     ttx -= dts;
     st->position -= st->velocity * dts;
     st->clockBias -= st->clockDrift * dts;
-    if (std::abs(dts) > 0.01) st = nav_.satelliteState(so.sat, ttx, cfg.ephemeris);  // implausible clock
+    if (std::abs(dts) > 0.01) st = ge ? glonassSatelliteState(*ge, ttx) : keplerSatelliteState(*ke, ttx);
     if (!st || (!st->healthy && !cfg.ephemeris.allowUnhealthy) || !st->position.allFinite() ||
         st->position.norm() < 1e7) {
       out.use = SatelliteUse::NoEphemeris;
       continue;
     }
     m.state = *st;
-    double gd = nav_.groupDelay(so.sat, s1->code, ttx, cfg.ephemeris);
-    if (m.ionosphereFree) gd = ifc.a1 * gd + ifc.a2 * nav_.groupDelay(so.sat, s2->code, ttx, cfg.ephemeris);
+    auto groupDelayOf = [&](ObsCode c) { return ge ? broadcastGroupDelay(*ge, c) : broadcastGroupDelay(*ke, c); };
+    double gd = groupDelayOf(s1->code);
+    if (m.ionosphereFree) gd = ifc.a1 * gd + ifc.a2 * groupDelayOf(s2->code);
     m.satClock = st->clockBias - gd;
     // Doppler: the primary signal's, else any signal with a known wavelength.
     const SignalObs* d = s1->hasDoppler() ? s1 : nullptr;
