@@ -384,6 +384,11 @@ int main(int argc, char** argv) {
                  static_cast<long long>(rs.specialRecords), static_cast<long long>(rs.emptyEpochs));
     for (const auto& m : rs.messages) std::fprintf(stderr, "    %s\n", m.c_str());
   }
+  if (!obs->header().ignoredTypes.empty()) {
+    std::fprintf(stderr, "  observation columns not used (unknown or non-measurement codes):");
+    for (const auto& t : obs->header().ignoredTypes) std::fprintf(stderr, " %s;", t.c_str());
+    std::fprintf(stderr, "\n");
+  }
   std::fprintf(stderr, "  time                   %8.3f s (%.0f epochs/s)\n", wall, wall > 0 ? epochs / wall : 0.0);
   if (stats) std::fputs(stats->table().c_str(), stderr);
   if (solutions == 0 && exitCode == 0) exitCode = 3;
