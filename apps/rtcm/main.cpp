@@ -13,11 +13,17 @@ namespace {
 constexpr const char* kUsage =
     "usage: gvins-rtcm <command> ...\n"
     "  info FILE|- [--date YYYY-MM-DD]\n"
-    "      one row per message type (type, count, description), time span, station, CRC failures\n"
-    "  to-rinex FILE|- --date YYYY-MM-DD -o PREFIX [--interval S]\n"
-    "      writes PREFIX.obs (RINEX 3.04 observations) and PREFIX.nav (RINEX 3.04 navigation)\n"
+    "      one row per message type (type, count, description), then time span, station,\n"
+    "      ephemerides, CRC failures and malformed messages. Without --date the date comes from\n"
+    "      the stream (1020 with N4, 1042, 1045/1046) or else from the host clock.\n"
+    "  to-rinex FILE|- --date YYYY-MM-DD -o PREFIX\n"
+    "      writes PREFIX.obs (RINEX 3.04 observations) and PREFIX.nav (RINEX 3.04 navigation);\n"
+    "      --date is any day within a few days of the data (RTCM times carry no date)\n"
     "  ntrip URL -o FILE|- [--duration S] [--frames N] [--version 1|2] [--timeout S] [--gga NMEA]\n"
-    "      records an NTRIP stream; URL = ntrip://user:pass@host:port/MOUNT\n";
+    "      records an NTRIP stream byte for byte; URL = ntrip://user:pass@host[:port]/MOUNT\n"
+    "      (port 2101 by default); --frames stops right after the N-th frame, --duration after\n"
+    "      S seconds; --timeout (default 10 s connect, 15 s data) gives up on a silent caster\n"
+    "exit status: 0 ok, 1 error (file, decoding, NTRIP), 2 usage\n";
 
 }  // namespace
 

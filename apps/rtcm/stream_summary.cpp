@@ -8,6 +8,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "gvins/base/constants.hpp"
 #include "gvins/base/geodetic.hpp"
 #include "gvins/rtcm/message_types.hpp"
 
@@ -85,8 +86,8 @@ void printSummary(std::ostream& out, const rtcm::Decoder& dec, const std::string
   if (const auto& p = dec.stationPosition()) {
     const Geodetic g = ecefToGeodetic(p->arp);
     out << std::fixed << std::setprecision(4) << "station        ID " << p->stationId << ": ARP ECEF " << p->arp.x() << " "
-        << p->arp.y() << " " << p->arp.z() << " m (lat " << std::setprecision(8) << g.lat * 180.0 / M_PI << " lon "
-        << g.lon * 180.0 / M_PI << " h " << std::setprecision(3) << g.height << " m)";
+        << p->arp.y() << " " << p->arp.z() << " m (lat " << std::setprecision(8) << g.lat * constants::kRadToDeg << " lon "
+        << g.lon * constants::kRadToDeg << " h " << std::setprecision(3) << g.height << " m)";
     if (p->antennaHeight) out << ", antenna height " << std::setprecision(4) << *p->antennaHeight << " m";
     out << "\n";
   } else {
