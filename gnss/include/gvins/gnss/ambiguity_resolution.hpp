@@ -1,0 +1,76 @@
+// Ambiguity resolution on top of LAMBDA: validation of the integer solution (ratio test,
+// bootstrapped success rate) and partial ambiguity resolution when the full set fails.
+//
+// Validation. The ratio test accepts the best integer vector when the second-best squared norm
+// is at least `ratioThreshold` times the best (threshold 3 by default, the usual fixed value; see
+// Verhagen & Teunissen 2013, "The ratio test for future GNSS ambiguity resolution", GPS Solutions
+// 17:535-548, for its theory). With `SuccessRate` the model-driven test of Teunissen (1998) is used
+// instead: the integer solution is accepted when the bootstrapped success rate of the decorrelated
+// problem, a sharp lower bound of the ILS success rate, is at least 1 − maxFailureRate, i.e. the
+// failure rate is bounded by `maxFailureRate` whatever the data (a fixed-failure-rate acceptance
+// that needs no simulated tables). `RatioAndSuccessRate` requires both.
+//
+// Partial ambiguity resolution (PAR). If the full set fails, the decorrelated ambiguities are
+// fixed from the back (where the reduction puts the smallest conditional variances) as long as
+// the bootstrapped success rate of the subset stays at least `partialSuccessRate` (Teunissen,
+// Joosten & Tiberius 1999, "A comparison of TCAR, CIR and LAMBDA GNSS ambiguity resolution",
+// ION GPS; Verhagen, Teunissen & Odijk 2011 on the subset choice), then validated by the ratio test
+// on that subset; if it fails the subset shrinks one ambiguity at a time down to `minFixed`.
+// The result is a set of integer linear combinations T a = t of the input ambiguities (rows of
+// Zᵀ), which the caller conditions its float solution on.
+#pragma once
+
+#include <cstdint>
+
+#include <Eigen/Core>
+
+#include "gvins/gnss/lambda.hpp"
+
+namespace gvins {
+
+enum class AmbiguityValidation {
+  Ratio,               ///< second-best / best squared norm ≥ ratioThreshold
+  SuccessRate,         ///< bootstrapped success rate ≥ 1 − maxFailureRate
+  RatioAndSuccessRate  ///< both
+};
+
+struct AmbiguityResolutionOptions {
+  AmbiguityValidation validation = AmbiguityValidation::Ratio;
+  double ratioThreshold = 3.0;
+  double maxFailureRate = 1e-3;  ///< for SuccessRate validation
+  bool partial = true;           ///< try partial fixing when the full set fails
+  double partialSuccessRate = 0.999;  ///< bootstrapped success rate a PAR subset must reach
+  int minFixed = 4;              ///< fewest ambiguities a (partial) fix may have
+  int maxPartialAttempts = 6;    ///< subsets tried after the full set
+  std::int64_t maxNodes = 200000;  ///< per ILS search
+};
+
+struct AmbiguityFix {
+  bool fixed = false;
+  bool partial = false;  ///< a subset (in the decorrelated parametrisation) was fixed
+  /// Rows: the fixed integer combinations of the input ambiguities (k × n, integers): T â ≈ t.
+  /// For a full fix T = I.
+  Eigen::MatrixXd T;
+  Eigen::VectorXd values;  ///< t (integers)
+  /// For a full fix the integer vector ǎ (same as `values`); empty otherwise.
+  Eigen::VectorXd fullSolution;
+  double ratio = 0.0;        ///< of the set that was accepted (or of the full set if none)
+  double successRate = 0.0;  ///< bootstrapped, of the accepted set (or of the full set)
+  double bestNorm = 0.0;     ///< squared norm of the accepted integer solution
+  int attempts = 0;          ///< ILS searches run
+  std::int64_t nodes = 0;    ///< search nodes over all attempts
+  /// Full-set ratio and success rate (diagnostics, also when a subset was fixed).
+  double fullRatio = 0.0;
+  double fullSuccessRate = 0.0;
+  int numFixed() const { return static_cast<int>(values.size()); }
+};
+
+/// Resolves float ambiguities â (cycles) with covariance Q. Never throws; `fixed` is false when
+/// nothing passed validation or Q is not positive definite.
+AmbiguityFix resolveAmbiguities(const Eigen::VectorXd& afloat, const Eigen::MatrixXd& Q,
+                                const AmbiguityResolutionOptions& options = {});
+
+/// Whether an accepted solution passes the validation rule (exposed for tests and tools).
+bool passesValidation(double ratio, double successRate, const AmbiguityResolutionOptions& options);
+
+}  // namespace gvins

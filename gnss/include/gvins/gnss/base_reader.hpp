@@ -1,0 +1,50 @@
+// Reading reference-station (base) observations for RTK from a file that is either RINEX
+// observation data (2.10-4.0x, plain or gzip) or a binary RTCM 3 log (legacy 1001-1012 or MSM
+// observations, 1005/1006 station position, ephemerides), detected from the content.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "gvins/base/gnss_time.hpp"
+#include "gvins/base/observation.hpp"
+#include "gvins/ephemeris/ephemeris_store.hpp"
+
+namespace gvins {
+
+enum class BaseFormat { Rinex, Rtcm };
+
+class BaseReader {
+ public:
+  virtual ~BaseReader() = default;
+
+  /// Opens `path`. `referenceTime` resolves the times of week of an RTCM stream (use the rover's
+  /// first epoch). Ephemerides an RTCM stream carries are added to `nav` (if not null) as they are
+  /// decoded. Throws ParseError for unreadable files or a malformed RINEX header;
+  /// `skipBadEpochs` as in RinexObsReaderOptions.
+  static std::unique_ptr<BaseReader> open(const std::string& path, const GpsTime& referenceTime,
+                                          EphemerisStore* nav, bool skipBadEpochs = true);
+  /// Detects the format from the first bytes (gzip or "RINEX VERSION / TYPE" text: RINEX; an RTCM
+  /// preamble 0xD3 with a valid frame header: RTCM). nullopt if neither.
+  static std::optional<BaseFormat> detect(const std::string& path);
+
+  /// Next observation epoch (time order as in the file); false at the end. RINEX format errors
+  /// throw ParseError unless skipped.
+  virtual bool next(ObsEpoch& epoch) = 0;
+  /// Antenna reference point (ECEF, m): the RINEX "APPROX POSITION XYZ" moved by "ANTENNA: DELTA
+  /// H/E/N", or the ARP of the latest RTCM 1005/1006 (which may only arrive after some epochs).
+  virtual std::optional<Eigen::Vector3d> antennaPosition() const = 0;
+  /// GLONASS channels known so far (RINEX header, RTCM 1020/MSM extended information).
+  virtual GlonassChannels glonassChannels() const = 0;
+  virtual BaseFormat format() const = 0;
+  /// One-line description for logs ("RINEX 2.10, marker 3040" / "RTCM 3, 1234 frames, ...").
+  virtual std::string describe() const = 0;
+  /// Malformed epochs or frames skipped so far.
+  virtual std::int64_t skipped() const = 0;
+};
+
+}  // namespace gvins

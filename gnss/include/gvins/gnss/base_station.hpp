@@ -1,0 +1,126 @@
+// Reference (base) station data for relative positioning: a short buffer of base epochs modelled
+// at the known base antenna position, and their alignment to a rover epoch.
+//
+// Each base signal is reduced to "observed minus computed" (OMC) values at the base epoch's own
+// time tag: OMC = observation − (|r_s − r_b| + Sagnac − c·dt_s + T_b), in metres, with the
+// satellite state at the base signal's transmit time. What remains is c·dt_b (common to every
+// signal of the epoch), the ambiguity (phase), atmosphere errors and noise: quantities that change
+// slowly, so the OMC of a base epoch some seconds older than the rover epoch still differences
+// well (the "age of differential"), and the OMC of two base epochs that bracket the rover epoch
+// can be interpolated linearly. Because c·dt_b differs between base epochs and only cancels when
+// every signal of a rover epoch uses the same base time (or the same interpolation weights), one
+// alignment is chosen per rover epoch:
+//   - a base epoch within `kSyncTolerance` of the rover time (synchronous data);
+//   - otherwise, with interpolation enabled, the two base epochs around the rover time if they are
+//     at most maxInterpolationGap apart (signals continuous across both only);
+//   - otherwise the newest earlier base epoch if it is at most maxAge old (held).
+// Holding rather than extrapolating is deliberate: a linear extrapolation of the OMC mostly
+// extrapolates c·dt_b, which cancels in double differences anyway, and amplifies the noise.
+//
+// Cycle slips of the base are detected here (its own CycleSlipDetector); every signal carries the
+// start of its continuous arc so that the rover side can tell when its single-difference
+// ambiguity must be reset.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "gvins/base/observation.hpp"
+#include "gvins/ephemeris/ephemeris_store.hpp"
+#include "gvins/gnss/cycle_slip_detector.hpp"
+#include "gvins/gnss/rtk_config.hpp"
+
+namespace gvins {
+
+/// One signal of a modelled base epoch.
+struct BaseSignal {
+  SatId sat;
+  ObsCode code;
+  bool hasPhase = false;
+  bool hasCode = false;
+  double phaseOmc = 0.0;  ///< m
+  double codeOmc = 0.0;   ///< m
+  double wavelength = 0.0;  ///< m (0 if unknown, e.g. GLONASS without channel)
+  GpsTime arcStart;       ///< start of the phase arc (base cycle-slip detector)
+  std::uint8_t slipFlags = 0;
+  double elevation = 0.0;  ///< rad, at the base
+};
+
+/// Base values aligned to one rover epoch.
+struct BaseSnapshot {
+  GpsTime time;     ///< base time the values refer to (the rover time when interpolated)
+  double age = 0.0;  ///< s, rover time minus the nearest base epoch used
+  bool interpolated = false;
+  std::vector<BaseSignal> signals;  ///< sorted by satellite, then code
+  /// The signal of a satellite with this code, or nullptr.
+  const BaseSignal* find(SatId sat, ObsCode code) const;
+  /// Whether the satellite has any signal.
+  bool has(SatId sat) const;
+};
+
+enum class BaseAvailability {
+  Ok,
+  NoPosition,  ///< base antenna position unknown (no header position, 1005/1006 or option)
+  NoData,      ///< no base epoch yet
+  TooOld,      ///< newest usable base epoch older than maxAge
+};
+const char* toString(BaseAvailability a);
+
+struct BaseStationStats {
+  std::int64_t epochs = 0;          ///< base epochs added
+  std::int64_t outOfOrder = 0;      ///< dropped: not later than the previous one
+  std::int64_t noEphemeris = 0;     ///< satellite-epochs without a usable ephemeris
+  std::int64_t positionChanges = 0; ///< base position changed (buffer cleared)
+};
+
+class BaseStation {
+ public:
+  /// Seconds within which base and rover time tags count as the same epoch.
+  static constexpr double kSyncTolerance = 0.05;
+
+  /// `nav` must outlive the station.
+  BaseStation(const EphemerisStore& nav, const RtkConfig& config);
+
+  /// Antenna reference point (ECEF, m). A change of more than 1 mm clears the buffered epochs
+  /// (their OMC values refer to the old position) and is counted.
+  void setPosition(const Eigen::Vector3d& arp);
+  const std::optional<Eigen::Vector3d>& position() const { return position_; }
+  /// GLONASS FDMA channels of the base (RINEX header, RTCM 1020/MSM); the navigation data fill gaps.
+  void setGlonassChannels(const GlonassChannels& channels);
+
+  /// Adds a base epoch; epochs must come in increasing time (others are dropped and counted).
+  void addEpoch(const ObsEpoch& epoch);
+  /// Aligns the buffered base data to a rover time (see the file comment).
+  BaseAvailability snapshot(const GpsTime& roverTime, BaseSnapshot& out);
+  /// Time of the newest base epoch, if any.
+  std::optional<GpsTime> latestTime() const;
+  /// Drops all buffered epochs and slip history.
+  void clear();
+
+  const BaseStationStats& stats() const { return stats_; }
+  const CycleSlipCounts& slipCounts() const { return slips_.counts(); }
+
+ private:
+  struct Epoch {
+    GpsTime time;
+    ObsEpoch raw;
+    bool modelled = false;
+    std::vector<BaseSignal> signals;
+  };
+  void model(Epoch& e);
+
+  const EphemerisStore& nav_;
+  RtkConfig config_;
+  std::optional<Eigen::Vector3d> position_;
+  GlonassChannels channels_;
+  CycleSlipDetector slips_;
+  std::deque<Epoch> epochs_;
+  BaseStationStats stats_;
+};
+
+}  // namespace gvins

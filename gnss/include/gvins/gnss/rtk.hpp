@@ -1,0 +1,189 @@
+// Real-time kinematic / static relative positioning with integer ambiguity resolution.
+//
+// Per rover epoch:
+//   1. single point positioning of the rover (fallback solution, Doppler velocity, sanity check);
+//   2. rover cycle-slip detection; base data aligned to the rover time (BaseStation);
+//   3. time update of the float filter (static: none; kinematic: random walk predicted with the
+//      Doppler velocity, or constant velocity with white-noise acceleration);
+//   4. single and double differences (DoubleDifferenceBuilder);
+//   5. single-difference ambiguity states are added for new arcs, re-initialised after slips
+//      (a slipped ambiguity is never kept) and marginalised when their satellite has been gone for
+//      `ambiguityOutage`;
+//   6. measurement update of the square-root information filter (gvins::sri) with the DD phase and
+//      code of each group, whitened with their exact correlation (shared reference); post-fit
+//      outliers re-initialise the ambiguity (phase) or drop the code, and the update is redone;
+//   7. ambiguity resolution: the float DD ambiguities of the eligible signals (system enabled for
+//      AR, above the AR mask, locked long enough, no half-cycle flag) and their covariance, taken
+//      from the square-root factor by triangular solves, go to LAMBDA with the ratio test and
+//      partial fixing (resolveAmbiguities); the fixed position is the float one conditioned on the
+//      fixed integer combinations, and is accepted only if every DD phase residual at it is within
+//      `fixValidationSigmas`; in fix-and-hold mode validated fixes are fed back as constraints.
+//
+// The float state is [SD ambiguities (cycles)..., position (, velocity)] in ECEF; ambiguities sit in
+// front so the position block stays at the back, where the filter updates and reads it cheaply.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "gvins/base/observation.hpp"
+#include "gvins/ephemeris/ephemeris_store.hpp"
+#include "gvins/gnss/base_station.hpp"
+#include "gvins/gnss/cycle_slip_detector.hpp"
+#include "gvins/gnss/double_difference.hpp"
+#include "gvins/gnss/position_solution.hpp"
+#include "gvins/gnss/rtk_config.hpp"
+#include "gvins/gnss/spp.hpp"
+#include "gvins/gnss/spp_config.hpp"
+#include "gvins/sri/sri_filter.hpp"
+
+namespace gvins {
+
+/// Why an epoch has no RTK (float or fixed) solution.
+enum class RtkIssue : std::uint8_t {
+  None,
+  NoBasePosition,      ///< base antenna position unknown
+  NoBaseData,          ///< no base epoch yet
+  BaseTooOld,          ///< base data older than maxAge (gap, missing base epochs)
+  NoCommonSatellites,  ///< fewer than four satellites differenced (no common satellites/signals)
+  FilterReset,         ///< the float solution left the SPP solution by more than maxSppDeviation
+};
+const char* toString(RtkIssue i);
+
+/// Outcome of ambiguity resolution in an epoch with a float solution.
+enum class ArStatus : std::uint8_t {
+  Off,                ///< AR disabled
+  TooFewAmbiguities,  ///< fewer eligible DD ambiguities than `ar.minFixed`
+  NotValidated,       ///< no (partial) integer solution passed the ratio / success-rate test
+  Rejected,           ///< an accepted solution failed the residual check at the fixed position
+  Fixed,              ///< the whole eligible set
+  PartialFixed,       ///< a subset (decorrelated combinations)
+};
+const char* toString(ArStatus s);
+
+struct RtkSolution {
+  GpsTime time;  ///< solution time (rover time tag corrected by the SPP receiver clock when known)
+  SolutionQuality quality = SolutionQuality::None;  ///< Fix, Float, Single or None
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();            ///< ECEF, m (of `quality`)
+  Eigen::Matrix3d positionCovariance = Eigen::Matrix3d::Zero();  ///< ECEF, m²
+  Eigen::Vector3d floatPosition = Eigen::Vector3d::Zero();       ///< when there is a float solution
+  Eigen::Matrix3d floatCovariance = Eigen::Matrix3d::Zero();
+  std::optional<Eigen::Vector3d> velocity;  ///< ECEF, m/s (Doppler, or the constant-velocity state)
+  Eigen::Matrix3d velocityCovariance = Eigen::Matrix3d::Zero();
+  int numSatellites = 0;   ///< satellites with DD phase (RTK) or used by SPP (single)
+  double age = 0.0;        ///< s, age of the base data
+  double ratio = 0.0;      ///< ratio-test value of the accepted set, else of the full set
+  double successRate = 0.0;  ///< bootstrapped success rate of the accepted (or full) set
+  int numAmbiguities = 0;  ///< eligible DD ambiguities
+  int numFixed = 0;        ///< integer combinations fixed
+  bool held = false;       ///< fix-and-hold constraints applied after this epoch
+  RtkIssue issue = RtkIssue::None;
+  ArStatus ar = ArStatus::Off;
+  int phaseOutliers = 0;   ///< ambiguities re-initialised by the post-fit test this epoch
+  int codeOutliers = 0;    ///< code DDs dropped this epoch
+  int ambiguityResets = 0; ///< ambiguities (re)initialised for new arcs or slips this epoch
+  SppStatus sppStatus = SppStatus::NoObservations;
+
+  bool valid() const { return quality != SolutionQuality::None; }
+  /// For the .pos writer.
+  PositionSolution toPositionSolution() const;
+};
+
+/// Totals over the session.
+struct RtkCounters {
+  std::int64_t ambiguitiesAdded = 0;   ///< new arcs and re-initialisations
+  std::int64_t slipResets = 0;         ///< re-initialisations after a detected slip / new base or rover arc
+  std::int64_t phaseOutliers = 0;      ///< re-initialisations by the post-fit test
+  std::int64_t codeOutliers = 0;       ///< code DDs dropped (prefit gate or post-fit test)
+  std::int64_t ambiguitiesRemoved = 0; ///< marginalised after an outage
+  std::int64_t filterResets = 0;
+  std::int64_t holdUpdates = 0;
+  std::int64_t arAttempts = 0;
+  std::int64_t partialFixes = 0;
+  std::int64_t rejectedFixes = 0;
+};
+
+class RtkSolver {
+ public:
+  /// `nav` must outlive the solver (it may grow, e.g. with ephemerides from an RTCM stream).
+  RtkSolver(const EphemerisStore& nav, RtkConfig config = {}, SppConfig spp = {});
+
+  /// Base antenna reference point, ECEF (m). Changing it clears the base buffer and the
+  /// ambiguities.
+  void setBasePosition(const Eigen::Vector3d& arp);
+  const std::optional<Eigen::Vector3d>& basePosition() const { return base_.position(); }
+  void setBaseGlonassChannels(const GlonassChannels& channels);
+  void setRoverGlonassChannels(const GlonassChannels& channels);
+  /// A-priori rover position for the first SPP iteration (e.g. RINEX header).
+  void setRoverInitialPosition(const Eigen::Vector3d& ecef);
+
+  /// Base epochs, in time order, up to (and, for interpolation, one past) each rover epoch.
+  void addBaseEpoch(const ObsEpoch& epoch);
+  /// Processes one rover epoch.
+  RtkSolution process(const ObsEpoch& rover);
+  /// The single and double differences of the last processed epoch, with the fixed ambiguities of
+  /// the DD phases when the epoch was fixed (for the fusion and for diagnostics).
+  const DdEpoch& measurements() const { return dd_; }
+  /// Forgets the float solution and all ambiguities (base buffer and slip history stay).
+  void reset();
+
+  const RtkConfig& config() const { return cfg_; }
+  const RtkCounters& counters() const { return counters_; }
+  const BaseStation& base() const { return base_; }
+  const DdFormationStats& differenceStats() const { return builder_.stats(); }
+  const CycleSlipCounts& roverSlipCounts() const { return roverSlips_.counts(); }
+
+ private:
+  struct Ambiguity {
+    sri::BlockId id;
+    SatId sat;
+    ObsCode code;
+    double wavelength = 0.0;
+    GpsTime roverArc, baseArc, lastSeen;
+    int lock = 0;
+  };
+  struct Group;  // per-epoch bookkeeping of the update (rtk.cpp)
+
+  static std::uint32_t key(SatId s, ObsCode c) {
+    return static_cast<std::uint32_t>(satIndex(s)) << 16 | static_cast<std::uint32_t>(c.band) << 8 |
+           static_cast<std::uint32_t>(static_cast<unsigned char>(c.attr));
+  }
+  void initialize(const Eigen::Vector3d& x, double sigma, const SppSolution& spp);
+  void timeUpdate(double dt, const SppSolution& spp);
+  void manageAmbiguities(const Eigen::Vector3d& x0, RtkSolution& sol);
+  void dropAmbiguity(std::uint32_t k);
+  /// Builds and applies the measurement update to filter_; returns false if nothing was applied.
+  bool measurementUpdate(const Eigen::Vector3d& x0);
+  /// Post-fit test: re-initialises one phase ambiguity or drops one code; true if it changed
+  /// something (the update must then be redone).
+  bool rejectOutlier(RtkSolution& sol);
+  void resolve(RtkSolution& sol);
+  Eigen::Vector3d positionEstimate() const;
+  double ambiguityEstimate(const SingleDifference& sd) const;
+
+  const EphemerisStore& nav_;
+  RtkConfig cfg_;
+  SppSolver spp_;
+  BaseStation base_;
+  CycleSlipDetector roverSlips_;
+  DoubleDifferenceBuilder builder_;
+  GlonassChannels roverChannels_;
+  sri::SriFilter<double> filter_;
+  bool initialized_ = false;
+  sri::BlockId pos_, vel_;
+  GpsTime lastTime_;
+  std::optional<Eigen::Vector3d> lastVelocity_;
+  std::unordered_map<std::uint32_t, Ambiguity> amb_;
+  std::unordered_set<std::uint32_t> forced_;  // ambiguities to re-initialise (post-fit outliers)
+  DdEpoch dd_;
+  BaseSnapshot snapshot_;
+  int consecutiveFixes_ = 0;
+  RtkCounters counters_;
+};
+
+}  // namespace gvins

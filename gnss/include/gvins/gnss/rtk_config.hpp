@@ -1,0 +1,134 @@
+// Options of relative positioning (RTK) and their YAML form.
+#pragma once
+
+#include <array>
+#include <string>
+#include <string_view>
+
+#include "gvins/base/constants.hpp"
+#include "gvins/base/satellite.hpp"
+#include "gvins/gnss/ambiguity_resolution.hpp"
+#include "gvins/gnss/cycle_slip_detector.hpp"
+
+namespace gvins {
+
+enum class RtkMode {
+  Static,     ///< the rover does not move: one position for the whole session
+  Kinematic,  ///< the rover moves: position follows `dynamics`
+};
+
+enum class RtkDynamics {
+  RandomWalk,        ///< position random walk (predicted with the Doppler velocity when available)
+  ConstantVelocity,  ///< position and velocity states, white-noise acceleration
+};
+
+enum class AmbiguityMode {
+  Off,            ///< float solution only
+  Continuous,     ///< ambiguities kept from epoch to epoch, resolved every epoch, never fed back
+  Instantaneous,  ///< every epoch on its own (single-epoch RTK)
+  FixAndHold,     ///< as Continuous, and validated fixes constrain the float ambiguities
+};
+
+struct RtkConfig {
+  RtkMode mode = RtkMode::Kinematic;
+  RtkDynamics dynamics = RtkDynamics::RandomWalk;
+  AmbiguityMode ambiguityMode = AmbiguityMode::Continuous;
+
+  /// Systems used (index systemIndex). Default: GPS, GLONASS, Galileo, BeiDou, QZSS.
+  std::array<bool, kNumSystems> systems{true, true, true, true, true, false, false};
+  /// Bands per system in order of preference (RINEX band digits); the first `frequencies`
+  /// available at both receivers are used. One double-difference group per system and band.
+  std::array<std::string, kNumSystems> bands{"125", "12", "157", "276", "125", "15", "59"};
+  int frequencies = 2;
+  double elevationMask = 15.0 * constants::kDegToRad;  ///< rad, at the rover
+  double snrMask = 0.0;                                ///< dB-Hz, 0 = off
+
+  // --- Ambiguity resolution.
+  /// Systems whose ambiguities are fixed. GLONASS is off: its FDMA inter-frequency phase biases
+  /// differ between receiver types, which breaks the integer nature of its double differences.
+  std::array<bool, kNumSystems> arSystems{true, false, true, true, true, false, false};
+  double arElevationMask = 15.0 * constants::kDegToRad;  ///< rad
+  int arMinLock = 0;  ///< epochs an ambiguity must have been estimated before it takes part in AR
+  AmbiguityResolutionOptions ar;
+  int holdMinFixes = 10;           ///< consecutive fixed epochs before fix-and-hold constrains
+  double holdSigmaCycles = 0.01;   ///< standard deviation of the hold constraints, cycles
+  /// A fixed solution is accepted only if every double-differenced phase residual at the fixed
+  /// position is within this many standard deviations (and the code within `codeOutlierSigmas`).
+  double fixValidationSigmas = 4.0;
+
+  // --- Measurement model.
+  /// Carrier-phase standard deviation per receiver: σ² = a² + b² / sin²(el), metres.
+  double phaseSigmaA = 0.003;
+  double phaseSigmaB = 0.003;
+  /// Code σ = codePhaseRatio × phase σ (RTKLIB's "eratio"), per system factor on top.
+  double codePhaseRatio = 100.0;
+  std::array<double, kNumSystems> codeSystemFactor{1.0, 1.5, 1.0, 1.0, 1.0, 3.0, 1.5};
+  bool troposphere = true;  ///< Saastamoinen/Niell slant delays at both receivers
+
+  // --- Base station.
+  double maxAge = 30.0;             ///< s, oldest base data used with a rover epoch
+  bool interpolateBase = true;      ///< interpolate between base epochs that bracket the rover
+  double maxInterpolationGap = 60.0;  ///< s, longest base interval interpolated over
+
+  // --- Cycle slips and outlier rejection.
+  CycleSlipOptions slip;
+  double ambiguityOutage = 60.0;  ///< s an unobserved ambiguity is kept before it is removed
+  /// Prefit gate of double-differenced code (m) and post-fit outlier tests (in σ).
+  double codeInnovationGate = 30.0;
+  double phaseOutlierSigmas = 6.0;
+  double codeOutlierSigmas = 6.0;
+  int maxOutlierRounds = 3;
+
+  // --- Filter.
+  double initialPositionSigma = 30.0;   ///< m, first epoch / after a reset (around SPP)
+  double ambiguityInitialSigma = 30.0;  ///< m (converted to cycles per signal)
+  double randomWalkSigma = 30.0;        ///< m/√s, kinematic random walk without Doppler
+  bool dopplerAided = true;             ///< predict the kinematic position with the Doppler velocity
+  double dopplerAidedSigma = 0.5;       ///< m/√s, random walk on top of the Doppler prediction
+  double accelerationSigmaHorizontal = 3.0;  ///< m/s²/√s, constant-velocity model
+  double accelerationSigmaVertical = 1.0;
+  double maxSppDeviation = 100.0;  ///< m: float farther from SPP resets the filter
+
+  bool useSystem(System s) const { return systems[systemIndex(s)]; }
+  bool fixSystem(System s) const { return arSystems[systemIndex(s)]; }
+};
+
+const char* toString(RtkMode m);
+const char* toString(AmbiguityMode m);
+const char* toString(RtkDynamics d);
+
+/// Reads options from the `rtk:` map of a YAML file (yaml-cpp); other top-level keys (e.g. the
+/// `spp:` section used for the single-point solutions) are left to their readers. Every key under
+/// `rtk:` must be known; missing keys keep `base`'s values. Errors (syntax, unknown key, wrong
+/// type, value out of range) throw ParseError naming the file, the line and the key.
+///
+///   rtk:
+///     mode: kinematic               # static | kinematic
+///     dynamics: random-walk         # random-walk | constant-velocity
+///     ambiguity_mode: continuous    # off | continuous | instantaneous | fix-and-hold
+///     systems: GRECJ
+///     frequencies: 2                # 1..3
+///     bands: {G: "125", E: "157", C: "276"}
+///     elevation_mask_deg: 15
+///     snr_mask_dbhz: 0
+///     ar: {systems: GECJ, elevation_mask_deg: 15, min_lock: 0, validation: ratio,
+///          ratio_threshold: 3, max_failure_rate: 0.001, partial: true,
+///          partial_success_rate: 0.999, min_fixed: 4, hold_min_fixes: 10,
+///          hold_sigma_cycles: 0.01, validation_sigmas: 4}
+///     phase_sigma_m: {a: 0.003, b: 0.003}
+///     code_phase_ratio: 100
+///     code_system_factor: {R: 1.5}
+///     troposphere: true
+///     base: {max_age_s: 30, interpolate: true, max_interpolation_gap_s: 60}
+///     cycle_slip: {lli: true, max_gap_s: 60, geometry_free: true, geometry_free_m: 0.05,
+///                  geometry_free_rate_mps: 0.0005, doppler: true, doppler_m: 0.6,
+///                  doppler_jerk_mps3: 1.0}
+///     ambiguity_outage_s: 60
+///     outliers: {code_gate_m: 30, phase_sigmas: 6, code_sigmas: 6, max_rounds: 3}
+///     filter: {initial_position_sigma_m: 30, ambiguity_sigma_m: 30, random_walk_mpsqrts: 30,
+///              doppler_aided: true, doppler_aided_mpsqrts: 0.5, acceleration_h_mps2: 3,
+///              acceleration_v_mps2: 1, max_spp_deviation_m: 100}
+RtkConfig loadRtkConfig(const std::string& path, const RtkConfig& base = {});
+RtkConfig parseRtkConfig(std::string_view yaml, std::string_view name, const RtkConfig& base = {});
+
+}  // namespace gvins

@@ -1,0 +1,141 @@
+#include "gvins/gnss/base_reader.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <variant>
+#include <vector>
+
+#include "gvins/base/geodetic.hpp"
+#include "gvins/base/local_frame.hpp"
+#include "gvins/base/parse_error.hpp"
+#include "gvins/base/rinex_obs_reader.hpp"
+#include "gvins/rtcm/decoder.hpp"
+
+namespace gvins {
+
+namespace {
+
+class RinexBase final : public BaseReader {
+ public:
+  RinexBase(const std::string& path, bool skip) : reader_(path, options(skip)) {}
+  bool next(ObsEpoch& e) override { return reader_.next(e); }
+  std::optional<Eigen::Vector3d> antennaPosition() const override {
+    const StationInfo& st = reader_.header().station;
+    if (!st.approxPosition || st.approxPosition->norm() < 1e6) return std::nullopt;
+    const Eigen::Vector3d& m = *st.approxPosition;
+    const Eigen::Vector3d& hen = st.antennaDeltaHen;
+    if (hen.isZero()) return m;
+    // ARP = marker + east/north/up offsets in the marker's local frame (RINEX 3.05, 5.2.4).
+    return enuToEcef(Eigen::Vector3d(hen[1], hen[2], hen[0]), m);
+  }
+  GlonassChannels glonassChannels() const override { return reader_.header().glonassChannels; }
+  BaseFormat format() const override { return BaseFormat::Rinex; }
+  std::string describe() const override {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "RINEX %.2f, marker '%s'", reader_.header().version,
+                  reader_.header().station.markerName.c_str());
+    return buf;
+  }
+  std::int64_t skipped() const override { return reader_.stats().skippedEpochs; }
+
+ private:
+  static RinexObsReaderOptions options(bool skip) {
+    RinexObsReaderOptions o;
+    o.skipBadEpochs = skip;
+    return o;
+  }
+  RinexObsReader reader_;
+};
+
+class RtcmBase final : public BaseReader {
+ public:
+  RtcmBase(const std::string& path, const GpsTime& reference, EphemerisStore* nav)
+      : in_(path, std::ios::binary), nav_(nav), decoder_(options(path, reference)) {
+    if (!in_) throw ParseError(path, 0, "", "cannot open file");
+    buf_.resize(1 << 16);
+  }
+  bool next(ObsEpoch& e) override {
+    for (;;) {
+      while (auto d = decoder_.poll()) {
+        if (auto* o = std::get_if<ObsEpoch>(&*d)) {
+          e = std::move(*o);
+          return true;
+        }
+        if (nav_) {
+          if (auto* k = std::get_if<KeplerEphemeris>(&*d)) nav_->add(*k);
+          else if (auto* g = std::get_if<GlonassEphemeris>(&*d)) nav_->add(*g);
+        }
+      }
+      if (done_) return false;
+      in_.read(reinterpret_cast<char*>(buf_.data()), static_cast<std::streamsize>(buf_.size()));
+      const auto n = in_.gcount();
+      if (n > 0) decoder_.feed(std::span<const std::uint8_t>(buf_.data(), static_cast<std::size_t>(n)));
+      if (n <= 0 || !in_) {
+        decoder_.finish();
+        done_ = true;
+      }
+    }
+  }
+  std::optional<Eigen::Vector3d> antennaPosition() const override {
+    const auto& p = decoder_.stationPosition();
+    if (!p || p->arp.norm() < 1e6) return std::nullopt;
+    return p->arp;
+  }
+  GlonassChannels glonassChannels() const override { return decoder_.glonassChannels(); }
+  BaseFormat format() const override { return BaseFormat::Rtcm; }
+  std::string describe() const override {
+    const auto& s = decoder_.stats();
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "RTCM 3, %lld frames, %lld CRC failures, %lld epochs",
+                  static_cast<long long>(s.framing.frames), static_cast<long long>(s.framing.crcFailures),
+                  static_cast<long long>(s.epochs));
+    return buf;
+  }
+  std::int64_t skipped() const override { return decoder_.stats().malformed + decoder_.stats().framing.crcFailures; }
+
+ private:
+  static rtcm::DecoderOptions options(const std::string& path, const GpsTime& reference) {
+    rtcm::DecoderOptions o;
+    o.referenceTime = reference;
+    o.streamName = path;
+    return o;
+  }
+  std::ifstream in_;
+  EphemerisStore* nav_;
+  rtcm::Decoder decoder_;
+  std::vector<std::uint8_t> buf_;
+  bool done_ = false;
+};
+
+}  // namespace
+
+std::optional<BaseFormat> BaseReader::detect(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return std::nullopt;
+  std::vector<unsigned char> head(4096);
+  in.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  if (head.size() >= 2 && head[0] == 0x1f && head[1] == 0x8b) return BaseFormat::Rinex;
+  const std::string text(head.begin(), head.end());
+  if (text.find("RINEX VERSION / TYPE") != std::string::npos) return BaseFormat::Rinex;
+  // An RTCM frame header: 0xD3, six zero bits, a 10-bit length.
+  for (std::size_t i = 0; i + 2 < head.size(); ++i) {
+    if (head[i] == 0xD3 && (head[i + 1] & 0xFC) == 0) return BaseFormat::Rtcm;
+  }
+  return std::nullopt;
+}
+
+std::unique_ptr<BaseReader> BaseReader::open(const std::string& path, const GpsTime& referenceTime,
+                                             EphemerisStore* nav, bool skipBadEpochs) {
+  const auto f = detect(path);
+  if (!f) {
+    std::ifstream probe(path, std::ios::binary);
+    if (!probe) throw ParseError(path, 0, "", "cannot open file");
+    throw ParseError(path, 1, "format", "neither RINEX observation data nor an RTCM 3 stream");
+  }
+  if (*f == BaseFormat::Rinex) return std::make_unique<RinexBase>(path, skipBadEpochs);
+  return std::make_unique<RtcmBase>(path, referenceTime, nav);
+}
+
+}  // namespace gvins

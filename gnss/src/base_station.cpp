@@ -1,0 +1,233 @@
+#include "gvins/gnss/base_station.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "gvins/base/constants.hpp"
+#include "gvins/base/geodetic.hpp"
+#include "gvins/base/local_frame.hpp"
+#include "gvins/gnss/troposphere.hpp"
+#include "gvins/gnss/zero_difference.hpp"
+
+namespace gvins {
+
+namespace {
+bool signalLess(const BaseSignal& a, const BaseSignal& b) {
+  return a.sat == b.sat ? a.code < b.code : a.sat < b.sat;
+}
+}  // namespace
+
+const char* toString(BaseAvailability a) {
+  switch (a) {
+    case BaseAvailability::Ok: return "ok";
+    case BaseAvailability::NoPosition: return "base position unknown";
+    case BaseAvailability::NoData: return "no base data yet";
+    case BaseAvailability::TooOld: return "base data too old";
+  }
+  return "?";
+}
+
+const BaseSignal* BaseSnapshot::find(SatId sat, ObsCode code) const {
+  BaseSignal key;
+  key.sat = sat;
+  key.code = code;
+  const auto it = std::lower_bound(signals.begin(), signals.end(), key, signalLess);
+  if (it == signals.end() || !(it->sat == sat) || !(it->code == code)) return nullptr;
+  return &*it;
+}
+
+bool BaseSnapshot::has(SatId sat) const {
+  BaseSignal key;
+  key.sat = sat;
+  key.code = ObsCode('0', 'A');
+  const auto it = std::lower_bound(signals.begin(), signals.end(), key, signalLess);
+  return it != signals.end() && it->sat == sat;
+}
+
+BaseStation::BaseStation(const EphemerisStore& nav, const RtkConfig& config)
+    : nav_(nav), config_(config), slips_(config.slip) {}
+
+void BaseStation::setPosition(const Eigen::Vector3d& arp) {
+  if (position_ && (*position_ - arp).norm() < 1e-3) return;
+  if (position_) {
+    ++stats_.positionChanges;
+    for (Epoch& e : epochs_) {
+      e.modelled = false;
+      e.signals.clear();
+    }
+  }
+  position_ = arp;
+}
+
+void BaseStation::setGlonassChannels(const GlonassChannels& channels) {
+  channels_ = channels;
+  channels_.mergeMissing(nav_.glonassChannels());
+}
+
+std::optional<GpsTime> BaseStation::latestTime() const {
+  if (epochs_.empty()) return std::nullopt;
+  return epochs_.back().time;
+}
+
+void BaseStation::clear() {
+  epochs_.clear();
+  slips_.reset();
+}
+
+void BaseStation::addEpoch(const ObsEpoch& epoch) {
+  if (!epochs_.empty() && !(epoch.time - epochs_.back().time > 1e-6)) {
+    ++stats_.outOfOrder;
+    return;
+  }
+  ++stats_.epochs;
+  GlonassChannels ch = channels_;
+  ch.mergeMissing(nav_.glonassChannels());
+  slips_.process(epoch, ch);
+  Epoch e;
+  e.time = epoch.time;
+  e.raw = epoch;
+  epochs_.push_back(std::move(e));
+  // Keep what alignment can still use: epochs within maxAge + maxInterpolationGap of the newest,
+  // and at least two.
+  const double keep = std::max(config_.maxAge, config_.maxInterpolationGap) + 1.0;
+  while (epochs_.size() > 2 && epochs_.back().time - epochs_[1].time > keep) epochs_.pop_front();
+  while (epochs_.size() > 16) epochs_.pop_front();
+  // Record slip flags and arcs now: the detector only knows the latest epoch.
+  Epoch& last = epochs_.back();
+  for (const SatObs& so : last.raw.sats) {
+    if (!so.sat.valid() || !config_.useSystem(so.sat.system)) continue;
+    for (const SignalObs& s : so.signals) {
+      BaseSignal b;
+      b.sat = so.sat;
+      b.code = s.code;
+      b.hasPhase = s.hasPhase() && s.carrierPhase != 0.0 && std::isfinite(s.carrierPhase);
+      b.hasCode = s.hasCode() && s.pseudorange > 1e6 && s.pseudorange < 1e8;
+      if (!b.hasPhase && !b.hasCode) continue;
+      if (b.hasPhase) {
+        b.slipFlags = slips_.flags(so.sat, s.code);
+        b.arcStart = slips_.arcStart(so.sat, s.code).value_or(last.time);
+      }
+      last.signals.push_back(b);
+    }
+  }
+  std::sort(last.signals.begin(), last.signals.end(), signalLess);
+  if (position_) model(last);
+}
+
+void BaseStation::model(Epoch& e) {
+  if (e.modelled || !position_) return;
+  const Eigen::Vector3d& rb = *position_;
+  const Geodetic g = ecefToGeodetic(rb);
+  GlonassChannels ch = channels_;
+  ch.mergeMissing(nav_.glonassChannels());
+  std::vector<BaseSignal> out;
+  out.reserve(e.signals.size());
+  std::size_t i = 0;
+  while (i < e.signals.size()) {
+    const SatId sat = e.signals[i].sat;
+    std::size_t j = i;
+    while (j < e.signals.size() && e.signals[j].sat == sat) ++j;
+    const SatObs* so = e.raw.find(sat);
+    // Transmit time from any plausible pseudorange of the satellite.
+    double pr = 0.0;
+    if (so) {
+      for (const SignalObs& s : so->signals) {
+        if (s.hasCode() && s.pseudorange > 1e6 && s.pseudorange < 1e8) {
+          pr = s.pseudorange;
+          break;
+        }
+      }
+    }
+    const auto tx = so ? satelliteAtTransmit(nav_, sat, e.time, pr) : std::nullopt;
+    if (!tx) {
+      ++stats_.noEphemeris;
+      i = j;
+      continue;
+    }
+    const double range = geometricRange(tx->state.position, rb);
+    const AzEl azel = azimuthElevation(g, rb, tx->state.position);
+    double tropo = 0.0;
+    if (config_.troposphere && azel.elevation > 0.0) tropo = slantTroposphereDelay(g, azel.elevation, e.time).slant;
+    const double computed = range - constants::kSpeedOfLight * tx->state.clockBias + tropo;
+    std::optional<int> channel;
+    if (sat.system == System::Glonass) channel = ch.get(sat.prn);
+    for (std::size_t k = i; k < j; ++k) {
+      BaseSignal b = e.signals[k];
+      const SignalObs* s = so->find(b.code);
+      if (!s) continue;
+      b.elevation = azel.elevation;
+      const auto lam = carrierWavelength(sat.system, b.code.band, channel);
+      b.wavelength = lam ? *lam : 0.0;
+      if (b.hasPhase && lam) b.phaseOmc = *lam * s->carrierPhase - computed;
+      else b.hasPhase = false;
+      if (b.hasCode) b.codeOmc = s->pseudorange - computed;
+      if (b.hasPhase || b.hasCode) out.push_back(b);
+    }
+    i = j;
+  }
+  e.signals = std::move(out);
+  e.modelled = true;
+}
+
+BaseAvailability BaseStation::snapshot(const GpsTime& t, BaseSnapshot& out) {
+  out.signals.clear();
+  out.interpolated = false;
+  if (!position_) return BaseAvailability::NoPosition;
+  if (epochs_.empty()) return BaseAvailability::NoData;
+  // eB: newest epoch not after t (within the sync tolerance); eA: the one after it.
+  int b = -1;
+  for (int k = static_cast<int>(epochs_.size()) - 1; k >= 0; --k) {
+    if (epochs_[static_cast<std::size_t>(k)].time - t <= kSyncTolerance) {
+      b = k;
+      break;
+    }
+  }
+  const int a = b + 1 < static_cast<int>(epochs_.size()) ? b + 1 : -1;
+  if (b < 0) return BaseAvailability::NoData;
+  Epoch& eb = epochs_[static_cast<std::size_t>(b)];
+  model(eb);
+  const double ageB = t - eb.time;
+  if (std::abs(ageB) <= kSyncTolerance) {
+    out.time = eb.time;
+    out.age = ageB;
+    out.signals = eb.signals;
+    return BaseAvailability::Ok;
+  }
+  if (config_.interpolateBase && a >= 0) {
+    Epoch& ea = epochs_[static_cast<std::size_t>(a)];
+    const double gap = ea.time - eb.time;
+    if (gap <= config_.maxInterpolationGap && gap > 0.0) {
+      model(ea);
+      const double w = (t - eb.time) / gap;
+      out.time = t;
+      out.age = std::min(ageB, ea.time - t);
+      out.interpolated = true;
+      std::size_t j = 0;
+      for (const BaseSignal& s0 : eb.signals) {
+        while (j < ea.signals.size() && signalLess(ea.signals[j], s0)) ++j;
+        if (j == ea.signals.size()) break;
+        const BaseSignal& s1 = ea.signals[j];
+        if (!(s1.sat == s0.sat) || !(s1.code == s0.code)) continue;
+        BaseSignal s = s1;
+        s.hasCode = s0.hasCode && s1.hasCode;
+        s.hasPhase = s0.hasPhase && s1.hasPhase && s1.arcStart == s0.arcStart;
+        if (s.hasCode) s.codeOmc = s0.codeOmc + w * (s1.codeOmc - s0.codeOmc);
+        if (s.hasPhase) s.phaseOmc = s0.phaseOmc + w * (s1.phaseOmc - s0.phaseOmc);
+        s.elevation = s0.elevation + w * (s1.elevation - s0.elevation);
+        s.slipFlags = s0.slipFlags;
+        s.arcStart = s0.arcStart;
+        if (s.hasCode || s.hasPhase) out.signals.push_back(s);
+      }
+      return BaseAvailability::Ok;
+    }
+  }
+  if (ageB <= config_.maxAge) {
+    out.time = eb.time;
+    out.age = ageB;
+    out.signals = eb.signals;
+    return BaseAvailability::Ok;
+  }
+  return BaseAvailability::TooOld;
+}
+
+}  // namespace gvins

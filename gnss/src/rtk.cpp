@@ -1,0 +1,657 @@
+#include "gvins/gnss/rtk.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+
+#include <Eigen/Cholesky>
+
+#include "gvins/base/geodetic.hpp"
+#include "gvins/base/local_frame.hpp"
+#include "gvins/gnss/ambiguity_resolution.hpp"
+
+namespace gvins {
+
+using Filter = sri::SriFilter<double>;
+using Meas = sri::Measurement<double>;
+
+const char* toString(RtkIssue i) {
+  switch (i) {
+    case RtkIssue::None: return "none";
+    case RtkIssue::NoBasePosition: return "base position unknown";
+    case RtkIssue::NoBaseData: return "no base data";
+    case RtkIssue::BaseTooOld: return "base data too old";
+    case RtkIssue::NoCommonSatellites: return "fewer than 4 common satellites";
+    case RtkIssue::FilterReset: return "float diverged from SPP (reset)";
+  }
+  return "?";
+}
+
+const char* toString(ArStatus s) {
+  switch (s) {
+    case ArStatus::Off: return "off";
+    case ArStatus::TooFewAmbiguities: return "too few ambiguities";
+    case ArStatus::NotValidated: return "ratio/success-rate test failed";
+    case ArStatus::Rejected: return "fix rejected by residual check";
+    case ArStatus::Fixed: return "fixed";
+    case ArStatus::PartialFixed: return "partially fixed";
+  }
+  return "?";
+}
+
+PositionSolution RtkSolution::toPositionSolution() const {
+  PositionSolution p;
+  p.time = time;
+  p.quality = quality;
+  p.position = position;
+  p.positionCovariance = positionCovariance;
+  p.numSatellites = numSatellites;
+  p.age = age;
+  p.ratio = ratio;
+  if (velocity) {
+    p.velocity = *velocity;
+    p.velocityCovariance = velocityCovariance;
+  }
+  return p;
+}
+
+RtkSolver::RtkSolver(const EphemerisStore& nav, RtkConfig config, SppConfig spp)
+    : nav_(nav),
+      cfg_(std::move(config)),
+      spp_(nav, std::move(spp)),
+      base_(nav, cfg_),
+      roverSlips_(cfg_.slip),
+      builder_(nav, cfg_) {}
+
+void RtkSolver::setBasePosition(const Eigen::Vector3d& arp) {
+  const auto old = base_.position();
+  base_.setPosition(arp);
+  if (old && (*old - arp).norm() >= 1e-3) reset();
+}
+
+void RtkSolver::setBaseGlonassChannels(const GlonassChannels& channels) { base_.setGlonassChannels(channels); }
+
+void RtkSolver::setRoverGlonassChannels(const GlonassChannels& channels) {
+  roverChannels_ = channels;
+  spp_.setGlonassChannels(channels);
+  builder_.setGlonassChannels(channels);
+}
+
+void RtkSolver::setRoverInitialPosition(const Eigen::Vector3d& ecef) { spp_.setInitialPosition(ecef); }
+
+void RtkSolver::addBaseEpoch(const ObsEpoch& epoch) { base_.addEpoch(epoch); }
+
+void RtkSolver::reset() {
+  filter_ = Filter();
+  amb_.clear();
+  initialized_ = false;
+  consecutiveFixes_ = 0;
+  lastVelocity_.reset();
+  pos_ = vel_ = sri::BlockId{};
+}
+
+Eigen::Vector3d RtkSolver::positionEstimate() const { return filter_.estimate(pos_).vector.head<3>(); }
+
+double RtkSolver::ambiguityEstimate(const SingleDifference& sd) const {
+  const auto it = amb_.find(key(sd.sat, sd.code));
+  return it == amb_.end() ? 0.0 : filter_.estimate(it->second.id).vector[0];
+}
+
+void RtkSolver::initialize(const Eigen::Vector3d& x, double sigma, const SppSolution& spp) {
+  reset();
+  pos_ = filter_.addBlock(sri::BlockSpec::vector("position", 3), sri::BlockEstimate<double>::fromVector(x),
+                          sri::Prior<double>::stdDev(3, sigma));
+  if (cfg_.mode == RtkMode::Kinematic && cfg_.dynamics == RtkDynamics::ConstantVelocity) {
+    Eigen::Vector3d v = Eigen::Vector3d::Zero();
+    double sv = 30.0;
+    if (spp.velocity.valid) {
+      v = spp.velocity.velocity;
+      sv = 1.0;
+    }
+    vel_ = filter_.addBlock(sri::BlockSpec::vector("velocity", 3), sri::BlockEstimate<double>::fromVector(v),
+                            sri::Prior<double>::stdDev(3, sv));
+  }
+  initialized_ = true;
+}
+
+void RtkSolver::timeUpdate(double dt, const SppSolution& spp) {
+  if (cfg_.mode == RtkMode::Static) return;
+  const Eigen::Vector3d x = positionEstimate();
+  const std::optional<Eigen::Vector3d> v =
+      spp.velocity.valid ? std::optional<Eigen::Vector3d>(spp.velocity.velocity) : std::nullopt;
+  if (cfg_.dynamics == RtkDynamics::RandomWalk) {
+    Eigen::Vector3d delta = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d Q;
+    if (cfg_.dopplerAided && v) {
+      // Trapezoid of the Doppler velocities at both ends of the interval.
+      delta = lastVelocity_ ? Eigen::Vector3d(0.5 * (*lastVelocity_ + *v) * dt) : Eigen::Vector3d(*v * dt);
+      Q = cfg_.dopplerAidedSigma * cfg_.dopplerAidedSigma * dt * Eigen::Matrix3d::Identity() +
+          dt * dt * spp.velocity.covariance;
+    } else {
+      Q = cfg_.randomWalkSigma * cfg_.randomWalkSigma * dt * Eigen::Matrix3d::Identity();
+    }
+    Q += 1e-10 * Eigen::Matrix3d::Identity();
+    sri::Propagation<double> p;
+    p.addNewBlock(sri::BlockSpec::vector("position", 3), sri::BlockEstimate<double>::fromVector(x + delta));
+    p.setTransition(pos_, Eigen::Matrix3d::Identity());
+    p.setNoiseCovariance(Q);
+    p.marginalizeAfter(pos_);
+    pos_ = filter_.propagate(p).front();
+  } else {
+    const Eigen::Vector3d vel = filter_.estimate(vel_).vector.head<3>();
+    const Geodetic g = ecefToGeodetic(x);
+    const Eigen::Matrix3d Ren = ecefToEnuRotation(g.lat, g.lon);
+    Eigen::Vector3d q(cfg_.accelerationSigmaHorizontal, cfg_.accelerationSigmaHorizontal, cfg_.accelerationSigmaVertical);
+    q = q.cwiseProduct(q);
+    const Eigen::Matrix3d Qa = Ren.transpose() * q.asDiagonal() * Ren + 1e-8 * Eigen::Matrix3d::Identity();
+    Eigen::MatrixXd Q(6, 6);
+    Q << dt * dt * dt / 3.0 * Qa, dt * dt / 2.0 * Qa, dt * dt / 2.0 * Qa, dt * Qa;
+    Eigen::MatrixXd phiP = Eigen::MatrixXd::Zero(6, 3), phiV = Eigen::MatrixXd::Zero(6, 3);
+    phiP.topRows(3).setIdentity();
+    phiV.topRows(3) = dt * Eigen::Matrix3d::Identity();
+    phiV.bottomRows(3).setIdentity();
+    sri::Propagation<double> p;
+    p.addNewBlock(sri::BlockSpec::vector("position", 3), sri::BlockEstimate<double>::fromVector(x + vel * dt));
+    p.addNewBlock(sri::BlockSpec::vector("velocity", 3), sri::BlockEstimate<double>::fromVector(vel));
+    p.setTransition(pos_, phiP);
+    p.setTransition(vel_, phiV);
+    p.setNoiseCovariance(Q);
+    p.marginalizeAfter(pos_);
+    p.marginalizeAfter(vel_);
+    const auto ids = filter_.propagate(p);
+    pos_ = ids[0];
+    vel_ = ids[1];
+    if (cfg_.dopplerAided && v) {
+      Meas m(3);
+      m.jacobian(vel_, 3).setIdentity();
+      m.residual() = *v - vel;
+      m.whitenCovariance(4.0 * spp.velocity.covariance + 1e-6 * Eigen::Matrix3d::Identity());
+      filter_.update(m);
+      filter_.correct();
+    }
+  }
+}
+
+void RtkSolver::dropAmbiguity(std::uint32_t k) {
+  const auto it = amb_.find(k);
+  if (it == amb_.end()) return;
+  filter_.marginalize(it->second.id);
+  amb_.erase(it);
+}
+
+void RtkSolver::manageAmbiguities(const Eigen::Vector3d& x0, RtkSolution& sol) {
+  std::vector<char> inPhase(dd_.sd.size(), 0);
+  for (const DoubleDifference& d : dd_.phase) {
+    inPhase[static_cast<std::size_t>(d.reference)] = 1;
+    inPhase[static_cast<std::size_t>(d.satellite)] = 1;
+  }
+  bool rebuild = false;
+  for (std::size_t i = 0; i < dd_.sd.size(); ++i) {
+    if (!inPhase[i]) continue;
+    SingleDifference& sd = dd_.sd[i];
+    const std::uint32_t k = key(sd.sat, sd.code);
+    const auto it = amb_.find(k);
+    if (it != amb_.end()) {
+      if (it->second.roverArc == sd.roverArc && it->second.baseArc == sd.baseArc && !forced_.count(k)) {
+        it->second.lastSeen = dd_.time;
+        continue;
+      }
+      // New arc at either receiver (slip, loss of lock, gap) or a post-fit outlier: the
+      // ambiguity is not kept.
+      dropAmbiguity(k);
+      if (!forced_.count(k)) ++counters_.slipResets;
+    }
+    if (!sd.hasCode) {
+      // Without a code the new ambiguity cannot be initialised (the SD clock is unknown).
+      sd.hasPhase = false;
+      rebuild = true;
+      continue;
+    }
+    const double n0 = (sdPhaseResidual(sd, x0) - sdCodeResidual(sd, x0)) / sd.wavelength;
+    const double sigma = cfg_.ambiguityInitialSigma / sd.wavelength;
+    Ambiguity a;
+    a.id = filter_.addBlock(sri::BlockSpec::vector("ambiguity", 1),
+                            sri::BlockEstimate<double>::fromVector(Eigen::VectorXd::Constant(1, n0)),
+                            sri::Prior<double>::stdDev(1, sigma), sri::Placement::before(pos_));
+    a.sat = sd.sat;
+    a.code = sd.code;
+    a.wavelength = sd.wavelength;
+    a.roverArc = sd.roverArc;
+    a.baseArc = sd.baseArc;
+    a.lastSeen = dd_.time;
+    amb_[k] = a;
+    ++counters_.ambiguitiesAdded;
+    ++sol.ambiguityResets;
+  }
+  // Ambiguities of satellites gone for too long.
+  std::vector<std::uint32_t> stale;
+  for (const auto& [k, a] : amb_) {
+    if (dd_.time - a.lastSeen > cfg_.ambiguityOutage) stale.push_back(k);
+  }
+  for (std::uint32_t k : stale) {
+    dropAmbiguity(k);
+    ++counters_.ambiguitiesRemoved;
+  }
+  if (rebuild) builder_.formDoubleDifferences(dd_);
+}
+
+bool RtkSolver::measurementUpdate(const Eigen::Vector3d& x0) {
+  bool any = false;
+  std::vector<int> ph, cd;
+  for (std::size_t g = 0; g < dd_.groups.size(); ++g) {
+    ph.clear();
+    cd.clear();
+    for (std::size_t i = 0; i < dd_.phase.size(); ++i) {
+      if (dd_.sd[static_cast<std::size_t>(dd_.phase[i].satellite)].group == static_cast<int>(g)) ph.push_back(static_cast<int>(i));
+    }
+    for (std::size_t i = 0; i < dd_.code.size(); ++i) {
+      if (dd_.sd[static_cast<std::size_t>(dd_.code[i].satellite)].group == static_cast<int>(g)) cd.push_back(static_cast<int>(i));
+    }
+    const int np = static_cast<int>(ph.size()), nc = static_cast<int>(cd.size());
+    if (np + nc == 0) continue;
+    Meas m(np + nc);
+    m.jacobian(pos_, 3);  // position columns first
+    Eigen::MatrixXd C = Eigen::MatrixXd::Zero(np + nc, np + nc);
+    for (int r = 0; r < np; ++r) {
+      const DoubleDifference& d = dd_.phase[static_cast<std::size_t>(ph[static_cast<std::size_t>(r)])];
+      const SingleDifference& s = dd_.sd[static_cast<std::size_t>(d.satellite)];
+      const SingleDifference& f = dd_.sd[static_cast<std::size_t>(d.reference)];
+      const Ambiguity& as = amb_.at(key(s.sat, s.code));
+      const Ambiguity& af = amb_.at(key(f.sat, f.code));
+      const double ns = filter_.estimate(as.id).vector[0], nf = filter_.estimate(af.id).vector[0];
+      const DdResidual res = ddPhaseResidual(dd_, d, x0);
+      m.residual()[r] = res.residual - (s.wavelength * ns - f.wavelength * nf);
+      // (jacobian() of a new block reallocates: always take the block afresh.)
+      m.jacobian(pos_, 3).row(r) = res.jacobian;
+      m.jacobian(as.id, 1)(r, 0) = s.wavelength;
+      m.jacobian(af.id, 1)(r, 0) = -f.wavelength;
+      C(r, r) = res.variance;
+      for (int q = 0; q < r; ++q) {
+        if (dd_.phase[static_cast<std::size_t>(ph[static_cast<std::size_t>(q)])].reference == d.reference) {
+          C(r, q) = C(q, r) = f.phaseVariance;
+        }
+      }
+    }
+    for (int r = 0; r < nc; ++r) {
+      const DoubleDifference& d = dd_.code[static_cast<std::size_t>(cd[static_cast<std::size_t>(r)])];
+      const DdResidual res = ddCodeResidual(dd_, d, x0);
+      const int row = np + r;
+      m.residual()[row] = res.residual;
+      m.jacobian(pos_, 3).row(row) = res.jacobian;
+      C(row, row) = res.variance;
+      for (int q = 0; q < r; ++q) {
+        if (dd_.code[static_cast<std::size_t>(cd[static_cast<std::size_t>(q)])].reference == d.reference) {
+          C(row, np + q) = C(np + q, row) = dd_.sd[static_cast<std::size_t>(d.reference)].codeVariance;
+        }
+      }
+    }
+    m.whitenCovariance(C);
+    filter_.update(m);
+    any = true;
+  }
+  if (any) filter_.correct();
+  return any;
+}
+
+bool RtkSolver::rejectOutlier(RtkSolution& sol) {
+  const Eigen::Vector3d x = positionEstimate();
+  double worst = 0.0;
+  int culprit = -1;
+  bool culpritPhase = false;
+  std::vector<double> norm;
+  std::vector<int> idx;
+  for (std::size_t g = 0; g < dd_.groups.size(); ++g) {
+    for (int pass = 0; pass < 2; ++pass) {
+      const bool phase = pass == 0;
+      const auto& list = phase ? dd_.phase : dd_.code;
+      const double thr = phase ? cfg_.phaseOutlierSigmas : cfg_.codeOutlierSigmas;
+      norm.clear();
+      idx.clear();
+      int ref = -1;
+      for (std::size_t i = 0; i < list.size(); ++i) {
+        const DoubleDifference& d = list[i];
+        const SingleDifference& s = dd_.sd[static_cast<std::size_t>(d.satellite)];
+        if (s.group != static_cast<int>(g)) continue;
+        ref = d.reference;
+        double v;
+        double var;
+        if (phase) {
+          const SingleDifference& f = dd_.sd[static_cast<std::size_t>(d.reference)];
+          const DdResidual r = ddPhaseResidual(dd_, d, x);
+          v = r.residual - (s.wavelength * ambiguityEstimate(s) - f.wavelength * ambiguityEstimate(f));
+          var = r.variance;
+        } else {
+          const DdResidual r = ddCodeResidual(dd_, d, x);
+          v = r.residual;
+          var = r.variance;
+        }
+        norm.push_back(std::abs(v) / std::sqrt(var));
+        idx.push_back(d.satellite);
+      }
+      if (norm.empty()) continue;
+      int over = 0;
+      std::size_t imax = 0;
+      for (std::size_t i = 0; i < norm.size(); ++i) {
+        if (norm[i] > thr) ++over;
+        if (norm[i] > norm[imax]) imax = i;
+      }
+      if (over == 0) continue;
+      // Most DDs of the group off: the reference is the likely culprit.
+      const bool blameRef = norm.size() >= 3 && over * 2 > static_cast<int>(norm.size());
+      const double score = norm[imax] / thr;
+      if (score > worst) {
+        worst = score;
+        culprit = blameRef ? ref : idx[imax];
+        culpritPhase = phase;
+      }
+    }
+  }
+  if (culprit < 0) return false;
+  SingleDifference& sd = dd_.sd[static_cast<std::size_t>(culprit)];
+  if (culpritPhase) {
+    // Re-initialise the ambiguity: an undetected slip, or a bad phase.
+    forced_.insert(key(sd.sat, sd.code));
+    ++sol.phaseOutliers;
+    ++counters_.phaseOutliers;
+  } else {
+    sd.hasCode = false;
+    builder_.formDoubleDifferences(dd_);
+    ++sol.codeOutliers;
+    ++counters_.codeOutliers;
+  }
+  return true;
+}
+
+RtkSolution RtkSolver::process(const ObsEpoch& rover) {
+  RtkSolution sol;
+  sol.time = rover.time;
+  const SppSolution spp = spp_.solve(rover);
+  sol.sppStatus = spp.status;
+  if (spp.valid()) sol.time = spp.solutionTime;
+  if (spp.velocity.valid) {
+    sol.velocity = spp.velocity.velocity;
+    sol.velocityCovariance = spp.velocity.covariance;
+  }
+  GlonassChannels ch = roverChannels_;
+  ch.mergeMissing(nav_.glonassChannels());
+  roverSlips_.process(rover, ch);
+
+  auto single = [&](RtkIssue issue) {
+    sol.issue = issue;
+    if (spp.valid()) {
+      sol.quality = SolutionQuality::Single;
+      sol.position = spp.position;
+      sol.positionCovariance = spp.positionCovariance;
+      sol.numSatellites = spp.numSatellites;
+    }
+    return sol;
+  };
+
+  forced_.clear();
+  if (cfg_.ambiguityMode == AmbiguityMode::Instantaneous) initialized_ = false;
+  const BaseAvailability avail = base_.snapshot(rover.time, snapshot_);
+  if (avail != BaseAvailability::Ok) {
+    dd_.clear();
+    dd_.time = rover.time;
+    switch (avail) {
+      case BaseAvailability::NoPosition: return single(RtkIssue::NoBasePosition);
+      case BaseAvailability::NoData: return single(RtkIssue::NoBaseData);
+      default: return single(RtkIssue::BaseTooOld);
+    }
+  }
+  sol.age = snapshot_.age;
+  const Eigen::Vector3d basePos = *base_.position();
+
+  if (!initialized_) {
+    if (spp.valid()) initialize(spp.position, cfg_.initialPositionSigma, spp);
+    else initialize(basePos, std::max(cfg_.initialPositionSigma, 1e4), spp);
+    lastTime_ = rover.time;
+  } else {
+    const double dt = rover.time - lastTime_;
+    if (dt > 0.0) timeUpdate(dt, spp);
+    lastTime_ = rover.time;
+  }
+  if (spp.velocity.valid) lastVelocity_ = spp.velocity.velocity;
+
+  const Eigen::Vector3d x0 = positionEstimate();
+  builder_.form(rover, roverSlips_, snapshot_, basePos, x0, dd_);
+
+  // Prefit gate on DD code (gross errors, multipath spikes).
+  bool gated = false;
+  for (const DoubleDifference& d : dd_.code) {
+    if (std::abs(ddCodeResidual(dd_, d, x0).residual) > cfg_.codeInnovationGate) {
+      dd_.sd[static_cast<std::size_t>(d.satellite)].hasCode = false;
+      ++sol.codeOutliers;
+      ++counters_.codeOutliers;
+      gated = true;
+    }
+  }
+  if (gated) builder_.formDoubleDifferences(dd_);
+
+  std::set<SatId> sats;
+  for (const auto* list : {&dd_.phase, &dd_.code}) {
+    for (const DoubleDifference& d : *list) {
+      sats.insert(dd_.sd[static_cast<std::size_t>(d.satellite)].sat);
+      sats.insert(dd_.sd[static_cast<std::size_t>(d.reference)].sat);
+    }
+  }
+  if (sats.size() < 4) return single(RtkIssue::NoCommonSatellites);
+
+  // Measurement update with post-fit outlier rejection (redone from the saved state).
+  Filter saved;
+  std::unordered_map<std::uint32_t, Ambiguity> savedAmb;
+  for (int round = 0;; ++round) {
+    manageAmbiguities(x0, sol);
+    saved = filter_;
+    savedAmb = amb_;
+    measurementUpdate(x0);
+    if (round >= cfg_.maxOutlierRounds || !rejectOutlier(sol)) break;
+    filter_ = saved;
+    amb_ = savedAmb;
+  }
+
+  const Eigen::Vector3d xf = positionEstimate();
+  if (spp.valid() && (xf - spp.position).norm() > cfg_.maxSppDeviation) {
+    ++counters_.filterResets;
+    reset();
+    return single(RtkIssue::FilterReset);
+  }
+  {
+    std::set<std::uint32_t> seen;
+    for (const DoubleDifference& d : dd_.phase) {
+      for (int i : {d.reference, d.satellite}) {
+        const SingleDifference& s = dd_.sd[static_cast<std::size_t>(i)];
+        const std::uint32_t k = key(s.sat, s.code);
+        if (seen.insert(k).second) {
+          const auto it = amb_.find(k);
+          if (it != amb_.end()) ++it->second.lock;
+        }
+      }
+    }
+  }
+  sol.floatPosition = xf;
+  const sri::BlockId pid[] = {pos_};
+  sol.floatCovariance = filter_.covariance(pid);
+  sol.quality = SolutionQuality::Float;
+  sol.position = xf;
+  sol.positionCovariance = sol.floatCovariance;
+  sol.numSatellites = dd_.phaseSatellites();
+  if (sol.numSatellites == 0) sol.numSatellites = static_cast<int>(sats.size());
+  if (vel_.valid() && cfg_.dynamics == RtkDynamics::ConstantVelocity && cfg_.mode == RtkMode::Kinematic) {
+    sol.velocity = filter_.estimate(vel_).vector.head<3>();
+    const sri::BlockId vid[] = {vel_};
+    sol.velocityCovariance = filter_.covariance(vid);
+  }
+  resolve(sol);
+  return sol;
+}
+
+void RtkSolver::resolve(RtkSolution& sol) {
+  if (cfg_.ambiguityMode == AmbiguityMode::Off) {
+    sol.ar = ArStatus::Off;
+    return;
+  }
+  // Eligible SDs per group and the DD pairs (AR reference, satellite).
+  std::vector<char> inPhase(dd_.sd.size(), 0);
+  for (const DoubleDifference& d : dd_.phase) {
+    inPhase[static_cast<std::size_t>(d.reference)] = 1;
+    inPhase[static_cast<std::size_t>(d.satellite)] = 1;
+  }
+  struct Pair {
+    int ref, sat;
+    sri::BlockId refId, satId;
+  };
+  std::vector<Pair> pairs;
+  std::vector<int> arRef(dd_.groups.size(), -1);
+  for (std::size_t g = 0; g < dd_.groups.size(); ++g) {
+    std::vector<int> members;
+    for (std::size_t i = 0; i < dd_.sd.size(); ++i) {
+      const SingleDifference& s = dd_.sd[i];
+      if (s.group != static_cast<int>(g) || !inPhase[i] || !s.hasPhase || s.halfCycle) continue;
+      if (!cfg_.fixSystem(s.sat.system) || s.elevation < cfg_.arElevationMask) continue;
+      const auto it = amb_.find(key(s.sat, s.code));
+      if (it == amb_.end() || it->second.lock < cfg_.arMinLock) continue;
+      members.push_back(static_cast<int>(i));
+    }
+    if (members.size() < 2) continue;
+    int ref = dd_.groups[g].phaseReference;
+    if (std::find(members.begin(), members.end(), ref) == members.end()) {
+      ref = members[0];
+      for (int i : members) {
+        if (dd_.sd[static_cast<std::size_t>(i)].elevation > dd_.sd[static_cast<std::size_t>(ref)].elevation) ref = i;
+      }
+    }
+    arRef[g] = ref;
+    const SingleDifference& f = dd_.sd[static_cast<std::size_t>(ref)];
+    const sri::BlockId rid = amb_.at(key(f.sat, f.code)).id;
+    for (int i : members) {
+      if (i == ref) continue;
+      const SingleDifference& s = dd_.sd[static_cast<std::size_t>(i)];
+      pairs.push_back(Pair{ref, i, rid, amb_.at(key(s.sat, s.code)).id});
+    }
+  }
+  const int m = static_cast<int>(pairs.size());
+  sol.numAmbiguities = m;
+  if (m < std::max(1, cfg_.ar.minFixed)) {
+    sol.ar = ArStatus::TooFewAmbiguities;
+    consecutiveFixes_ = 0;
+    return;
+  }
+  ++counters_.arAttempts;
+  // Joint covariance of [position; DD ambiguities] from the square-root factor: with M the rows
+  // selecting/combining state columns, cov = (M R⁻¹)(M R⁻¹)ᵀ, one triangular solve Rᵀ Y = Mᵀ.
+  const int n = filter_.dim();
+  const Eigen::MatrixXd R = filter_.squareRootInformation();
+  Eigen::MatrixXd Mt = Eigen::MatrixXd::Zero(n, 3 + m);
+  const int po = filter_.layout().block(pos_).offset;
+  for (int c = 0; c < 3; ++c) Mt(po + c, c) = 1.0;
+  Eigen::VectorXd a(m);
+  for (int k = 0; k < m; ++k) {
+    const int os = filter_.layout().block(pairs[static_cast<std::size_t>(k)].satId).offset;
+    const int orf = filter_.layout().block(pairs[static_cast<std::size_t>(k)].refId).offset;
+    Mt(os, 3 + k) = 1.0;
+    Mt(orf, 3 + k) = -1.0;
+    a[k] = filter_.estimate(pairs[static_cast<std::size_t>(k)].satId).vector[0] -
+           filter_.estimate(pairs[static_cast<std::size_t>(k)].refId).vector[0];
+  }
+  const Eigen::MatrixXd Y = R.triangularView<Eigen::Upper>().transpose().solve(Mt);
+  Eigen::MatrixXd Q = Eigen::MatrixXd::Zero(3 + m, 3 + m);
+  Q.selfadjointView<Eigen::Lower>().rankUpdate(Y.transpose());
+  Q = Q.selfadjointView<Eigen::Lower>();
+  const Eigen::MatrixXd Qaa = Q.bottomRightCorner(m, m);
+  const Eigen::MatrixXd Qxa = Q.topRightCorner(3, m);
+  const AmbiguityFix fix = resolveAmbiguities(a, Qaa, cfg_.ar);
+  sol.ratio = fix.fixed ? fix.ratio : fix.fullRatio;
+  sol.successRate = fix.fixed ? fix.successRate : fix.fullSuccessRate;
+  if (!fix.fixed) {
+    sol.ar = ArStatus::NotValidated;
+    consecutiveFixes_ = 0;
+    return;
+  }
+  // Condition the float solution on the fixed combinations y = T a = t (T = I for a full fix).
+  Eigen::VectorXd ac;
+  Eigen::Vector3d xfix;
+  Eigen::Matrix3d Pfix;
+  {
+    const bool full = !fix.partial;
+    const Eigen::VectorXd dy = full ? Eigen::VectorXd(a - fix.values) : Eigen::VectorXd(fix.T * a - fix.values);
+    const Eigen::MatrixXd QaT = full ? Qaa : Eigen::MatrixXd(Qaa * fix.T.transpose());  // Q_ay
+    const Eigen::MatrixXd Qyy = full ? Qaa : Eigen::MatrixXd(fix.T * QaT);
+    const Eigen::MatrixXd QxT = full ? Qxa : Eigen::MatrixXd(Qxa * fix.T.transpose());  // Q_xy
+    const Eigen::LLT<Eigen::MatrixXd> llt(Qyy);
+    if (llt.info() != Eigen::Success) {
+      sol.ar = ArStatus::NotValidated;
+      consecutiveFixes_ = 0;
+      return;
+    }
+    const Eigen::VectorXd w = llt.solve(dy);
+    xfix = sol.floatPosition - QxT * w;
+    Pfix = sol.floatCovariance - QxT * llt.solve(QxT.transpose());
+    ac = full ? Eigen::VectorXd(fix.values) : Eigen::VectorXd(a - QaT * w);
+  }
+  // Residual check of every DD in the AR set at the fixed position.
+  for (int k = 0; k < m; ++k) {
+    const Pair& p = pairs[static_cast<std::size_t>(k)];
+    const SingleDifference& s = dd_.sd[static_cast<std::size_t>(p.sat)];
+    const SingleDifference& f = dd_.sd[static_cast<std::size_t>(p.ref)];
+    const double nref = filter_.estimate(p.refId).vector[0];
+    const double v = sdPhaseResidual(s, xfix) - sdPhaseResidual(f, xfix) -
+                     (s.wavelength * ac[k] + (s.wavelength - f.wavelength) * nref);
+    if (std::abs(v) > cfg_.fixValidationSigmas * std::sqrt(s.phaseVariance + f.phaseVariance)) {
+      sol.ar = ArStatus::Rejected;
+      ++counters_.rejectedFixes;
+      consecutiveFixes_ = 0;
+      return;
+    }
+  }
+  sol.quality = SolutionQuality::Fix;
+  sol.position = xfix;
+  sol.positionCovariance = 0.5 * (Pfix + Pfix.transpose());
+  sol.ar = fix.partial ? ArStatus::PartialFixed : ArStatus::Fixed;
+  sol.numFixed = fix.numFixed();
+  if (fix.partial) ++counters_.partialFixes;
+
+  // Fixed ambiguities of the DD phases (values relative to each group's AR reference).
+  std::vector<double> rel(dd_.sd.size(), std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t g = 0; g < arRef.size(); ++g) {
+    if (arRef[g] >= 0) rel[static_cast<std::size_t>(arRef[g])] = 0.0;
+  }
+  for (int k = 0; k < m; ++k) rel[static_cast<std::size_t>(pairs[static_cast<std::size_t>(k)].sat)] = ac[k];
+  for (DoubleDifference& d : dd_.phase) {
+    const double vs = rel[static_cast<std::size_t>(d.satellite)], vr = rel[static_cast<std::size_t>(d.reference)];
+    if (!std::isfinite(vs) || !std::isfinite(vr)) continue;
+    const double val = vs - vr;
+    if (std::abs(val - std::round(val)) > 1e-3) continue;
+    const SingleDifference& s = dd_.sd[static_cast<std::size_t>(d.satellite)];
+    const SingleDifference& f = dd_.sd[static_cast<std::size_t>(d.reference)];
+    d.fixedCycles = std::round(val);
+    d.ambiguityMeters = s.wavelength * *d.fixedCycles + (s.wavelength - f.wavelength) * ambiguityEstimate(f);
+  }
+
+  ++consecutiveFixes_;
+  if (cfg_.ambiguityMode == AmbiguityMode::FixAndHold && consecutiveFixes_ >= cfg_.holdMinFixes) {
+    // Fixed combinations as constraints on the SD ambiguity states.
+    const Eigen::MatrixXd& T = fix.T;
+    Meas h(static_cast<int>(T.rows()));
+    for (int r = 0; r < T.rows(); ++r) {
+      double cur = 0.0;
+      for (int k = 0; k < m; ++k) {
+        const double c = T(r, k);
+        if (c == 0.0) continue;
+        const Pair& p = pairs[static_cast<std::size_t>(k)];
+        h.jacobian(p.satId, 1)(r, 0) += c;
+        h.jacobian(p.refId, 1)(r, 0) -= c;
+        cur += c * a[k];
+      }
+      h.residual()[r] = fix.values[r] - cur;
+    }
+    h.whitenStdDev(cfg_.holdSigmaCycles);
+    filter_.update(h);
+    filter_.correct();
+    sol.held = true;
+    ++counters_.holdUpdates;
+  }
+}
+
+}  // namespace gvins
