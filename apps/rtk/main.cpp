@@ -1,0 +1,543 @@
+// gvins-rtk: relative positioning (RTK, static or kinematic) with integer ambiguity resolution
+// from rover RINEX observations, base RINEX observations or an RTCM 3 log, and broadcast
+// navigation files; writes an RTKLIB-compatible .pos file.
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "gvins/base/constants.hpp"
+#include "gvins/base/geodetic.hpp"
+#include "gvins/base/parse_error.hpp"
+#include "gvins/base/rinex_obs_reader.hpp"
+#include "gvins/ephemeris/ephemeris_store.hpp"
+#include "gvins/ephemeris/rinex_nav.hpp"
+#include "gvins/gnss/accuracy_statistics.hpp"
+#include "gvins/gnss/base_reader.hpp"
+#include "gvins/gnss/pos_writer.hpp"
+#include "gvins/gnss/rtk.hpp"
+#include "gvins/gnss/rtk_config.hpp"
+#include "gvins/gnss/spp_config.hpp"
+
+namespace {
+
+const char* kUsage =
+    "usage: gvins-rtk [options] -o OUT.pos ROVER_OBS BASE_OBS|BASE_RTCM NAV [NAV...]\n"
+    "\n"
+    "Relative positioning (RTK) with integer ambiguity resolution. ROVER_OBS is RINEX observation\n"
+    "data (2.10/2.11, 3.0x, 4.0x; plain or .gz); the base is RINEX as well or a binary RTCM 3 log\n"
+    "(MSM or legacy observations, 1005/1006 position, ephemerides), told apart by content. NAV are\n"
+    "RINEX navigation files (merged). Writes one RTKLIB-style .pos row per epoch with a solution\n"
+    "(Q=1 fixed, 2 float, 5 single-point fallback), prints progress and a summary to stderr.\n"
+    "\n"
+    "  -o FILE               output .pos file ('-' for stdout); required\n"
+    "  --config F.yaml       options from the 'rtk:' (and 'spp:') sections of a YAML file;\n"
+    "                        command-line options override it\n"
+    "  --base-xyz X,Y,Z      base antenna reference point, ECEF (m)\n"
+    "  --base-llh LAT,LON,H  the same as latitude, longitude (deg), ellipsoidal height (m)\n"
+    "                        (default: RINEX header position + antenna delta, or RTCM 1005/1006)\n"
+    "  --mode M              static | kinematic (default kinematic)\n"
+    "  --dynamics D          random-walk | constant-velocity (kinematic; default random-walk)\n"
+    "  --armode M            off | continuous | instantaneous | fix-and-hold (default continuous)\n"
+    "  --ratio R             ratio-test threshold (default 3)\n"
+    "  --validation V        ratio | success-rate | ratio+success-rate (default ratio)\n"
+    "  --no-partial          no partial ambiguity resolution\n"
+    "  --systems GRECJ       systems used (default GRECJ)\n"
+    "  --ar-systems GECJ     systems whose ambiguities are fixed (default GECJ: GLONASS float)\n"
+    "  --freq N              bands per system, 1-3 (default 2)\n"
+    "  --elmask DEG          elevation mask, degrees (default 15); also the AR mask\n"
+    "  --max-age S           oldest base data used, s (default 30)\n"
+    "  --no-interpolation    do not interpolate the base between its epochs\n"
+    "  --xyz                 ECEF x/y/z columns instead of latitude/longitude/height\n"
+    "  --no-velocity         no velocity columns\n"
+    "  --time-decimals N     decimals of the time column (default 3)\n"
+    "  --truth X,Y,Z         true rover position (ECEF, m): accuracy tables of the fixed and of\n"
+    "                        all RTK solutions\n"
+    "  --truth-llh LAT,LON,H the same as latitude, longitude (deg), ellipsoidal height (m)\n"
+    "  --strict              stop at the first malformed epoch (default: skip it and count it)\n"
+    "  -q, --quiet           no progress line\n"
+    "  -h, --help            this text\n";
+
+struct Args {
+  std::string config, out;
+  std::vector<std::string> inputs;
+  std::optional<Eigen::Vector3d> baseXyz, truth;
+  std::optional<std::string> mode, dynamics, armode, systems, arSystems, validation;
+  std::optional<double> ratio, elmask, maxAge;
+  std::optional<int> freq;
+  bool noPartial = false, noInterpolation = false, xyz = false, noVelocity = false, strict = false, quiet = false;
+  int timeDecimals = 3;
+};
+
+[[noreturn]] void usageError(const std::string& msg) {
+  std::fprintf(stderr, "gvins-rtk: %s (see --help)\n", msg.c_str());
+  std::exit(2);
+}
+
+bool parseTriple(const std::string& s, double v[3]) {
+  char extra = 0;
+  return std::sscanf(s.c_str(), "%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &extra) == 3 && std::isfinite(v[0]) &&
+         std::isfinite(v[1]) && std::isfinite(v[2]);
+}
+
+double parseNumber(const std::string& opt, const std::string& s) {
+  char* end = nullptr;
+  const double v = std::strtod(s.c_str(), &end);
+  if (end == s.c_str() || *end != '\0' || !std::isfinite(v)) usageError(opt + " needs a number, not '" + s + "'");
+  return v;
+}
+
+Eigen::Vector3d parsePosition(const std::string& opt, const std::string& s, bool llh) {
+  double v[3];
+  if (!parseTriple(s, v)) usageError(opt + " needs three comma-separated numbers, not '" + s + "'");
+  if (!llh) {
+    if (Eigen::Vector3d(v[0], v[1], v[2]).norm() < 1e6) usageError(opt + " is not a position near the Earth's surface");
+    return {v[0], v[1], v[2]};
+  }
+  if (std::abs(v[0]) > 90.0 || std::abs(v[1]) > 360.0) usageError(opt + " latitude/longitude out of range");
+  return gvins::geodeticToEcef(gvins::geodeticFromDegrees(v[0], v[1], v[2]));
+}
+
+Args parseArgs(int argc, char** argv) {
+  Args a;
+  auto value = [&](int& i, const std::string& opt) -> std::string {
+    if (i + 1 >= argc) usageError(opt + " needs a value");
+    return argv[++i];
+  };
+  for (int i = 1; i < argc; ++i) {
+    const std::string o = argv[i];
+    if (o == "-h" || o == "--help") {
+      std::fputs(kUsage, stdout);
+      std::exit(0);
+    } else if (o == "-o") {
+      a.out = value(i, o);
+    } else if (o == "--config") {
+      a.config = value(i, o);
+    } else if (o == "--base-xyz") {
+      a.baseXyz = parsePosition(o, value(i, o), false);
+    } else if (o == "--base-llh") {
+      a.baseXyz = parsePosition(o, value(i, o), true);
+    } else if (o == "--mode") {
+      a.mode = value(i, o);
+    } else if (o == "--dynamics") {
+      a.dynamics = value(i, o);
+    } else if (o == "--armode") {
+      a.armode = value(i, o);
+    } else if (o == "--ratio") {
+      a.ratio = parseNumber(o, value(i, o));
+      if (*a.ratio < 1.0) usageError("--ratio must be at least 1");
+    } else if (o == "--validation") {
+      a.validation = value(i, o);
+    } else if (o == "--no-partial") {
+      a.noPartial = true;
+    } else if (o == "--systems") {
+      a.systems = value(i, o);
+    } else if (o == "--ar-systems") {
+      a.arSystems = value(i, o);
+    } else if (o == "--freq") {
+      const double f = parseNumber(o, value(i, o));
+      if (f != 1.0 && f != 2.0 && f != 3.0) usageError("--freq must be 1, 2 or 3");
+      a.freq = static_cast<int>(f);
+    } else if (o == "--elmask") {
+      a.elmask = parseNumber(o, value(i, o));
+      if (*a.elmask < -10.0 || *a.elmask > 90.0) usageError("--elmask must be within -10..90 degrees");
+    } else if (o == "--max-age") {
+      a.maxAge = parseNumber(o, value(i, o));
+      if (*a.maxAge < 0.0) usageError("--max-age must not be negative");
+    } else if (o == "--no-interpolation") {
+      a.noInterpolation = true;
+    } else if (o == "--xyz") {
+      a.xyz = true;
+    } else if (o == "--no-velocity") {
+      a.noVelocity = true;
+    } else if (o == "--time-decimals") {
+      const double d = parseNumber(o, value(i, o));
+      if (d < 0 || d > 9 || d != std::floor(d)) usageError("--time-decimals must be 0..9");
+      a.timeDecimals = static_cast<int>(d);
+    } else if (o == "--truth") {
+      a.truth = parsePosition(o, value(i, o), false);
+    } else if (o == "--truth-llh") {
+      a.truth = parsePosition(o, value(i, o), true);
+    } else if (o == "--strict") {
+      a.strict = true;
+    } else if (o == "-q" || o == "--quiet") {
+      a.quiet = true;
+    } else if (o.size() > 1 && o[0] == '-') {
+      usageError("unknown option '" + o + "'");
+    } else {
+      a.inputs.push_back(o);
+    }
+  }
+  if (a.out.empty()) usageError("no output file (-o OUT.pos)");
+  if (a.inputs.size() < 3) usageError("need a rover observation file, base data and at least one navigation file");
+  return a;
+}
+
+std::string systemsText(const std::array<bool, gvins::kNumSystems>& s) {
+  std::string t;
+  for (int i = 0; i < gvins::kNumSystems; ++i) {
+    if (s[static_cast<std::size_t>(i)]) t += gvins::systemLetter(static_cast<gvins::System>(i));
+  }
+  return t.empty() ? "-" : t;
+}
+
+void printError(const gvins::ParseError& e) { std::fprintf(stderr, "gvins-rtk: error: %s\n", e.what()); }
+
+double pct(long a, long b) { return b > 0 ? 100.0 * static_cast<double>(a) / static_cast<double>(b) : 0.0; }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace gvins;
+  const Args args = parseArgs(argc, argv);
+  const auto wall0 = std::chrono::steady_clock::now();
+
+  // Configuration: defaults, YAML, command line.
+  RtkConfig cfg;
+  SppConfig sppCfg;
+  try {
+    if (!args.config.empty()) {
+      cfg = loadRtkConfig(args.config, cfg);
+      sppCfg = loadSppConfig(args.config, sppCfg);
+    }
+  } catch (const ParseError& e) {
+    printError(e);
+    return 2;
+  }
+  if (args.mode) {
+    if (*args.mode == "static") cfg.mode = RtkMode::Static;
+    else if (*args.mode == "kinematic") cfg.mode = RtkMode::Kinematic;
+    else usageError("--mode must be static or kinematic");
+  }
+  if (args.dynamics) {
+    if (*args.dynamics == "random-walk") cfg.dynamics = RtkDynamics::RandomWalk;
+    else if (*args.dynamics == "constant-velocity") cfg.dynamics = RtkDynamics::ConstantVelocity;
+    else usageError("--dynamics must be random-walk or constant-velocity");
+  }
+  if (args.armode) {
+    if (*args.armode == "off") cfg.ambiguityMode = AmbiguityMode::Off;
+    else if (*args.armode == "continuous") cfg.ambiguityMode = AmbiguityMode::Continuous;
+    else if (*args.armode == "instantaneous") cfg.ambiguityMode = AmbiguityMode::Instantaneous;
+    else if (*args.armode == "fix-and-hold") cfg.ambiguityMode = AmbiguityMode::FixAndHold;
+    else usageError("--armode must be off, continuous, instantaneous or fix-and-hold");
+  }
+  if (args.validation) {
+    if (*args.validation == "ratio") cfg.ar.validation = AmbiguityValidation::Ratio;
+    else if (*args.validation == "success-rate") cfg.ar.validation = AmbiguityValidation::SuccessRate;
+    else if (*args.validation == "ratio+success-rate") cfg.ar.validation = AmbiguityValidation::RatioAndSuccessRate;
+    else usageError("--validation must be ratio, success-rate or ratio+success-rate");
+  }
+  if (args.ratio) cfg.ar.ratioThreshold = *args.ratio;
+  if (args.noPartial) cfg.ar.partial = false;
+  try {
+    if (args.systems) {
+      cfg.systems = parseSystemLetters(*args.systems);
+      sppCfg.systems = cfg.systems;
+    }
+    if (args.arSystems) cfg.arSystems = parseSystemLetters(*args.arSystems);
+  } catch (const std::invalid_argument& e) {
+    usageError(std::string("--systems/--ar-systems: ") + e.what());
+  }
+  if (args.freq) cfg.frequencies = *args.freq;
+  if (args.elmask) {
+    cfg.elevationMask = *args.elmask * constants::kDegToRad;
+    cfg.arElevationMask = cfg.elevationMask;
+    sppCfg.elevationMask = cfg.elevationMask;
+  }
+  if (args.maxAge) cfg.maxAge = *args.maxAge;
+  if (args.noInterpolation) cfg.interpolateBase = false;
+
+  // Navigation data.
+  EphemerisStore nav;
+  try {
+    for (std::size_t i = 2; i < args.inputs.size(); ++i) nav.add(readRinexNav(args.inputs[i]));
+  } catch (const ParseError& e) {
+    printError(e);
+    return 1;
+  }
+
+  // Rover and base.
+  std::optional<RinexObsReader> rover;
+  RinexObsReaderOptions ropt;
+  ropt.skipBadEpochs = !args.strict;
+  std::unique_ptr<BaseReader> base;
+  ObsEpoch roverEpoch;
+  bool haveRover = false;
+  try {
+    rover.emplace(args.inputs[0], ropt);
+    haveRover = rover->next(roverEpoch);
+    const GpsTime ref = haveRover ? roverEpoch.time : rover->header().firstObs.value_or(GpsTime());
+    base = BaseReader::open(args.inputs[1], ref, &nav, !args.strict);
+  } catch (const ParseError& e) {
+    printError(e);
+    return 1;
+  }
+  if (nav.size() == 0 && base->format() != BaseFormat::Rtcm) {
+    std::fprintf(stderr, "gvins-rtk: error: no usable ephemeris in the navigation files\n");
+    return 1;
+  }
+  const RinexObsHeader& hdr = rover->header();
+
+  RtkSolver solver(nav, cfg, sppCfg);
+  solver.setRoverGlonassChannels(hdr.glonassChannels);
+  if (hdr.station.approxPosition && hdr.station.approxPosition->norm() > 1e6) {
+    solver.setRoverInitialPosition(*hdr.station.approxPosition);
+  }
+  std::string baseSource = "command line";
+  if (args.baseXyz) solver.setBasePosition(*args.baseXyz);
+
+  std::ofstream file;
+  std::ostream* out = &std::cout;
+  if (args.out != "-") {
+    file.open(args.out);
+    if (!file) {
+      std::fprintf(stderr, "gvins-rtk: error: cannot create '%s'\n", args.out.c_str());
+      return 1;
+    }
+    out = &file;
+  }
+  PosWriterOptions popt;
+  popt.coordinates = args.xyz ? PosCoordinates::Xyz : PosCoordinates::Llh;
+  popt.velocity = !args.noVelocity;
+  popt.timeDecimals = args.timeDecimals;
+  popt.program = "SRI-GVINS gvins-rtk";
+  for (const auto& f : args.inputs) popt.headerFields.emplace_back("inp file", f);
+  popt.headerFields.emplace_back("pos mode", std::string(toString(cfg.mode)) + " (" +
+                                                 (cfg.mode == RtkMode::Kinematic ? toString(cfg.dynamics) : "fixed position") + ")");
+  char buf[200];
+  std::snprintf(buf, sizeof buf, "%d", cfg.frequencies);
+  popt.headerFields.emplace_back("freqs", buf);
+  std::snprintf(buf, sizeof buf, "%.1f deg", cfg.elevationMask * constants::kRadToDeg);
+  popt.headerFields.emplace_back("elev mask", buf);
+  popt.headerFields.emplace_back("navi sys", systemsText(cfg.systems));
+  std::snprintf(buf, sizeof buf, "%s, systems %s, ratio %.1f, %s%s", toString(cfg.ambiguityMode), systemsText(cfg.arSystems).c_str(),
+                cfg.ar.ratioThreshold,
+                cfg.ar.validation == AmbiguityValidation::Ratio ? "ratio test"
+                : cfg.ar.validation == AmbiguityValidation::SuccessRate ? "success-rate test"
+                                                                          : "ratio and success-rate tests",
+                cfg.ar.partial ? ", partial" : "");
+  popt.headerFields.emplace_back("amb res", buf);
+  // The base position line is added once known (before the first row is written).
+  std::unique_ptr<PosWriter> writer;
+
+  std::optional<AccuracyStatistics> fixStats, rtkStats;
+  if (args.truth) {
+    fixStats.emplace(*args.truth);
+    rtkStats.emplace(*args.truth);
+  }
+
+  // Counters.
+  long epochs = 0, fixed = 0, floats = 0, singles = 0, none = 0, partial = 0, held = 0;
+  std::map<RtkIssue, long> issues;
+  std::map<ArStatus, long> arStatus;
+  QuantileHistogram ratios;
+  double ratioMin = 1e300, ratioMax = 0.0, ratioSum = 0.0;
+  long ratioCount = 0;
+  double satSum = 0.0, ageMax = 0.0;
+  int exitCode = 0;
+  const bool tty = isatty(fileno(stderr));
+  auto lastProgress = wall0;
+  const double span = hdr.firstObs && hdr.lastObs ? *hdr.lastObs - *hdr.firstObs : 0.0;
+  std::optional<GpsTime> first;
+
+  ObsEpoch baseEpoch;
+  bool baseDone = false, basePending = false;
+  long baseEpochs = 0;
+  std::optional<Eigen::Vector3d> basePosUsed = args.baseXyz;
+
+  while (haveRover) {
+    ++epochs;
+    if (!first) first = roverEpoch.time;
+    // Feed base epochs up to the rover time and one beyond (interpolation).
+    try {
+      while (!baseDone) {
+        if (!basePending) {
+          if (!base->next(baseEpoch)) {
+            baseDone = true;
+            break;
+          }
+          basePending = true;
+          ++baseEpochs;
+        }
+        if (!args.baseXyz && !basePosUsed) {
+          if (auto p = base->antennaPosition()) {
+            solver.setBasePosition(*p);
+            basePosUsed = p;
+            baseSource = base->format() == BaseFormat::Rtcm ? "RTCM 1005/1006" : "RINEX header";
+          }
+        }
+        solver.setBaseGlonassChannels(base->glonassChannels());
+        solver.addBaseEpoch(baseEpoch);
+        basePending = false;
+        if (baseEpoch.time - roverEpoch.time > BaseStation::kSyncTolerance) break;
+      }
+    } catch (const ParseError& e) {
+      printError(e);
+      exitCode = 1;
+      baseDone = true;
+    }
+    if (!args.baseXyz && !basePosUsed) {
+      if (auto p = base->antennaPosition()) {
+        solver.setBasePosition(*p);
+        basePosUsed = p;
+        baseSource = base->format() == BaseFormat::Rtcm ? "RTCM 1005/1006" : "RINEX header";
+      }
+    }
+
+    const RtkSolution sol = solver.process(roverEpoch);
+    if (sol.issue != RtkIssue::None) ++issues[sol.issue];
+    if (sol.quality == SolutionQuality::Fix || sol.quality == SolutionQuality::Float) {
+      ++arStatus[sol.ar];
+      if (sol.ar != ArStatus::Off && sol.ar != ArStatus::TooFewAmbiguities && sol.ratio > 0.0) {
+        ratios.add(sol.ratio);
+        ratioMin = std::min(ratioMin, sol.ratio);
+        ratioMax = std::max(ratioMax, sol.ratio);
+        ratioSum += sol.ratio;
+        ++ratioCount;
+      }
+    }
+    switch (sol.quality) {
+      case SolutionQuality::Fix: ++fixed; break;
+      case SolutionQuality::Float: ++floats; break;
+      case SolutionQuality::Single: ++singles; break;
+      default: ++none; break;
+    }
+    if (sol.ar == ArStatus::PartialFixed && sol.quality == SolutionQuality::Fix) ++partial;
+    if (sol.held) ++held;
+    if (sol.valid()) {
+      if (!writer) {
+        if (basePosUsed) {
+          std::snprintf(buf, sizeof buf, "%.4f %.4f %.4f (%s)", (*basePosUsed)[0], (*basePosUsed)[1], (*basePosUsed)[2],
+                        baseSource.c_str());
+          popt.headerFields.emplace_back("ref pos", buf);
+        }
+        writer = std::make_unique<PosWriter>(*out, popt);
+      }
+      writer->write(sol.toPositionSolution());
+      satSum += sol.numSatellites;
+      if (sol.quality != SolutionQuality::Single) ageMax = std::max(ageMax, sol.age);
+      if (fixStats && sol.quality == SolutionQuality::Fix) fixStats->addPosition(sol.position);
+      if (rtkStats && sol.quality != SolutionQuality::Single) rtkStats->addPosition(sol.position);
+    }
+    if (!args.quiet) {
+      const auto now = std::chrono::steady_clock::now();
+      if (now - lastProgress > std::chrono::milliseconds(tty ? 200 : 5000)) {
+        lastProgress = now;
+        std::string p;
+        if (span > 0.0 && hdr.firstObs) {
+          std::snprintf(buf, sizeof buf, " %5.1f%%", 100.0 * std::clamp((roverEpoch.time - *hdr.firstObs) / span, 0.0, 1.0));
+          p = buf;
+        }
+        std::fprintf(stderr, "%s%s epoch %ld%s fix %ld float %ld single %ld ratio %.1f%s", tty ? "\r" : "",
+                     roverEpoch.time.toString(1).c_str(), epochs, p.c_str(), fixed, floats, singles, sol.ratio,
+                     tty ? "   " : "\n");
+        std::fflush(stderr);
+      }
+    }
+    try {
+      haveRover = rover->next(roverEpoch);
+    } catch (const ParseError& e) {
+      printError(e);
+      exitCode = 1;
+      break;
+    }
+  }
+  if (!writer) writer = std::make_unique<PosWriter>(*out, popt);
+  writer->finish();
+  if (file.is_open()) {
+    file.close();
+    if (!file) {
+      std::fprintf(stderr, "gvins-rtk: error: writing '%s' failed\n", args.out.c_str());
+      exitCode = 1;
+    }
+  }
+  if (!args.quiet && tty) std::fprintf(stderr, "\r%90s\r", "");
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+
+  // Summary.
+  const long solved = fixed + floats + singles;
+  std::fprintf(stderr, "gvins-rtk summary (%s, base %s)\n", args.inputs[0].c_str(), base->describe().c_str());
+  std::fprintf(stderr, "  mode                   %s, %s, AR %s, ratio %.1f\n", toString(cfg.mode),
+               cfg.mode == RtkMode::Kinematic ? toString(cfg.dynamics) : "static position", toString(cfg.ambiguityMode),
+               cfg.ar.ratioThreshold);
+  if (basePosUsed) {
+    std::fprintf(stderr, "  base position          %.4f %.4f %.4f (%s)\n", (*basePosUsed)[0], (*basePosUsed)[1], (*basePosUsed)[2],
+                 baseSource.c_str());
+  } else {
+    std::fprintf(stderr, "  base position          unknown (no header position, 1005/1006 or --base-xyz)\n");
+  }
+  std::fprintf(stderr, "  rover epochs           %8ld\n", epochs);
+  std::fprintf(stderr, "  base epochs read       %8ld\n", baseEpochs);
+  std::fprintf(stderr, "  fixed   (Q=1)          %8ld  %6.2f %%%s\n", fixed, pct(fixed, epochs),
+               partial ? (" (" + std::to_string(partial) + " partial)").c_str() : "");
+  std::fprintf(stderr, "  float   (Q=2)          %8ld  %6.2f %%\n", floats, pct(floats, epochs));
+  std::fprintf(stderr, "  single  (Q=5)          %8ld  %6.2f %%\n", singles, pct(singles, epochs));
+  std::fprintf(stderr, "  no solution            %8ld  %6.2f %%\n", none, pct(none, epochs));
+  std::fprintf(stderr, "  fix rate               %8.2f %% of epochs, %.2f %% of RTK epochs\n", pct(fixed, epochs),
+               pct(fixed, fixed + floats));
+  if (ratioCount) {
+    std::fprintf(stderr, "  ratio                  min %.2f  median %.2f  mean %.2f  max %.1f  (%ld epochs)\n", ratioMin,
+                 ratios.quantile(0.5), ratioSum / ratioCount, ratioMax, ratioCount);
+  }
+  std::fprintf(stderr, "  mean satellites        %8.1f   max age %.1f s\n", solved ? satSum / solved : 0.0, ageMax);
+  if (held) std::fprintf(stderr, "  fix-and-hold updates   %8ld\n", held);
+  for (const auto& [i, n] : issues) std::fprintf(stderr, "  no RTK: %-30s %6ld\n", toString(i), n);
+  for (const auto& [s, n] : arStatus) {
+    if (s != ArStatus::Fixed && s != ArStatus::PartialFixed) std::fprintf(stderr, "  AR: %-34s %6ld\n", toString(s), n);
+  }
+  const RtkCounters& c = solver.counters();
+  std::fprintf(stderr, "  ambiguities            %lld added, %lld slip resets, %lld outlier resets, %lld removed\n",
+               static_cast<long long>(c.ambiguitiesAdded), static_cast<long long>(c.slipResets),
+               static_cast<long long>(c.phaseOutliers), static_cast<long long>(c.ambiguitiesRemoved));
+  if (c.codeOutliers || c.filterResets || c.rejectedFixes) {
+    std::fprintf(stderr, "  rejected               %lld code DDs, %lld fixes by residual check, %lld filter resets\n",
+                 static_cast<long long>(c.codeOutliers), static_cast<long long>(c.rejectedFixes),
+                 static_cast<long long>(c.filterResets));
+  }
+  auto slipLine = [&](const char* who, const CycleSlipCounts& s) {
+    std::fprintf(stderr, "  %s slips             LLI %lld, geometry-free %lld, Doppler %lld, gap %lld, half-cycle %lld\n", who,
+                 static_cast<long long>(s.lli), static_cast<long long>(s.geometryFree), static_cast<long long>(s.doppler),
+                 static_cast<long long>(s.gaps), static_cast<long long>(s.halfCycle));
+  };
+  slipLine("rover", solver.roverSlipCounts());
+  slipLine("base ", solver.base().slipCounts());
+  const DdFormationStats& ds = solver.differenceStats();
+  if (ds.notAtBase || ds.signalMismatch || ds.noEphemeris || ds.systemDisabled) {
+    std::fprintf(stderr, "  satellite-epochs       %lld not at base, %lld signal mismatches, %lld no ephemeris, %lld below mask\n",
+                 static_cast<long long>(ds.notAtBase), static_cast<long long>(ds.signalMismatch),
+                 static_cast<long long>(ds.noEphemeris), static_cast<long long>(ds.belowMask));
+  }
+  const BaseStationStats& bs = solver.base().stats();
+  if (bs.outOfOrder || bs.positionChanges) {
+    std::fprintf(stderr, "  base input             %lld epochs out of order, %lld position changes\n",
+                 static_cast<long long>(bs.outOfOrder), static_cast<long long>(bs.positionChanges));
+  }
+  const auto& rs = rover->stats();
+  if (rs.skippedEpochs || base->skipped()) {
+    std::fprintf(stderr, "  input                  %lld malformed rover epochs skipped, %lld base epochs/frames skipped\n",
+                 static_cast<long long>(rs.skippedEpochs), static_cast<long long>(base->skipped()));
+    for (const auto& m : rs.messages) std::fprintf(stderr, "    %s\n", m.c_str());
+  }
+  std::fprintf(stderr, "  time                   %8.3f s (%.0f epochs/s)\n", wall, wall > 0 ? epochs / wall : 0.0);
+  if (fixStats && fixStats->position().count > 0) {
+    std::fputs("  fixed solutions vs truth:\n", stderr);
+    std::fputs(fixStats->table().c_str(), stderr);
+  }
+  if (rtkStats && rtkStats->position().count > 0) {
+    std::fputs("  fixed and float solutions vs truth:\n", stderr);
+    std::fputs(rtkStats->table().c_str(), stderr);
+  }
+  if (solved == 0 && exitCode == 0) exitCode = 3;
+  return exitCode;
+}
