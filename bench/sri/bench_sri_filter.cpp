@@ -13,7 +13,9 @@
 //   Solve           back-substitution R Δx = r
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <deque>
+#include <vector>
 
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
@@ -185,16 +187,28 @@ void sizes(benchmark::internal::Benchmark* b) {
     for (int m : {40, 60}) b->Args({n, m});
   }
   b->Unit(benchmark::kMicrosecond);
+  // Other engineers share the 2 cores: run with --benchmark_repetitions and read min/median.
+  b->ComputeStatistics("min", [](const std::vector<double>& v) {
+    return *std::min_element(v.begin(), v.end());
+  });
 }
 void margSizes(benchmark::internal::Benchmark* b) {
   for (int n : {150, 300, 400}) {
     for (int order : {0, 1}) b->Args({n, order});
   }
   b->Unit(benchmark::kMicrosecond);
+  // Other engineers share the 2 cores: run with --benchmark_repetitions and read min/median.
+  b->ComputeStatistics("min", [](const std::vector<double>& v) {
+    return *std::min_element(v.begin(), v.end());
+  });
 }
 void nSizes(benchmark::internal::Benchmark* b) {
   for (int n : {150, 300, 400}) b->Args({n});
   b->Unit(benchmark::kMicrosecond);
+  // Other engineers share the 2 cores: run with --benchmark_repetitions and read min/median.
+  b->ComputeStatistics("min", [](const std::vector<double>& v) {
+    return *std::min_element(v.begin(), v.end());
+  });
 }
 
 BENCHMARK(BM_Update<double>)->Apply(sizes);

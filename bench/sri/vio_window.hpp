@@ -98,6 +98,9 @@ Measurement<S> vioRows(const Window<S>& w, int m, unsigned seed = 11) {
     }
     return a;
   };
+  auto randv = [&](Eigen::Matrix<S, Eigen::Dynamic, 1>& v) {
+    for (Eigen::Index i = 0; i < v.size(); ++i) v(i) = static_cast<S>(g(rng));
+  };
   const int slamRows = 2 * std::max(1, m / 10);
   const int msckfRows = m - slamRows;
   Measurement<S> all(0);
@@ -107,7 +110,7 @@ Measurement<S> vioRows(const Window<S>& w, int m, unsigned seed = 11) {
     const int nc = static_cast<int>(w.clones.size());
     for (int c = std::max(0, nc - 8); c < nc; ++c) z.jacobian(w.clones[static_cast<std::size_t>(c)], 6) = randm(msckfRows, 6);
     z.jacobian(w.extrinsic, 6) = randm(msckfRows, 6);
-    z.residual() = randm(msckfRows, 1);
+    randv(z.residual());
     z.setWhitened();
     all.stack(z);
   }
@@ -117,7 +120,7 @@ Measurement<S> vioRows(const Window<S>& w, int m, unsigned seed = 11) {
     z.jacobian(w.features[static_cast<std::size_t>(pickFeature(rng))], 3) = randm(2, 3);
     z.jacobian(w.clones.back(), 6) = randm(2, 6);
     z.jacobian(w.extrinsic, 6) = randm(2, 6);
-    z.residual() = randm(2, 1);
+    randv(z.residual());
     z.setWhitened();
     all.stack(z);
   }

@@ -66,12 +66,17 @@ inline Scalar makeGivens(Scalar a, Scalar b, Scalar& c, Scalar& s) {
 
 #if defined(__GNUC__) || defined(__clang__)
 #define GVINS_SRI_VECTOR_EXT 1
-/// 16-byte SIMD vector of Scalar (GCC/Clang vector extension; SSE2 on x86-64 by default, wider
-/// registers are combined from these when the target allows).
+#if defined(__AVX__)
+#define GVINS_SRI_SIMD_BYTES 32
+#else
+#define GVINS_SRI_SIMD_BYTES 16
+#endif
+/// SIMD vector of Scalar (GCC/Clang vector extension): 16 bytes (SSE2, the x86-64 baseline) or
+/// 32 bytes when the target has AVX (-march=native, GVINS_SRI_NATIVE).
 template <typename Scalar>
 struct Simd {
-  typedef Scalar type __attribute__((vector_size(16)));
-  static constexpr int kLanes = 16 / static_cast<int>(sizeof(Scalar));
+  typedef Scalar type __attribute__((vector_size(GVINS_SRI_SIMD_BYTES)));
+  static constexpr int kLanes = GVINS_SRI_SIMD_BYTES / static_cast<int>(sizeof(Scalar));
   static type load(const Scalar* p) {
     type v;
     std::memcpy(&v, p, sizeof(v));
@@ -110,6 +115,53 @@ void applyReflectorsScalar(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int 
   }
 }
 
+#ifdef GVINS_SRI_VECTOR_EXT
+/// One chunk of NV SIMD vectors (columns t0 .. t0 + NV·lanes) of applyReflectors.
+template <typename Scalar, int P, int NV>
+inline void applyReflectorsChunk(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a, int t0,
+                                 const typename Simd<Scalar>::type* vv, const Scalar* T) {
+  using V = Simd<Scalar>;
+  using Vec = typename V::type;
+  constexpr int L = V::kLanes;
+  Vec z[P][NV];
+  for (int p = 0; p < P; ++p) {
+    for (int u = 0; u < NV; ++u) z[p][u] = V::load(x[p] + t0 + u * L);
+  }
+  for (int i = 0; i < a; ++i) {
+    const Scalar* wi = w0 + i * ws + t0;
+    Vec wr[NV];
+    for (int u = 0; u < NV; ++u) wr[u] = V::load(wi + u * L);
+    for (int p = 0; p < P; ++p) {
+      const Vec vp = vv[i * P + p];
+      for (int u = 0; u < NV; ++u) z[p][u] += vp * wr[u];
+    }
+  }
+  for (int p = P - 1; p >= 0; --p) {  // Z ← Tᵀ Z (Tᵀ lower triangular)
+    const Vec tpp = V::broadcast(T[p * P + p]);
+    Vec acc[NV];
+    for (int u = 0; u < NV; ++u) acc[u] = tpp * z[p][u];
+    for (int q = 0; q < p; ++q) {
+      const Vec tq = V::broadcast(T[p * P + q]);
+      for (int u = 0; u < NV; ++u) acc[u] += tq * z[q][u];
+    }
+    for (int u = 0; u < NV; ++u) z[p][u] = acc[u];
+  }
+  for (int p = 0; p < P; ++p) {
+    for (int u = 0; u < NV; ++u) V::store(x[p] + t0 + u * L, V::load(x[p] + t0 + u * L) - z[p][u]);
+  }
+  for (int i = 0; i < a; ++i) {
+    Scalar* wi = w0 + i * ws + t0;
+    Vec wr[NV];
+    for (int u = 0; u < NV; ++u) wr[u] = V::load(wi + u * L);
+    for (int p = 0; p < P; ++p) {
+      const Vec vp = vv[i * P + p];
+      for (int u = 0; u < NV; ++u) wr[u] -= vp * z[p][u];
+    }
+    for (int u = 0; u < NV; ++u) V::store(wi + u * L, wr[u]);
+  }
+}
+#endif
+
 /// As applyReflectorsScalar on [0, len), register-blocked: per chunk of 2 SIMD vectors the P
 /// rows of Z stay in registers while the rows of W stream through twice. vb holds V_W(i, p)
 /// broadcast to full vectors at vb[i·P + p] (SSE2 has no cheap broadcast from memory).
@@ -119,55 +171,10 @@ void applyReflectors(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a, int
   int t0 = 0;
 #ifdef GVINS_SRI_VECTOR_EXT
   using V = Simd<Scalar>;
-  using Vec = typename V::type;
   constexpr int L = V::kLanes;
-  const Vec* vv = static_cast<const Vec*>(vb);
-  for (; t0 + 2 * L <= len; t0 += 2 * L) {
-    Vec z0[P];
-    Vec z1[P];
-    for (int p = 0; p < P; ++p) {
-      z0[p] = V::load(x[p] + t0);
-      z1[p] = V::load(x[p] + t0 + L);
-    }
-    for (int i = 0; i < a; ++i) {
-      const Scalar* wi = w0 + i * ws + t0;
-      const Vec a0 = V::load(wi);
-      const Vec a1 = V::load(wi + L);
-      for (int p = 0; p < P; ++p) {
-        const Vec vp = vv[i * P + p];
-        z0[p] += vp * a0;
-        z1[p] += vp * a1;
-      }
-    }
-    for (int p = P - 1; p >= 0; --p) {  // Z ← Tᵀ Z (Tᵀ lower triangular)
-      const Vec tpp = V::broadcast(T[p * P + p]);
-      Vec acc0 = tpp * z0[p];
-      Vec acc1 = tpp * z1[p];
-      for (int q = 0; q < p; ++q) {
-        const Vec tq = V::broadcast(T[p * P + q]);
-        acc0 += tq * z0[q];
-        acc1 += tq * z1[q];
-      }
-      z0[p] = acc0;
-      z1[p] = acc1;
-    }
-    for (int p = 0; p < P; ++p) {
-      V::store(x[p] + t0, V::load(x[p] + t0) - z0[p]);
-      V::store(x[p] + t0 + L, V::load(x[p] + t0 + L) - z1[p]);
-    }
-    for (int i = 0; i < a; ++i) {
-      Scalar* wi = w0 + i * ws + t0;
-      Vec a0 = V::load(wi);
-      Vec a1 = V::load(wi + L);
-      for (int p = 0; p < P; ++p) {
-        const Vec vp = vv[i * P + p];
-        a0 -= vp * z0[p];
-        a1 -= vp * z1[p];
-      }
-      V::store(wi, a0);
-      V::store(wi + L, a1);
-    }
-  }
+  const auto* vv = static_cast<const typename V::type*>(vb);
+  for (; t0 + 2 * L <= len; t0 += 2 * L) applyReflectorsChunk<Scalar, P, 2>(x, w0, ws, a, t0, vv, T);
+  for (; t0 + L <= len; t0 += L) applyReflectorsChunk<Scalar, P, 1>(x, w0, ws, a, t0, vv, T);
 #endif
   applyReflectorsScalar<Scalar, P>(x, w0, ws, a, t0, len, v, T);
 }
@@ -299,6 +306,40 @@ void chainRotationsScalar(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a
   }
 }
 
+#ifdef GVINS_SRI_VECTOR_EXT
+/// One chunk of NV SIMD vectors of chainRotations.
+template <typename Scalar, int P, int NV>
+inline void chainRotationsChunk(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a, int t0,
+                                const typename Simd<Scalar>::type* cb,
+                                const typename Simd<Scalar>::type* sb) {
+  using V = Simd<Scalar>;
+  using Vec = typename V::type;
+  constexpr int L = V::kLanes;
+  Vec xr[P][NV];
+  for (int p = 0; p < P; ++p) {
+    for (int u = 0; u < NV; ++u) xr[p][u] = V::load(x[p] + t0 + u * L);
+  }
+  for (int i = 0; i < a; ++i) {
+    Scalar* wi = w0 + i * ws + t0;
+    Vec wr[NV];
+    for (int u = 0; u < NV; ++u) wr[u] = V::load(wi + u * L);
+    for (int p = 0; p < P; ++p) {
+      const Vec c = cb[i * P + p];
+      const Vec sn = sb[i * P + p];
+      for (int u = 0; u < NV; ++u) {
+        const Vec xv = xr[p][u];
+        xr[p][u] = c * xv + sn * wr[u];
+        wr[u] = c * wr[u] - sn * xv;
+      }
+    }
+    for (int u = 0; u < NV; ++u) V::store(wi + u * L, wr[u]);
+  }
+  for (int p = 0; p < P; ++p) {
+    for (int u = 0; u < NV; ++u) V::store(x[p] + t0 + u * L, xr[p][u]);
+  }
+}
+#endif
+
 /// Applies, on the columns [0, len) of P pivot rows x[p] and of the a rows of W (row stride
 /// ws), the rotations of P consecutive columns: for every row i of W and p = 0..P−1 in turn,
 /// (x_p, w_i) ← (c x_p + s w_i, c w_i − s x_p) with (c, s) = (C[p·ld + i], S[p·ld + i]).
@@ -315,35 +356,10 @@ void chainRotations(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a, int 
   using V = Simd<Scalar>;
   using Vec = typename V::type;
   constexpr int L = V::kLanes;
-  for (; t0 + 2 * L <= len; t0 += 2 * L) {
-    Vec x0[P];
-    Vec x1[P];
-    for (int p = 0; p < P; ++p) {
-      x0[p] = V::load(x[p] + t0);
-      x1[p] = V::load(x[p] + t0 + L);
-    }
-    for (int i = 0; i < a; ++i) {
-      Scalar* wi = w0 + i * ws + t0;
-      Vec w0v = V::load(wi);
-      Vec w1v = V::load(wi + L);
-      for (int p = 0; p < P; ++p) {
-        const Vec c = static_cast<const Vec*>(cb)[i * P + p];
-        const Vec sn = static_cast<const Vec*>(sb)[i * P + p];
-        const Vec a0 = x0[p];
-        const Vec a1 = x1[p];
-        x0[p] = c * a0 + sn * w0v;
-        x1[p] = c * a1 + sn * w1v;
-        w0v = c * w0v - sn * a0;
-        w1v = c * w1v - sn * a1;
-      }
-      V::store(wi, w0v);
-      V::store(wi + L, w1v);
-    }
-    for (int p = 0; p < P; ++p) {
-      V::store(x[p] + t0, x0[p]);
-      V::store(x[p] + t0 + L, x1[p]);
-    }
-  }
+  const auto* cv = static_cast<const Vec*>(cb);
+  const auto* sv = static_cast<const Vec*>(sb);
+  for (; t0 + 2 * L <= len; t0 += 2 * L) chainRotationsChunk<Scalar, P, 2>(x, w0, ws, a, t0, cv, sv);
+  for (; t0 + L <= len; t0 += L) chainRotationsChunk<Scalar, P, 1>(x, w0, ws, a, t0, cv, sv);
 #endif
   chainRotationsScalar<Scalar, P>(x, w0, ws, a, t0, len, C, S, ld);
 }

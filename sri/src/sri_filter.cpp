@@ -336,7 +336,7 @@ std::vector<BlockId> SriFilter<Scalar>::propagate(const Propagation<Scalar>& ste
     S = MatrixT::Identity(d, d);
     solveLowerInPlace<Scalar>(*L, S);  // S = L⁻¹, SᵀS = Q'⁻¹
   }
-  // Paper eq. (6): rows [S Φ  −S], right-hand side −S e.
+  // Paper eq. (8) (and (21) for the clocks): rows [S Φ  −S], right-hand side −S e.
   Measurement<Scalar> rows(d);
   for (const auto& [id, phi] : step.transitions()) {
     rows.jacobian(id, layout_.block(id).dim) += S * phi;
@@ -471,23 +471,36 @@ std::optional<ChiSquare<Scalar>> SriFilter<Scalar>::chiSquare(const Measurement<
     boff[static_cast<std::size_t>(b)] = info.offset;
     if (!m.jacobianAt(b).isZero(0)) c0 = std::min(c0, info.offset);
   }
-  const int k = n_ - c0;
+  const int k0 = n_ - c0;
   // Y = J R⁻¹ vanishes before c0; Yᵀ = R_ttᵀ⁻¹ J_tᵀ on the trailing block.
-  Matrix Yt = Matrix::Zero(k, rows);
+  Matrix Jt = Matrix::Zero(k0, rows);
   for (int b = 0; b < nb; ++b) {
     const auto J = m.jacobianAt(b);
     if (boff[static_cast<std::size_t>(b)] < c0) continue;  // all zero
-    Yt.middleRows(boff[static_cast<std::size_t>(b)] - c0, J.cols()) += J.transpose();
+    Jt.middleRows(boff[static_cast<std::size_t>(b)] - c0, J.cols()) += J.transpose();
   }
   Vector zp = m.residual();
-  if (k > 0 && rows > 0) {
-    for (int j = c0; j < n_; ++j) {
-      if (rowPtr(j)[j] == Scalar(0)) return std::nullopt;
+  if (k0 > 0 && rows > 0) {
+    std::vector<int> keep;
+    RowMatrix<Scalar> copy;
+    const auto Rt = informedTrailing(c0, keep, copy);
+    if (!Rt) return std::nullopt;
+    const int k = static_cast<int>(keep.size());
+    Matrix Yt(k, rows);
+    Vector rt(k);
+    std::vector<char> kept(static_cast<std::size_t>(k0), 0);
+    for (int i = 0; i < k; ++i) {
+      const int j = keep[static_cast<std::size_t>(i)];
+      kept[static_cast<std::size_t>(j)] = 1;
+      Yt.row(i) = Jt.row(j);
+      rt(i) = rbuf_(off_ + c0 + j);
     }
-    const auto Rt = cview(c0, c0, k, k);
-    Rt.transpose().template triangularView<Eigen::Lower>().solveInPlace(Yt);
+    for (int j = 0; j < k0; ++j) {  // rows touching state without information
+      if (!kept[static_cast<std::size_t>(j)] && !Jt.row(j).isZero(0)) return std::nullopt;
+    }
+    Rt->transpose().template triangularView<Eigen::Lower>().solveInPlace(Yt);
     // Predicted residual z' = z − J R⁻¹ r.
-    zp.noalias() -= Yt.transpose() * rbuf_.segment(off_ + c0, k);
+    zp.noalias() -= Yt.transpose() * rt;
     // χ² = z'ᵀ (I + YYᵀ)⁻¹ z' with UᵀU = I + YYᵀ: QR of the rows of Yᵀ stacked under the
     // identity (qr_update.hpp), then w = U⁻ᵀ z' by forward substitution.
     RowMatrix<Scalar> U = RowMatrix<Scalar>::Identity(rows, rows);
@@ -559,6 +572,34 @@ void SriFilter<Scalar>::correct() {
 }
 
 template <typename Scalar>
+std::optional<typename SriFilter<Scalar>::ConstView> SriFilter<Scalar>::informedTrailing(
+    int c, std::vector<int>& keep, RowMatrix<Scalar>& copy) const {
+  const int k = n_ - c;
+  keep.clear();
+  bool all = true;
+  for (int j = c; j < n_; ++j) {
+    if (rowPtr(j)[j] != Scalar(0)) {
+      keep.push_back(j - c);
+      continue;
+    }
+    // No information on this column: harmless only if it is decoupled from the others.
+    bool coupled = false;
+    for (int i = c; i < j && !coupled; ++i) coupled = rowPtr(i)[j] != Scalar(0);
+    for (int q = j + 1; q < n_ && !coupled; ++q) coupled = rowPtr(j)[q] != Scalar(0);
+    if (coupled) return std::nullopt;
+    all = false;
+  }
+  if (all) return cview(c, c, k, k);
+  const int kk = static_cast<int>(keep.size());
+  copy.setZero(kk, kk);
+  for (int a = 0; a < kk; ++a) {
+    const Scalar* row = rowPtr(c + keep[static_cast<std::size_t>(a)]);
+    for (int b = a; b < kk; ++b) copy(a, b) = row[c + keep[static_cast<std::size_t>(b)]];
+  }
+  return ConstView(copy.data(), kk, kk, Eigen::OuterStride<>(std::max(kk, 1)));
+}
+
+template <typename Scalar>
 typename SriFilter<Scalar>::Matrix SriFilter<Scalar>::covariance(
     std::span<const BlockId> ids) const {
   int c = n_;
@@ -569,20 +610,27 @@ typename SriFilter<Scalar>::Matrix SriFilter<Scalar>::covariance(
     s += b.dim;
   }
   if (s == 0) return Matrix();
-  const int k = n_ - c;
-  for (int j = c; j < n_; ++j) {
-    if (rowPtr(j)[j] == Scalar(0)) {
-      throw std::domain_error("sri::SriFilter::covariance: a block without information is involved");
-    }
+  std::vector<int> keep;
+  RowMatrix<Scalar> copy;
+  const auto Rt = informedTrailing(c, keep, copy);
+  if (!Rt) {
+    throw std::domain_error(
+        "sri::SriFilter::covariance: a later block without information is coupled to the others");
   }
-  Matrix Y = Matrix::Zero(k, s);
+  // Position of every trailing column in the reduced factor (−1: dropped).
+  std::vector<int> pos(static_cast<std::size_t>(n_ - c), -1);
+  for (std::size_t a = 0; a < keep.size(); ++a) pos[static_cast<std::size_t>(keep[a])] = static_cast<int>(a);
+  Matrix Y = Matrix::Zero(static_cast<Eigen::Index>(keep.size()), s);
   int col = 0;
   for (BlockId id : ids) {
     const BlockInfo& b = layout_.block(id);
-    Y.block(b.offset - c, col, b.dim, b.dim).setIdentity();
-    col += b.dim;
+    for (int q = 0; q < b.dim; ++q, ++col) {
+      const int p = pos[static_cast<std::size_t>(b.offset - c + q)];
+      if (p < 0) throw std::domain_error("sri::SriFilter::covariance: block '" + b.name + "' has no information");
+      Y(p, col) = Scalar(1);
+    }
   }
-  cview(c, c, k, k).transpose().template triangularView<Eigen::Lower>().solveInPlace(Y);
+  Rt->transpose().template triangularView<Eigen::Lower>().solveInPlace(Y);
   return Y.transpose() * Y;
 }
 

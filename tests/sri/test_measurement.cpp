@@ -284,12 +284,30 @@ TEST(Measurement, UninformativePriorGivesLeastSquares) {
   const Vd ls = H.colPivHouseholderQr().solve(y);
   EXPECT_LT((f.estimate(a).vector - ls).norm(), 1e-12);
   EXPECT_EQ(f.estimate(b).vector, Eigen::Vector2d::Zero());  // left alone
-  // Marginal covariance of a: (HᵀH/σ²)⁻¹.
+  // Marginal covariance of a: (HᵀH/σ²)⁻¹, although b (behind it) has no information at all.
   const Md Pa = (H.transpose() * H / 0.04).inverse();
-  // b has no information; a's block of R is invertible on its own because a comes first.
-  const Md R = f.squareRootInformation();
-  const Md Ra = R.topLeftCorner(3, 3);
-  EXPECT_LT(((Ra.transpose() * Ra).inverse() - Pa).norm(), 1e-12);
+  EXPECT_LT((f.covariance(std::vector<BlockId>{a}) - Pa).norm(), 1e-12);
+  // Gating a new measurement of a works; one that involves b cannot be gated yet.
+  Measurement<double> za(1);
+  za.jacobian(a, 3) = Eigen::RowVector3d(1, -1, 0.5);
+  za.residual()(0) = 0.3;
+  za.setWhitened();
+  const auto ca = f.chiSquare(za);
+  ASSERT_TRUE(ca.has_value());
+  const Eigen::RowVector3d h(1, -1, 0.5);
+  EXPECT_NEAR(ca->value, 0.09 / (1 + h * Pa * h.transpose()), 1e-12);
+  Measurement<double> zb(1);
+  zb.jacobian(b, 2) = Eigen::RowVector2d(1, 0);
+  zb.setWhitened();
+  EXPECT_FALSE(f.chiSquare(zb).has_value());
+  // Once b is tied to a by a row that leaves part of b undetermined, R has a coupled zero pivot
+  // and the covariance is refused rather than computed wrongly.
+  Measurement<double> tie(1);
+  tie.jacobian(a, 3) = Eigen::RowVector3d(1, 0, 0);
+  tie.jacobian(b, 2) = Eigen::RowVector2d(1, 1);
+  tie.setWhitened();
+  f.update(tie);
+  EXPECT_THROW(f.covariance(std::vector<BlockId>{a}), std::domain_error);
 }
 
 TEST(Measurement, SetEstimateKeepsTheDistribution) {

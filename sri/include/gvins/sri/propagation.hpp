@@ -1,4 +1,4 @@
-// Description of a propagation step for SriFilter::propagate (paper, Sec. II-A, eq. (6)).
+// Description of a propagation step for SriFilter::propagate (paper, Sec. II-A, eq. (8); eq. (21) for the receiver clocks).
 //
 // New blocks x_new (e.g. the next IMU pose clone and IMU extra state) follow the linearized
 // process model in error state

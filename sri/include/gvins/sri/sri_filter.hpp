@@ -9,8 +9,10 @@
 //   - marginalizing blocks that sit first costs nothing (their rows and columns are dropped);
 //   - measurement rows whose first non-zero column is c₀ only touch the columns ≥ c₀;
 //   - the covariance of the trailing blocks comes from the trailing block of R alone.
-// So put what will be marginalized first and what is new last, e.g. for the SRI-SWF
-//   [old IMU extra | SLAM features | clones (oldest first) | parameters | newest clone].
+// So put what will be marginalized soon first and what measurements touch most last. For the
+// SRI-SWF (paper eq. (1)) [SLAM features | clones, oldest first | parameters | IMU extra] keeps
+// VIO updates cheap (rows start at the recent clones) while marginalizing the oldest clone
+// costs a sweep over the feature rows; docs/sri_core.md has the measured trade-offs.
 //
 // Error-state conventions (block.hpp): vectors x = x̂ + δx; rotations R = R̂·Exp(δθ) (kRight,
 // default) or Exp(δθ)·R̂ (kLeft), chosen per block; poses [δθ; δp] with p = p̂ + δp.
@@ -28,13 +30,13 @@
 //   z.jacobian(p, 3).setIdentity();
 //   z.residual() = fix - f.estimate(p).vector;   // z − h(x̂)
 //   z.whitenStdDev(0.02);
-//   if (auto chi2 = f.chiSquare(z); chi2 && chi2->value < 11.34) {  // 99 %, 3 dof
+//   if (auto c = f.chiSquare(z); c && c->value < chiSquareQuantile(0.99, c->dof)) {
 //     f.update(z);
 //     f.correct();                                // x̂ ← x̂ ⊞ R⁻¹r, r ← 0
 //   }
 //   Eigen::MatrixXd P = f.covariance(std::vector{p});  // 3×3 marginal covariance
 //
-// Propagation (paper eq. (6)) is described by a Propagation object (propagation.hpp);
+// Propagation (paper eq. (8)) is described by a Propagation object (propagation.hpp);
 // measurement rows by a Measurement (measurement.hpp), which also does null-space projection
 // of nuisance columns and QR compression. docs/sri_core.md has the derivations.
 //
@@ -49,6 +51,7 @@
 
 #include "gvins/sri/block.hpp"
 #include "gvins/sri/block_estimate.hpp"
+#include "gvins/sri/chi_square.hpp"
 #include "gvins/sri/measurement.hpp"
 #include "gvins/sri/prior.hpp"
 #include "gvins/sri/propagation.hpp"
@@ -122,17 +125,18 @@ class SriFilter {
   void setEstimate(BlockId id, const BlockEstimate<Scalar>& value);
 
   // ---------------------------------------------------------------- filter steps
-  /// Appends the propagation block row of the paper's eq. (6) for new blocks, re-triangularizes
+  /// Appends the propagation block row of the paper's eq. (8) for new blocks, re-triangularizes
   /// and marginalizes the listed blocks. Returns the ids of the new blocks (in order added).
   std::vector<BlockId> propagate(const Propagation<Scalar>& step);
   /// Stacks the whitened rows [H r] under [R r] and re-triangularizes the columns from the first
-  /// one they touch (the paper's eq. (9)). The estimate is not moved; call correct() (or keep
+  /// one they touch (the paper's eq. (12)). The estimate is not moved; call correct() (or keep
   /// stacking measurements first). Throws std::logic_error if the rows are not whitened or still
   /// have nuisance columns, std::out_of_range for an unknown block.
   UpdateResult<Scalar> update(const Measurement<Scalar>& m, const UpdateOptions& options = {});
   /// Mahalanobis distance of a candidate measurement without forming a covariance (triangular
-  /// solve with the trailing block of R from the first touched column). nullopt if that block of
-  /// R is singular (part of the touched state has no information yet).
+  /// solve with the trailing block of R from the first touched column). nullopt if it touches
+  /// state without information, or if the trailing block has a coupled zero pivot (see
+  /// covariance()).
   std::optional<ChiSquare<Scalar>> chiSquare(const Measurement<Scalar>& m) const;
   /// Δx = R⁻¹ r by back-substitution. Components without information (zero pivots) get 0.
   Vector solve() const;
@@ -142,7 +146,11 @@ class SriFilter {
   // ---------------------------------------------------------------- covariance
   /// Joint marginal covariance of the listed blocks, in the listed order: Y = R⁻ᵀ E on the
   /// trailing part of R from the first listed block (forward substitution), P = YᵀY. Cheap for
-  /// blocks at the back. Throws std::domain_error if that part of R is singular.
+  /// blocks at the back. Later blocks that carry no information and are not coupled (e.g. new,
+  /// not yet observed) are ignored. Throws std::domain_error if a listed block has no
+  /// information, or if a later column without information (zero pivot) is coupled to the rest:
+  /// R alone then does not give the covariance (it would need a pseudo-inverse); give such
+  /// blocks a weak prior instead of none, or marginalize them.
   Matrix covariance(std::span<const BlockId> ids) const;
   /// Full covariance R⁻¹R⁻ᵀ (for tests and debugging; O(n³)).
   Matrix fullCovariance() const;
@@ -174,6 +182,13 @@ class SriFilter {
   /// Drops rows [0, d) and columns [c, c+d) after sweepColumnsToFront(c, d, 0).
   void dropFrontAfterSweep(int c, int d);
   bool hasZeroPivot(int from) const;
+  using ConstView = Eigen::Map<const RowMatrix<Scalar>, Eigen::Unaligned, Eigen::OuterStride<>>;
+  /// The trailing factor R[c:, c:] without the columns that carry no information and are not
+  /// coupled to any other (e.g. a new block with an uninformative prior): those do not change
+  /// any covariance or chi-square of the others. `keep` lists the kept columns (relative to c);
+  /// `copy` holds the reduced factor when one was needed. nullopt if a column without
+  /// information is coupled to the others (see covariance()).
+  std::optional<ConstView> informedTrailing(int c, std::vector<int>& keep, RowMatrix<Scalar>& copy) const;
 
   SriOptions options_;
   StateLayout layout_;
