@@ -1,0 +1,409 @@
+#include "gvins/sim/gnss_receiver_sim.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "gvins/base/constants.hpp"
+#include "gvins/gnss/sagnac.hpp"
+#include "gvins/sim/gnss_atmosphere.hpp"
+
+namespace gvins::sim {
+
+const char* toString(GnssReceiverRole r) { return r == GnssReceiverRole::Rover ? "rover" : "base"; }
+
+namespace {
+
+constexpr double kC = constants::kSpeedOfLight;
+// Earth's gravitational constant for the Shapiro delay (IERS Conventions 2010, table 1.1).
+constexpr double kGmEarth = 3.986004418e14;
+// Step of the finite differences that give the atmosphere's rates for the Doppler, s.
+constexpr double kRateStep = 1.0;
+
+std::string systemLetters(const std::array<bool, kNumSystems>& s) {
+  std::string out;
+  for (int i = 0; i < kNumSystems; ++i)
+    if (s[i]) out += systemLetter(static_cast<System>(i));
+  return out;
+}
+
+// Light-time solution: satellite state at the true transmit time, rotated into the ECEF frame of
+// reception, and the exact range rate.
+struct Geometry {
+  double tau = 0.0;
+  GpsTime transmit;
+  GnssSatelliteState sat;          // at the transmit time (ECEF of the transmit time)
+  Eigen::Vector3d satRx = Eigen::Vector3d::Zero();     // position in the ECEF frame of reception
+  Eigen::Vector3d satRxRate = Eigen::Vector3d::Zero(); // d(satRx)/dt
+  double range = 0.0;
+  double rangeRate = 0.0;
+};
+
+bool solveGeometry(const GnssConstellation& con, SatId sat, const GpsTime& t, const GnssAntennaState& rx,
+                   double tauGuess, Geometry& g) {
+  double tau = tauGuess;
+  GpsTime tEval = t - tau;
+  auto s = con.state(sat, tEval);
+  if (!s) return false;
+  Eigen::Vector3d p, rot;
+  double dtx = 0.0;
+  for (int it = 0; it < 12; ++it) {
+    dtx = (t - tau) - tEval;
+    if (std::fabs(dtx) > 1e-5) {  // far from the evaluated state: evaluate again
+      tEval = t - tau;
+      s = con.state(sat, tEval);
+      if (!s) return false;
+      dtx = 0.0;
+    }
+    p = s->position + s->velocity * dtx;
+    rot = rotateEarth(p, tau);
+    const double newTau = (rot - rx.position).norm() / kC;
+    const bool converged = std::fabs(newTau - tau) < 1e-14;
+    tau = newTau;
+    if (converged) break;
+  }
+  dtx = (t - tau) - tEval;
+  g.tau = tau;
+  g.transmit = t - tau;
+  g.sat = *s;
+  g.sat.position = s->position + s->velocity * dtx;
+  g.sat.broadcastPosition = s->broadcastPosition + s->velocity * dtx;
+  g.sat.clock = s->clock + s->clockDrift * dtx;
+  g.sat.broadcastClock = s->broadcastClock + s->clockDrift * dtx;
+  g.satRx = rotateEarth(g.sat.position, tau);
+  g.range = (g.satRx - rx.position).norm();
+  // d/dt of R(omega tau) r_s(t - tau): A tau_dot + B (1 - tau_dot), with B = R v_s and
+  // A = omega R'(omega tau) r_s; rho_dot = e.(B - v_r) / (1 - e.(A - B)/c).
+  const double th = constants::kWgs84OmegaE * tau;
+  const double c = std::cos(th), sn = std::sin(th);
+  const Eigen::Vector3d& r = g.sat.position;
+  const Eigen::Vector3d A = constants::kWgs84OmegaE * Eigen::Vector3d(-sn * r.x() + c * r.y(), -c * r.x() - sn * r.y(), 0.0);
+  const Eigen::Vector3d B = rotateEarth(g.sat.velocity, tau);
+  const Eigen::Vector3d e = (g.satRx - rx.position) / g.range;
+  g.rangeRate = e.dot(B - rx.velocity) / (1.0 - e.dot(A - B) / kC);
+  const double tauDot = g.rangeRate / kC;
+  g.satRxRate = B + tauDot * (A - B);
+  return true;
+}
+
+double shapiroDelay(const Eigen::Vector3d& sat, const Eigen::Vector3d& rx, double range) {
+  const double rs = sat.norm(), rr = rx.norm();
+  return 2.0 * kGmEarth / (kC * kC) * std::log((rs + rr + range) / (rs + rr - range));
+}
+
+}  // namespace
+
+GnssReceiverSim::GnssReceiverSim(const GnssSimWorld& world, GnssReceiverRole role, GnssAntennaMotion motion)
+    : world_(world),
+      cfg_(world.config()),
+      role_(role),
+      rc_(role == GnssReceiverRole::Rover ? world.config().rover : world.config().base.receiver),
+      motion_(std::move(motion)),
+      clock_(rc_.clock, streamSeed(world.seed(), {0xC1, static_cast<std::uint64_t>(role)})),
+      outageActive_(rc_.outages.size(), false) {
+  // First tag: the first multiple of 1/rate at or after the start (receiver time).
+  const GpsTime s = world.start();
+  const double k0 = std::ceil(s.fraction() * rc_.rate - 1e-9);
+  gridStart_ = GpsTime::fromSeconds(s.wholeSeconds(), 0.0) + k0 / rc_.rate;
+  const auto& sats = world.constellation().satellites();
+  sats_.resize(sats.size());
+  for (std::size_t i = 0; i < sats.size(); ++i) {
+    SatTrack& st = sats_[i];
+    st.sat = sats[i];
+    const std::uint64_t si = static_cast<std::uint64_t>(satIndex(st.sat));
+    st.rng.reseed(streamSeed(world.seed(), {0xC2, static_cast<std::uint64_t>(role), si}));
+    st.cn0Offset = st.rng.normal(rc_.cn0.satelliteSigma);
+    for (const ObsCode& code : cfg_.signals[systemIndex(st.sat.system)]) {
+      if (!cfg_.transmits(st.sat, code)) continue;
+      SignalTrack sg;
+      sg.code = code;
+      sg.rng.reseed(streamSeed(world.seed(), {0xC3, static_cast<std::uint64_t>(role), si,
+                                              static_cast<std::uint64_t>(code.band) * 256 + static_cast<std::uint64_t>(code.attr)}));
+      st.signals.push_back(sg);
+    }
+  }
+}
+
+std::optional<GpsTime> GnssReceiverSim::peekTag() const {
+  if (done_) return std::nullopt;
+  const GpsTime tag = gridStart_ + static_cast<double>(k_) / rc_.rate;
+  // The true time is within a few ms of the tag; past the end by more than that: finished.
+  if (tag - world_.end() > 0.1) return std::nullopt;
+  return tag;
+}
+
+std::optional<GnssSimEpoch> GnssReceiverSim::next() {
+  while (!done_) {
+    const GpsTime tag = gridStart_ + static_cast<double>(k_) / rc_.rate;
+    if (tag - world_.end() > 0.1) {
+      done_ = true;
+      break;
+    }
+    ++k_;
+    const GpsTime t = clock_.advanceToTag(tag);
+    if (t < world_.start()) continue;
+    if (world_.end() < t) {
+      done_ = true;
+      break;
+    }
+    GnssSimEpoch out;
+    produce(tag, t, out);
+    lastTag_ = tag;
+    first_ = false;
+    ++epochs_;
+    return out;
+  }
+  return std::nullopt;
+}
+
+void GnssReceiverSim::loseSignal(SignalTrack& sg, const char* cause) {
+  if (!sg.active) return;
+  sg.active = false;
+  sg.restartCause = cause;
+}
+
+void GnssReceiverSim::lose(SatTrack& st, const char* cause) {
+  for (SignalTrack& sg : st.signals) loseSignal(sg, cause);
+}
+
+void GnssReceiverSim::produce(const GpsTime& tag, const GpsTime& t, GnssSimEpoch& out) {
+  out.role = role_;
+  ObsEpoch& obs = out.obs;
+  GnssReceiverTruth& tr = out.truth;
+  obs.time = tag;
+  if (rc_.clock.reportOffset) obs.receiverClockOffset = clock_.reportedOffset();
+  tr.tag = tag;
+  tr.time = t;
+  tr.clockBias = clock_.bias();
+  tr.clockDrift = clock_.drift();
+  for (int s = 0; s < kNumSystems; ++s) tr.systemClockBias[s] = clock_.systemBias(static_cast<System>(s));
+
+  const GnssAntennaState rx = motion_(t);
+  tr.antennaPosition = rx.position;
+  tr.antennaVelocity = rx.velocity;
+  const Geodetic rxGeo = ecefToGeodetic(rx.position);
+  const GnssAntennaState rxAhead{rx.position + rx.velocity * kRateStep, rx.velocity};
+  const Geodetic rxGeoAhead = ecefToGeodetic(rxAhead.position);
+  const GpsTime tAhead = t + kRateStep;
+  const double dt = first_ ? 0.0 : tag - lastTag_;
+  const double flight = t - world_.start();
+  const double mask = rc_.elevationMaskDeg * constants::kDegToRad;
+
+  // Scheduled outages.
+  std::array<bool, kNumSystems> outSys{};
+  for (std::size_t i = 0; i < rc_.outages.size(); ++i) {
+    const GnssOutage& o = rc_.outages[i];
+    const bool on = flight >= o.start && flight < o.start + o.duration;
+    if (on)
+      for (int s = 0; s < kNumSystems; ++s) outSys[s] = outSys[s] || o.systems[s];
+    outageActive_[i] = on;
+  }
+
+  const GnssConstellation& con = world_.constellation();
+  const GnssAtmosphere& atm = world_.atmosphere();
+  for (SatTrack& st : sats_) {
+    const SatId sat = st.sat;
+    Geometry g;
+    if (!solveGeometry(con, sat, t, rx, st.tauValid ? st.tau : 0.075, g)) {
+      lose(st, nullptr);
+      st.tauValid = false;
+      continue;
+    }
+    st.tau = g.tau;
+    st.tauValid = true;
+    const AzEl azel = azimuthElevation(rxGeo, rx.position, g.satRx);
+    if (azel.elevation < mask) {
+      lose(st, nullptr);
+      continue;
+    }
+
+    // Satellite-level events.
+    const double rateFactor = dt / 60.0;
+    if (st.blocked && !(t < st.blockEnd)) {
+      st.blocked = false;
+      events_[static_cast<std::size_t>(st.blockEvent)].end = t;
+    } else if (!st.blocked && dt > 0.0 && rc_.blockage.ratePerMinute > 0.0 &&
+               azel.elevation < rc_.blockage.maxElevationDeg * constants::kDegToRad &&
+               st.rng.bernoulli(1.0 - std::exp(-rc_.blockage.ratePerMinute * rateFactor))) {
+      st.blocked = true;
+      st.blockEnd = t + std::max(st.rng.exponential(rc_.blockage.meanDuration), 0.5 * dt);
+      st.blockEvent = static_cast<int>(events_.size());
+      events_.push_back({role_, "blockage", sat, "", t, st.blockEnd, 0.0});
+    }
+    if (st.blocked) {
+      lose(st, "blockage");
+      continue;
+    }
+    if (outSys[systemIndex(sat.system)]) {
+      lose(st, "outage");
+      continue;
+    }
+    bool nlosChange = false;
+    if (st.nlos && !(t < st.nlosEnd)) {
+      st.nlos = false;
+      st.nlosBias = 0.0;
+      events_[static_cast<std::size_t>(st.nlosEvent)].end = t;
+      nlosChange = true;
+    } else if (!st.nlos && dt > 0.0 && rc_.nlos.ratePerMinute > 0.0 &&
+               azel.elevation < rc_.nlos.maxElevationDeg * constants::kDegToRad &&
+               st.rng.bernoulli(1.0 - std::exp(-rc_.nlos.ratePerMinute * rateFactor))) {
+      st.nlos = true;
+      st.nlosEnd = t + std::max(st.rng.exponential(rc_.nlos.meanDuration), 0.5 * dt);
+      st.nlosBias = st.rng.uniform(rc_.nlos.biasMin, rc_.nlos.biasMax);
+      st.nlosEvent = static_cast<int>(events_.size());
+      events_.push_back({role_, "nlos", sat, "", t, st.nlosEnd, st.nlosBias});
+      nlosChange = true;
+    }
+    if (nlosChange) lose(st, "nlos");  // the carrier loop loses lock when the direct path goes or comes back
+
+    // Atmosphere and its rate (forward difference over kRateStep along the predicted geometry).
+    const GnssAtmosphereDelays atmo = atm.delays(rxGeo, rx.position, azel, t);
+    const Eigen::Vector3d satAhead = g.satRx + g.satRxRate * kRateStep;
+    const AzEl azelAhead = azimuthElevation(rxGeoAhead, rxAhead.position, satAhead);
+    const GnssAtmosphereDelays atmoAhead = atm.delays(rxGeoAhead, rxAhead.position, azelAhead, tAhead);
+    const double tropoRate = (atmoAhead.troposphere - atmo.troposphere) / kRateStep;
+    const double ionoRate = (atmoAhead.ionosphereL1 - atmo.ionosphereL1) / kRateStep;
+
+    GnssSatelliteTruth satTruth;
+    satTruth.sat = sat;
+    satTruth.transmitTime = g.transmit;
+    satTruth.satPosition = g.sat.position;
+    satTruth.satVelocity = g.sat.velocity;
+    satTruth.satClock = g.sat.clock;
+    satTruth.satClockDrift = g.sat.clockDrift;
+    satTruth.broadcastClock = g.sat.broadcastClock;
+    satTruth.orbitError = g.sat.orbitError;
+    satTruth.clockError = g.sat.clockError;
+    satTruth.range = g.range;
+    satTruth.rangeRate = g.rangeRate;
+    satTruth.shapiro = cfg_.shapiroDelay ? shapiroDelay(g.sat.position, rx.position, g.range) : 0.0;
+    satTruth.azel = azel;
+    satTruth.troposphere = atmo.troposphere;
+    satTruth.troposphereModel = atmo.troposphereModel;
+    satTruth.troposphereRate = tropoRate;
+    satTruth.ionosphereL1 = atmo.ionosphereL1;
+    satTruth.ionosphereModelL1 = atmo.ionosphereModelL1;
+    satTruth.ionosphereL1Rate = ionoRate;
+    satTruth.nlosBias = st.nlos ? st.nlosBias : 0.0;
+
+    SatObs satObs;
+    satObs.sat = sat;
+    const double sinEl = std::sin(azel.elevation);
+    const double elFactor = 1.0 / std::max(sinEl, 0.1);
+    const double clockTerm = kC * clock_.systemBias(sat.system);
+    const double clockRate = kC * clock_.drift();
+    const std::optional<int> channel = con.glonassChannel(sat);
+    for (SignalTrack& sg : st.signals) {
+      const auto freq = carrierFrequency(sat.system, sg.code.band, channel);
+      if (!freq) continue;
+      const double lambda = kC / *freq;
+      // C/N0.
+      const double oneMinus = 1.0 - sinEl;
+      double cn0 = rc_.cn0.zenith - (rc_.cn0.zenith - rc_.cn0.horizon) * oneMinus * oneMinus +
+                   cfg_.cn0Offset(sat.system, sg.code) + st.cn0Offset + sg.rng.normal(rc_.cn0.noise);
+      if (st.nlos) cn0 -= rc_.nlos.cn0Drop;
+      // Multipath (advanced even while the signal is not tracked: it belongs to the geometry).
+      const double a = sg.mpStarted ? std::exp(-std::max(t - sg.mpTime, 0.0) / rc_.multipath.timeConstant) : 0.0;
+      const double wc = sg.rng.normal(), wp = sg.rng.normal();
+      sg.mpCode = sg.mpStarted ? a * sg.mpCode + std::sqrt(1.0 - a * a) * wc : wc;
+      sg.mpPhase = sg.mpStarted ? a * sg.mpPhase + std::sqrt(1.0 - a * a) * wp : wp;
+      sg.mpStarted = true;
+      sg.mpTime = t;
+      const double nc = sg.rng.normal(), np = sg.rng.normal(), nd = sg.rng.normal();
+      const double slipDraw = sg.rng.uniform();
+      const std::int64_t slipSize = sg.rng.integer(1, std::max(rc_.slips.maxCycles, 1));
+      const bool slipNegative = sg.rng.bernoulli(0.5);
+      const bool slipFlagged = sg.rng.bernoulli(rc_.slips.flaggedFraction);
+      if (cn0 < rc_.cn0.minimum) {
+        loseSignal(sg, "cn0");
+        continue;
+      }
+
+      GnssSignalTruth sgt;
+      sgt.code = sg.code;
+      sgt.frequency = *freq;
+      sgt.wavelength = lambda;
+      sgt.cn0 = cn0;
+      sgt.groupDelay = con.groupDelay(sat, sg.code, g.transmit);
+      const double ionoScale = (kGnssSimL1Frequency / *freq) * (kGnssSimL1Frequency / *freq);
+      sgt.ionosphere = atmo.ionosphereL1 * ionoScale;
+      sgt.interFrequencyBias = channel ? rc_.clock.glonassIfbPerChannel * *channel : 0.0;
+      sgt.multipathCode = rc_.multipath.code * elFactor * sg.mpCode;
+      sgt.multipathPhase = std::clamp(rc_.multipath.phase * elFactor * sg.mpPhase, -0.25 * lambda, 0.25 * lambda);
+      const double thermal = std::pow(10.0, (45.0 - cn0) / 20.0);
+      sgt.codeSigma = rc_.noise.code * cfg_.codeNoiseFactor(sat.system, sg.code) * thermal;
+      sgt.phaseSigma = rc_.noise.phase * lambda * thermal;
+      sgt.codeNoise = sgt.codeSigma * nc;
+      sgt.phaseNoise = sgt.phaseSigma * np;
+      sgt.dopplerNoise = rc_.noise.doppler * thermal * nd;
+
+      const double common = g.range + satTruth.shapiro + clockTerm - kC * g.sat.clock + atmo.troposphere + satTruth.nlosBias;
+      const double code = common + sgt.interFrequencyBias + kC * sgt.groupDelay + sgt.ionosphere + sgt.multipathCode +
+                          sgt.codeNoise;
+      const double phaseNoN = (common - sgt.ionosphere + sgt.multipathPhase + sgt.phaseNoise) / lambda;
+
+      bool lli = false;
+      if (!sg.active) {
+        // (Re)acquisition: the receiver aligns the phase with its pseudorange.
+        const std::int64_t n = std::llround(code / lambda - phaseNoN);
+        const char* cause = first_ ? "start" : (sg.restartCause ? sg.restartCause : "rise");
+        if (sg.arc >= 0 && sg.restartCause) slips_.push_back({role_, tag, sat, sg.code, n - sg.ambiguity, true, cause});
+        sg.restartCause = nullptr;
+        sg.active = true;
+        sg.ambiguity = n;
+        sg.arc = static_cast<int>(arcs_.size());
+        arcs_.push_back({role_, sat, sg.code, tag, tag, n, lambda, cause});
+        sgt.arcStart = true;
+        lli = !first_;
+      } else if (rc_.slips.ratePerMinute > 0.0 && dt > 0.0 &&
+                 slipDraw < 1.0 - std::exp(-rc_.slips.ratePerMinute * dt / 60.0)) {
+        const std::int64_t jump = slipNegative ? -slipSize : slipSize;
+        sg.ambiguity += jump;
+        sg.arc = static_cast<int>(arcs_.size());
+        arcs_.push_back({role_, sat, sg.code, tag, tag, sg.ambiguity, lambda, "slip"});
+        slips_.push_back({role_, tag, sat, sg.code, jump, slipFlagged, "slip"});
+        sgt.arcStart = true;
+        lli = slipFlagged;
+      }
+      arcs_[static_cast<std::size_t>(sg.arc)].lastTag = tag;
+      sgt.ambiguity = sg.ambiguity;
+      sgt.lossOfLock = lli;
+
+      // Doppler: -(d/dt of the phase range) / lambda per unit of receiver time.
+      const double phaseRangeRate = g.rangeRate + clockRate - kC * g.sat.clockDrift + tropoRate - ionoRate * ionoScale;
+      const double doppler = -(phaseRangeRate / (1.0 + clock_.drift()) + sgt.dopplerNoise) / lambda;
+
+      SignalObs so;
+      so.code = sg.code;
+      so.setCode(code);
+      so.setPhase(phaseNoN + static_cast<double>(sg.ambiguity));
+      so.setDoppler(doppler);
+      so.setSnr(cn0);
+      so.lli = lli ? 1 : 0;
+      so.ssi = static_cast<std::uint8_t>(std::clamp(static_cast<int>(std::floor(cn0 / 6.0)), 1, 9));
+      satObs.signals.push_back(so);
+      satTruth.signals.push_back(sgt);
+    }
+    if (satObs.signals.empty()) continue;
+    obs.sats.push_back(std::move(satObs));
+    tr.sats.push_back(std::move(satTruth));
+  }
+}
+
+void GnssReceiverSim::finish() {
+  for (SatTrack& st : sats_) {
+    if (st.blocked) events_[static_cast<std::size_t>(st.blockEvent)].end = std::min(st.blockEnd, world_.end());
+    if (st.nlos) events_[static_cast<std::size_t>(st.nlosEvent)].end = std::min(st.nlosEnd, world_.end());
+  }
+  for (const GnssOutage& o : rc_.outages) {
+    if (o.start > world_.duration()) continue;
+    GnssEventInterval e;
+    e.role = role_;
+    e.kind = "outage";
+    e.systems = systemLetters(o.systems);
+    e.start = world_.start() + o.start;
+    e.end = world_.start() + std::min(o.start + o.duration, world_.duration());
+    events_.push_back(e);
+  }
+}
+
+}  // namespace gvins::sim
