@@ -32,7 +32,7 @@ struct BasisTable {
         for (int p = 0; p + 1 <= 7; ++p) c[n][m][p] = c[n - 1][m][p + 1] * (p + 1);
   }
 };
-const BasisTable& basis() {
+const BasisTable& basisTable() {
   static const BasisTable table;
   return table;
 }
@@ -52,7 +52,7 @@ UniformBSpline<Dim>::UniformBSpline(double t0, double dt, std::vector<Vector> co
 template <int Dim>
 void UniformBSpline<Dim>::evaluate(double t, int order, Vector* out) const {
   if (order < 0 || order > kMaxDerivative) throw std::invalid_argument("UniformBSpline: derivative order");
-  const BasisTable& b = basis();
+  const BasisTable& b = basisTable();
   const double x = (t - t0_) / dt_;
   const long n = static_cast<long>(c_.size());
   // Far outside the control range the curve is constant; clamp x to keep k in range.
@@ -81,7 +81,20 @@ void UniformBSpline<Dim>::evaluate(double t, int order, Vector* out) const {
   }
 }
 
+template <int Dim>
+void UniformBSpline<Dim>::basis(double u, int derivative, double w[8]) {
+  if (derivative < 0 || derivative > kMaxDerivative) throw std::invalid_argument("UniformBSpline: derivative order");
+  const BasisTable& b = basisTable();
+  for (int m = 0; m < 8; ++m) {
+    const auto& cf = b.c[derivative][m];
+    double v = 0.0;
+    for (int p = 7 - derivative; p >= 0; --p) v = v * u + cf[p];
+    w[m] = v;
+  }
+}
+
 template class UniformBSpline<1>;
 template class UniformBSpline<3>;
+template class UniformBSpline<4>;
 
 }  // namespace gvins::sim

@@ -34,6 +34,10 @@ class UniformBSpline {
     return v;
   }
 
+  /// The 8 weights (or their d-th derivatives w.r.t. the normalised time, d <= 4) of the
+  /// control points k-3 .. k+4 active at (t - t0)/dt = k + u, u in [0, 1).
+  static void basis(double u, int derivative, double w[8]);
+
   double t0() const { return t0_; }
   double dt() const { return dt_; }
   const std::vector<Vector>& controls() const { return c_; }
@@ -45,5 +49,6 @@ class UniformBSpline {
 
 extern template class UniformBSpline<1>;
 extern template class UniformBSpline<3>;
+extern template class UniformBSpline<4>;
 
 }  // namespace gvins::sim
