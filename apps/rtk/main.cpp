@@ -353,15 +353,17 @@ int main(int argc, char** argv) {
 
   ObsEpoch baseEpoch;
   bool baseDone = false, basePending = false;
+  std::optional<GpsTime> lastBaseTime;
   long baseEpochs = 0;
   std::optional<Eigen::Vector3d> basePosUsed = args.baseXyz;
 
   while (haveRover) {
     ++epochs;
     if (!first) first = roverEpoch.time;
-    // Feed base epochs up to the rover time and one beyond (interpolation).
+    // Feed base epochs up to the rover time and the first one after it (for interpolation),
+    // never more: the base buffer only keeps what alignment can use.
     try {
-      while (!baseDone) {
+      while (!baseDone && !(lastBaseTime && *lastBaseTime - roverEpoch.time > BaseStation::kSyncTolerance)) {
         if (!basePending) {
           if (!base->next(baseEpoch)) {
             baseDone = true;
@@ -379,8 +381,8 @@ int main(int argc, char** argv) {
         }
         solver.setBaseGlonassChannels(base->glonassChannels());
         solver.addBaseEpoch(baseEpoch);
+        lastBaseTime = baseEpoch.time;
         basePending = false;
-        if (baseEpoch.time - roverEpoch.time > BaseStation::kSyncTolerance) break;
       }
     } catch (const ParseError& e) {
       printError(e);

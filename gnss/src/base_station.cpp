@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "gvins/base/constants.hpp"
 #include "gvins/base/geodetic.hpp"
@@ -87,11 +88,12 @@ void BaseStation::addEpoch(const ObsEpoch& epoch) {
   e.time = epoch.time;
   e.raw = epoch;
   epochs_.push_back(std::move(e));
-  // Keep what alignment can still use: epochs within maxAge + maxInterpolationGap of the newest,
-  // and at least two.
-  const double keep = std::max(config_.maxAge, config_.maxInterpolationGap) + 1.0;
+  // Keep what alignment can still use: the newest epoch may be one past the rover time, the one
+  // held up to maxAge older, and the rate window of extrapolation up to maxInterpolationGap before
+  // that; at least two epochs, at most kMaxEpochs.
+  const double keep = config_.maxAge + config_.maxInterpolationGap + 1.0;
   while (epochs_.size() > 2 && epochs_.back().time - epochs_[1].time > keep) epochs_.pop_front();
-  while (epochs_.size() > 16) epochs_.pop_front();
+  while (epochs_.size() > kMaxEpochs) epochs_.pop_front();
   // Record slip flags and arcs now: the detector only knows the latest epoch.
   Epoch& last = epochs_.back();
   for (const SatObs& so : last.raw.sats) {
@@ -172,6 +174,7 @@ void BaseStation::model(Epoch& e) {
 BaseAvailability BaseStation::snapshot(const GpsTime& t, BaseSnapshot& out) {
   out.signals.clear();
   out.interpolated = false;
+  out.extrapolated = false;
   if (!position_) return BaseAvailability::NoPosition;
   if (epochs_.empty()) return BaseAvailability::NoData;
   // eB: newest epoch not after t (within the sync tolerance); eA: the one after it.
@@ -225,9 +228,59 @@ BaseAvailability BaseStation::snapshot(const GpsTime& t, BaseSnapshot& out) {
     out.time = eb.time;
     out.age = ageB;
     out.signals = eb.signals;
+    if (config_.extrapolateBase) extrapolate(b, t, out);
     return BaseAvailability::Ok;
   }
   return BaseAvailability::TooOld;
+}
+
+void BaseStation::extrapolate(int b, const GpsTime& t, BaseSnapshot& out) {
+  const Epoch& eb = epochs_[static_cast<std::size_t>(b)];
+  // Rate window: the buffered epochs at most maxInterpolationGap before the held one; the rate of
+  // each phase is the least-squares slope of its OMC over the epochs of the same arc, provided
+  // they span at least kMinRateSpan seconds (shorter spans make the rate noise, multiplied by the
+  // age, larger than the effect).
+  int first = b;
+  while (first > 0 && eb.time - epochs_[static_cast<std::size_t>(first - 1)].time <= config_.maxInterpolationGap) --first;
+  if (eb.time - epochs_[static_cast<std::size_t>(first)].time < kMinRateSpan) return;
+  for (int k = first; k < b; ++k) model(epochs_[static_cast<std::size_t>(k)]);
+  std::vector<double> rate(out.signals.size(), std::numeric_limits<double>::quiet_NaN());
+  std::vector<double> all;
+  std::vector<std::size_t> cursor(static_cast<std::size_t>(b - first), 0);
+  for (std::size_t i = 0; i < out.signals.size(); ++i) {
+    const BaseSignal& s1 = out.signals[i];
+    if (!s1.hasPhase) continue;
+    // Sums for the slope over (t - t_b, omc - omc_b), the held epoch included.
+    double n = 1.0, st = 0.0, sy = 0.0, stt = 0.0, sty = 0.0, tmin = 0.0;
+    for (int k = first; k < b; ++k) {
+      const Epoch& e = epochs_[static_cast<std::size_t>(k)];
+      std::size_t& j = cursor[static_cast<std::size_t>(k - first)];
+      while (j < e.signals.size() && signalLess(e.signals[j], s1)) ++j;
+      if (j == e.signals.size()) continue;
+      const BaseSignal& s0 = e.signals[j];
+      if (!(s0.sat == s1.sat) || !(s0.code == s1.code) || !s0.hasPhase || !(s0.arcStart == s1.arcStart)) continue;
+      const double x = e.time - eb.time, y = s0.phaseOmc - s1.phaseOmc;
+      n += 1.0;
+      st += x;
+      sy += y;
+      stt += x * x;
+      sty += x * y;
+      tmin = std::min(tmin, x);
+    }
+    const double den = n * stt - st * st;
+    if (n < 2.0 || -tmin < kMinRateSpan || !(den > 0.0)) continue;
+    rate[i] = (n * sty - st * sy) / den;
+    all.push_back(rate[i]);
+  }
+  if (all.size() < 3) return;
+  const std::size_t mid = all.size() / 2;
+  std::nth_element(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(mid), all.end());
+  const double common = all[mid];
+  const double age = t - eb.time;
+  for (std::size_t i = 0; i < out.signals.size(); ++i) {
+    if (std::isfinite(rate[i])) out.signals[i].phaseOmc += (rate[i] - common) * age;
+  }
+  out.extrapolated = true;
 }
 
 }  // namespace gvins

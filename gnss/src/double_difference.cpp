@@ -29,25 +29,25 @@ int DdEpoch::phaseSatellites() const {
   return static_cast<int>(s.size());
 }
 
-double sdModelRange(const SingleDifference& sd, const Eigen::Vector3d& x, Eigen::Vector3d* los) {
-  return geometricRange(sd.satPosition, x, los) - sd.satClock + sd.troposphere;
+double sdModelRange(const SingleDifference& sd, const Eigen::Vector3d& x, Eigen::Vector3d* gradient) {
+  return geometricRange(sd.satPosition, x, gradient) - sd.satClock + sd.troposphere;
 }
 
-double sdPhaseResidual(const SingleDifference& sd, const Eigen::Vector3d& x, Eigen::Vector3d* los) {
-  return sd.roverPhase - sdModelRange(sd, x, los) - sd.basePhaseOmc;
+double sdPhaseResidual(const SingleDifference& sd, const Eigen::Vector3d& x, Eigen::Vector3d* gradient) {
+  return sd.roverPhase - sdModelRange(sd, x, gradient) - sd.basePhaseOmc;
 }
 
-double sdCodeResidual(const SingleDifference& sd, const Eigen::Vector3d& x, Eigen::Vector3d* los) {
-  return sd.roverCode - sdModelRange(sd, x, los) - sd.baseCodeOmc;
+double sdCodeResidual(const SingleDifference& sd, const Eigen::Vector3d& x, Eigen::Vector3d* gradient) {
+  return sd.roverCode - sdModelRange(sd, x, gradient) - sd.baseCodeOmc;
 }
 
 DdResidual ddPhaseResidual(const DdEpoch& e, const DoubleDifference& dd, const Eigen::Vector3d& x) {
   const SingleDifference& s = e.sd[static_cast<std::size_t>(dd.satellite)];
   const SingleDifference& r = e.sd[static_cast<std::size_t>(dd.reference)];
-  Eigen::Vector3d us, ur;
+  Eigen::Vector3d gs, gr;
   DdResidual out;
-  out.residual = sdPhaseResidual(s, x, &us) - sdPhaseResidual(r, x, &ur) - dd.ambiguityMeters.value_or(0.0);
-  out.jacobian = (ur - us).transpose();
+  out.residual = sdPhaseResidual(s, x, &gs) - sdPhaseResidual(r, x, &gr) - dd.ambiguityMeters.value_or(0.0);
+  out.jacobian = (gs - gr).transpose();
   out.variance = s.phaseVariance + r.phaseVariance;
   return out;
 }
@@ -55,10 +55,10 @@ DdResidual ddPhaseResidual(const DdEpoch& e, const DoubleDifference& dd, const E
 DdResidual ddCodeResidual(const DdEpoch& e, const DoubleDifference& dd, const Eigen::Vector3d& x) {
   const SingleDifference& s = e.sd[static_cast<std::size_t>(dd.satellite)];
   const SingleDifference& r = e.sd[static_cast<std::size_t>(dd.reference)];
-  Eigen::Vector3d us, ur;
+  Eigen::Vector3d gs, gr;
   DdResidual out;
-  out.residual = sdCodeResidual(s, x, &us) - sdCodeResidual(r, x, &ur);
-  out.jacobian = (ur - us).transpose();
+  out.residual = sdCodeResidual(s, x, &gs) - sdCodeResidual(r, x, &gr);
+  out.jacobian = (gs - gr).transpose();
   out.variance = s.codeVariance + r.codeVariance;
   return out;
 }

@@ -198,10 +198,11 @@ void apply(const Reader& r, const YAML::Node& rtk, RtkConfig& c) {
     } else if (k == "troposphere") {
       c.troposphere = r.boolean(v, full);
     } else if (k == "base") {
-      static const std::set<std::string> kB = {"max_age_s", "interpolate", "max_interpolation_gap_s"};
+      static const std::set<std::string> kB = {"max_age_s", "interpolate", "max_interpolation_gap_s", "extrapolate"};
       r.map(v, full, kB, [&](const std::string& bk, const std::string& bf, const YAML::Node& bv) {
         if (bk == "max_age_s") c.maxAge = r.number(bv, bf, 0.0, 86400.0);
         else if (bk == "interpolate") c.interpolateBase = r.boolean(bv, bf);
+        else if (bk == "extrapolate") c.extrapolateBase = r.boolean(bv, bf);
         else c.maxInterpolationGap = r.number(bv, bf, 0.0, 86400.0);
       });
     } else if (k == "cycle_slip") {

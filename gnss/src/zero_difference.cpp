@@ -30,10 +30,13 @@ std::optional<TransmitState> satelliteAtTransmit(const EphemerisStore& nav, SatI
   return TransmitState{ttx, *st};
 }
 
-double geometricRange(const Eigen::Vector3d& satellite, const Eigen::Vector3d& receiver, Eigen::Vector3d* los) {
+double geometricRange(const Eigen::Vector3d& satellite, const Eigen::Vector3d& receiver, Eigen::Vector3d* gradient) {
   const Eigen::Vector3d d = satellite - receiver;
   const double r = d.norm();
-  if (los) *los = d / r;
+  if (gradient) {
+    const double w = constants::kWgs84OmegaE / constants::kSpeedOfLight;
+    *gradient = -d / r + Eigen::Vector3d(-w * satellite.y(), w * satellite.x(), 0.0);
+  }
   return r + sagnacRangeCorrection(satellite, receiver);
 }
 

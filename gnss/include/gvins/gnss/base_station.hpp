@@ -13,9 +13,15 @@
 //   - a base epoch within `kSyncTolerance` of the rover time (synchronous data);
 //   - otherwise, with interpolation enabled, the two base epochs around the rover time if they are
 //     at most maxInterpolationGap apart (signals continuous across both only);
-//   - otherwise the newest earlier base epoch if it is at most maxAge old (held).
-// Holding rather than extrapolating is deliberate: a linear extrapolation of the OMC mostly
-// extrapolates c·dt_b, which cancels in double differences anyway, and amplifies the noise.
+//   - otherwise the newest earlier base epoch if it is at most maxAge old (held). Held phases keep
+//     changing at the rover with the satellite-specific part of their rate (ionosphere, satellite
+//     clock and orbit errors: at solar maximum several mm/s on L2 for low satellites, a cycle in
+//     under a minute), so with `extrapolateBase` each held phase is moved to the rover time with
+//     its own rate (least-squares slope over the buffered base epochs of the same arc up to
+//     maxInterpolationGap before, spanning at least kMinRateSpan), minus the median rate of all
+//     signals: the common part is c·ḋt_b, which cancels in double differences, and leaving it
+//     out keeps extrapolated and merely held signals consistent. Codes are held (their noise
+//     dwarfs the effect).
 //
 // Cycle slips of the base are detected here (its own CycleSlipDetector); every signal carries the
 // start of its continuous arc so that the rover side can tell when its single-difference
@@ -56,6 +62,7 @@ struct BaseSnapshot {
   GpsTime time;     ///< base time the values refer to (the rover time when interpolated)
   double age = 0.0;  ///< s, rover time minus the nearest base epoch used
   bool interpolated = false;
+  bool extrapolated = false;        ///< held phases moved to the rover time (see above)
   std::vector<BaseSignal> signals;  ///< sorted by satellite, then code
   /// The signal of a satellite with this code, or nullptr.
   const BaseSignal* find(SatId sat, ObsCode code) const;
@@ -82,6 +89,10 @@ class BaseStation {
  public:
   /// Seconds within which base and rover time tags count as the same epoch.
   static constexpr double kSyncTolerance = 0.05;
+  /// Shortest span of base epochs a phase rate for extrapolation is estimated from, s.
+  static constexpr double kMinRateSpan = 5.0;
+  /// Most base epochs buffered.
+  static constexpr std::size_t kMaxEpochs = 256;
 
   /// `nav` must outlive the station.
   BaseStation(const EphemerisStore& nav, const RtkConfig& config);
@@ -113,6 +124,8 @@ class BaseStation {
     std::vector<BaseSignal> signals;
   };
   void model(Epoch& e);
+  /// Moves the phases of a held epoch `b` to `t` with their satellite-specific rates.
+  void extrapolate(int b, const GpsTime& t, BaseSnapshot& out);
 
   const EphemerisStore& nav_;
   RtkConfig config_;

@@ -102,13 +102,14 @@ struct DdEpoch {
   int phaseSatellites() const;
 };
 
-/// Modelled SD range at rover position x: |r_s − x| + Sagnac − c·dt_s + T_r (m); `los` receives
-/// the unit vector rover → satellite.
-double sdModelRange(const SingleDifference& sd, const Eigen::Vector3d& x, Eigen::Vector3d* los = nullptr);
-/// SD phase residual (observed minus modelled, m) at x: c(dt_r − dt_b) + λN_rb + noise.
-double sdPhaseResidual(const SingleDifference& sd, const Eigen::Vector3d& x, Eigen::Vector3d* los = nullptr);
+/// Modelled SD range at rover position x: |r_s − x| + Sagnac − c·dt_s + T_r (m); `gradient`
+/// receives its derivative w.r.t. x (see geometricRange).
+double sdModelRange(const SingleDifference& sd, const Eigen::Vector3d& x, Eigen::Vector3d* gradient = nullptr);
+/// SD phase residual (observed minus modelled, m) at x: c(dt_r − dt_b) + λN_rb + noise;
+/// `gradient` receives the derivative of the model (not of the residual).
+double sdPhaseResidual(const SingleDifference& sd, const Eigen::Vector3d& x, Eigen::Vector3d* gradient = nullptr);
 /// SD code residual at x: c(dt_r − dt_b) + noise (the SD pseudorange of the paper, eq. z_dp).
-double sdCodeResidual(const SingleDifference& sd, const Eigen::Vector3d& x, Eigen::Vector3d* los = nullptr);
+double sdCodeResidual(const SingleDifference& sd, const Eigen::Vector3d& x, Eigen::Vector3d* gradient = nullptr);
 
 struct DdResidual {
   double residual = 0.0;  ///< observed minus modelled, m (phase: minus the fixed ambiguity term)

@@ -69,6 +69,9 @@ struct RtkConfig {
   double maxAge = 30.0;             ///< s, oldest base data used with a rover epoch
   bool interpolateBase = true;      ///< interpolate between base epochs that bracket the rover
   double maxInterpolationGap = 60.0;  ///< s, longest base interval interpolated over
+  /// Held (older) base phases are moved to the rover time with their own rate, estimated from an
+  /// earlier base epoch, minus the rate common to all signals (the base clock, which cancels).
+  bool extrapolateBase = true;
 
   // --- Cycle slips and outlier rejection.
   CycleSlipOptions slip;
@@ -119,7 +122,7 @@ const char* toString(RtkDynamics d);
 ///     code_phase_ratio: 100
 ///     code_system_factor: {R: 1.5}
 ///     troposphere: true
-///     base: {max_age_s: 30, interpolate: true, max_interpolation_gap_s: 60}
+///     base: {max_age_s: 30, interpolate: true, max_interpolation_gap_s: 60, extrapolate: true}
 ///     cycle_slip: {lli: true, max_gap_s: 60, geometry_free: true, geometry_free_m: 0.05,
 ///                  geometry_free_rate_mps: 0.0005, doppler: true, doppler_m: 0.6,
 ///                  doppler_jerk_mps3: 1.0}

@@ -29,9 +29,10 @@ std::optional<TransmitState> satelliteAtTransmit(const EphemerisStore& nav, SatI
                                                  double pseudorange, const EphemerisSelection& policy = {});
 
 /// Geometric range |r_s − r| plus the Sagnac term for a satellite position in the ECEF frame of
-/// its transmit time and a receiver position in that of the receive time; `los` (optional)
-/// receives the unit vector from the receiver to the satellite, so ∂range/∂r = −los.
+/// its transmit time and a receiver position in that of the receive time. `gradient` (optional)
+/// receives ∂range/∂receiver = −los + (ω_e/c)(−y_s, x_s, 0), with los the unit vector from the
+/// receiver to the satellite (the Sagnac part is a few 1e-6).
 double geometricRange(const Eigen::Vector3d& satellite, const Eigen::Vector3d& receiver,
-                      Eigen::Vector3d* los = nullptr);
+                      Eigen::Vector3d* gradient = nullptr);
 
 }  // namespace gvins
