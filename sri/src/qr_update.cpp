@@ -473,7 +473,10 @@ void sweepColumnsToFront(RowMatrixView<Scalar> R, VectorView<Scalar> r, int c, i
   if (d <= 0 || c <= t) return;
   std::vector<Scalar> cs(static_cast<std::size_t>(d));
   std::vector<Scalar> sn(static_cast<std::size_t>(d));
-  std::vector<Scalar> carry(static_cast<std::size_t>(std::max(n, 1)));
+#ifdef GVINS_SRI_VECTOR_EXT
+  std::vector<typename Simd<Scalar>::type> cb(static_cast<std::size_t>(d));
+  std::vector<typename Simd<Scalar>::type> sb(static_cast<std::size_t>(d));
+#endif
   const int cend = c + d;
   for (int i = c - 1; i >= t; --i) {
     // Rotation k acts on rows (i+k, i+k+1) and zeroes R(i+k+1, c+k); computed sequentially on
@@ -493,28 +496,52 @@ void sweepColumnsToFront(RowMatrixView<Scalar> R, VectorView<Scalar> r, int c, i
       }
       cs[static_cast<std::size_t>(k)] = ck;
       sn[static_cast<std::size_t>(k)] = sk;
+#ifdef GVINS_SRI_VECTOR_EXT
+      cb[static_cast<std::size_t>(k)] = Simd<Scalar>::broadcast(ck);
+      sb[static_cast<std::size_t>(k)] = Simd<Scalar>::broadcast(sk);
+#endif
     }
     // The same chain on the other columns ≥ i and on r: one pass per row, the "bottom" result
     // of rotation k is carried into rotation k+1.
+    // One pass per chunk of columns with the carried row in registers: each row of the window
+    // is loaded and stored once.
     auto chain = [&](int col0, int len) {
       if (len <= 0) return;
-      Scalar* __restrict cr = carry.data();
-      const Scalar* src = &R(i, col0);
-      for (int q = 0; q < len; ++q) cr[q] = src[q];
-      for (int k = 0; k < d; ++k) {
-        Scalar* __restrict top = &R(i + k, col0);
-        const Scalar* __restrict bot = &R(i + k + 1, col0);
-        const Scalar ck = cs[static_cast<std::size_t>(k)];
-        const Scalar sk = sn[static_cast<std::size_t>(k)];
-        for (int q = 0; q < len; ++q) {
-          const Scalar x = cr[q];
-          const Scalar y = bot[q];
-          top[q] = ck * x + sk * y;
-          cr[q] = ck * y - sk * x;
+      int q0 = 0;
+#ifdef GVINS_SRI_VECTOR_EXT
+      using V = Simd<Scalar>;
+      using Vec = typename V::type;
+      constexpr int L = V::kLanes;
+      Scalar* base = &R(i, col0);
+      const std::ptrdiff_t rs = R.outerStride();
+      for (; q0 + 2 * L <= len; q0 += 2 * L) {
+        Vec c0 = V::load(base + q0);
+        Vec c1 = V::load(base + q0 + L);
+        for (int k = 0; k < d; ++k) {
+          const Vec ck = cb[static_cast<std::size_t>(k)];
+          const Vec sk = sb[static_cast<std::size_t>(k)];
+          Scalar* top = base + k * rs + q0;
+          const Scalar* bot = top + rs;
+          const Vec y0 = V::load(bot);
+          const Vec y1 = V::load(bot + L);
+          V::store(top, ck * c0 + sk * y0);
+          V::store(top + L, ck * c1 + sk * y1);
+          c0 = ck * y0 - sk * c0;
+          c1 = ck * y1 - sk * c1;
         }
+        V::store(base + d * rs + q0, c0);
+        V::store(base + d * rs + q0 + L, c1);
       }
-      Scalar* dst = &R(i + d, col0);
-      for (int q = 0; q < len; ++q) dst[q] = cr[q];
+#endif
+      for (int q = q0; q < len; ++q) {
+        Scalar x = R(i, col0 + q);
+        for (int k = 0; k < d; ++k) {
+          const Scalar y = R(i + k + 1, col0 + q);
+          R(i + k, col0 + q) = cs[static_cast<std::size_t>(k)] * x + sn[static_cast<std::size_t>(k)] * y;
+          x = cs[static_cast<std::size_t>(k)] * y - sn[static_cast<std::size_t>(k)] * x;
+        }
+        R(i + d, col0 + q) = x;
+      }
     };
     // Column i: only row i is non-zero there (the rows below are below their diagonals, whose
     // storage is not read), so the chain reduces to scalars.

@@ -97,7 +97,7 @@ TEST(SriFilterBookkeeping, RemoveFirstMiddleLastAndEmptyState) {
   }
   // Couple everything with one measurement so that marginalization is not trivial.
   Measurement<double> z(3);
-  for (BlockId id : ids) z.jacobian(id, 2) = Eigen::Matrix<double, 3, 2>::Random();
+  for (BlockId id : ids) z.jacobian(id, 2) = Eigen::MatrixXd::Random(3, 2);
   z.residual() = Eigen::Vector3d(0.1, -0.2, 0.3);
   z.whitenStdDev(0.5);
   f.update(z);
