@@ -1,0 +1,179 @@
+// The SRI-SWF visual-inertial estimator (paper Sec. II; Wu et al. 2015): a square-root inverse
+// sliding-window filter over [SLAM features | IMU pose clones, oldest first | parameters | IMU
+// extra], built on gvins::sri::SriFilter. docs/vio_estimator.md describes state, order and steps.
+//
+// Driver (one thread, time order):
+//   SriSwfEstimator<double> est(config);
+//   for each IMU sample: est.addImu(sample);            // IMU up to (at least) the frame time
+//   for each FeatureFrame: FrameResult r = est.processFrame(frame);
+//   est.newestImuState(), est.poseCovariance()         // 6×6, [δθ; δp], double
+// Clients (fusion/) use the EstimatorBackend interface (estimator_backend.hpp).
+//
+// Per frame: propagate the newest IMU state to the frame time by appending the paper's block row
+// (eq. (8), Φ and G Q Gᵀ from ImuPropagator) — the new pose block is the frame's clone and the
+// previous extra block is marginalized; SLAM re-observations (anchored inverse depth, gated);
+// MSCKF updates of lost / window-long tracks (triangulation, null-space projection, χ² gate);
+// delayed SLAM initialisation from window-long tracks; one correction; marginalization of lost
+// SLAM features and of the oldest clone (SLAM features anchored there are re-anchored first).
+//
+// Scalar: float or double (both instantiated). Estimates handed out are double.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "gvins/vio/estimator_backend.hpp"
+#include "gvins/vio/feature_frame.hpp"
+#include "gvins/vio/imu_noise.hpp"
+#include "gvins/vio/imu_sample.hpp"
+#include "gvins/vio/sensor_yaml.hpp"
+
+namespace gvins::vio {
+
+struct SriSwfConfig {
+  // ---- sensors
+  ImuNoise imu;             ///< noise densities / random walks (Kalibr names)
+  double gravity = 9.81;    ///< m/s², W is z-up: gravity (0, 0, −g)
+  /// 1 (mono) or 2 (stereo) cameras; T_BS is the camera pose in the IMU frame (T_IC).
+  std::vector<CameraCalibration> cameras;
+  double pixel_noise = 1.0;  ///< px, 1-σ per axis (mapped to normalised coordinates by 1/f)
+
+  // ---- window and features
+  int window = 11;             ///< pose clones kept (the newest pose included)
+  int max_slam_features = 50;  ///< SLAM features in the state at most
+  int min_track_msckf = 3;     ///< frames a lost track needs for an MSCKF update
+  double min_depth = 0.2;      ///< m, triangulated depth bounds (all observing cameras)
+  double max_depth = 500.0;
+  /// Minimum ratio of triangulation baseline to depth (rejects near-degenerate tracks).
+  double min_baseline_ratio = 0.005;
+  double chi2_probability = 0.95;  ///< χ² gate of each feature's rows (≥ 1: no gate)
+  int max_msckf_per_frame = 40;    ///< MSCKF features used per frame at most (longest first)
+  /// Re-anchoring noise (normalised coordinates / relative inverse depth) when the anchor clone
+  /// of a SLAM feature leaves the window.
+  double reanchor_sigma = 1e-4;
+
+  // ---- initialisation
+  double init_window = 1.0;          ///< s of IMU used by the static test / gravity mean
+  double static_max_accel_std = 0.15;  ///< m/s², per-axis std of the accelerometer at rest
+  double static_max_gyro_std = 0.02;   ///< rad/s
+  double static_max_parallax = 1.0;    ///< px, median feature displacement over the window
+  bool init_in_motion = true;          ///< stereo: linear visual-inertial alignment
+  int init_motion_frames = 10;         ///< frames used by the in-motion alignment
+  double init_position_sigma = 1e-3;   ///< m (gauge: the VIO frame is defined by the start)
+  double init_yaw_sigma = 1e-3;        ///< rad (gauge)
+  double init_tilt_sigma = 0.02;       ///< rad, roll/pitch
+  double init_velocity_sigma = 0.05;   ///< m/s static (in motion: 3× this)
+  double init_gyro_bias_sigma = 0.02;  ///< rad/s when not estimated from a standstill
+  double init_accel_bias_sigma = 0.1;  ///< m/s²
+
+  // ---- online calibration
+  bool calibrate_extrinsics = false;
+  double extrinsic_rotation_sigma = 0.01;     ///< rad
+  double extrinsic_translation_sigma = 0.01;  ///< m
+  bool calibrate_time_offset = false;         ///< not supported yet: the constructor throws
+
+  /// Precision the application should instantiate (SriSwfEstimator<float> or <double>).
+  bool use_float = false;
+
+  /// Throws std::invalid_argument naming the first bad value.
+  void validate() const;
+};
+
+/// YAML configuration (all keys optional except cameras, unknown keys are errors):
+///   imu: {gyroscope_noise_density, gyroscope_random_walk, accelerometer_noise_density,
+///         accelerometer_random_walk, rate_hz}  or  imu_yaml: <EuRoC/Kalibr imu yaml path>
+///   gravity, pixel_noise, window, max_slam_features, min_track_msckf, min_depth, max_depth,
+///   min_baseline_ratio, chi2_probability, max_msckf_per_frame, reanchor_sigma,
+///   init: {window, static_max_accel_std, static_max_gyro_std, static_max_parallax, in_motion,
+///          motion_frames, position_sigma, yaw_sigma, tilt_sigma, velocity_sigma,
+///          gyro_bias_sigma, accel_bias_sigma},
+///   calibrate_extrinsics, extrinsic_rotation_sigma, extrinsic_translation_sigma,
+///   calibrate_time_offset, precision: double | float,
+///   cameras: [<EuRoC camera sensor.yaml path>, ...]  or  camchain: <Kalibr camchain path>
+/// Relative paths are relative to the YAML file's folder. Errors: gvins::ParseError naming the
+/// file, line and field.
+SriSwfConfig loadSriSwfConfig(const std::string& path);
+SriSwfConfig parseSriSwfConfig(std::string_view text, const std::string& name,
+                               const std::string& base_dir = ".");
+
+/// What processFrame did.
+struct FrameResult {
+  bool initialized = false;  ///< estimator initialised (after this frame)
+  bool updated = false;      ///< at least one visual update applied this frame
+  double estimator_ms = 0;   ///< wall-clock time of processFrame
+  int msckf_features = 0;    ///< MSCKF features used in the update
+  int slam_features = 0;     ///< SLAM features in the state after the frame
+};
+
+template <typename Scalar>
+class SriSwfEstimator final : public EstimatorBackend<Scalar> {
+ public:
+  using typename EstimatorBackend<Scalar>::Matrix;
+  using typename EstimatorBackend<Scalar>::Vector;
+
+  /// Throws std::invalid_argument for an invalid configuration.
+  explicit SriSwfEstimator(const SriSwfConfig& config);
+  ~SriSwfEstimator() override;
+  SriSwfEstimator(const SriSwfEstimator&) = delete;
+  SriSwfEstimator& operator=(const SriSwfEstimator&) = delete;
+
+  // ------------------------------------------------------------------ driver
+  /// Buffers one IMU sample (strictly increasing stamps; older or repeated ones are ignored).
+  void addImu(const ImuSample& sample);
+  /// Processes one camera time step. The IMU must have been added up to the frame time (a frame
+  /// not covered by the IMU buffer is skipped: nothing changes, updated = false).
+  FrameResult processFrame(const FeatureFrame& frame);
+  /// 6×6 marginal covariance of the newest pose, [δθ; δp] (right rotation perturbation of R_WI,
+  /// imu_state.hpp). Zero before initialisation.
+  Eigen::Matrix<double, 6, 6> poseCovariance() const;
+  /// Covariance of the newest 15-dim ImuErr state ([δθ δp δv δbg δba]).
+  Eigen::Matrix<double, 15, 15> imuCovariance() const;
+  const SriSwfConfig& config() const { return config_; }
+  /// Current window: clone times, oldest first (the newest = newestTime()).
+  std::vector<std::int64_t> cloneTimes() const;
+  int slamFeatureCount() const;
+  /// Extrinsic pose T_IC of camera `cam` (estimated when calibrate_extrinsics).
+  Eigen::Matrix4d cameraExtrinsic(int cam) const;
+  /// The underlying filter (tests, diagnostics).
+  const sri::SriFilter<Scalar>& filter() const;
+
+  // ------------------------------------------------------------------ EstimatorBackend
+  bool initialized() const override;
+  std::int64_t newestTime() const override;
+  ImuState newestImuState() const override;
+  ImuBlocks newestImuBlocks() const override;
+  Eigen::Vector3d gravity() const override;
+  ImuNoise imuNoise() const override;
+  std::optional<ImuIntegration> integrateToNewest(std::int64_t t_ns) const override;
+  std::optional<Eigen::Vector3d> angularRateAt(std::int64_t t_ns) const override;
+
+  sri::BlockId addBlock(const sri::BlockSpec& spec, const sri::BlockEstimate<Scalar>& estimate,
+                        const sri::Prior<Scalar>& prior,
+                        ClientBlockRegion region = ClientBlockRegion::kParameters) override;
+  std::vector<sri::BlockId> propagate(const sri::Propagation<Scalar>& step,
+                                      ClientBlockRegion region = ClientBlockRegion::kParameters) override;
+  void marginalize(std::span<const sri::BlockId> ids) override;
+  bool contains(sri::BlockId id) const override;
+  const sri::BlockEstimate<Scalar>& estimate(sri::BlockId id) const override;
+  Matrix covariance(std::span<const sri::BlockId> ids) const override;
+  std::optional<sri::ChiSquare<Scalar>> chiSquare(const sri::Measurement<Scalar>& m) const override;
+  BackendUpdate<Scalar> update(const sri::Measurement<Scalar>& m, double gate_probability) override;
+
+ private:
+  struct Impl;
+  SriSwfConfig config_;
+  std::unique_ptr<Impl> impl_;
+};
+
+extern template class SriSwfEstimator<float>;
+extern template class SriSwfEstimator<double>;
+
+}  // namespace gvins::vio
