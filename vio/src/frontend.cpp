@@ -115,23 +115,33 @@ FeatureFrame StereoFrontend::process(std::int64_t t_ns, const cv::Mat& leftIn, c
 
   if (doStereo) {
     t0 = Clock::now();
-    // Start from last frame's right pixel moved by the left motion, or from the median depth.
-    std::vector<cv::Point2f> rightPts(pts.size(), cv::Point2f(std::nanf(""), 0.f));
+    // Features matched last frame start from that match moved by the left motion; new ones from
+    // the median stereo depth. Features whose match failed before (occluded in cam1, out of its
+    // view) are retried only every kRetry-th frame: failing matches cost the most (every pyramid
+    // level runs to the iteration limit).
+    constexpr std::uint64_t kRetry = 3;
+    std::vector<std::size_t> idx;
+    std::vector<cv::Point2f> leftPts, rightPts;
     for (std::size_t i = 0; i < pts.size(); ++i) {
       const auto it = s.lastStereo.find(ids[i]);
-      if (it != s.lastStereo.end() && lengths[i] > 1) rightPts[i] = it->second + (pts[i] - prevPts[i]);
+      const bool prior = it != s.lastStereo.end() && lengths[i] > 1;
+      if (!prior && lengths[i] > 1 && (out.index + ids[i]) % kRetry != 0) continue;
+      idx.push_back(i);
+      leftPts.push_back(pts[i]);
+      rightPts.push_back(prior ? it->second + (pts[i] - prevPts[i]) : cv::Point2f(std::nanf(""), 0.f));
     }
     std::vector<unsigned char> status;
-    s.matcher->match(leftPyr, rightPyr, pts, rightPts, status, s.medianDepth);
+    s.matcher->match(leftPyr, rightPyr, leftPts, rightPts, status, s.medianDepth);
     s.lastStereo.clear();
     std::vector<double> depths;
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-      if (!status[i]) continue;
+    for (std::size_t k = 0; k < idx.size(); ++k) {
+      if (!status[k]) continue;
+      const std::size_t i = idx[k];
       FeatureObservation& f = out.features[i];
       f.stereo = true;
-      f.pixel1 = {rightPts[i].x, rightPts[i].y};
+      f.pixel1 = {rightPts[k].x, rightPts[k].y};
       f.normalized1 = s.cam1->undistort(f.pixel1);
-      s.lastStereo.emplace(ids[i], rightPts[i]);
+      s.lastStereo.emplace(ids[i], rightPts[k]);
       if (const auto z = s.matcher->depth(f.normalized0, f.normalized1)) depths.push_back(*z);
     }
     if (!depths.empty()) {

@@ -199,21 +199,25 @@ void ImuPropagator::propagate(ImuState& state, std::span<const ImuSample> sample
   forEachImuInterval(samples, state.t_ns, t_end_ns, [&](const ImuInterval& m) {
     integrateImuInterval(m, s.bg, s.ba, gravity_, s.R_WI, s.p_WI, s.v_WI, wantJ ? &J : nullptr);
     if (!wantJ) return;
-    // Step transition: navigation block A, bias columns Bg/Ba, biases constant.
-    Matrix15d F = Matrix15d::Identity();
-    F.topLeftCorner<9, 9>() = J.A;
-    F.block<9, 3>(0, ImuErr::kBg) = J.Bg;
-    F.block<9, 3>(0, ImuErr::kBa) = J.Ba;
-    phiTotal = (F * phiTotal).eval();
+    // Step transition F = [A B; 0 I] (A: navigation 9x9, B = [Bg Ba]: bias columns, biases
+    // constant). Products are formed block-wise: Phi <- F Phi, q <- F q F^T + G Q G^T.
+    Eigen::Matrix<double, 9, 6> B;
+    B << J.Bg, J.Ba;
+    auto phiTop = phiTotal.topRows<9>();
+    phiTop.leftCols<9>() = (J.A * phiTop.leftCols<9>()).eval();
+    phiTop.rightCols<6>() = (J.A * phiTop.rightCols<6>() + B).eval();
     if (Qd) {
-      // G Q G^T: white noise held over the step (sigma^2/h) enters like the biases; bias random
-      // walk adds sigma_b^2 h.
       const double h = m.dt;
-      Matrix15d Qs = Matrix15d::Zero();
-      Qs.topLeftCorner<9, 9>() = (sg2 / h) * J.Bg * J.Bg.transpose() + (sa2 / h) * J.Ba * J.Ba.transpose();
-      Qs.block<3, 3>(ImuErr::kBg, ImuErr::kBg).diagonal().setConstant(sbg2 * h);
-      Qs.block<3, 3>(ImuErr::kBa, ImuErr::kBa).diagonal().setConstant(sba2 * h);
-      q = (F * q * F.transpose() + Qs).eval();
+      const Eigen::Matrix<double, 9, 9> M = J.A * q.topLeftCorner<9, 9>() + B * q.bottomLeftCorner<6, 9>();
+      const Eigen::Matrix<double, 9, 6> N = J.A * q.topRightCorner<9, 6>() + B * q.bottomRightCorner<6, 6>();
+      // White noise held over the step (sigma^2/h) enters like the biases; bias random walk
+      // adds sigma_b^2 h.
+      q.topLeftCorner<9, 9>() = M * J.A.transpose() + N * B.transpose() + (sg2 / h) * J.Bg * J.Bg.transpose() +
+                                (sa2 / h) * J.Ba * J.Ba.transpose();
+      q.topRightCorner<9, 6>() = N;
+      q.bottomLeftCorner<6, 9>() = N.transpose();
+      q.block<3, 3>(ImuErr::kBg, ImuErr::kBg).diagonal().array() += sbg2 * h;
+      q.block<3, 3>(ImuErr::kBa, ImuErr::kBa).diagonal().array() += sba2 * h;
     }
   });
   s.t_ns = t_end_ns;
