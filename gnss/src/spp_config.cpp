@@ -8,97 +8,13 @@
 #include <yaml-cpp/yaml.h>
 
 #include "gvins/base/parse_error.hpp"
+#include "gvins/base/yaml_reader.hpp"
 
 namespace gvins {
 
-std::array<bool, kNumSystems> parseSystemLetters(std::string_view letters) {
-  std::array<bool, kNumSystems> out{};
-  for (char c : letters) {
-    if (c == ',' || c == ' ') continue;
-    const auto s = systemFromLetter(static_cast<char>(std::toupper(static_cast<unsigned char>(c))));
-    if (!s) throw std::invalid_argument(std::string("unknown system letter '") + c + "' (use G R E C J S I)");
-    out[systemIndex(*s)] = true;
-  }
-  return out;
-}
-
 namespace {
 
-class Reader {
- public:
-  explicit Reader(std::string file) : file_(std::move(file)) {}
-
-  [[noreturn]] void fail(const YAML::Node& n, const std::string& key, const std::string& what) const {
-    const auto m = n.Mark();
-    throw ParseError(file_, m.line >= 0 ? m.line + 1 : 0, key, what);
-  }
-
-  template <class T>
-  T get(const YAML::Node& n, const std::string& key) const {
-    try {
-      return n.as<T>();
-    } catch (const YAML::Exception&) {
-      fail(n, key, "wrong type for '" + key + "'");
-    }
-  }
-
-  double number(const YAML::Node& n, const std::string& key, double lo, double hi) const {
-    if (!n.IsScalar()) fail(n, key, "'" + key + "' must be a number");
-    const double v = get<double>(n, key);
-    if (!(v >= lo && v <= hi)) {
-      std::ostringstream os;
-      os << "'" << key << "' = " << v << " is outside [" << lo << ", " << hi << "]";
-      fail(n, key, os.str());
-    }
-    return v;
-  }
-  int integer(const YAML::Node& n, const std::string& key, int lo, int hi) const {
-    if (!n.IsScalar()) fail(n, key, "'" + key + "' must be an integer");
-    const int v = get<int>(n, key);
-    if (v < lo || v > hi) {
-      fail(n, key, "'" + key + "' = " + std::to_string(v) + " is outside [" + std::to_string(lo) + ", " +
-                       std::to_string(hi) + "]");
-    }
-    return v;
-  }
-  bool boolean(const YAML::Node& n, const std::string& key) const {
-    if (!n.IsScalar()) fail(n, key, "'" + key + "' must be true or false");
-    return get<bool>(n, key);
-  }
-  std::string text(const YAML::Node& n, const std::string& key) const {
-    if (!n.IsScalar()) fail(n, key, "'" + key + "' must be a string");
-    return get<std::string>(n, key);
-  }
-  std::string key(const YAML::Node& k, const std::string& where) const {
-    if (!k.IsScalar()) fail(k, where, "keys of '" + where + "' must be plain names");
-    return k.Scalar();
-  }
-  /// Iterates a map, rejecting keys not in `known`.
-  template <class F>
-  void map(const YAML::Node& n, const std::string& where, const std::set<std::string>& known, F&& f) const {
-    if (!n.IsMap()) fail(n, where, "'" + where + "' must be a map");
-    for (auto it = n.begin(); it != n.end(); ++it) {
-      const std::string k = key(it->first, where);
-      const std::string full = where.empty() ? k : where + "." + k;
-      if (!known.count(k)) fail(it->first, full, "unknown key '" + full + "'");
-      f(k, full, it->second);
-    }
-  }
-  /// Map keyed by system letter.
-  template <class F>
-  void perSystem(const YAML::Node& n, const std::string& where, F&& f) const {
-    if (!n.IsMap()) fail(n, where, "'" + where + "' must be a map of system letters");
-    for (auto it = n.begin(); it != n.end(); ++it) {
-      const std::string k = key(it->first, where);
-      const auto s = k.size() == 1 ? systemFromLetter(k[0]) : std::nullopt;
-      if (!s) fail(it->first, where + "." + k, "unknown system '" + k + "' (use G R E C J S I)");
-      f(*s, where + "." + k, it->second);
-    }
-  }
-
- private:
-  std::string file_;
-};
+using Reader = YamlReader;
 
 void apply(const Reader& r, const YAML::Node& spp, SppConfig& c) {
   static const std::set<std::string> kKeys = {
@@ -108,11 +24,7 @@ void apply(const Reader& r, const YAML::Node& spp, SppConfig& c) {
       "max_iterations", "velocity", "allow_unhealthy"};
   r.map(spp, "spp", kKeys, [&](const std::string& k, const std::string& full, const YAML::Node& v) {
     if (k == "systems") {
-      try {
-        c.systems = parseSystemLetters(r.text(v, full));
-      } catch (const std::invalid_argument& e) {
-        r.fail(v, full, e.what());
-      }
+      c.systems = r.systems(v, full);
     } else if (k == "elevation_mask_deg") {
       c.elevationMask = r.number(v, full, -10.0, 90.0) * constants::kDegToRad;
     } else if (k == "snr_mask_dbhz") {
@@ -233,14 +145,7 @@ void apply(const Reader& r, const YAML::Node& spp, SppConfig& c) {
 SppConfig parseSppConfig(std::string_view yaml, std::string_view name, const SppConfig& base) {
   SppConfig c = base;
   const Reader r{std::string(name)};
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(yaml));
-  } catch (const YAML::ParserException& e) {
-    throw ParseError(std::string(name), e.mark.line >= 0 ? e.mark.line + 1 : 0, "YAML", e.msg);
-  } catch (const YAML::Exception& e) {
-    throw ParseError(std::string(name), e.mark.line >= 0 ? e.mark.line + 1 : 0, "YAML", e.msg);
-  }
+  const YAML::Node root = YamlReader::loadText(std::string(yaml), std::string(name));
   if (root.IsNull()) return c;  // empty file: defaults
   if (!root.IsMap()) r.fail(root, "", "the configuration must be a map with an 'spp' section");
   try {

@@ -1,6 +1,8 @@
 // Options of single point positioning and their YAML form.
 #pragma once
 
+#include "gvins/base/yaml_reader.hpp"  // parseSystemLetters
+
 #include <array>
 #include <string>
 #include <string_view>
@@ -87,8 +89,6 @@ struct SppConfig {
   bool useSystem(System s) const { return systems[systemIndex(s)]; }
 };
 
-/// Parses "GRECJ"-style system letters; throws std::invalid_argument naming a bad letter.
-std::array<bool, kNumSystems> parseSystemLetters(std::string_view letters);
 
 /// Reads options from YAML (yaml-cpp). The options live under a top-level `spp:` map (other
 /// top-level keys are left to other tools); every key under it must be known. Missing keys keep

@@ -1,0 +1,70 @@
+// YamlReader: every rejection is a ParseError naming the file, the 1-based line and the key.
+#include "gvins/base/yaml_reader.hpp"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+namespace gvins {
+namespace {
+
+/// Runs f and returns the ParseError it throws (fails the test if it throws nothing else).
+template <class F>
+ParseError errorOf(F&& f) {
+  try {
+    f();
+  } catch (const ParseError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "no ParseError";
+  return ParseError("", 0, "", "");
+}
+
+TEST(YamlReader, ReadsTypedValuesAndRejectsOutOfRangeWithLineAndKey) {
+  const YAML::Node root = YamlReader::loadText("a:\n  x: 2.5\n  n: 7\n  b: true\n  s: kinematic\n  v: [1, 2, 3]\n", "t.yaml");
+  const YamlReader r("t.yaml");
+  EXPECT_DOUBLE_EQ(r.number(root["a"]["x"], "a.x", 0.0, 3.0), 2.5);
+  EXPECT_EQ(r.integer(root["a"]["n"], "a.n", 0, 10), 7);
+  EXPECT_TRUE(r.boolean(root["a"]["b"], "a.b"));
+  EXPECT_EQ(r.choice(root["a"]["s"], "a.s", {"static", "kinematic"}), "kinematic");
+  EXPECT_EQ(r.numbers(root["a"]["v"], "a.v", 3, -10, 10), (std::vector<double>{1, 2, 3}));
+
+  const ParseError range = errorOf([&] { r.number(root["a"]["x"], "a.x", 0.0, 1.0); });
+  EXPECT_EQ(range.file(), "t.yaml");
+  EXPECT_EQ(range.line(), 2);
+  EXPECT_EQ(range.field(), "a.x");
+  EXPECT_NE(std::string(range.what()).find("outside [0, 1]"), std::string::npos);
+
+  EXPECT_EQ(errorOf([&] { r.integer(root["a"]["s"], "a.s", 0, 1); }).line(), 5);
+  EXPECT_EQ(errorOf([&] { r.choice(root["a"]["s"], "a.s", {"static"}); }).field(), "a.s");
+  EXPECT_EQ(errorOf([&] { r.numbers(root["a"]["v"], "a.v", 2, -10, 10); }).line(), 6);
+  EXPECT_EQ(errorOf([&] { r.numbers(root["a"]["v"], "a.v", 3, 0, 2.5); }).field(), "a.v[2]");
+}
+
+TEST(YamlReader, MapRejectsUnknownKeysAndSystemsRejectsUnknownLetters) {
+  const YAML::Node root = YamlReader::loadText("top:\n  known: 1\n  typo: 2\nsys: GRX\n", "m.yaml");
+  const YamlReader r("m.yaml");
+  int seen = 0;
+  const ParseError e = errorOf([&] { r.map(root["top"], "top", {"known"}, [&](auto&&...) { ++seen; }); });
+  EXPECT_EQ(seen, 1);  // 'known' was handled before 'typo' was refused
+  EXPECT_EQ(e.line(), 3);
+  EXPECT_EQ(e.field(), "top.typo");
+  const ParseError s = errorOf([&] { r.systems(root["sys"], "sys"); });
+  EXPECT_EQ(s.line(), 4);
+  EXPECT_NE(std::string(s.what()).find("'X'"), std::string::npos);
+  const auto g = parseSystemLetters("G, E");
+  EXPECT_TRUE(g[systemIndex(System::Gps)]);
+  EXPECT_TRUE(g[systemIndex(System::Galileo)]);
+  EXPECT_FALSE(g[systemIndex(System::Glonass)]);
+}
+
+TEST(YamlReader, SyntaxErrorsAndMissingFilesNameTheFile) {
+  const ParseError syntax = errorOf([] { YamlReader::loadText("a: [1, 2\nb: 3\n", "bad.yaml"); });
+  EXPECT_EQ(syntax.file(), "bad.yaml");
+  EXPECT_GE(syntax.line(), 1);
+  const ParseError missing = errorOf([] { YamlReader::loadFile("/nonexistent/dir/x.yaml"); });
+  EXPECT_EQ(missing.file(), "/nonexistent/dir/x.yaml");
+}
+
+}  // namespace
+}  // namespace gvins
