@@ -3,12 +3,15 @@
 #include <algorithm>
 #include <array>
 
-#include "gvins/gnss/chi_square.hpp"
+#include <limits>
+
+#include "gvins/sri/chi_square.hpp"
 
 namespace gvins {
 
 double globalTestThreshold(int dof, double pfa) {
   if (dof < 1) return 0.0;
+  if (!(pfa > 0.0 && pfa < 1.0)) return std::numeric_limits<double>::infinity();  // no test
   // Cache of the common case (same pfa, small dof): the quantile costs ~100 CDF evaluations.
   static thread_local double cachedPfa = -1.0;
   static thread_local std::array<double, 128> cache{};
@@ -17,10 +20,10 @@ double globalTestThreshold(int dof, double pfa) {
       cache.fill(0.0);
       cachedPfa = pfa;
     }
-    if (cache[dof] == 0.0) cache[dof] = chiSquareQuantile(1.0 - pfa, dof);
+    if (cache[dof] == 0.0) cache[dof] = sri::chiSquareQuantile(1.0 - pfa, dof);
     return cache[dof];
   }
-  return chiSquareQuantile(1.0 - pfa, dof);
+  return sri::chiSquareQuantile(1.0 - pfa, dof);
 }
 
 FaultExclusionResult detectAndExclude(std::vector<char>& use,

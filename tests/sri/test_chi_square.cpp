@@ -63,5 +63,15 @@ TEST(ChiSquare, QuantileInvertsTheCdf) {
   EXPECT_THROW(chiSquareQuantile(0.5, 0), std::invalid_argument);
 }
 
+TEST(ChiSquare, QuantilesMatchPublishedTables) {
+  // NIST/SEMATECH e-Handbook of Statistical Methods, table 1.3.6.7.4 (upper critical values).
+  EXPECT_NEAR(chiSquareQuantile(0.95, 5), 11.070, 1e-3);
+  EXPECT_NEAR(chiSquareQuantile(0.99, 10), 23.209, 1e-3);
+  EXPECT_NEAR(chiSquareQuantile(0.999, 1), 10.828, 1e-3);
+  EXPECT_NEAR(chiSquareQuantile(0.999, 20), 45.315, 1e-3);
+  EXPECT_NEAR(chiSquareQuantile(0.999, 100), 149.449, 1e-3);
+  EXPECT_NEAR(chiSquareCdf(2.0, 2), 1.0 - std::exp(-1.0), 1e-14);  // exponential with mean 2
+}
+
 }  // namespace
 }  // namespace gvins::sri
