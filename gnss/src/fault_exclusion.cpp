@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-
 #include <limits>
 
 #include "gvins/sri/chi_square.hpp"
