@@ -24,6 +24,7 @@ const char* toString(RtkIssue i) {
     case RtkIssue::BaseTooOld: return "base data too old";
     case RtkIssue::NoCommonSatellites: return "fewer than 4 common satellites";
     case RtkIssue::FilterReset: return "float diverged from SPP (reset)";
+    case RtkIssue::Undetermined: return "float position not determined";
   }
   return "?";
 }
@@ -414,13 +415,17 @@ RtkSolution RtkSolver::process(const ObsEpoch& rover) {
   }
   if (spp.velocity.valid) lastVelocity_ = spp.velocity.velocity;
 
-  const Eigen::Vector3d x0 = positionEstimate();
+  Eigen::Vector3d x0 = positionEstimate();
   builder_.form(rover, roverSlips_, snapshot_, basePos, x0, dd_);
 
-  // Prefit gate on DD code (gross errors, multipath spikes).
+  // Prefit gate on DD code (gross errors, multipath spikes), widened by the uncertainty of the
+  // predicted position (a DD line-of-sight difference is at most 2 in length).
+  const sri::BlockId pidPrior[] = {pos_};
+  const double priorSigma = std::sqrt(std::max(filter_.covariance(pidPrior).trace(), 0.0));
+  const double gate = cfg_.codeInnovationGate + 6.0 * priorSigma;
   bool gated = false;
   for (const DoubleDifference& d : dd_.code) {
-    if (std::abs(ddCodeResidual(dd_, d, x0).residual) > cfg_.codeInnovationGate) {
+    if (std::abs(ddCodeResidual(dd_, d, x0).residual) > gate) {
       dd_.sd[static_cast<std::size_t>(d.satellite)].hasCode = false;
       ++sol.codeOutliers;
       ++counters_.codeOutliers;
@@ -438,20 +443,33 @@ RtkSolution RtkSolver::process(const ObsEpoch& rover) {
   }
   if (sats.size() < 4) return single(RtkIssue::NoCommonSatellites);
 
-  // Measurement update with post-fit outlier rejection (redone from the saved state).
+  // Measurement update with post-fit outlier rejection (redone from the saved state). When the
+  // update moves the position by more than kRelinearize (a poor first position, e.g. without SPP)
+  // it is redone about the updated position: ranges are non-linear at that scale.
+  constexpr double kRelinearize = 1.0;
+  const Filter predicted = filter_;
+  const auto predictedAmb = amb_;
   Filter saved;
   std::unordered_map<std::uint32_t, Ambiguity> savedAmb;
-  for (int round = 0;; ++round) {
-    manageAmbiguities(x0, sol);
-    saved = filter_;
-    savedAmb = amb_;
-    measurementUpdate(x0);
-    if (round >= cfg_.maxOutlierRounds || !rejectOutlier(sol)) break;
-    filter_ = saved;
-    amb_ = savedAmb;
+  Eigen::Vector3d xf = x0;
+  for (int iteration = 0; iteration < 3; ++iteration) {
+    for (int round = 0;; ++round) {
+      manageAmbiguities(x0, sol);
+      saved = filter_;
+      savedAmb = amb_;
+      measurementUpdate(x0);
+      if (round >= cfg_.maxOutlierRounds || !rejectOutlier(sol)) break;
+      filter_ = saved;
+      amb_ = savedAmb;
+    }
+    xf = positionEstimate();
+    if ((xf - x0).norm() < kRelinearize || iteration == 2) break;
+    filter_ = predicted;
+    amb_ = predictedAmb;
+    filter_.setEstimate(pos_, sri::BlockEstimate<double>::fromVector(xf));
+    x0 = xf;
   }
 
-  const Eigen::Vector3d xf = positionEstimate();
   if (spp.valid() && (xf - spp.position).norm() > cfg_.maxSppDeviation) {
     ++counters_.filterResets;
     reset();
@@ -473,6 +491,10 @@ RtkSolution RtkSolver::process(const ObsEpoch& rover) {
   sol.floatPosition = xf;
   const sri::BlockId pid[] = {pos_};
   sol.floatCovariance = filter_.covariance(pid);
+  if (!(std::sqrt(std::max(sol.floatCovariance.trace(), 0.0)) < kMaxFloatSigma) || !xf.allFinite()) {
+    // The differences did not determine the position (e.g. the code was all gated away).
+    return single(RtkIssue::Undetermined);
+  }
   sol.quality = SolutionQuality::Float;
   sol.position = xf;
   sol.positionCovariance = sol.floatCovariance;

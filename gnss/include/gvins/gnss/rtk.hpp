@@ -52,6 +52,7 @@ enum class RtkIssue : std::uint8_t {
   BaseTooOld,          ///< base data older than maxAge (gap, missing base epochs)
   NoCommonSatellites,  ///< fewer than four satellites differenced (no common satellites/signals)
   FilterReset,         ///< the float solution left the SPP solution by more than maxSppDeviation
+  Undetermined,        ///< the float position's standard deviation exceeds kMaxFloatSigma
 };
 const char* toString(RtkIssue i);
 
@@ -110,6 +111,9 @@ struct RtkCounters {
 
 class RtkSolver {
  public:
+  /// Float solutions with a larger position standard deviation (m, √trace) are not reported.
+  static constexpr double kMaxFloatSigma = 30.0;
+
   /// `nav` must outlive the solver (it may grow, e.g. with ephemerides from an RTCM stream).
   RtkSolver(const EphemerisStore& nav, RtkConfig config = {}, SppConfig spp = {});
 
