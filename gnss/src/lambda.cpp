@@ -42,6 +42,8 @@ namespace {
 /// Z ← Z G and Z⁻¹ ← G⁻¹ Z⁻¹ (kept transposed, so both are column operations).
 void gaussTransform(Reduction& r, Eigen::MatrixXd& ZinvT, int i, int j) {
   Eigen::MatrixXd& L = r.factor.L;
+  // Most entries are already reduced: test before rounding (nearbyint is a library call).
+  if (std::abs(L(i, j)) <= 0.5) return;
   const double mu = std::nearbyint(L(i, j));
   if (mu == 0.0) return;
   const int n = static_cast<int>(L.rows());
@@ -86,11 +88,12 @@ Reduction reduceLambda(const LtdlFactor& f) {
   r.Z = Eigen::MatrixXd::Identity(n, n);
   Eigen::MatrixXd ZinvT = Eigen::MatrixXd::Identity(n, n);
   if (n >= 2) {
-    // Columns are reduced from the back. After a permutation at k the scan restarts at the last
-    // column, but only columns ≤ k1 (those the permutations changed) need their Gauss
-    // transformations again (Chang et al. 2005, sec. 3): columns beyond k1 are still reduced, so
-    // passing over them only re-checks the ordering. Reducing whole columns before each decision
-    // keeps every entry of L bounded, and with it Z.
+    // Columns are reduced from the back. A permutation at k changes d_k, d_{k+1} and columns k,
+    // k+1 of L (and rows k, k+1 of the earlier columns), so the ordering of columns ≥ k+2 still
+    // holds and the scan resumes at k+1 (Chang et al. 2005, sec. 3). Only columns ≤ k1 (those the
+    // permutations changed) need their Gauss transformations again: column k+1 receives the
+    // already reduced entries of column k. Reducing whole columns before each decision keeps
+    // every entry of L bounded, and with it Z.
     int k = n - 2;
     int k1 = n - 2;
     const double tol = 1e-12;
@@ -105,7 +108,7 @@ Reduction reduceLambda(const LtdlFactor& f) {
       if (delta < (1.0 - tol) * r.factor.d[k + 1]) {
         permute(r, ZinvT, k, delta);
         k1 = k;
-        k = n - 2;
+        k = std::min(k + 1, n - 2);
       } else {
         --k;
       }
