@@ -1,0 +1,180 @@
+// gvins-eval: accuracy of an estimated trajectory (TUM) against ground truth (EuRoC/ASL CSV or
+// TUM): time association, alignment, absolute and relative errors, NEES, SVG plots.
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "gvins/base/line_reader.hpp"
+#include "gvins/base/parse_error.hpp"
+#include "gvins/vio/euroc_csv.hpp"
+#include "gvins/vio/pose_covariance_csv.hpp"
+#include "gvins/vio/trajectory_metrics.hpp"
+#include "gvins/vio/tum_trajectory.hpp"
+
+namespace fs = std::filesystem;
+using namespace gvins::vio;
+
+namespace {
+
+const char* kUsage =
+    "usage: gvins-eval [options] EST GT\n"
+    "\n"
+    "Accuracy of the estimated trajectory EST (TUM: 't x y z qx qy qz qw', t in seconds) against the\n"
+    "ground truth GT: an EuRoC/ASL state_groundtruth_estimate0/data.csv (or a dataset folder that\n"
+    "contains mav0/state_groundtruth_estimate0/data.csv), or a TUM file. Prints position, rotation\n"
+    "and velocity errors (RMSE, mean, median, max), relative errors over travelled distance\n"
+    "(drift %), and position/orientation NEES when pose covariances are available.\n"
+    "\n"
+    "  --align KIND       none | 4dof | se3 | sim3 (default se3). 4dof (yaw + translation) is the\n"
+    "                     right choice for VIO, none for GNSS-fused global results, sim3 for mono\n"
+    "  --gt-format F      auto | asl | tum (default auto: ASL if the first data line has a\n"
+    "                     comma-separated integer nanosecond stamp)\n"
+    "  --tolerance MS     time association tolerance, ms (default 20)\n"
+    "  --segments L,...   relative-error segment lengths, m (default 10,50,100)\n"
+    "  --align-first N    align on the first N matched poses only (default all)\n"
+    "  --cov FILE         pose covariances (6x6 of [dtheta_body; dp_world] per pose, see\n"
+    "                     docs/replay.md); default EST with its extension replaced by .cov.csv,\n"
+    "                     used if it exists\n"
+    "  --no-cov           ignore covariances\n"
+    "  --plots PREFIX     write PREFIXtrajectory_top.svg, PREFIXposition_error.svg,\n"
+    "                     PREFIXrotation_error.svg (PREFIX may be a folder ending in '/')\n"
+    "  -h, --help         this text\n"
+    "\n"
+    "Exit status: 0 success, 1 input or evaluation error, 2 usage error.\n";
+
+[[noreturn]] void usageError(const std::string& msg) {
+  std::fprintf(stderr, "gvins-eval: %s (see --help)\n", msg.c_str());
+  std::exit(2);
+}
+
+double parseNumber(const std::string& s, const char* opt) {
+  try {
+    std::size_t pos = 0;
+    const double v = std::stod(s, &pos);
+    if (pos != s.size()) throw std::invalid_argument("trailing");
+    return v;
+  } catch (const std::exception&) {
+    usageError(std::string("bad number '") + s + "' for " + opt);
+  }
+}
+
+bool looksLikeAsl(const std::string& path) {
+  gvins::LineReader r(path);
+  std::string line;
+  while (r.next(line)) {
+    const auto b = line.find_first_not_of(" \t");
+    if (b == std::string::npos || line[b] == '#') continue;
+    const auto comma = line.find(',');
+    if (comma == std::string::npos) return false;
+    // Integer nanoseconds (optionally with a ".000" fraction) have >= 12 digits before any '.';
+    // TUM seconds since 1970 have 10.
+    const std::string first = line.substr(b, comma - b);
+    const std::string whole = first.substr(0, first.find('.'));
+    return whole.size() >= 12 && whole.find_first_not_of("0123456789") == std::string::npos;
+  }
+  return false;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> pos;
+  EvaluationOptions opt;
+  std::string gtFormat = "auto", covPath, plots;
+  bool noCov = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) usageError("option " + a + " needs a value");
+      return argv[++i];
+    };
+    if (a == "-h" || a == "--help") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    } else if (a == "--align") {
+      const std::string v = value();
+      const auto k = parseAlignmentKind(v);
+      if (!k) usageError("unknown alignment '" + v + "'");
+      opt.alignment = *k;
+    } else if (a == "--gt-format") {
+      gtFormat = value();
+      if (gtFormat != "auto" && gtFormat != "asl" && gtFormat != "tum") usageError("unknown --gt-format '" + gtFormat + "'");
+    } else if (a == "--tolerance") {
+      const double ms = parseNumber(value(), "--tolerance");
+      if (!(ms >= 0.0 && ms < 1e6)) usageError("--tolerance must be in [0, 1e6) ms");
+      opt.tolerance_ns = static_cast<std::int64_t>(ms * 1e6);
+    } else if (a == "--segments") {
+      opt.segmentLengths.clear();
+      std::string v = value(), tok;
+      std::size_t start = 0;
+      while (start <= v.size()) {
+        const auto c = v.find(',', start);
+        tok = v.substr(start, c == std::string::npos ? std::string::npos : c - start);
+        const double L = parseNumber(tok, "--segments");
+        if (!(L > 0.0)) usageError("segment lengths must be positive");
+        opt.segmentLengths.push_back(L);
+        if (c == std::string::npos) break;
+        start = c + 1;
+      }
+    } else if (a == "--align-first") {
+      const double n = parseNumber(value(), "--align-first");
+      if (!(n >= 2.0)) usageError("--align-first needs at least 2");
+      opt.alignFirst = static_cast<std::size_t>(n);
+    } else if (a == "--cov") {
+      covPath = value();
+    } else if (a == "--no-cov") {
+      noCov = true;
+    } else if (a == "--plots") {
+      plots = value();
+    } else if (!a.empty() && a[0] == '-') {
+      usageError("unknown option " + a);
+    } else {
+      pos.push_back(a);
+    }
+  }
+  if (pos.size() != 2) usageError("need EST and GT");
+  try {
+    const std::string estPath = pos[0];
+    std::string gtPath = pos[1];
+    if (fs::is_directory(gtPath)) {
+      for (const char* sub : {"mav0/state_groundtruth_estimate0/data.csv", "state_groundtruth_estimate0/data.csv"}) {
+        if (fs::exists(fs::path(gtPath) / sub)) {
+          gtPath = (fs::path(gtPath) / sub).string();
+          break;
+        }
+      }
+      if (fs::is_directory(gtPath)) throw std::runtime_error("no state_groundtruth_estimate0/data.csv in " + gtPath);
+    }
+    const auto est = toTrajectorySamples(readTumTrajectory(estPath));
+    const bool asl = gtFormat == "asl" || (gtFormat == "auto" && looksLikeAsl(gtPath));
+    const auto gt = asl ? toTrajectorySamples(readGroundTruthCsv(gtPath)) : toTrajectorySamples(readTumTrajectory(gtPath));
+    std::vector<PoseCovariance> cov;
+    if (!noCov) {
+      if (covPath.empty()) {
+        const std::string guess = (fs::path(estPath).parent_path() / fs::path(estPath).stem()).string() + ".cov.csv";
+        if (fs::exists(guess)) covPath = guess;
+      }
+      if (!covPath.empty()) cov = readPoseCovarianceCsv(covPath);
+    }
+    std::printf("estimate  %s (%zu poses)\nreference %s (%zu poses, %s)\n", estPath.c_str(), est.size(), gtPath.c_str(),
+                gt.size(), asl ? "ASL" : "TUM");
+    if (!covPath.empty()) std::printf("covariance %s (%zu rows)\n", covPath.c_str(), cov.size());
+    const EvaluationResult r = evaluateTrajectory(est, gt, cov, opt);
+    printEvaluation(std::cout, r);
+    if (!plots.empty()) {
+      if (plots.back() == '/') fs::create_directories(plots);
+      for (const auto& f : writeEvaluationPlots(r, plots)) std::printf("wrote %s\n", f.c_str());
+    }
+    return 0;
+  } catch (const gvins::ParseError& e) {
+    std::fprintf(stderr, "gvins-eval: %s\n", e.what());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "gvins-eval: %s\n", e.what());
+  }
+  return 1;
+}
