@@ -1,0 +1,455 @@
+// SRI-SWF estimator: Jacobians against finite differences, simulated UAV flights against the
+// simulation truth (drift, NEES, float vs double), standstill initialisation, the
+// EstimatorBackend contract, YAML configuration errors, and the real EuRoC static clip.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <Eigen/Eigenvalues>
+#include <gtest/gtest.h>
+
+#include "gvins/base/parse_error.hpp"
+#include "gvins/sri/so3.hpp"
+#include "gvins/vio/euroc_dataset.hpp"
+#include "gvins/vio/frontend.hpp"
+#include "gvins/vio/imu_propagation.hpp"
+#include "gvins/vio/so3.hpp"
+#include "gvins/vio/sri_swf_estimator.hpp"
+#include "gvins/vio/visual_jacobians.hpp"
+#include "vio_sim_scene.hpp"
+
+namespace gvins::vio {
+namespace {
+
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+
+PoseEstimate perturbPose(const PoseEstimate& p, const Eigen::Matrix<double, 6, 1>& d) {
+  PoseEstimate q;
+  q.R_WI = p.R_WI * so3::exp(d.head<3>());
+  q.p_WI = p.p_WI + d.tail<3>();
+  return q;
+}
+CameraExtrinsic perturbExt(const CameraExtrinsic& e, const Eigen::Matrix<double, 6, 1>& d) {
+  return {e.R_IC * so3::exp(d.head<3>()), e.p_IC + d.tail<3>()};
+}
+
+// Central differences of a vector function of a 6-dim or 3-dim perturbation.
+template <int N, typename F>
+Eigen::MatrixXd numericJacobian(F&& fn, double h = 1e-6) {
+  const Eigen::VectorXd f0 = fn(Eigen::Matrix<double, N, 1>::Zero());
+  Eigen::MatrixXd J(f0.size(), N);
+  for (int k = 0; k < N; ++k) {
+    Eigen::Matrix<double, N, 1> d = Eigen::Matrix<double, N, 1>::Zero();
+    d(k) = h;
+    const Eigen::VectorXd fp = fn(d);
+    d(k) = -h;
+    const Eigen::VectorXd fm = fn(d);
+    J.col(k) = (fp - fm) / (2 * h);
+  }
+  return J;
+}
+
+struct Geometry {
+  PoseEstimate pose, anchor;
+  CameraExtrinsic ext0, ext1;
+  Vector3d p_W;
+  Geometry() {
+    pose.R_WI = so3::exp(Vector3d(0.3, -0.2, 1.1));
+    pose.p_WI = Vector3d(3, -2, 30);
+    anchor.R_WI = so3::exp(Vector3d(0.25, -0.1, 0.9));
+    anchor.p_WI = Vector3d(1, -3, 29);
+    ext0.R_IC = so3::exp(Vector3d(3.0, 0.05, -0.02));
+    ext0.p_IC = Vector3d(0.05, 0.02, -0.05);
+    ext1.R_IC = so3::exp(Vector3d(3.0, 0.06, -0.01));
+    ext1.p_IC = Vector3d(0.45, 0.02, -0.05);
+    p_W = Vector3d(5, 4, 1.5);
+  }
+};
+
+Eigen::Vector2d project(const Vector3d& pc) { return pc.head<2>() / pc.z(); }
+
+TEST(SriSwfJacobians, CameraPointAndProjectionMatchFiniteDifferences) {
+  const Geometry g;
+  for (const CameraExtrinsic& e : {g.ext0, g.ext1}) {  // mono and the stereo partner
+    const CameraPoint cp = cameraPoint(g.pose, e, g.p_W);
+    ASSERT_GT(cp.p_C.z(), 10.0);
+    const auto Jp = numericJacobian<6>([&](const Eigen::Matrix<double, 6, 1>& d) {
+      return Eigen::VectorXd(project(cameraPoint(perturbPose(g.pose, d), e, g.p_W).p_C));
+    });
+    const auto Je = numericJacobian<6>([&](const Eigen::Matrix<double, 6, 1>& d) {
+      return Eigen::VectorXd(project(cameraPoint(g.pose, perturbExt(e, d), g.p_W).p_C));
+    });
+    const auto Jw = numericJacobian<3>([&](const Vector3d& d) {
+      return Eigen::VectorXd(project(cameraPoint(g.pose, e, g.p_W + d).p_C));
+    });
+    const Eigen::Matrix<double, 2, 3> P = projectionJacobian(cp.p_C);
+    EXPECT_LT(((P * cp.J_pose) - Jp).norm(), 1e-7 * Jp.norm());
+    EXPECT_LT(((P * cp.J_ext) - Je).norm(), 1e-7 * Je.norm());
+    EXPECT_LT(((P * cp.J_point) - Jw).norm(), 1e-7 * Jw.norm());
+  }
+}
+
+TEST(SriSwfJacobians, InverseDepthFeatureAndReanchoringMatchFiniteDifferences) {
+  const Geometry g;
+  const Vector3d f = inverseDepthOf(g.p_W, g.anchor, g.ext0);
+  // Round trip.
+  EXPECT_LT((anchoredPoint(f, g.anchor, g.ext0).p_W - g.p_W).norm(), 1e-9);
+  // SLAM observation in cam1 of another clone: z(f, anchor, pose, ext0, ext1).
+  auto obs = [&](const Vector3d& ff, const PoseEstimate& a, const PoseEstimate& p, const CameraExtrinsic& e0,
+                 const CameraExtrinsic& e1) {
+    return Eigen::VectorXd(project(cameraPoint(p, e1, anchoredPoint(ff, a, e0).p_W).p_C));
+  };
+  const AnchoredPoint ap = anchoredPoint(f, g.anchor, g.ext0);
+  const CameraPoint cp = cameraPoint(g.pose, g.ext1, ap.p_W);
+  const Eigen::Matrix<double, 2, 3> A = projectionJacobian(cp.p_C) * cp.J_point;
+  const auto Jf = numericJacobian<3>([&](const Vector3d& d) { return obs(f + d, g.anchor, g.pose, g.ext0, g.ext1); }, 1e-7);
+  const auto Ja = numericJacobian<6>([&](const Eigen::Matrix<double, 6, 1>& d) {
+    return obs(f, perturbPose(g.anchor, d), g.pose, g.ext0, g.ext1);
+  });
+  const auto Je0 = numericJacobian<6>([&](const Eigen::Matrix<double, 6, 1>& d) {
+    return obs(f, g.anchor, g.pose, perturbExt(g.ext0, d), g.ext1);
+  });
+  EXPECT_LT((A * ap.J_feature - Jf).norm(), 1e-6 * Jf.norm());
+  EXPECT_LT((A * ap.J_anchor - Ja).norm(), 1e-6 * Ja.norm());
+  EXPECT_LT((A * ap.J_ext - Je0).norm(), 1e-6 * Je0.norm());
+  // Re-anchoring map f' = g(f, anchor, new anchor) and its chain-rule Jacobians.
+  auto re = [&](const Vector3d& ff, const PoseEstimate& a, const PoseEstimate& b) {
+    return Eigen::VectorXd(inverseDepthOf(anchoredPoint(ff, a, g.ext0).p_W, b, g.ext0));
+  };
+  Matrix3d D;
+  CameraPoint cb;
+  inverseDepthOf(ap.p_W, g.pose, g.ext0, &D, &cb);
+  const auto Rf = numericJacobian<3>([&](const Vector3d& d) { return re(f + d, g.anchor, g.pose); }, 1e-7);
+  const auto Rb = numericJacobian<6>([&](const Eigen::Matrix<double, 6, 1>& d) {
+    return re(f, g.anchor, perturbPose(g.pose, d));
+  });
+  EXPECT_LT((D * cb.J_point * ap.J_feature - Rf).norm(), 1e-6 * Rf.norm());
+  EXPECT_LT((D * cb.J_pose - Rb).norm(), 1e-6 * Rb.norm());
+}
+
+TEST(SriSwfJacobians, PropagationTransitionMatchesFiniteDifferences) {
+  // Φ used for the block row [V₁ −Q'^(−½)] against central differences of the propagator.
+  test::AnalyticMotion m;
+  const auto samples = m.samples(2.0, 200.0, Vector3d(0.01, -0.02, 0.005), Vector3d(0.05, 0.02, -0.03));
+  ImuPropagator prop(ImuNoise{}, m.g);
+  ImuState s0 = m.state(0.5);
+  s0.bg = Vector3d(0.01, -0.02, 0.0);
+  s0.ba = Vector3d(0.04, 0.0, -0.02);
+  const std::int64_t t1 = 550'000'000;
+  ImuState s1 = s0;
+  Matrix15d Phi, Qd;
+  prop.propagate(s1, samples, t1, &Phi, &Qd);
+  Matrix15d Jn;
+  for (int k = 0; k < 15; ++k) {
+    Vector15d d = Vector15d::Zero();
+    const double h = 1e-6;
+    d(k) = h;
+    ImuState a = s0, b = s0;
+    boxPlus(a, d);
+    boxPlus(b, -d);
+    prop.propagate(a, samples, t1);
+    prop.propagate(b, samples, t1);
+    Jn.col(k) = (boxMinus(a, s1) - boxMinus(b, s1)) / (2 * h);
+  }
+  EXPECT_LT((Phi - Jn).cwiseAbs().maxCoeff(), 1e-6);
+  // Q' is symmetric positive definite (the row needs Q'^(−½)).
+  EXPECT_LT((Qd - Qd.transpose()).norm(), 1e-15);
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Matrix15d>(Qd).eigenvalues()(0), 0.0);
+}
+
+// ------------------------------------------------------------------ simulated flights
+struct RunStats {
+  double drift = 0, distance = 0, rmse = 0;
+  double nees_theta = 0, nees_p = 0;
+  int frames = 0, init_frame = -1;
+  double median_ms = 0;
+};
+
+template <typename Scalar>
+RunStats runScene(const test::SimScene& sc, const SriSwfConfig& cfg) {
+  SriSwfEstimator<Scalar> est(cfg);
+  RunStats st;
+  std::size_t k = 0;
+  bool aligned = false;
+  Matrix3d Rz = Matrix3d::Identity();
+  Vector3d tz = Vector3d::Zero();
+  Vector3d prev = Vector3d::Zero();
+  int nn = 0;
+  double se = 0;
+  std::vector<double> ms;
+  for (const FeatureFrame& fr : sc.frames) {
+    while (k < sc.imu.size() && sc.imu[k].t_ns <= fr.t_ns + 20'000'000) est.addImu(sc.imu[k++]);
+    const FrameResult r = est.processFrame(fr);
+    ++st.frames;
+    if (!r.initialized) continue;
+    const ImuState e = est.newestImuState();
+    const ImuState t = sc.truth(e.t_ns);
+    if (!aligned) {
+      // The VIO frame's yaw and origin are gauge: align them to the truth at initialisation.
+      const Matrix3d dR = t.R_WI * e.R_WI.transpose();
+      const double yaw = std::atan2(dR(1, 0), dR(0, 0));
+      Rz = test::AnalyticMotion::rz(yaw);
+      tz = t.p_WI - Rz * e.p_WI;
+      aligned = true;
+      st.init_frame = st.frames;
+      prev = t.p_WI;
+      continue;
+    }
+    ms.push_back(r.estimator_ms);
+    st.distance += (t.p_WI - prev).norm();
+    prev = t.p_WI;
+    const Matrix3d Ra = Rz * e.R_WI;
+    const Vector3d pa = Rz * e.p_WI + tz;
+    Eigen::Matrix<double, 6, 1> err;
+    err.head<3>() = so3::log(Matrix3d(Ra.transpose() * t.R_WI));
+    err.tail<3>() = t.p_WI - pa;
+    Eigen::Matrix<double, 6, 6> T = Eigen::Matrix<double, 6, 6>::Identity();
+    T.bottomRightCorner<3, 3>() = Rz;
+    const Eigen::Matrix<double, 6, 6> P = T * est.poseCovariance() * T.transpose();
+    st.drift = err.tail<3>().norm();
+    se += err.tail<3>().squaredNorm();
+    if (st.frames - st.init_frame > 100) {  // after the first 5 s
+      st.nees_theta += err.head<3>().dot(P.topLeftCorner<3, 3>().ldlt().solve(err.head<3>()));
+      st.nees_p += err.tail<3>().dot(P.bottomRightCorner<3, 3>().ldlt().solve(err.tail<3>()));
+      ++nn;
+    }
+  }
+  st.nees_theta /= std::max(nn, 1);
+  st.nees_p /= std::max(nn, 1);
+  st.rmse = std::sqrt(se / std::max<std::size_t>(ms.size(), 1));
+  if (!ms.empty()) {
+    std::nth_element(ms.begin(), ms.begin() + static_cast<std::ptrdiff_t>(ms.size() / 2), ms.end());
+    st.median_ms = ms[ms.size() / 2];
+  }
+  std::fprintf(stderr,
+               "  %s: init at frame %d, distance %.1f m, final drift %.3f m (%.3f %%), RMSE %.3f m, NEES θ %.2f p %.2f, "
+               "median %.2f ms\n",
+               sizeof(Scalar) == 4 ? "float " : "double", st.init_frame, st.distance, st.drift,
+               100 * st.drift / std::max(st.distance, 1e-9), st.rmse, st.nees_theta, st.nees_p, st.median_ms);
+  return st;
+}
+
+TEST(SriSwfSimulation, StereoCircleDriftNeesAndFloat) {
+  double nt = 0, np = 0;
+  const int seeds = 3;
+  for (int seed = 1; seed <= seeds; ++seed) {
+    test::SimScene sc;
+    sc.duration = 60.0;
+    sc.seed = static_cast<std::uint64_t>(seed);
+    sc.build();
+    const SriSwfConfig cfg = sc.config();
+    const RunStats d = runScene<double>(sc, cfg);
+    ASSERT_GE(d.init_frame, 0);
+    EXPECT_LE(d.init_frame, 25) << "in-motion initialisation should take ~0.5 s";
+    EXPECT_GT(d.distance, 400.0);
+    EXPECT_LT(d.drift / d.distance, 0.003) << "seed " << seed;
+    nt += d.nees_theta;
+    np += d.nees_p;
+    if (seed == 1) {
+      const RunStats f = runScene<float>(sc, cfg);
+      EXPECT_LT(std::abs(f.rmse - d.rmse), 0.05 * d.rmse) << "float RMSE " << f.rmse << " vs double " << d.rmse;
+    }
+  }
+  nt /= seeds;
+  np /= seeds;
+  std::fprintf(stderr, "  mean NEES over %d seeds: orientation %.2f, position %.2f (dimension 3)\n", seeds, nt, np);
+  EXPECT_GT(nt, 1.5);
+  EXPECT_LT(nt, 6.0);
+  EXPECT_GT(np, 1.5);
+  EXPECT_LT(np, 6.0);
+}
+
+TEST(SriSwfSimulation, StandstillInitialisesAndStays) {
+  test::SimScene sc;
+  sc.moving = false;
+  sc.duration = 12.0;
+  sc.build();
+  SriSwfConfig cfg = sc.config();
+  cfg.init_in_motion = false;  // must be the static path
+  SriSwfEstimator<double> est(cfg);
+  std::size_t k = 0;
+  int init_frame = -1;
+  Vector3d p0 = Vector3d::Zero();
+  for (std::size_t i = 0; i < sc.frames.size(); ++i) {
+    const FeatureFrame& fr = sc.frames[i];
+    while (k < sc.imu.size() && sc.imu[k].t_ns <= fr.t_ns + 20'000'000) est.addImu(sc.imu[k++]);
+    const FrameResult r = est.processFrame(fr);
+    if (r.initialized && init_frame < 0) {
+      init_frame = static_cast<int>(i);
+      p0 = est.newestImuState().p_WI;
+      // Gravity direction: the tilt of the initial attitude against the truth.
+      const ImuState e = est.newestImuState();
+      const ImuState t = sc.truth(e.t_ns);
+      const double tilt = std::acos(std::clamp((e.R_WI * t.R_WI.transpose() * Vector3d::UnitZ()).z(), -1.0, 1.0));
+      EXPECT_LT(tilt, 0.03) << "tilt error " << tilt;  // accelerometer turn-on bias 0.05 m/s² → ~5 mrad
+      EXPECT_LT((e.bg - t.bg).norm(), 2e-3);
+    }
+  }
+  ASSERT_GE(init_frame, 0);
+  EXPECT_LE(init_frame, 25);  // one init window (1 s) at 20 Hz
+  const ImuState e = est.newestImuState();
+  std::fprintf(stderr, "  standstill: init at frame %d, position change %.4f m, speed %.4f m/s\n", init_frame,
+               (e.p_WI - p0).norm(), e.v_WI.norm());
+  EXPECT_LT((e.p_WI - p0).norm(), 0.02);
+  EXPECT_LT(e.v_WI.norm(), 0.01);
+  EXPECT_LT((e.bg - sc.truth(e.t_ns).bg).norm(), 2e-3);
+}
+
+// ------------------------------------------------------------------ EstimatorBackend contract
+TEST(SriSwfBackend, ClientBlocksPropagateMarginalizeAndGatedUpdate) {
+  test::SimScene sc;
+  sc.duration = 8.0;
+  sc.build();
+  SriSwfEstimator<double> est(sc.config());
+  EXPECT_FALSE(est.initialized());
+  std::size_t k = 0;
+  for (const FeatureFrame& fr : sc.frames) {
+    while (k < sc.imu.size() && sc.imu[k].t_ns <= fr.t_ns + 20'000'000) est.addImu(sc.imu[k++]);
+    est.processFrame(fr);
+  }
+  ASSERT_TRUE(est.initialized());
+  EXPECT_EQ(static_cast<int>(est.cloneTimes().size()), 11);
+  // IMU integration terms over the last 0.5 s reproduce the newest state from an earlier one.
+  const std::int64_t tn = est.newestTime();
+  auto integ = est.integrateToNewest(tn - 500'000'000);
+  ASSERT_TRUE(integ.has_value());
+  EXPECT_NEAR(integ->dt(), 0.5, 1e-9);
+  EXPECT_FALSE(est.integrateToNewest(tn + 1).has_value());
+  EXPECT_FALSE(est.integrateToNewest(tn - 10'000'000'000).has_value());
+  const auto w = est.angularRateAt(tn - 100'000'000);
+  ASSERT_TRUE(w.has_value());
+  const double tw = static_cast<double>(tn - 100'000'000) * 1e-9;
+  EXPECT_LT((*w - sc.motion.gyro(tw)).norm(), 0.01);  // bias-corrected rate vs truth (noise 2.4 mrad/s)
+
+  // A client clock [bias, drift] in the parameters: prior, then x' = F x + w; the filter's
+  // marginal covariance must equal the closed form F P Fᵀ + Q.
+  Eigen::Matrix2d P0;
+  P0 << 4.0, 0.0, 0.0, 0.25;
+  const sri::BlockId clk = est.addBlock(sri::BlockSpec::vector("clock", 2),
+                                        sri::BlockEstimate<double>::fromVector(Eigen::Vector2d(10, 1)),
+                                        sri::Prior<double>::covariance(P0));
+  EXPECT_TRUE(est.contains(clk));
+  Eigen::Matrix2d F;
+  F << 1, 2, 0, 1;
+  Eigen::Matrix2d Q;
+  Q << 0.1, 0.02, 0.02, 0.05;
+  sri::Propagation<double> step;
+  step.addNewBlock(sri::BlockSpec::vector("clock", 2), sri::BlockEstimate<double>::fromVector(F * Eigen::Vector2d(10, 1)));
+  step.setTransition(clk, F);
+  step.setNoiseCovariance(Q);
+  step.marginalizeAfter(clk);
+  const std::vector<sri::BlockId> nid = est.propagate(step);
+  ASSERT_EQ(nid.size(), 1u);
+  EXPECT_FALSE(est.contains(clk));
+  const sri::BlockId c2 = nid[0];
+  const Eigen::MatrixXd Pc = est.covariance(std::span<const sri::BlockId>(&c2, 1));
+  EXPECT_LT((Pc - (F * P0 * F.transpose() + Q)).norm(), 1e-9);
+  EXPECT_NEAR(est.estimate(c2).vector(0), 12.0, 1e-12);
+
+  // A GNSS-like position fix of the IMU (σ = 2 cm) 5 cm east of the estimate: gated in, it moves
+  // the estimate by the Kalman gain computed from the marginal covariance (independent closed
+  // form), and shrinks the covariance.
+  const ImuState e = est.newestImuState();
+  const ImuBlocks b = est.newestImuBlocks();
+  const Eigen::Matrix<double, 6, 6> Pp = est.poseCovariance();
+  const double s = 0.02;
+  sri::Measurement<double> z(3);
+  z.jacobian(b.pose, 6).rightCols<3>().setIdentity();
+  const Vector3d fix = e.p_WI + Vector3d(0.05, 0, 0);
+  z.residual() = fix - e.p_WI;
+  z.whitenStdDev(s);
+  const double prior_var = Pp(3, 3);
+  const BackendUpdate<double> u = est.update(z, 0.999);
+  EXPECT_TRUE(u.applied);
+  EXPECT_EQ(u.dof, 3);
+  const Matrix3d Ppp = Pp.bottomRightCorner<3, 3>();
+  const Vector3d expected_shift = Ppp * (Ppp + s * s * Matrix3d::Identity()).ldlt().solve(Vector3d(0.05, 0, 0));
+  EXPECT_LT((est.newestImuState().p_WI - e.p_WI - expected_shift).norm(), 1e-9);
+  EXPECT_GT(expected_shift.x(), 0.01);
+  EXPECT_LT(est.poseCovariance()(3, 3), prior_var);
+  // A fix 100 m off is gated out and leaves the state untouched.
+  const ImuState before = est.newestImuState();
+  sri::Measurement<double> bad(3);
+  bad.jacobian(b.pose, 6).rightCols<3>().setIdentity();
+  bad.residual() = Vector3d(100, 0, 0);
+  bad.whitenStdDev(s);
+  const BackendUpdate<double> ub = est.update(bad, 0.999);
+  EXPECT_FALSE(ub.applied);
+  EXPECT_GT(ub.chi2, 1e4);
+  EXPECT_EQ(est.newestImuState().p_WI, before.p_WI);
+  // The client marginalizes its own block.
+  const sri::BlockId ids[] = {c2};
+  est.marginalize(ids);
+  EXPECT_FALSE(est.contains(c2));
+}
+
+// ------------------------------------------------------------------ configuration
+TEST(SriSwfConfig, YamlValuesAndErrorsNameLineAndField) {
+  const std::string dir = std::string(GVINS_TEST_DATA) + "/euroc/v101_static_stereo/mav0";
+  const std::string text =
+      "window: 9\nmax_slam_features: 30\npixel_noise: 0.7\nprecision: float\ninit:\n  window: 0.8\n"
+      "cameras: [cam0/sensor.yaml, cam1/sensor.yaml]\nimu_yaml: imu0/sensor.yaml\n";
+  const SriSwfConfig c = parseSriSwfConfig(text, "cfg.yaml", dir);
+  EXPECT_EQ(c.window, 9);
+  EXPECT_EQ(c.max_slam_features, 30);
+  EXPECT_DOUBLE_EQ(c.pixel_noise, 0.7);
+  EXPECT_TRUE(c.use_float);
+  EXPECT_DOUBLE_EQ(c.init_window, 0.8);
+  ASSERT_EQ(c.cameras.size(), 2u);
+  EXPECT_DOUBLE_EQ(c.cameras[0].intrinsics.fx, 458.654);
+  EXPECT_DOUBLE_EQ(c.imu.gyroscope_noise_density, 1.6968e-04);
+  auto expectError = [&](const std::string& t, int line, const std::string& field) {
+    try {
+      parseSriSwfConfig(t, "bad.yaml", dir);
+      ADD_FAILURE() << "no error for: " << t;
+    } catch (const ParseError& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find("bad.yaml"), std::string::npos) << msg;
+      EXPECT_NE(msg.find(std::to_string(line)), std::string::npos) << msg;
+      EXPECT_NE(msg.find(field), std::string::npos) << msg;
+    }
+  };
+  expectError("cameras: [cam0/sensor.yaml]\nwindow: abc\n", 2, "window");
+  expectError("cameras: [cam0/sensor.yaml]\ninit:\n  bogus: 1\n", 3, "init.bogus");
+  expectError("cameras: [cam0/sensor.yaml]\nprecision: half\n", 2, "precision");
+  expectError("window: 5\n", 1, "cameras");
+  expectError("cameras: [cam0/sensor.yaml]\nwindow: 1\n", 1, "window");
+}
+
+// ------------------------------------------------------------------ real data
+TEST(SriSwfEuroc, StaticClipInitialisesAndDriftsLittle) {
+  const std::string root = std::string(GVINS_TEST_DATA) + "/euroc/v101_static_stereo";
+  EurocDataset ds(root);
+  SriSwfConfig cfg;
+  cfg.imu = ds.imuCalibration().noise;
+  cfg.cameras = {ds.cameraCalibration(0), ds.cameraCalibration(1)};
+  cfg.init_window = 0.5;  // the clip is 1.2 s long
+  SriSwfEstimator<double> est(cfg);
+  StereoFrontend fe(FrontendConfig{}, ds.cameraCalibration(0), &ds.cameraCalibration(1));
+  std::size_t k = 0;
+  const auto& imu = ds.imu();
+  int init_frame = -1, i = 0;
+  Vector3d p0 = Vector3d::Zero();
+  for (const EurocFrame& f : ds.frames()) {
+    while (k < imu.size() && imu[k].t_ns <= f.t_ns + 20'000'000) est.addImu(imu[k++]);
+    const cv::Mat l = ds.loadImage(0, f.cam0);
+    const cv::Mat r = f.cam1 ? ds.loadImage(1, *f.cam1) : cv::Mat();
+    const FrameResult res = est.processFrame(fe.process(f.t_ns, l, r));
+    if (res.initialized && init_frame < 0) {
+      init_frame = i;
+      p0 = est.newestImuState().p_WI;
+    }
+    ++i;
+  }
+  ASSERT_GE(init_frame, 0) << "did not initialise from standstill";
+  const double drift = (est.newestImuState().p_WI - p0).norm();
+  std::fprintf(stderr, "  EuRoC static clip: %d frames, init at frame %d, drift %.4f m over %.2f s\n", i, init_frame,
+               drift, static_cast<double>(est.newestTime() - ds.frames()[static_cast<std::size_t>(init_frame)].t_ns) * 1e-9);
+  EXPECT_LT(drift, 0.02);
+  EXPECT_LT(est.newestImuState().v_WI.norm(), 0.05);
+}
+
+}  // namespace
+}  // namespace gvins::vio

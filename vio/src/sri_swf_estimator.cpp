@@ -1,0 +1,945 @@
+// SRI-SWF visual-inertial estimator (see sri_swf_estimator.hpp and docs/vio_estimator.md).
+#include "gvins/vio/sri_swf_estimator.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <unordered_set>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+#include "gvins/sri/chi_square.hpp"
+#include "gvins/vio/imu_propagation.hpp"
+#include "gvins/vio/so3.hpp"
+#include "gvins/vio/visual_jacobians.hpp"
+
+namespace gvins::vio {
+namespace {
+
+using sri::BlockEstimate;
+using sri::BlockId;
+using sri::BlockSpec;
+using sri::Placement;
+
+template <typename S>
+PoseEstimate poseOf(const BlockEstimate<S>& e) {
+  PoseEstimate p;
+  p.R_WI = e.rotation.template cast<double>().normalized().toRotationMatrix();
+  p.p_WI = e.vector.template cast<double>().head(3);
+  return p;
+}
+
+template <typename S>
+BlockEstimate<S> poseEstimate(const Eigen::Matrix3d& R, const Eigen::Vector3d& p) {
+  return BlockEstimate<S>::fromPose(Eigen::Quaterniond(R).normalized().cast<S>(), p.cast<S>());
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+}  // namespace
+
+// ======================================================================================= Impl
+template <typename Scalar>
+struct SriSwfEstimator<Scalar>::Impl {
+  using Filter = sri::SriFilter<Scalar>;
+  using Meas = sri::Measurement<Scalar>;
+  using MatrixS = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
+  using VectorS = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
+
+  struct Obs {
+    BlockId clone;
+    int cam = 0;
+    Eigen::Vector2d z = Eigen::Vector2d::Zero();
+  };
+  struct Track {
+    std::vector<Obs> obs;  // in time order, clones in the window only
+    int frames = 0;        // frames with a cam0 observation in `obs`
+  };
+  struct Clone {
+    BlockId id;
+    std::int64_t t_ns = 0;
+  };
+  struct Slam {
+    BlockId block;
+    BlockId anchor;
+    bool seen = false;  // observed in the current frame
+  };
+
+  const SriSwfConfig& cfg;
+  Filter f;
+  ImuPropagator prop;
+  std::vector<ImuSample> imu;
+  bool initialized = false;
+  std::int64_t t_newest = 0;
+  ImuBlocks newest;
+  std::deque<Clone> clones;
+  std::vector<CameraExtrinsic> ext_fixed;
+  std::vector<BlockId> ext_ids;  // calibrate_extrinsics
+  std::vector<double> sigma_n;   // per camera: pixel noise in normalised units
+  std::unordered_map<std::uint64_t, Track> tracks;
+  std::unordered_map<std::uint64_t, Slam> slam;
+  std::deque<FeatureFrame> init_frames;
+  std::unordered_map<std::uint64_t, PoseEstimate> pose_cache;
+  mutable std::vector<double> chi2_thr;
+
+  explicit Impl(const SriSwfConfig& c) : cfg(c), prop(c.imu, c.gravity) {
+    for (const CameraCalibration& cam : c.cameras) {
+      CameraExtrinsic e;
+      e.R_IC = Eigen::Quaterniond(Eigen::Matrix3d(cam.T_BS.topLeftCorner<3, 3>())).normalized().toRotationMatrix();
+      e.p_IC = cam.T_BS.topRightCorner<3, 1>();
+      ext_fixed.push_back(e);
+      const double fmean = 0.5 * (cam.intrinsics.fx + cam.intrinsics.fy);
+      sigma_n.push_back(c.pixel_noise / fmean);
+    }
+  }
+
+  bool stereo() const { return cfg.cameras.size() > 1; }
+
+  double chi2Threshold(int dof) const {
+    if (cfg.chi2_probability >= 1.0) return std::numeric_limits<double>::infinity();
+    if (static_cast<int>(chi2_thr.size()) <= dof) {
+      const int old = static_cast<int>(chi2_thr.size());
+      chi2_thr.resize(static_cast<std::size_t>(dof + 16));
+      for (int d = std::max(old, 1); d < static_cast<int>(chi2_thr.size()); ++d) {
+        chi2_thr[static_cast<std::size_t>(d)] = sri::chiSquareQuantile(cfg.chi2_probability, d);
+      }
+    }
+    return chi2_thr[static_cast<std::size_t>(dof)];
+  }
+
+  // ------------------------------------------------------------------ state access
+  CameraExtrinsic ext(int cam) const {
+    if (!ext_ids.empty()) {
+      const PoseEstimate p = poseOf(f.estimate(ext_ids[static_cast<std::size_t>(cam)]));
+      return {p.R_WI, p.p_WI};
+    }
+    return ext_fixed[static_cast<std::size_t>(cam)];
+  }
+  const PoseEstimate& pose(BlockId id) {
+    auto it = pose_cache.find(id.value);
+    if (it == pose_cache.end()) it = pose_cache.emplace(id.value, poseOf(f.estimate(id))).first;
+    return it->second;
+  }
+  ImuState newestState() const {
+    ImuState s;
+    if (!initialized) return s;
+    s.t_ns = t_newest;
+    const PoseEstimate p = poseOf(f.estimate(newest.pose));
+    s.R_WI = p.R_WI;
+    s.p_WI = p.p_WI;
+    const Eigen::VectorXd x = f.estimate(newest.extra).vector.template cast<double>();
+    s.v_WI = x.segment<3>(0);
+    s.bg = x.segment<3>(3);
+    s.ba = x.segment<3>(6);
+    return s;
+  }
+
+  // ------------------------------------------------------------------ IMU buffer
+  void addImu(const ImuSample& s) {
+    if (!imu.empty() && s.t_ns <= imu.back().t_ns) return;
+    imu.push_back(s);
+  }
+  void trimImu() {
+    if (imu.empty()) return;
+    std::int64_t keep = imu.back().t_ns - static_cast<std::int64_t>(3.0e9);
+    if (!initialized) {
+      keep = imu.back().t_ns - static_cast<std::int64_t>((cfg.init_window + 2.0) * 1e9);
+      if (!init_frames.empty()) keep = std::min(keep, init_frames.front().t_ns - 100'000'000);
+    } else if (!clones.empty()) {
+      keep = std::min(keep, clones.front().t_ns - 100'000'000);
+    }
+    auto it = std::lower_bound(imu.begin(), imu.end(), keep,
+                               [](const ImuSample& a, std::int64_t t) { return a.t_ns < t; });
+    if (it - imu.begin() > 2000) imu.erase(imu.begin(), it - 1);  // amortised
+  }
+  std::span<const ImuSample> imuSpan() const { return {imu.data(), imu.size()}; }
+  bool imuCovers(std::int64_t t0, std::int64_t t1) const {
+    return !imu.empty() && imu.front().t_ns <= t0 && imu.back().t_ns >= t1;
+  }
+
+  // ------------------------------------------------------------------ initialisation
+  void createState(const ImuState& s, const Eigen::Matrix3d& Ptheta_world, double sigma_v, double sigma_bg) {
+    Eigen::Matrix<double, 6, 6> P = Eigen::Matrix<double, 6, 6>::Zero();
+    P.topLeftCorner<3, 3>() = s.R_WI.transpose() * Ptheta_world * s.R_WI;  // body-frame δθ
+    P.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() * cfg.init_position_sigma * cfg.init_position_sigma;
+    const BlockId pid = f.addBlock(BlockSpec::pose("imu_pose"), poseEstimate<Scalar>(s.R_WI, s.p_WI),
+                                   sri::Prior<Scalar>::covariance(P.cast<Scalar>()));
+    if (cfg.calibrate_extrinsics) {
+      for (std::size_t c = 0; c < ext_fixed.size(); ++c) {
+        Eigen::Matrix<Scalar, 6, 1> sd;
+        sd << Eigen::Matrix<Scalar, 3, 1>::Constant(static_cast<Scalar>(cfg.extrinsic_rotation_sigma)),
+            Eigen::Matrix<Scalar, 3, 1>::Constant(static_cast<Scalar>(cfg.extrinsic_translation_sigma));
+        ext_ids.push_back(f.addBlock(BlockSpec::pose("T_IC" + std::to_string(c)),
+                                     poseEstimate<Scalar>(ext_fixed[c].R_IC, ext_fixed[c].p_IC),
+                                     sri::Prior<Scalar>::stdDevs(sd)));
+      }
+    }
+    Eigen::Matrix<double, 9, 1> x;
+    x << s.v_WI, s.bg, s.ba;
+    Eigen::Matrix<double, 9, 1> sd;
+    sd << Eigen::Vector3d::Constant(sigma_v), Eigen::Vector3d::Constant(sigma_bg),
+        Eigen::Vector3d::Constant(cfg.init_accel_bias_sigma);
+    const BlockId eid = f.addBlock(BlockSpec::vector("imu_extra", 9),
+                                   BlockEstimate<Scalar>::fromVector(x.cast<Scalar>()),
+                                   sri::Prior<Scalar>::stdDevs(sd.cast<Scalar>()));
+    newest = {pid, eid};
+    t_newest = s.t_ns;
+    clones.push_back({pid, s.t_ns});
+    initialized = true;
+  }
+
+  bool tryStatic(const FeatureFrame& frame) {
+    const std::int64_t t1 = frame.t_ns;
+    const std::int64_t t0 = t1 - static_cast<std::int64_t>(cfg.init_window * 1e9);
+    if (!imuCovers(t0, t1)) return false;
+    // Oldest buffered frame inside the window for the parallax test; it must be at least half a
+    // window old.
+    const FeatureFrame* ref = nullptr;
+    for (const FeatureFrame& fr : init_frames) {
+      if (fr.t_ns >= t0) {
+        ref = &fr;
+        break;
+      }
+    }
+    if (!ref || static_cast<double>(t1 - ref->t_ns) < 0.5e9 * cfg.init_window) return false;
+    Eigen::Vector3d ma = Eigen::Vector3d::Zero(), mg = Eigen::Vector3d::Zero();
+    Eigen::Vector3d sa = Eigen::Vector3d::Zero(), sg = Eigen::Vector3d::Zero();
+    int n = 0;
+    for (const ImuSample& s : imu) {
+      if (s.t_ns < t0 || s.t_ns > t1) continue;
+      ma += s.accel;
+      mg += s.gyro;
+      sa += s.accel.cwiseAbs2();
+      sg += s.gyro.cwiseAbs2();
+      ++n;
+    }
+    if (n < 10) return false;
+    ma /= n;
+    mg /= n;
+    const Eigen::Vector3d va = (sa / n - ma.cwiseAbs2()).cwiseMax(0.0);
+    const Eigen::Vector3d vg = (sg / n - mg.cwiseAbs2()).cwiseMax(0.0);
+    if (std::sqrt(va.maxCoeff()) > cfg.static_max_accel_std || std::sqrt(vg.maxCoeff()) > cfg.static_max_gyro_std) {
+      return false;
+    }
+    std::unordered_map<std::uint64_t, Eigen::Vector2d> refpx;
+    for (const FeatureObservation& o : ref->features) refpx.emplace(o.id, o.pixel0);
+    std::vector<double> par;
+    for (const FeatureObservation& o : frame.features) {
+      auto it = refpx.find(o.id);
+      if (it != refpx.end()) par.push_back((o.pixel0 - it->second).norm());
+    }
+    if (par.size() < 5 || median(par) > cfg.static_max_parallax) return false;
+
+    ImuState s;
+    s.t_ns = t1;
+    s.R_WI = Eigen::Quaterniond::FromTwoVectors(ma.normalized(), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    s.bg = mg;
+    const double sigma_mean = cfg.imu.gyroscope_noise_density * std::sqrt(cfg.imu.rate_hz) / std::sqrt(double(n));
+    const double sbg = std::max(5.0 * sigma_mean, 1e-3);
+    const Eigen::Matrix3d Pw =
+        Eigen::Vector3d(cfg.init_tilt_sigma * cfg.init_tilt_sigma, cfg.init_tilt_sigma * cfg.init_tilt_sigma,
+                        cfg.init_yaw_sigma * cfg.init_yaw_sigma)
+            .asDiagonal();
+    createState(s, Pw, cfg.init_velocity_sigma, sbg);
+    return true;
+  }
+
+  // Stereo depth of a cam0 observation: d with p_C0 = d (n0, 1).
+  std::optional<double> stereoDepth(const FeatureObservation& o) const {
+    const CameraExtrinsic& e0 = ext_fixed[0];
+    const CameraExtrinsic& e1 = ext_fixed[1];
+    const Eigen::Matrix3d R10 = e1.R_IC.transpose() * e0.R_IC;
+    const Eigen::Vector3d t10 = e1.R_IC.transpose() * (e0.p_IC - e1.p_IC);
+    const Eigen::Vector3d b0(o.normalized0.x(), o.normalized0.y(), 1.0);
+    const Eigen::Vector3d b1(o.normalized1.x(), o.normalized1.y(), 1.0);
+    const Eigen::Vector3d a = b1.cross(R10 * b0);
+    const Eigen::Vector3d c = b1.cross(t10);
+    const double den = a.squaredNorm();
+    if (den <= 0.0) return std::nullopt;
+    const double d = -a.dot(c) / den;
+    if (!(d >= cfg.min_depth && d <= cfg.max_depth)) return std::nullopt;
+    return d;
+  }
+
+  // Linear visual-inertial alignment over the buffered stereo frames (in motion).
+  bool tryMotion() {
+    const int N = cfg.init_motion_frames;
+    if (static_cast<int>(init_frames.size()) < N) return false;
+    const FeatureFrame& F0 = init_frames[init_frames.size() - static_cast<std::size_t>(N)];
+    const std::int64_t t0 = F0.t_ns;
+    const std::int64_t tN = init_frames.back().t_ns;
+    if (!imuCovers(t0, tN)) return false;
+    const CameraExtrinsic& e0 = ext_fixed[0];
+    std::unordered_map<std::uint64_t, Eigen::Vector3d> pts;  // in I0
+    for (const FeatureObservation& o : F0.features) {
+      if (!o.stereo) continue;
+      if (auto d = stereoDepth(o)) {
+        pts.emplace(o.id, e0.R_IC * (*d * Eigen::Vector3d(o.normalized0.x(), o.normalized0.y(), 1.0)) + e0.p_IC);
+      }
+    }
+    if (pts.size() < 15) return false;
+    Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Zero();
+    Eigen::Matrix<double, 6, 1> b = Eigen::Matrix<double, 6, 1>::Zero();
+    std::vector<double> dts;
+    std::vector<Eigen::Vector3d> ys;
+    for (std::size_t j = init_frames.size() - static_cast<std::size_t>(N) + 1; j < init_frames.size(); ++j) {
+      const FeatureFrame& Fj = init_frames[j];
+      ImuIntegration integ(cfg.imu, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+      integ.integrate(imuSpan(), t0, Fj.t_ns);
+      const Eigen::Matrix3d R0j = integ.gamma();
+      // Translation t of I_j in I_0 from bearings of the stereo points: [b]× p_Cj = 0.
+      std::vector<std::pair<Eigen::Matrix3d, Eigen::Vector3d>> rows;
+      for (const FeatureObservation& o : Fj.features) {
+        auto it = pts.find(o.id);
+        if (it == pts.end()) continue;
+        const Eigen::Vector3d bj = Eigen::Vector3d(o.normalized0.x(), o.normalized0.y(), 1.0).normalized();
+        const Eigen::Matrix3d K = so3::skew(bj) * e0.R_IC.transpose();
+        rows.emplace_back(-K * R0j.transpose(), -K * (R0j.transpose() * it->second - e0.p_IC));
+      }
+      if (rows.size() < 10) return false;
+      Eigen::Vector3d t = Eigen::Vector3d::Zero();
+      std::vector<char> use(rows.size(), 1);
+      for (int pass = 0; pass < 2; ++pass) {
+        Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+        Eigen::Vector3d g = Eigen::Vector3d::Zero();
+        for (std::size_t k = 0; k < rows.size(); ++k) {
+          if (!use[k]) continue;
+          H += rows[k].first.transpose() * rows[k].first;
+          g += rows[k].first.transpose() * rows[k].second;
+        }
+        t = H.ldlt().solve(g);
+        std::vector<double> res(rows.size());
+        for (std::size_t k = 0; k < rows.size(); ++k) res[k] = (rows[k].first * t - rows[k].second).norm();
+        const double med = median(res);
+        for (std::size_t k = 0; k < rows.size(); ++k) use[k] = res[k] <= 3.0 * med + 1e-12;
+      }
+      const double dt = static_cast<double>(Fj.t_ns - t0) * 1e-9;
+      const Eigen::Vector3d y = t - integ.alpha();
+      Eigen::Matrix<double, 3, 6> J;
+      J << dt * Eigen::Matrix3d::Identity(), 0.5 * dt * dt * Eigen::Matrix3d::Identity();
+      A += J.transpose() * J;
+      b += J.transpose() * y;
+      dts.push_back(dt);
+      ys.push_back(y);
+    }
+    const Eigen::Matrix<double, 6, 1> x = A.ldlt().solve(b);
+    Eigen::Vector3d gb = x.tail<3>();
+    if (std::abs(gb.norm() - cfg.gravity) > 1.0) return false;
+    gb *= cfg.gravity / gb.norm();
+    double sdd = 0.0;
+    Eigen::Vector3d sv = Eigen::Vector3d::Zero();
+    for (std::size_t k = 0; k < dts.size(); ++k) {
+      sv += dts[k] * (ys[k] - 0.5 * dts[k] * dts[k] * gb);
+      sdd += dts[k] * dts[k];
+    }
+    const Eigen::Vector3d vb = sv / sdd;
+    ImuState s;
+    s.t_ns = t0;
+    s.R_WI = Eigen::Quaterniond::FromTwoVectors(-gb.normalized(), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    s.v_WI = s.R_WI * vb;
+    prop.propagate(s, imuSpan(), tN);
+    const double tilt = 1.5 * cfg.init_tilt_sigma;
+    const Eigen::Matrix3d Pw =
+        Eigen::Vector3d(tilt * tilt, tilt * tilt, cfg.init_yaw_sigma * cfg.init_yaw_sigma).asDiagonal();
+    createState(s, Pw, 3.0 * cfg.init_velocity_sigma, cfg.init_gyro_bias_sigma);
+    return true;
+  }
+
+  bool tryInitialize(const FeatureFrame& frame) {
+    init_frames.push_back(frame);
+    const std::int64_t horizon = static_cast<std::int64_t>(cfg.init_window * 1e9);
+    while (init_frames.size() > static_cast<std::size_t>(cfg.init_motion_frames) &&
+           frame.t_ns - init_frames.front().t_ns > horizon) {
+      init_frames.pop_front();
+    }
+    bool ok = tryStatic(frame);
+    if (!ok && stereo() && cfg.init_in_motion) ok = tryMotion();
+    if (ok) {
+      init_frames.clear();
+      pose_cache.clear();
+      addObservations(frame);
+    }
+    return ok;
+  }
+
+  // ------------------------------------------------------------------ propagation
+  bool propagateTo(std::int64_t t) {
+    ImuState s = newestState();
+    Matrix15d Phi, Qd;
+    prop.propagate(s, imuSpan(), t, &Phi, &Qd);
+    Qd.diagonal().array() += 1e-14;  // keeps Q' positive definite for back-to-back frames
+    sri::Propagation<Scalar> step;
+    step.addNewBlock(BlockSpec::pose("imu_pose"), poseEstimate<Scalar>(s.R_WI, s.p_WI), Placement::after(newest.pose));
+    Eigen::Matrix<double, 9, 1> x;
+    x << s.v_WI, s.bg, s.ba;
+    step.addNewBlock(BlockSpec::vector("imu_extra", 9), BlockEstimate<Scalar>::fromVector(x.cast<Scalar>()),
+                     Placement::back());
+    step.setTransition(newest.pose, Phi.leftCols<6>().cast<Scalar>());
+    step.setTransition(newest.extra, Phi.rightCols<9>().cast<Scalar>());
+    step.setNoiseCovariance(Qd.cast<Scalar>());
+    step.marginalizeAfter(newest.extra);
+    const std::vector<BlockId> ids = f.propagate(step);
+    newest = {ids[0], ids[1]};
+    t_newest = t;
+    clones.push_back({ids[0], t});
+    return true;
+  }
+
+  // ------------------------------------------------------------------ features
+  void addObservations(const FeatureFrame& frame) {
+    const BlockId c = newest.pose;
+    for (const FeatureObservation& o : frame.features) {
+      if (auto it = slam.find(o.id); it != slam.end()) {
+        it->second.seen = true;
+        continue;
+      }
+      Track& tr = tracks[o.id];
+      tr.obs.push_back({c, 0, o.normalized0});
+      if (stereo() && o.stereo) tr.obs.push_back({c, 1, o.normalized1});
+      ++tr.frames;
+    }
+  }
+
+  /// Gauss-Newton triangulation (inverse depth in the first observing camera).
+  bool triangulate(const std::vector<Obs>& obs, Eigen::Vector3d& p_W) {
+    if (obs.size() < 2) return false;
+    // Linear initial guess: the point closest to all rays.
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+    std::vector<Eigen::Vector3d> centres;
+    for (const Obs& o : obs) {
+      const PoseEstimate& P = pose(o.clone);
+      const CameraExtrinsic e = ext(o.cam);
+      const Eigen::Vector3d b = (P.R_WI * e.R_IC * Eigen::Vector3d(o.z.x(), o.z.y(), 1.0)).normalized();
+      const Eigen::Vector3d c = P.p_WI + P.R_WI * e.p_IC;
+      const Eigen::Matrix3d M = Eigen::Matrix3d::Identity() - b * b.transpose();
+      A += M;
+      rhs += M * c;
+      centres.push_back(c);
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(A);
+    if (es.eigenvalues()(0) < 1e-9 * es.eigenvalues()(2)) return false;
+    p_W = A.ldlt().solve(rhs);
+    const PoseEstimate& P0 = pose(obs[0].clone);
+    const CameraExtrinsic e0 = ext(obs[0].cam);
+    const CameraPoint c0 = cameraPoint(P0, e0, p_W);
+    if (!(c0.p_C.z() > cfg.min_depth)) return false;
+    Eigen::Vector3d fpar(c0.p_C.x() / c0.p_C.z(), c0.p_C.y() / c0.p_C.z(), 1.0 / c0.p_C.z());
+    for (int it = 0; it < 8; ++it) {
+      const AnchoredPoint ap = anchoredPoint(fpar, P0, e0);
+      Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+      Eigen::Vector3d g = Eigen::Vector3d::Zero();
+      for (const Obs& o : obs) {
+        const CameraPoint cp = cameraPoint(pose(o.clone), ext(o.cam), ap.p_W);
+        if (!(cp.p_C.z() > 1e-6)) return false;
+        const Eigen::Vector2d r = o.z - cp.p_C.head<2>() / cp.p_C.z();
+        const Eigen::Matrix<double, 2, 3> J = projectionJacobian(cp.p_C) * cp.J_point * ap.J_feature;
+        H += J.transpose() * J;
+        g += J.transpose() * r;
+      }
+      const Eigen::Vector3d d = H.ldlt().solve(g);
+      if (!d.allFinite()) return false;
+      fpar += d;
+      if (!(fpar.z() > 0.0)) return false;
+      if (d.norm() < 1e-10 * (1.0 + fpar.norm())) break;
+    }
+    p_W = anchoredPoint(fpar, P0, e0).p_W;
+    double depth0 = 0.0, base = 0.0;
+    for (std::size_t k = 0; k < obs.size(); ++k) {
+      const double z = cameraPoint(pose(obs[k].clone), ext(obs[k].cam), p_W).p_C.z();
+      if (!(z >= cfg.min_depth && z <= cfg.max_depth)) return false;
+      if (k == 0) depth0 = z;
+      base = std::max(base, (centres[k] - centres[0]).norm());
+    }
+    return base >= cfg.min_baseline_ratio * depth0;
+  }
+
+  /// Rows of a feature at world point p_W (nuisance columns) for the listed observations.
+  void featureRows(const std::vector<Obs>& obs, const Eigen::Vector3d& p_W, Meas& m) {
+    m.reset(2 * static_cast<int>(obs.size()));
+    auto N = m.nuisance(3);
+    for (std::size_t k = 0; k < obs.size(); ++k) {
+      const Obs& o = obs[k];
+      const int r = 2 * static_cast<int>(k);
+      const CameraPoint cp = cameraPoint(pose(o.clone), ext(o.cam), p_W);
+      const double is = 1.0 / sigma_n[static_cast<std::size_t>(o.cam)];
+      const Eigen::Matrix<double, 2, 3> Jp = is * projectionJacobian(cp.p_C);
+      m.jacobian(o.clone, 6).middleRows(r, 2) += (Jp * cp.J_pose).template cast<Scalar>();
+      if (!ext_ids.empty()) {
+        m.jacobian(ext_ids[static_cast<std::size_t>(o.cam)], 6).middleRows(r, 2) +=
+            (Jp * cp.J_ext).template cast<Scalar>();
+      }
+      N.middleRows(r, 2) = (Jp * cp.J_point).template cast<Scalar>();
+      m.residual().segment(r, 2) = (is * (o.z - cp.p_C.head<2>() / cp.p_C.z())).template cast<Scalar>();
+    }
+    m.setWhitened();
+  }
+
+  /// Rows of a SLAM feature (state block) for observations from the listed clones.
+  bool slamRows(const Slam& s, const std::vector<Obs>& obs, Meas& m) {
+    m.reset(2 * static_cast<int>(obs.size()));
+    const Eigen::Vector3d fx = f.estimate(s.block).vector.template cast<double>();
+    const AnchoredPoint ap = anchoredPoint(fx, pose(s.anchor), ext(0));
+    for (std::size_t k = 0; k < obs.size(); ++k) {
+      const Obs& o = obs[k];
+      const int r = 2 * static_cast<int>(k);
+      const CameraPoint cp = cameraPoint(pose(o.clone), ext(o.cam), ap.p_W);
+      if (!(cp.p_C.z() > cfg.min_depth)) return false;
+      const double is = 1.0 / sigma_n[static_cast<std::size_t>(o.cam)];
+      const Eigen::Matrix<double, 2, 3> Jp = is * projectionJacobian(cp.p_C);
+      const Eigen::Matrix<double, 2, 3> A = Jp * cp.J_point;
+      m.jacobian(s.block, 3).middleRows(r, 2) += (A * ap.J_feature).template cast<Scalar>();
+      m.jacobian(s.anchor, 6).middleRows(r, 2) += (A * ap.J_anchor).template cast<Scalar>();
+      m.jacobian(o.clone, 6).middleRows(r, 2) += (Jp * cp.J_pose).template cast<Scalar>();
+      if (!ext_ids.empty()) {
+        m.jacobian(ext_ids[0], 6).middleRows(r, 2) += (A * ap.J_ext).template cast<Scalar>();
+        m.jacobian(ext_ids[static_cast<std::size_t>(o.cam)], 6).middleRows(r, 2) +=
+            (Jp * cp.J_ext).template cast<Scalar>();
+      }
+      m.residual().segment(r, 2) = (is * (o.z - cp.p_C.head<2>() / cp.p_C.z())).template cast<Scalar>();
+    }
+    m.setWhitened();
+    return true;
+  }
+
+  bool gate(const Meas& m) const {
+    if (cfg.chi2_probability >= 1.0) return true;
+    const auto c = f.chiSquare(m);
+    return c && static_cast<double>(c->value) <= chi2Threshold(c->dof);
+  }
+
+  /// Re-anchors SLAM features anchored at `old_anchor` to the newest clone (Propagation with a
+  /// small noise, then the old blocks are marginalized). Features that cannot be re-anchored
+  /// are returned for marginalization.
+  std::vector<BlockId> reanchor(BlockId old_anchor) {
+    std::vector<std::uint64_t> ids;
+    std::vector<BlockId> drop;
+    for (auto& [id, s] : slam) {
+      if (s.anchor == old_anchor) ids.push_back(id);
+    }
+    if (ids.empty()) return drop;
+    std::sort(ids.begin(), ids.end());
+    const PoseEstimate& Pa = pose(old_anchor);
+    const PoseEstimate& Pb = pose(newest.pose);
+    const CameraExtrinsic e0 = ext(0);
+    struct Item {
+      std::uint64_t id;
+      Eigen::Vector3d fnew;
+      Eigen::Matrix3d Jf;
+      Eigen::Matrix<double, 3, 6> Ja, Jb, Je;
+    };
+    std::vector<Item> items;
+    for (std::uint64_t id : ids) {
+      Slam& s = slam[id];
+      const Eigen::Vector3d fx = f.estimate(s.block).vector.template cast<double>();
+      const AnchoredPoint ap = anchoredPoint(fx, Pa, e0);
+      Eigen::Matrix3d D;
+      CameraPoint cp;
+      const Eigen::Vector3d fn = inverseDepthOf(ap.p_W, Pb, e0, &D, &cp);
+      if (!(cp.p_C.z() > cfg.min_depth)) {
+        drop.push_back(s.block);
+        slam.erase(id);
+        continue;
+      }
+      Item it;
+      it.id = id;
+      it.fnew = fn;
+      it.Jf = D * cp.J_point * ap.J_feature;
+      it.Ja = D * cp.J_point * ap.J_anchor;
+      it.Jb = D * cp.J_pose;
+      it.Je = D * (cp.J_point * ap.J_ext + cp.J_ext);
+      items.push_back(it);
+    }
+    if (items.empty()) return drop;
+    const int K = static_cast<int>(items.size());
+    sri::Propagation<Scalar> step;
+    MatrixS Pa_phi = MatrixS::Zero(3 * K, 6), Pb_phi = MatrixS::Zero(3 * K, 6), Pe_phi = MatrixS::Zero(3 * K, 6);
+    VectorS q(3 * K);
+    for (int k = 0; k < K; ++k) {
+      const Item& it = items[static_cast<std::size_t>(k)];
+      const Slam& s = slam[it.id];
+      step.addNewBlock(BlockSpec::vector("slam", 3), BlockEstimate<Scalar>::fromVector(it.fnew.template cast<Scalar>()),
+                       Placement::after(s.block));
+      MatrixS Pf = MatrixS::Zero(3 * K, 3);
+      Pf.middleRows(3 * k, 3) = it.Jf.template cast<Scalar>();
+      step.setTransition(s.block, Pf);
+      Pa_phi.middleRows(3 * k, 3) = it.Ja.template cast<Scalar>();
+      Pb_phi.middleRows(3 * k, 3) = it.Jb.template cast<Scalar>();
+      Pe_phi.middleRows(3 * k, 3) = it.Je.template cast<Scalar>();
+      const double sg = cfg.reanchor_sigma;
+      q.segment(3 * k, 3) << Scalar(sg * sg), Scalar(sg * sg), Scalar(sg * sg * it.fnew.z() * it.fnew.z());
+      step.marginalizeAfter(s.block);
+    }
+    step.setTransition(old_anchor, Pa_phi);
+    step.setTransition(newest.pose, Pb_phi);
+    if (!ext_ids.empty()) step.setTransition(ext_ids[0], Pe_phi);
+    step.setNoiseCovariance(MatrixS(q.asDiagonal()));
+    const std::vector<BlockId> nids = f.propagate(step);
+    for (int k = 0; k < K; ++k) {
+      Slam& s = slam[items[static_cast<std::size_t>(k)].id];
+      s.block = nids[static_cast<std::size_t>(k)];
+      s.anchor = newest.pose;
+    }
+    return drop;
+  }
+
+  FrameResult process(const FeatureFrame& frame) {
+    FrameResult res;
+    pose_cache.clear();
+    if (!initialized) {
+      res.initialized = tryInitialize(frame);
+      trimImu();
+      return res;
+    }
+    res.initialized = true;
+    if (frame.t_ns <= t_newest || !imuCovers(t_newest, frame.t_ns)) {
+      res.slam_features = static_cast<int>(slam.size());
+      return res;
+    }
+    propagateTo(frame.t_ns);
+    for (auto& [id, s] : slam) s.seen = false;
+    addObservations(frame);
+    const bool dropping = static_cast<int>(clones.size()) > cfg.window;
+    const BlockId oldest = clones.front().id;
+    std::unordered_set<std::uint64_t> observed;
+    for (const FeatureObservation& o : frame.features) observed.insert(o.id);
+
+    // 1. SLAM re-observations (newest clone).
+    Meas total;
+    bool have_total = false;
+    auto addTotal = [&](const Meas& m) {
+      if (!have_total) {
+        total = m;
+        have_total = true;
+      } else {
+        total.stack(m);
+      }
+    };
+    std::vector<BlockId> lost_slam;
+    {
+      std::vector<std::uint64_t> sids;
+      for (auto& [id, s] : slam) sids.push_back(id);
+      std::sort(sids.begin(), sids.end());
+      Meas m;
+      for (const FeatureObservation& o : frame.features) {
+        auto it = slam.find(o.id);
+        if (it == slam.end()) continue;
+        std::vector<Obs> obs{{newest.pose, 0, o.normalized0}};
+        if (stereo() && o.stereo) obs.push_back({newest.pose, 1, o.normalized1});
+        if (slamRows(it->second, obs, m) && gate(m)) {
+          addTotal(m);
+        } else {
+          it->second.seen = false;  // treat as lost
+        }
+      }
+      for (std::uint64_t id : sids) {
+        if (!slam[id].seen) {
+          lost_slam.push_back(slam[id].block);
+          slam.erase(id);
+        }
+      }
+    }
+    if (have_total) {
+      f.update(total);
+      res.updated = true;
+    }
+
+    // 2. Candidates: lost tracks and window-long tracks.
+    struct Cand {
+      std::uint64_t id;
+      int frames;
+      bool alive;
+    };
+    std::vector<Cand> cands;
+    for (auto& [id, tr] : tracks) {
+      const bool alive = observed.count(id) != 0;
+      if (!alive) {
+        if (tr.frames >= cfg.min_track_msckf) cands.push_back({id, tr.frames, false});
+      } else if (dropping && !tr.obs.empty() && tr.obs.front().clone == oldest) {
+        cands.push_back({id, tr.frames, true});
+      }
+    }
+    std::sort(cands.begin(), cands.end(), [](const Cand& a, const Cand& b) {
+      return a.frames != b.frames ? a.frames > b.frames : a.id < b.id;
+    });
+    // 2a. SLAM initialisation from window-long tracks.
+    int slots = cfg.max_slam_features - static_cast<int>(slam.size());
+    std::vector<std::uint64_t> msckf_ids;
+    std::vector<std::uint64_t> slam_new;
+    for (const Cand& c : cands) {
+      if (c.alive && slots > 0) {
+        slam_new.push_back(c.id);
+        --slots;
+      } else if (static_cast<int>(msckf_ids.size()) < cfg.max_msckf_per_frame && c.frames >= cfg.min_track_msckf) {
+        msckf_ids.push_back(c.id);
+      }
+    }
+    // 2b. MSCKF updates.
+    have_total = false;
+    Meas m;
+    for (std::uint64_t id : msckf_ids) {
+      const Track& tr = tracks[id];
+      Eigen::Vector3d p;
+      if (!triangulate(tr.obs, p)) continue;
+      featureRows(tr.obs, p, m);
+      m.projectNuisance();
+      if (!gate(m)) continue;
+      addTotal(m);
+      ++res.msckf_features;
+    }
+    if (have_total) {
+      total.compress();
+      f.update(total);
+      res.updated = true;
+    }
+    // 2c. New SLAM features: triangulate, gate the projected rows, add the block with no prior
+    // and apply the full rows (the block gets its information from them).
+    for (std::uint64_t id : slam_new) {
+      const Track& tr = tracks[id];
+      Eigen::Vector3d p;
+      if (!triangulate(tr.obs, p)) continue;
+      featureRows(tr.obs, p, m);
+      m.projectNuisance();
+      if (!gate(m)) continue;
+      const Eigen::Vector3d f0 = inverseDepthOf(p, pose(newest.pose), ext(0));
+      Slam s;
+      s.block = f.addBlock(BlockSpec::vector("slam", 3), BlockEstimate<Scalar>::fromVector(f0.cast<Scalar>()),
+                           sri::Prior<Scalar>::uninformative(), Placement::before(clones.front().id));
+      s.anchor = newest.pose;
+      s.seen = true;
+      if (!slamRows(s, tr.obs, m)) {
+        f.marginalize(s.block);
+        continue;
+      }
+      f.update(m);
+      slam.emplace(id, s);
+      res.updated = true;
+    }
+    for (const Cand& c : cands) tracks.erase(c.id);  // used (or unusable): restart alive ones
+    for (auto it = tracks.begin(); it != tracks.end();) {
+      it = observed.count(it->first) ? std::next(it) : tracks.erase(it);
+    }
+    f.correct();
+    pose_cache.clear();
+
+    // 3. Marginalization: lost SLAM features, oldest clone (after re-anchoring).
+    std::vector<BlockId> marg = lost_slam;
+    if (dropping) {
+      const std::vector<BlockId> d = reanchor(oldest);
+      marg.insert(marg.end(), d.begin(), d.end());
+      marg.push_back(oldest);
+      clones.pop_front();
+      for (auto& [id, tr] : tracks) {
+        auto& o = tr.obs;
+        const auto n0 = o.size();
+        o.erase(std::remove_if(o.begin(), o.end(), [&](const Obs& x) { return x.clone == oldest; }), o.end());
+        if (o.size() != n0) --tr.frames;
+      }
+    }
+    if (!marg.empty()) f.marginalize(marg);
+    pose_cache.clear();
+    trimImu();
+    res.slam_features = static_cast<int>(slam.size());
+    return res;
+  }
+};
+
+// ======================================================================================= API
+template <typename Scalar>
+SriSwfEstimator<Scalar>::SriSwfEstimator(const SriSwfConfig& config) : config_(config) {
+  config_.validate();
+  impl_ = std::make_unique<Impl>(config_);
+}
+
+template <typename Scalar>
+SriSwfEstimator<Scalar>::~SriSwfEstimator() = default;
+
+template <typename Scalar>
+void SriSwfEstimator<Scalar>::addImu(const ImuSample& sample) {
+  impl_->addImu(sample);
+}
+
+template <typename Scalar>
+FrameResult SriSwfEstimator<Scalar>::processFrame(const FeatureFrame& frame) {
+  const auto t0 = std::chrono::steady_clock::now();
+  FrameResult r = impl_->process(frame);
+  r.estimator_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+template <typename Scalar>
+Eigen::Matrix<double, 6, 6> SriSwfEstimator<Scalar>::poseCovariance() const {
+  if (!impl_->initialized) return Eigen::Matrix<double, 6, 6>::Zero();
+  const sri::BlockId id = impl_->newest.pose;
+  return impl_->f.covariance(std::span<const sri::BlockId>(&id, 1)).template cast<double>();
+}
+
+template <typename Scalar>
+Eigen::Matrix<double, 15, 15> SriSwfEstimator<Scalar>::imuCovariance() const {
+  if (!impl_->initialized) return Eigen::Matrix<double, 15, 15>::Zero();
+  const std::vector<sri::BlockId> ids{impl_->newest.pose, impl_->newest.extra};
+  return impl_->f.covariance(ids).template cast<double>();
+}
+
+template <typename Scalar>
+std::vector<std::int64_t> SriSwfEstimator<Scalar>::cloneTimes() const {
+  std::vector<std::int64_t> t;
+  for (const auto& c : impl_->clones) t.push_back(c.t_ns);
+  return t;
+}
+
+template <typename Scalar>
+int SriSwfEstimator<Scalar>::slamFeatureCount() const {
+  return static_cast<int>(impl_->slam.size());
+}
+
+template <typename Scalar>
+Eigen::Matrix4d SriSwfEstimator<Scalar>::cameraExtrinsic(int cam) const {
+  if (cam < 0 || cam >= static_cast<int>(config_.cameras.size())) throw std::out_of_range("cameraExtrinsic");
+  const CameraExtrinsic e = impl_->initialized ? impl_->ext(cam) : impl_->ext_fixed[static_cast<std::size_t>(cam)];
+  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+  T.topLeftCorner<3, 3>() = e.R_IC;
+  T.topRightCorner<3, 1>() = e.p_IC;
+  return T;
+}
+
+template <typename Scalar>
+const sri::SriFilter<Scalar>& SriSwfEstimator<Scalar>::filter() const {
+  return impl_->f;
+}
+
+template <typename Scalar>
+bool SriSwfEstimator<Scalar>::initialized() const {
+  return impl_->initialized;
+}
+
+template <typename Scalar>
+std::int64_t SriSwfEstimator<Scalar>::newestTime() const {
+  return impl_->t_newest;
+}
+
+template <typename Scalar>
+ImuState SriSwfEstimator<Scalar>::newestImuState() const {
+  return impl_->newestState();
+}
+
+template <typename Scalar>
+ImuBlocks SriSwfEstimator<Scalar>::newestImuBlocks() const {
+  return impl_->newest;
+}
+
+template <typename Scalar>
+Eigen::Vector3d SriSwfEstimator<Scalar>::gravity() const {
+  return {0.0, 0.0, -config_.gravity};
+}
+
+template <typename Scalar>
+ImuNoise SriSwfEstimator<Scalar>::imuNoise() const {
+  return config_.imu;
+}
+
+template <typename Scalar>
+std::optional<ImuIntegration> SriSwfEstimator<Scalar>::integrateToNewest(std::int64_t t_ns) const {
+  const Impl& I = *impl_;
+  if (!I.initialized || t_ns > I.t_newest || !I.imuCovers(t_ns, I.t_newest)) return std::nullopt;
+  const ImuState s = I.newestState();
+  ImuIntegration integ(config_.imu, s.bg, s.ba);
+  integ.integrate(I.imuSpan(), t_ns, I.t_newest);
+  return integ;
+}
+
+template <typename Scalar>
+std::optional<Eigen::Vector3d> SriSwfEstimator<Scalar>::angularRateAt(std::int64_t t_ns) const {
+  const Impl& I = *impl_;
+  if (!I.imuCovers(t_ns, t_ns)) return std::nullopt;
+  const ImuSample s = interpolateImu(I.imuSpan(), t_ns);
+  return Eigen::Vector3d(s.gyro - (I.initialized ? I.newestState().bg : Eigen::Vector3d::Zero()));
+}
+
+template <typename Scalar>
+sri::BlockId SriSwfEstimator<Scalar>::addBlock(const sri::BlockSpec& spec, const sri::BlockEstimate<Scalar>& estimate,
+                                               const sri::Prior<Scalar>& prior, ClientBlockRegion region) {
+  if (!impl_->initialized) throw std::logic_error("SriSwfEstimator::addBlock: not initialised");
+  const Placement where =
+      region == ClientBlockRegion::kFront ? Placement::front() : Placement::before(impl_->newest.extra);
+  return impl_->f.addBlock(spec, estimate, prior, where);
+}
+
+template <typename Scalar>
+std::vector<sri::BlockId> SriSwfEstimator<Scalar>::propagate(const sri::Propagation<Scalar>& step,
+                                                             ClientBlockRegion region) {
+  if (!impl_->initialized) throw std::logic_error("SriSwfEstimator::propagate: not initialised");
+  sri::Propagation<Scalar> p;
+  for (const auto& nb : step.newBlocks()) {
+    p.addNewBlock(nb.spec, nb.estimate,
+                  region == ClientBlockRegion::kFront ? Placement::front() : Placement::before(impl_->newest.extra));
+  }
+  for (const auto& [id, phi] : step.transitions()) p.setTransition(id, phi);
+  if (step.noiseIsSqrtInformation()) {
+    p.setNoiseSqrtInformation(step.noise());
+  } else {
+    p.setNoiseCovariance(step.noise());
+  }
+  if (step.residual().size() > 0) p.setResidual(step.residual());
+  for (const sri::BlockId id : step.marginalized()) p.marginalizeAfter(id);
+  return impl_->f.propagate(p);
+}
+
+template <typename Scalar>
+void SriSwfEstimator<Scalar>::marginalize(std::span<const sri::BlockId> ids) {
+  impl_->f.marginalize(ids);
+}
+
+template <typename Scalar>
+bool SriSwfEstimator<Scalar>::contains(sri::BlockId id) const {
+  return impl_->f.layout().contains(id);
+}
+
+template <typename Scalar>
+const sri::BlockEstimate<Scalar>& SriSwfEstimator<Scalar>::estimate(sri::BlockId id) const {
+  return impl_->f.estimate(id);
+}
+
+template <typename Scalar>
+typename SriSwfEstimator<Scalar>::Matrix SriSwfEstimator<Scalar>::covariance(std::span<const sri::BlockId> ids) const {
+  return impl_->f.covariance(ids);
+}
+
+template <typename Scalar>
+std::optional<sri::ChiSquare<Scalar>> SriSwfEstimator<Scalar>::chiSquare(const sri::Measurement<Scalar>& m) const {
+  return impl_->f.chiSquare(m);
+}
+
+template <typename Scalar>
+BackendUpdate<Scalar> SriSwfEstimator<Scalar>::update(const sri::Measurement<Scalar>& m, double gate_probability) {
+  BackendUpdate<Scalar> out;
+  if (gate_probability < 1.0) {
+    const auto c = impl_->f.chiSquare(m);
+    if (c) {
+      out.chi2 = c->value;
+      out.dof = c->dof;
+      if (static_cast<double>(c->value) > sri::chiSquareQuantile(gate_probability, c->dof)) return out;
+    }
+  }
+  const sri::UpdateResult<Scalar> u = impl_->f.update(m);
+  if (gate_probability >= 1.0 || out.dof == 0) {
+    out.chi2 = u.chi2;
+    out.dof = u.dof;
+  }
+  impl_->f.correct();
+  out.applied = true;
+  return out;
+}
+
+template class SriSwfEstimator<float>;
+template class SriSwfEstimator<double>;
+
+}  // namespace gvins::vio
