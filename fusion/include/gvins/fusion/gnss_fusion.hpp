@@ -1,0 +1,131 @@
+// Tightly-coupled GNSS fusion on the VIO backend interface (paper Sec. III). The driver calls
+// processEpoch() after each camera frame for every rover epoch whose time tag is <= the newest IMU
+// state's time. Per epoch:
+//   1. SPP (gnss/ SppSolver) for the frame initialisation and the loosely-coupled velocity; the
+//      RTK solver (gnss/ RtkSolver, LAMBDA) on rover + base for the SD code and the fixed DD phase.
+//   2. Frame initialisation (stage kFrameInit): client block [ψ, p_NW] with an uninformative prior
+//      added at the first SPP fix with enough speed (yaw guess from the velocity headings), updated
+//      with the SPP position/velocity predicted through the IMU integration until σ_ψ < σ_θ. The
+//      block is then KEPT as a state (not marginalised as in the paper): the VIO yaw and position
+//      drift, and a frame that stays in the state absorbs it with the GNSS information instead of
+//      freezing the first estimate.
+//   3. Clocks (stage kTight): c·dt per constellation + c·ḋt initialised by RANSAC + least squares
+//      (gnss_clock_init.hpp) at the current antenna estimate, added as one client block and
+//      propagated lazily at each GNSS epoch (bias += drift·Δt, random walks).
+//   4. Rows of the configured mode (gnss_measurement_models.hpp), each gated by a chi-square test
+//      (robust to NLOS), the accepted rows stacked, whitened with Σ_m + J Σ_g Jᵀ and applied with an
+//      epoch gate. No minimum satellite count once initialised.
+//   5. Outages: after `outageReset` s without an applied GNSS update the clocks are re-initialised
+//      and the RTK ambiguities reset.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "gvins/base/geodetic.hpp"
+#include "gvins/base/observation.hpp"
+#include "gvins/ephemeris/ephemeris_store.hpp"
+#include "gvins/fusion/gnss_fusion_config.hpp"
+#include "gvins/fusion/gnss_measurement_models.hpp"
+#include "gvins/gnss/rtk.hpp"
+#include "gvins/gnss/spp.hpp"
+#include "gvins/vio/estimator_backend.hpp"
+
+namespace gvins::fusion {
+
+enum class GnssFusionStage : std::uint8_t {
+  kWaitingVio,    ///< estimator not initialised
+  kWaitingFix,    ///< no SPP fix with enough speed yet
+  kFrameInit,     ///< frame block being estimated from SPP
+  kTight,         ///< frame converged, raw measurements used
+};
+const char* toString(GnssFusionStage s);
+
+struct GnssTypeCount {
+  int used = 0;
+  int rejected = 0;  ///< gated out (row or epoch test)
+};
+
+struct GnssEpochReport {
+  GpsTime time;                 ///< rover time tag
+  std::int64_t t_ns = 0;        ///< measurement time used (tag − receiver clock)
+  GnssFusionStage stage = GnssFusionStage::kWaitingVio;
+  GnssTypeCount psr, dopp, dpsr, ddcp, vel, frame;
+  bool updated = false;         ///< at least one update applied
+  bool clocksInitialized = false;  ///< this epoch
+  bool reset = false;           ///< outage reset this epoch
+  bool rtkFixed = false;
+  std::optional<Eigen::Vector3d> antennaEcef;  ///< after the update (at t_ns)
+  std::optional<Eigen::Vector3d> antennaVelocityEcef;
+  Geodetic antennaGeodetic;
+  double chi2 = 0.0;
+  int dof = 0;
+  double elapsedMicroseconds = 0.0;
+};
+
+template <typename Scalar>
+class GnssFusion {
+ public:
+  explicit GnssFusion(GnssFusionConfig config);
+  ~GnssFusion();
+  GnssFusion(const GnssFusion&) = delete;
+  GnssFusion& operator=(const GnssFusion&) = delete;
+
+  /// Base antenna position (ECEF); overrides the configuration's.
+  void setBasePosition(const Eigen::Vector3d& ecef);
+
+  GnssEpochReport processEpoch(vio::EstimatorBackend<Scalar>& est, const ObsEpoch& rover, const ObsEpoch* base,
+                               const EphemerisStore& nav);
+
+  const GnssFusionConfig& config() const { return config_; }
+  GnssFusionStage stage() const { return stage_; }
+  bool clocksInitialized() const { return clockBlock_.valid(); }
+  /// [ψ, p_NW] and the anchor, when the frame block exists.
+  std::optional<Eigen::Vector4d> frame(const vio::EstimatorBackend<Scalar>& est) const;
+  const GnssAnchor& anchor() const { return anchor_; }
+  Eigen::Vector3d leverArm(const vio::EstimatorBackend<Scalar>& est) const;
+  /// Clock estimate [c·dt per clock system..., c·ḋt] and the systems (clock indices).
+  std::optional<Eigen::VectorXd> clocks(const vio::EstimatorBackend<Scalar>& est) const;
+  const std::vector<System>& clockSystems() const { return clockSystems_; }
+  /// Antenna position/velocity (ECEF) at time t_ns from the current estimates (frame needed).
+  std::optional<AntennaKinematics> antennaAt(const vio::EstimatorBackend<Scalar>& est, std::int64_t t_ns) const;
+  /// Satellite models of an epoch at antenna position x (for tests and diagnostics).
+  std::vector<SatelliteModel> satelliteModels(const ObsEpoch& rover, const EphemerisStore& nav,
+                                              const Eigen::Vector3d& x) const;
+  /// Clock system index of a satellite (QZSS shares GPS's clock), or -1 if not estimated.
+  int clockIndex(SatId sat) const;
+
+ private:
+  struct Pending;
+  bool buildState(const vio::EstimatorBackend<Scalar>& est, std::int64_t t_ns, GnssStateValues& s) const;
+  void ensureLever(vio::EstimatorBackend<Scalar>& est);
+  bool startFrame(vio::EstimatorBackend<Scalar>& est, const SppSolution& spp, std::int64_t t_ns);
+  bool initClocks(vio::EstimatorBackend<Scalar>& est, const std::vector<SatelliteModel>& models,
+                  const AntennaKinematics& k, const GpsTime& t);
+  void propagateClocks(vio::EstimatorBackend<Scalar>& est, const GpsTime& t);
+  /// Gates rows one by one, stacks the accepted ones and applies them; returns the update.
+  vio::BackendUpdate<Scalar> apply(vio::EstimatorBackend<Scalar>& est, std::vector<GnssRow>& rows,
+                                   const Eigen::MatrixXd& noise, const Eigen::Matrix<double, 9, 9>& intCov,
+                                   std::vector<bool>& accepted, bool gate);
+
+  GnssFusionConfig config_;
+  GnssFusionStage stage_ = GnssFusionStage::kWaitingVio;
+  GnssAnchor anchor_;
+  sri::BlockId frameBlock_, leverBlock_, clockBlock_;
+  std::vector<System> clockSystems_;
+  GpsTime clockTime_;
+  std::optional<GpsTime> lastUpdate_;
+  const EphemerisStore* nav_ = nullptr;
+  std::unique_ptr<SppSolver> spp_;
+  std::unique_ptr<RtkSolver> rtk_;
+  std::optional<GpsTime> lastBase_;
+};
+
+extern template class GnssFusion<float>;
+extern template class GnssFusion<double>;
+
+}  // namespace gvins::fusion

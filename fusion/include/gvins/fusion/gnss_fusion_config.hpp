@@ -1,0 +1,83 @@
+// Configuration of the GNSS fusion (GnssFusion) and its YAML form.
+//
+//   gnss_fusion:
+//     mode: vio+dopp+psr        # vio | vio+gpsvel | vio+dopp | vio+dopp+psr | vio+dopp+dpsr |
+//                               # vio+dopp+ddcp | vio+dopp+psr-nointegration
+//     lever_arm: [0.0, 0.0, 0.1]          # ^I p_r, m (initial value)
+//     calibrate_lever_arm: true
+//     lever_arm_sigma: 0.2                # m, prior 1-sigma per axis when calibrated
+//     min_rotation_rate: 0.3              # rad/s: lever-arm Jacobian used by Doppler rows above it
+//     systems: GREJ                       # RINEX letters of the constellations used
+//     elevation_mask_deg: 10
+//     code_sigma: 0.6                     # m at zenith; variance (a² + a²/sin²(el)) style
+//     doppler_sigma: 0.1                  # m/s at zenith
+//     clock_bias_random_walk: 0.1         # m/√s per constellation bias
+//     clock_drift_random_walk: 0.5        # m/s/√s
+//     row_gate: 0.999                     # chi-square probability per measurement row
+//     epoch_gate: 0.99999                 # chi-square probability of the stacked rows
+//     frame_yaw_sigma_deg: 3              # convergence threshold σ_θ
+//     frame_min_speed: 1.0                # m/s before the yaw guess from velocity headings
+//     outage_reset: 60                    # s without GNSS update: clocks/ambiguities reset
+//     clock_ransac_threshold: 5.0         # m (pseudorange) for the clock RANSAC
+//     base_position: [x, y, z]            # ECEF of the base antenna (dpsr/ddcp)
+//     max_base_age: 2.0                   # s
+// Every key is optional. Errors are gvins::ParseError with file, line and field.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include <Eigen/Core>
+
+#include "gvins/base/satellite.hpp"
+
+namespace gvins::fusion {
+
+enum class GnssFusionMode : std::uint8_t {
+  kVio,           ///< no GNSS
+  kGpsVel,        ///< loosely-coupled SPP Doppler velocity
+  kDopp,          ///< Doppler
+  kDoppPsr,       ///< Doppler + pseudorange
+  kDoppDpsr,      ///< Doppler + single-differenced pseudorange
+  kDoppDdcp,      ///< Doppler + SD pseudorange + double-differenced carrier phase (fixed)
+  kDoppPsrNoInt,  ///< as kDoppPsr without IMU integration to the measurement time (ablation)
+};
+const char* toString(GnssFusionMode m);
+std::optional<GnssFusionMode> gnssFusionModeFromString(std::string_view s);
+
+struct GnssFusionConfig {
+  GnssFusionMode mode = GnssFusionMode::kDoppPsr;
+  Eigen::Vector3d leverArm = Eigen::Vector3d::Zero();
+  bool calibrateLeverArm = false;
+  double leverArmSigma = 0.2;
+  double minRotationRate = 0.3;
+  std::array<bool, kNumSystems> systems{true, true, true, true, true, false, false};
+  double elevationMaskDeg = 10.0;
+  double codeSigma = 0.6;
+  double dopplerSigma = 0.1;
+  double clockBiasRandomWalk = 0.1;
+  double clockDriftRandomWalk = 0.5;
+  double rowGate = 0.999;
+  double epochGate = 0.99999;
+  double frameYawSigmaDeg = 3.0;
+  double frameMinSpeed = 1.0;
+  double outageReset = 60.0;
+  double clockRansacThreshold = 5.0;
+  std::optional<Eigen::Vector3d> basePosition;
+  double maxBaseAge = 2.0;
+
+  bool useSystem(System s) const { return systems[static_cast<std::size_t>(systemIndex(s))]; }
+  bool usesDoppler() const;
+  bool usesPseudorange() const;
+  bool usesDifferences() const;
+  bool integration() const { return mode != GnssFusionMode::kDoppPsrNoInt; }
+};
+
+/// Reads the `gnss_fusion` mapping of a YAML document (or the top-level mapping when there is no
+/// such key). `file` names the source in errors. Throws gvins::ParseError.
+GnssFusionConfig parseGnssFusionConfig(std::string_view yaml, const std::string& file = "<string>");
+GnssFusionConfig loadGnssFusionConfig(const std::string& path);
+
+}  // namespace gvins::fusion

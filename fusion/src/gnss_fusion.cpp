@@ -1,0 +1,578 @@
+#include "gvins/fusion/gnss_fusion.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "gvins/base/constants.hpp"
+#include "gvins/base/local_frame.hpp"
+#include "gvins/fusion/gnss_clock_init.hpp"
+#include "gvins/gnss/klobuchar.hpp"
+#include "gvins/gnss/sagnac.hpp"
+#include "gvins/gnss/troposphere.hpp"
+#include "gvins/gnss/zero_difference.hpp"
+#include "gvins/sri/chi_square.hpp"
+
+namespace gvins::fusion {
+namespace {
+
+constexpr double kC = constants::kSpeedOfLight;
+
+std::int64_t toNs(const GpsTime& t) {
+  return t.wholeSeconds() * 1000000000LL + std::llround(t.fraction() * 1e9);
+}
+
+System clockSystemOf(System s) { return s == System::Qzss ? System::Gps : s; }
+
+enum RowType : int { kPsr, kDopp, kDpsr, kDdcp, kVel, kFrame };
+
+GnssTypeCount& countOf(GnssEpochReport& r, int type) {
+  switch (type) {
+    case kPsr: return r.psr;
+    case kDopp: return r.dopp;
+    case kDpsr: return r.dpsr;
+    case kDdcp: return r.ddcp;
+    case kVel: return r.vel;
+    default: return r.frame;
+  }
+}
+
+}  // namespace
+
+const char* toString(GnssFusionStage s) {
+  switch (s) {
+    case GnssFusionStage::kWaitingVio: return "waiting-vio";
+    case GnssFusionStage::kWaitingFix: return "waiting-fix";
+    case GnssFusionStage::kFrameInit: return "frame-init";
+    case GnssFusionStage::kTight: return "tight";
+  }
+  return "?";
+}
+
+template <typename Scalar>
+GnssFusion<Scalar>::GnssFusion(GnssFusionConfig config) : config_(std::move(config)) {}
+
+template <typename Scalar>
+GnssFusion<Scalar>::~GnssFusion() = default;
+
+template <typename Scalar>
+void GnssFusion<Scalar>::setBasePosition(const Eigen::Vector3d& ecef) {
+  config_.basePosition = ecef;
+  if (rtk_) rtk_->setBasePosition(ecef);
+}
+
+template <typename Scalar>
+int GnssFusion<Scalar>::clockIndex(SatId sat) const {
+  const System s = clockSystemOf(sat.system);
+  for (std::size_t i = 0; i < clockSystems_.size(); ++i) {
+    if (clockSystems_[i] == s) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+template <typename Scalar>
+std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& rover, const EphemerisStore& nav,
+                                                                 const Eigen::Vector3d& x) const {
+  std::vector<SatelliteModel> out;
+  const Geodetic g = ecefToGeodetic(x);
+  const IonosphereParameters& iono = nav.ionosphere();
+  const double fL1 = *carrierFrequency(System::Gps, '1');
+  for (const SatObs& so : rover.sats) {
+    if (!so.sat.valid() || !config_.useSystem(so.sat.system)) continue;
+    const char band = primaryBand(so.sat.system);
+    const SignalObs* s = so.bestOnBand(band, SignalObs::kCode);
+    if (!s) continue;
+    std::optional<int> channel;
+    if (so.sat.system == System::Glonass) channel = nav.glonassChannels().get(so.sat.prn);
+    const auto f = carrierFrequency(so.sat.system, band, channel);
+    if (!f) continue;
+    const auto tx = satelliteAtTransmit(nav, so.sat, rover.time, s->pseudorange);
+    if (!tx) continue;
+    SatelliteModel m;
+    m.sat = so.sat;
+    m.code = s->code;
+    m.clock = clockIndex(so.sat);
+    m.position = tx->state.position;
+    m.velocity = tx->state.velocity;
+    m.clockBias = tx->state.clockBias;
+    m.clockDrift = tx->state.clockDrift;
+    m.groupDelay = nav.groupDelay(so.sat, s->code, tx->transmitTime);
+    m.wavelength = kC / *f;
+    m.azel = azimuthElevation(g, x, m.position);
+    if (m.azel.elevation < config_.elevationMaskDeg * constants::kDegToRad) continue;
+    m.troposphere = slantTroposphereDelay(g, m.azel.elevation, rover.time).slant;
+    if (so.sat.system == System::BeiDou && iono.beidou) {
+      m.ionosphere = beidouKlobucharDelayB1I(*iono.beidou, g, m.azel, rover.time) *
+                     ionosphereFrequencyScale(*carrierFrequency(System::BeiDou, '2'), *f);
+    } else if (iono.gps) {
+      m.ionosphere = klobucharDelayL1(*iono.gps, g, m.azel, rover.time) * ionosphereFrequencyScale(fL1, *f);
+    }
+    m.pseudorange = s->pseudorange;
+    const double sinEl = std::max(std::sin(m.azel.elevation), 0.1);
+    // Code: white noise and multipath growing with 1/sin(el), plus 30 % of the broadcast
+    // ionosphere (Klobuchar corrects about half of the delay; IS-GPS-200N 20.3.3.5.2.5).
+    m.codeVariance = std::pow(config_.codeSigma, 2) * (0.5 + 0.5 / (sinEl * sinEl)) + std::pow(0.3 * m.ionosphere, 2);
+    m.dopplerVariance = std::pow(config_.dopplerSigma, 2) * (0.5 + 0.5 / (sinEl * sinEl));
+    const SignalObs* d = s->hasDoppler() ? s : nullptr;
+    if (d && std::abs(d->doppler) < 1e5) {
+      m.hasDoppler = true;
+      m.rangeRate = -m.wavelength * d->doppler;
+    }
+    out.push_back(m);
+  }
+  return out;
+}
+
+template <typename Scalar>
+bool GnssFusion<Scalar>::buildState(const vio::EstimatorBackend<Scalar>& est, std::int64_t t_ns,
+                                    GnssStateValues& s) const {
+  s.newest = est.newestImuState();
+  s.gravity = est.gravity();
+  s.integration.reset();
+  if (config_.integration() && t_ns < s.newest.t_ns) {
+    s.integration = est.integrateToNewest(t_ns);
+    if (!s.integration) return false;
+  }
+  const auto w = est.angularRateAt(config_.integration() ? t_ns : s.newest.t_ns);
+  s.omegaMeasured = (w ? *w : Eigen::Vector3d::Zero()) + s.newest.bg;
+  s.anchor = anchor_;
+  if (frameBlock_.valid()) {
+    const auto v = est.estimate(frameBlock_).vector.template cast<double>();
+    s.yaw = v[0];
+    s.p_NW = v.template segment<3>(1);
+  } else {
+    s.yaw = 0.0;
+    s.p_NW.setZero();
+  }
+  s.lever = leverArm(est);
+  return true;
+}
+
+template <typename Scalar>
+Eigen::Vector3d GnssFusion<Scalar>::leverArm(const vio::EstimatorBackend<Scalar>& est) const {
+  if (leverBlock_.valid()) return est.estimate(leverBlock_).vector.template cast<double>();
+  return config_.leverArm;
+}
+
+template <typename Scalar>
+std::optional<Eigen::Vector4d> GnssFusion<Scalar>::frame(const vio::EstimatorBackend<Scalar>& est) const {
+  if (!frameBlock_.valid()) return std::nullopt;
+  return Eigen::Vector4d(est.estimate(frameBlock_).vector.template cast<double>());
+}
+
+template <typename Scalar>
+std::optional<Eigen::VectorXd> GnssFusion<Scalar>::clocks(const vio::EstimatorBackend<Scalar>& est) const {
+  if (!clockBlock_.valid()) return std::nullopt;
+  return Eigen::VectorXd(est.estimate(clockBlock_).vector.template cast<double>());
+}
+
+template <typename Scalar>
+std::optional<AntennaKinematics> GnssFusion<Scalar>::antennaAt(const vio::EstimatorBackend<Scalar>& est,
+                                                               std::int64_t t_ns) const {
+  if (!frameBlock_.valid()) return std::nullopt;
+  GnssStateValues s;
+  if (!buildState(est, t_ns, s)) return std::nullopt;
+  return antennaKinematics(s);
+}
+
+template <typename Scalar>
+void GnssFusion<Scalar>::ensureLever(vio::EstimatorBackend<Scalar>& est) {
+  if (!config_.calibrateLeverArm || leverBlock_.valid()) return;
+  leverBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_lever_arm", 3),
+                             sri::BlockEstimate<Scalar>::fromVector(config_.leverArm.template cast<Scalar>()),
+                             sri::Prior<Scalar>::stdDev(3, static_cast<Scalar>(config_.leverArmSigma)));
+}
+
+template <typename Scalar>
+bool GnssFusion<Scalar>::startFrame(vio::EstimatorBackend<Scalar>& est, const SppSolution& spp, std::int64_t t_ns) {
+  if (!spp.valid() || !spp.velocity.valid) return false;
+  anchor_ = GnssAnchor::at(spp.position);
+  GnssStateValues s;
+  if (!buildState(est, t_ns, s)) return false;
+  const AntennaKinematics k = antennaKinematics(s);  // yaw 0, p_NW 0: p_N = p_W
+  const Eigen::Vector3d vN = anchor_.R_EN.transpose() * spp.velocity.velocity;
+  const double minV = config_.frameMinSpeed;
+  if (vN.head<2>().norm() < minV || k.v_N.head<2>().norm() < minV) return false;
+  const double yaw = std::atan2(vN.y(), vN.x()) - std::atan2(k.v_N.y(), k.v_N.x());
+  const Eigen::Vector3d pN = anchor_.R_EN.transpose() * (spp.position - anchor_.ecef);
+  Eigen::Matrix<Scalar, Eigen::Dynamic, 1> x(4);
+  x[0] = static_cast<Scalar>(std::remainder(yaw, 2.0 * constants::kPi));
+  x.template tail<3>() = (pN - yawRotation(yaw) * k.p_N).template cast<Scalar>();
+  // Paper Sec. III-A: uninformative ("infinite covariance") prior.
+  frameBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_frame", 4), sri::BlockEstimate<Scalar>::fromVector(x),
+                             sri::Prior<Scalar>::uninformative());
+  return true;
+}
+
+template <typename Scalar>
+bool GnssFusion<Scalar>::initClocks(vio::EstimatorBackend<Scalar>& est, const std::vector<SatelliteModel>& models,
+                                    const AntennaKinematics& k, const GpsTime& t) {
+  clockSystems_.clear();
+  for (const SatelliteModel& m : models) {
+    const System s = clockSystemOf(m.sat.system);
+    if (std::find(clockSystems_.begin(), clockSystems_.end(), s) == clockSystems_.end()) clockSystems_.push_back(s);
+  }
+  std::sort(clockSystems_.begin(), clockSystems_.end());
+  if (clockSystems_.empty()) return false;
+  const int n = static_cast<int>(clockSystems_.size());
+  std::vector<ClockRow> rows;
+  for (const SatelliteModel& m : models) {
+    const int c = clockIndex(m.sat);
+    const double rho = geometricRange(m.position, k.x_E);
+    rows.push_back({c, m.pseudorange - (rho - kC * (m.clockBias - m.groupDelay) + m.troposphere + m.ionosphere),
+                    config_.clockRansacThreshold});
+    if (m.hasDoppler) {
+      const Eigen::Vector3d e = (m.position - k.x_E).normalized();
+      const double h = e.dot(m.velocity - k.u_E) + sagnacRangeRateCorrection(m.position, m.velocity, k.x_E, k.u_E) -
+                       kC * m.clockDrift;
+      rows.push_back({n, m.rangeRate - h, std::max(0.5, 10.0 * config_.dopplerSigma)});
+    }
+  }
+  const ClockInitResult r = initializeClocksRansac(rows, n + 1, 64, 1, 7);
+  if (r.inliers[static_cast<std::size_t>(n)] == 0) return false;  // no drift
+  Eigen::Matrix<Scalar, Eigen::Dynamic, 1> x(n + 1), sigma(n + 1);
+  for (int i = 0; i <= n; ++i) {
+    x[i] = static_cast<Scalar>(r.x[static_cast<std::size_t>(i)]);
+    // The antenna position error (SPP level after the frame initialisation) enters the bias.
+    sigma[i] = static_cast<Scalar>(i < n ? std::max(r.sigma[static_cast<std::size_t>(i)], 5.0)
+                                         : std::max(r.sigma[static_cast<std::size_t>(i)], 0.3));
+    if (r.inliers[static_cast<std::size_t>(i)] == 0) sigma[i] = static_cast<Scalar>(1e3);
+  }
+  clockBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_clock", n + 1), sri::BlockEstimate<Scalar>::fromVector(x),
+                             sri::Prior<Scalar>::stdDevs(sigma));
+  clockTime_ = t;
+  return true;
+}
+
+template <typename Scalar>
+void GnssFusion<Scalar>::propagateClocks(vio::EstimatorBackend<Scalar>& est, const GpsTime& t) {
+  const double dt = t - clockTime_;
+  if (!clockBlock_.valid() || dt <= 0.0) return;
+  const int n = static_cast<int>(clockSystems_.size());
+  using Mat = typename sri::Propagation<Scalar>::Matrix;
+  Mat phi = Mat::Identity(n + 1, n + 1);
+  phi.col(n).head(n).setConstant(static_cast<Scalar>(dt));
+  // Bias b_j' = b_j + d·dt, drift d' = d: white-noise drift q_d and per-bias q_b over dt
+  // (two-state clock model, e.g. Brown & Hwang, "Introduction to Random Signals and Applied
+  // Kalman Filtering", 4th ed., sec. 9.3), the drift part shared by all biases.
+  const double qb = std::pow(config_.clockBiasRandomWalk, 2), qd = std::pow(config_.clockDriftRandomWalk, 2);
+  Eigen::MatrixXd Q = Eigen::MatrixXd::Constant(n + 1, n + 1, qd * dt * dt * dt / 3.0);
+  Q.diagonal().head(n).array() += qb * dt;
+  Q.col(n).setConstant(qd * dt * dt / 2.0);
+  Q.row(n).setConstant(qd * dt * dt / 2.0);
+  Q(n, n) = qd * dt;
+  const Eigen::VectorXd x = est.estimate(clockBlock_).vector.template cast<double>();
+  const Eigen::VectorXd xp = phi.template cast<double>() * x;
+  sri::Propagation<Scalar> step;
+  step.addNewBlock(sri::BlockSpec::vector("gnss_clock", n + 1),
+                   sri::BlockEstimate<Scalar>::fromVector(xp.template cast<Scalar>()));
+  step.setTransition(clockBlock_, phi);
+  step.setNoiseCovariance(Q.template cast<Scalar>());
+  step.marginalizeAfter(clockBlock_);
+  clockBlock_ = est.propagate(step, vio::ClientBlockRegion::kParameters).at(0);
+  clockTime_ = t;
+}
+
+template <typename Scalar>
+vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scalar>& est, std::vector<GnssRow>& rows,
+                                                     const Eigen::MatrixXd& noise,
+                                                     const Eigen::Matrix<double, 9, 9>& intCov,
+                                                     std::vector<bool>& accepted, bool gate) {
+  const vio::ImuBlocks ib = est.newestImuBlocks();
+  const int nc = clockBlock_.valid() ? static_cast<int>(clockSystems_.size()) + 1 : 0;
+  auto fill = [&](sri::Measurement<Scalar>& m, const std::vector<int>& idx) {
+    m.reset(static_cast<int>(idx.size()));
+    bool lever = false, clock = false;
+    for (int i : idx) {
+      lever = lever || !rows[static_cast<std::size_t>(i)].H_lever.isZero();
+      clock = clock || rows[static_cast<std::size_t>(i)].clockBias >= 0 || rows[static_cast<std::size_t>(i)].H_drift != 0.0;
+    }
+    for (std::size_t j = 0; j < idx.size(); ++j) {
+      const GnssRow& r = rows[static_cast<std::size_t>(idx[j])];
+      const int jj = static_cast<int>(j);
+      m.jacobian(ib.pose, 6).row(jj) = r.H_imu.template head<6>().template cast<Scalar>();
+      m.jacobian(ib.extra, 9).row(jj) = r.H_imu.template tail<9>().template cast<Scalar>();
+      if (frameBlock_.valid()) m.jacobian(frameBlock_, 4).row(jj) = r.H_frame.template cast<Scalar>();
+      if (lever && leverBlock_.valid()) m.jacobian(leverBlock_, 3).row(jj) = r.H_lever.template cast<Scalar>();
+      if (clock && nc > 0) {
+        auto J = m.jacobian(clockBlock_, nc);
+        if (r.clockBias >= 0) J(jj, r.clockBias) = Scalar(1);
+        J(jj, nc - 1) = static_cast<Scalar>(r.H_drift);
+      }
+      m.residual()[jj] = static_cast<Scalar>(r.residual);
+    }
+    Eigen::MatrixXd S(idx.size(), idx.size());
+    Eigen::MatrixXd He(idx.size(), 9);
+    for (std::size_t a = 0; a < idx.size(); ++a) {
+      He.row(static_cast<Eigen::Index>(a)) = rows[static_cast<std::size_t>(idx[a])].H_earlier;
+      for (std::size_t b = 0; b < idx.size(); ++b) S(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) = noise(idx[a], idx[b]);
+    }
+    S += He * intCov * He.transpose();  // Σ = Σ_m + J Σ_g Jᵀ (paper Sec. III-C)
+    m.whitenCovariance(S.template cast<Scalar>());
+  };
+  accepted.assign(rows.size(), false);
+  std::vector<int> keep;
+  const double q1 = gate && config_.rowGate < 1.0 ? sri::chiSquareQuantile(config_.rowGate, 1) : 0.0;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    if (!std::isfinite(rows[i].residual)) continue;
+    if (gate && config_.rowGate < 1.0) {
+      sri::Measurement<Scalar> one;
+      fill(one, {static_cast<int>(i)});
+      const auto c = est.chiSquare(one);
+      if (c && static_cast<double>(c->value) > q1) continue;
+    }
+    keep.push_back(static_cast<int>(i));
+  }
+  vio::BackendUpdate<Scalar> u;
+  if (keep.empty()) return u;
+  sri::Measurement<Scalar> m;
+  fill(m, keep);
+  u = est.update(m, gate ? config_.epochGate : 1.0);
+  if (u.applied) {
+    for (int i : keep) accepted[static_cast<std::size_t>(i)] = true;
+  }
+  return u;
+}
+
+template <typename Scalar>
+GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& est, const ObsEpoch& rover,
+                                                 const ObsEpoch* base, const EphemerisStore& nav) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  GnssEpochReport rep;
+  rep.time = rover.time;
+  auto finish = [&]() {
+    rep.stage = stage_;
+    rep.elapsedMicroseconds =
+        std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - wall0).count();
+    return rep;
+  };
+  if (config_.mode == GnssFusionMode::kVio) return finish();
+  if (nav_ != &nav) {
+    nav_ = &nav;
+    spp_ = std::make_unique<SppSolver>(nav);
+    if (config_.usesDifferences()) {
+      rtk_ = std::make_unique<RtkSolver>(nav);
+      if (config_.basePosition) rtk_->setBasePosition(*config_.basePosition);
+    }
+  }
+  const SppSolution spp = spp_->solve(rover);
+  std::optional<RtkSolution> rtk;
+  if (rtk_) {
+    if (base && (!lastBase_ || base->time > *lastBase_)) {
+      rtk_->addBaseEpoch(*base);
+      lastBase_ = base->time;
+    }
+    rtk = rtk_->process(rover);
+    rep.rtkFixed = rtk->quality == SolutionQuality::Fix;
+  }
+  if (!est.initialized()) {
+    stage_ = GnssFusionStage::kWaitingVio;
+    return finish();
+  }
+  if (stage_ == GnssFusionStage::kWaitingVio) stage_ = GnssFusionStage::kWaitingFix;
+
+  // Outage: clocks and ambiguities start again.
+  if (lastUpdate_ && rover.time - *lastUpdate_ > config_.outageReset && stage_ == GnssFusionStage::kTight) {
+    if (clockBlock_.valid()) {
+      const sri::BlockId id = clockBlock_;
+      est.marginalize(std::span<const sri::BlockId>(&id, 1));
+      clockBlock_ = {};
+    }
+    if (rtk_) rtk_->reset();
+    rep.reset = true;
+    lastUpdate_.reset();
+  }
+
+  // Measurement time: the tag minus the receiver clock (GPS, or the first system estimated).
+  double dtr = 0.0;
+  if (clockBlock_.valid()) {
+    const Eigen::VectorXd c = est.estimate(clockBlock_).vector.template cast<double>();
+    dtr = (c[0] + c[c.size() - 1] * (rover.time - clockTime_)) / kC;
+  } else if (spp.valid()) {
+    for (const auto& b : spp.clockBias) {
+      if (b) {
+        dtr = *b / kC;
+        break;
+      }
+    }
+  }
+  if (!(std::abs(dtr) < 0.01)) dtr = 0.0;
+  const GpsTime tMeas = rover.time - dtr;
+  std::int64_t t_ns = toNs(tMeas);
+  const std::int64_t newest = est.newestTime();
+  if (t_ns > newest) {
+    if (t_ns - newest > 10000000) return finish();  // the driver sends epochs up to newestTime()
+    t_ns = newest;
+  }
+  rep.t_ns = t_ns;
+  ensureLever(est);
+
+  if (stage_ == GnssFusionStage::kWaitingFix) {
+    if (!startFrame(est, spp, t_ns)) return finish();
+    stage_ = GnssFusionStage::kFrameInit;
+  }
+
+  GnssStateValues s;
+  if (!buildState(est, t_ns, s)) return finish();
+  AntennaKinematics k = antennaKinematics(s);
+  std::vector<GnssRow> rows;
+  std::vector<int> types;
+  std::vector<double> diag;
+  Eigen::MatrixXd noise;
+
+  if (stage_ == GnssFusionStage::kFrameInit) {
+    if (!spp.valid()) return finish();
+    const Eigen::Matrix3d R_NE = anchor_.R_EN.transpose();
+    const Eigen::Vector3d pN = R_NE * (spp.position - anchor_.ecef);
+    const int nv = spp.velocity.valid ? 3 : 0;
+    noise = Eigen::MatrixXd::Zero(3 + nv, 3 + nv);
+    for (int a = 0; a < 3; ++a) {
+      rows.push_back(positionRow(pN, a, k));
+      types.push_back(kFrame);
+    }
+    noise.block<3, 3>(0, 0) = R_NE * spp.positionCovariance * R_NE.transpose() + 0.25 * Eigen::Matrix3d::Identity();
+    if (nv) {
+      const Eigen::Vector3d vN = R_NE * spp.velocity.velocity;
+      for (int a = 0; a < 3; ++a) {
+        rows.push_back(velocityRow(vN, a, k));
+        types.push_back(kFrame);
+      }
+      noise.block<3, 3>(3, 3) = R_NE * spp.velocity.covariance * R_NE.transpose() + 0.0025 * Eigen::Matrix3d::Identity();
+    }
+    bool informed = true;
+    try {
+      const sri::BlockId id = frameBlock_;
+      (void)est.covariance(std::span<const sri::BlockId>(&id, 1));
+    } catch (const std::exception&) {
+      informed = false;
+    }
+    std::vector<bool> acc;
+    const auto u = apply(est, rows, noise, k.integrationCovariance, acc, informed);
+    rep.chi2 = static_cast<double>(u.chi2);
+    rep.dof = u.dof;
+    for (std::size_t i = 0; i < rows.size(); ++i) (acc[i] ? rep.frame.used : rep.frame.rejected)++;
+    rep.updated = u.applied;
+    try {
+      const sri::BlockId id = frameBlock_;
+      const auto P = est.covariance(std::span<const sri::BlockId>(&id, 1));
+      const double sth = config_.frameYawSigmaDeg * constants::kDegToRad;
+      if (static_cast<double>(P(0, 0)) < sth * sth) stage_ = GnssFusionStage::kTight;
+    } catch (const std::exception&) {
+    }
+  } else {
+    // Tight stage.
+    const bool needClocks = config_.usesDoppler();
+    std::vector<SatelliteModel> models = satelliteModels(rover, nav, k.x_E);
+    if (needClocks && !clockBlock_.valid()) {
+      if (!initClocks(est, models, k, tMeas)) return finish();
+      rep.clocksInitialized = true;
+      for (SatelliteModel& m : models) m.clock = clockIndex(m.sat);
+    }
+    if (clockBlock_.valid()) propagateClocks(est, tMeas);
+    Eigen::VectorXd clk;
+    if (clockBlock_.valid()) clk = est.estimate(clockBlock_).vector.template cast<double>();
+    const int n = static_cast<int>(clockSystems_.size());
+    const bool excited = config_.calibrateLeverArm &&
+                         (s.omegaMeasured - s.newest.bg).norm() >= config_.minRotationRate;
+    if (config_.usesDoppler()) {
+      for (const SatelliteModel& m : models) {
+        if (!m.hasDoppler) continue;
+        GnssRow r = dopplerRow(m, k, clk[n]);
+        if (!excited) r.H_lever.setZero();
+        rows.push_back(r);
+        types.push_back(kDopp);
+        diag.push_back(r.variance);
+      }
+    }
+    if (config_.usesPseudorange()) {
+      for (const SatelliteModel& m : models) {
+        if (m.clock < 0) continue;
+        GnssRow r = pseudorangeRow(m, k, clk[m.clock]);
+        r.H_lever.setZero();
+        rows.push_back(r);
+        types.push_back(kPsr);
+        diag.push_back(r.variance);
+      }
+    }
+    if (config_.mode == GnssFusionMode::kGpsVel && spp.velocity.valid) {
+      const Eigen::Matrix3d R_NE = anchor_.R_EN.transpose();
+      const Eigen::Vector3d vN = R_NE * spp.velocity.velocity;
+      for (int a = 0; a < 3; ++a) {
+        GnssRow r = velocityRow(vN, a, k);
+        r.H_lever.setZero();
+        rows.push_back(r);
+        types.push_back(kVel);
+        diag.push_back(0.0);
+      }
+    }
+    const std::size_t nIndependent = rows.size();
+    std::vector<DoubleDifference> phase;
+    if (rtk && config_.usesDifferences() && rtk->age <= config_.maxBaseAge) {
+      const DdEpoch& e = rtk_->measurements();
+      // Base clock per system: mean base code OMC (clock + errors common to the base).
+      std::vector<double> sum(static_cast<std::size_t>(n), 0.0);
+      std::vector<int> cnt(static_cast<std::size_t>(n), 0);
+      for (const SingleDifference& sd : e.sd) {
+        const int c = clockIndex(sd.sat);
+        if (c < 0 || !sd.hasCode) continue;
+        sum[static_cast<std::size_t>(c)] += sd.baseCodeOmc;
+        cnt[static_cast<std::size_t>(c)]++;
+      }
+      for (const SingleDifference& sd : e.sd) {
+        const int c = clockIndex(sd.sat);
+        if (c < 0 || !sd.hasCode || sd.elevation < config_.elevationMaskDeg * constants::kDegToRad) continue;
+        const double cb = sum[static_cast<std::size_t>(c)] / cnt[static_cast<std::size_t>(c)];
+        GnssRow r = sdPseudorangeRow(sd, k, clk[c], cb);
+        r.clockBias = c;
+        rows.push_back(r);
+        types.push_back(kDpsr);
+        diag.push_back(r.variance);
+      }
+      if (config_.mode == GnssFusionMode::kDoppDdcp && rep.rtkFixed) {
+        for (const DoubleDifference& dd : e.phase) {
+          if (dd.ambiguityMeters) phase.push_back(dd);
+        }
+        for (const DoubleDifference& dd : phase) {
+          rows.push_back(ddPhaseRow(e, dd, k));
+          types.push_back(kDdcp);
+        }
+      }
+    }
+    noise = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows.size()), static_cast<Eigen::Index>(rows.size()));
+    for (std::size_t i = 0; i < diag.size(); ++i) noise(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)) = diag[i];
+    if (config_.mode == GnssFusionMode::kGpsVel && spp.velocity.valid) {
+      const Eigen::Matrix3d R_NE = anchor_.R_EN.transpose();
+      const Eigen::Index o = static_cast<Eigen::Index>(nIndependent) - 3;
+      noise.block<3, 3>(o, o) = R_NE * spp.velocity.covariance * R_NE.transpose() + 0.0025 * Eigen::Matrix3d::Identity();
+    }
+    if (!phase.empty()) {
+      const Eigen::Index o = static_cast<Eigen::Index>(diag.size());
+      const Eigen::Index np = static_cast<Eigen::Index>(phase.size());
+      noise.block(o, o, np, np) = ddCovariance(rtk_->measurements(), phase, true);
+    }
+    if (!rows.empty()) {
+      std::vector<bool> acc;
+      const auto u = apply(est, rows, noise, k.integrationCovariance, acc, true);
+      rep.chi2 = static_cast<double>(u.chi2);
+      rep.dof = u.dof;
+      rep.updated = u.applied;
+      for (std::size_t i = 0; i < rows.size(); ++i) {
+        GnssTypeCount& c = countOf(rep, types[i]);
+        (acc[i] ? c.used : c.rejected)++;
+      }
+    }
+  }
+  if (rep.updated) lastUpdate_ = rover.time;
+  if (buildState(est, t_ns, s)) {
+    k = antennaKinematics(s);
+    rep.antennaEcef = k.x_E;
+    rep.antennaVelocityEcef = k.u_E;
+    rep.antennaGeodetic = ecefToGeodetic(k.x_E);
+  }
+  return finish();
+}
+
+template class GnssFusion<float>;
+template class GnssFusion<double>;
+
+}  // namespace gvins::fusion

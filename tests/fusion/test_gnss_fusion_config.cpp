@@ -1,0 +1,79 @@
+// GnssFusionConfig YAML: every mode name, values, and errors with line and field.
+#include <gtest/gtest.h>
+
+#include "gvins/base/parse_error.hpp"
+#include "gvins/fusion/gnss_fusion_config.hpp"
+
+namespace gvins::fusion {
+namespace {
+
+TEST(GnssFusionConfig, ParsesAllKeys) {
+  const GnssFusionConfig c = parseGnssFusionConfig(
+      "other: 1\n"
+      "gnss_fusion:\n"
+      "  mode: vio+dopp+ddcp\n"
+      "  lever_arm: [0.1, -0.2, 0.3]\n"
+      "  calibrate_lever_arm: true\n"
+      "  systems: GE\n"
+      "  code_sigma: 0.8\n"
+      "  base_position: [1, 2, 3]\n"
+      "  row_gate: 0.99\n");
+  EXPECT_EQ(c.mode, GnssFusionMode::kDoppDdcp);
+  EXPECT_EQ(c.leverArm, Eigen::Vector3d(0.1, -0.2, 0.3));
+  EXPECT_TRUE(c.calibrateLeverArm);
+  EXPECT_TRUE(c.useSystem(System::Gps));
+  EXPECT_TRUE(c.useSystem(System::Galileo));
+  EXPECT_FALSE(c.useSystem(System::BeiDou));
+  EXPECT_DOUBLE_EQ(c.codeSigma, 0.8);
+  EXPECT_DOUBLE_EQ(c.rowGate, 0.99);
+  ASSERT_TRUE(c.basePosition);
+  EXPECT_EQ(*c.basePosition, Eigen::Vector3d(1, 2, 3));
+  EXPECT_TRUE(c.usesDifferences());
+}
+
+TEST(GnssFusionConfig, ModeNamesRoundTrip) {
+  for (const char* n : {"vio", "vio+gpsvel", "vio+dopp", "vio+dopp+psr", "vio+dopp+dpsr", "vio+dopp+ddcp",
+                        "vio+dopp+psr-nointegration"}) {
+    const auto m = gnssFusionModeFromString(n);
+    ASSERT_TRUE(m) << n;
+    EXPECT_STREQ(toString(*m), n);
+  }
+  EXPECT_FALSE(gnssFusionModeFromString("vio+psr"));
+  EXPECT_FALSE(parseGnssFusionConfig("gnss_fusion:\n  mode: vio+dopp+psr-nointegration\n").integration());
+}
+
+TEST(GnssFusionConfig, ErrorsNameFileLineAndField) {
+  try {
+    parseGnssFusionConfig("gnss_fusion:\n  mode: vio+dopp\n  code_sigma: -1\n", "f.yaml");
+    FAIL() << "no error";
+  } catch (const ParseError& e) {
+    EXPECT_EQ(e.file(), "f.yaml");
+    EXPECT_EQ(e.line(), 3);
+    EXPECT_EQ(e.field(), "code_sigma");
+  }
+  try {
+    parseGnssFusionConfig("gnss_fusion:\n  mode: bogus\n", "g.yaml");
+    FAIL() << "no error";
+  } catch (const ParseError& e) {
+    EXPECT_EQ(e.line(), 2);
+    EXPECT_EQ(e.field(), "mode");
+  }
+  try {
+    parseGnssFusionConfig("gnss_fusion:\n  lever_arm: [1, 2]\n  typo_key: 3\n");
+    FAIL() << "no error";
+  } catch (const ParseError& e) {
+    EXPECT_EQ(e.field(), "lever_arm");
+  }
+  try {
+    parseGnssFusionConfig("gnss_fusion:\n  typo_key: 3\n");
+    FAIL() << "no error";
+  } catch (const ParseError& e) {
+    EXPECT_EQ(e.line(), 2);
+    EXPECT_EQ(e.field(), "typo_key");
+  }
+  EXPECT_THROW(parseGnssFusionConfig("gnss_fusion: [\n"), ParseError);
+  EXPECT_THROW(loadGnssFusionConfig("/nonexistent/gnss.yaml"), ParseError);
+}
+
+}  // namespace
+}  // namespace gvins::fusion
