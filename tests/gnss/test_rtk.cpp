@@ -541,6 +541,49 @@ TEST(RtkBadInput, MissingBaseEpochsAndTimeGaps) {
   EXPECT_EQ(r.issues(RtkIssue::BaseTooOld), 20);
 }
 
+// The rover goes silent: 100 s (longer than the slip detector's max gap and the ambiguity outage,
+// so every ambiguity starts a new arc) and 20 s (shorter: arcs continue, the Doppler-aided random
+// walk bridges the gap). Both must fix again at once and stay within 1 cm of the truth.
+TEST(RtkBadInput, RoverTimeGaps) {
+  const Dataset& d = nagoya();
+  for (const int gap : {100, 20}) {
+    RtkSolver s(d.nav, nagoyaConfig());
+    s.setRoverGlonassChannels(d.roverHeader.glonassChannels);
+    s.setBaseGlonassChannels(d.baseHeader.glonassChannels);
+    s.setBasePosition(d.basePosition);
+    std::size_t b = 0;
+    std::vector<RtkSolution> after;
+    std::int64_t addedBefore = 0;
+    for (int i = 0; i < 50 + gap + 30; ++i) {
+      if (i >= 50 && i < 50 + gap) continue;  // rover epochs missing
+      const ObsEpoch& e = d.rover[static_cast<std::size_t>(i)];
+      while (b < d.base.size() && (b == 0 || d.base[b - 1].time - e.time <= BaseStation::kSyncTolerance)) {
+        s.addBaseEpoch(d.base[b++]);
+      }
+      const RtkSolution sol = s.process(e);
+      if (i == 49) addedBefore = s.counters().ambiguitiesAdded;
+      if (i >= 50 + gap) after.push_back(sol);
+    }
+    ASSERT_EQ(after.size(), 30u);
+    int fixed = 0;
+    for (const RtkSolution& sol : after) {
+      EXPECT_NE(sol.quality, SolutionQuality::Single) << gap;
+      if (sol.quality != SolutionQuality::Fix) continue;
+      ++fixed;
+      EXPECT_LT((sol.position - d.truth).norm(), 0.01) << gap;
+    }
+    EXPECT_GE(fixed, 29) << gap;
+    const std::int64_t added = s.counters().ambiguitiesAdded - addedBefore;
+    if (gap == 100) {
+      EXPECT_GT(s.roverSlipCounts().gaps, 40);  // every rover signal starts a new arc
+      EXPECT_GT(added, 40);
+    } else {
+      EXPECT_EQ(s.roverSlipCounts().gaps, 0);
+      EXPECT_LT(added, 10);  // the arcs survive (only satellites rising in the gap are new)
+    }
+  }
+}
+
 TEST(RtkBadInput, MismatchedSignalsAndNoCommonSatellites) {
   const Dataset& d = nagoya();
   // The base reports GPS L2 as "2X" (no other L2 code): L2 cannot be differenced for GPS.
