@@ -1,0 +1,57 @@
+// Simulated feature tracks of a feature-only dataset (gvins-sim with cameras.output: features):
+// mav0/camN/features.csv, one observation per line
+//   #timestamp [ns],landmark_id,u [px],v [px]
+// (distorted pixel coordinates). gvins-replay turns them into FeatureFrames (the landmark id is
+// the track id; cam1 observations of the same landmark at the same stamp are the stereo match)
+// instead of running the image front end.
+// Errors: gvins::ParseError naming file, line and field (malformed numbers, wrong column count,
+// decreasing stamps, a landmark listed twice at one stamp).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "gvins/vio/camera_model.hpp"
+#include "gvins/vio/feature_frame.hpp"
+
+namespace gvins::fusion {
+
+struct TrackObservation {
+  std::uint64_t id = 0;
+  Eigen::Vector2d pixel = Eigen::Vector2d::Zero();
+};
+
+/// All observations of one stamp.
+struct TrackStamp {
+  std::int64_t t_ns = 0;
+  std::vector<TrackObservation> obs;
+};
+
+std::vector<TrackStamp> readFeatureTracksCsv(const std::string& path);
+std::vector<TrackStamp> parseFeatureTracksCsv(std::string_view text, const std::string& name);
+
+/// Builds FeatureFrames from cam0 (and optionally cam1) tracks: normalised coordinates through
+/// the camera models, track lengths counted over consecutive cam0 stamps, stereo where cam1 has
+/// the landmark at the same stamp. `cam1`/`model1` may be null.
+class FeatureTrackFrames {
+ public:
+  FeatureTrackFrames(std::vector<TrackStamp> cam0, const vio::CameraModel& model0,
+                     std::vector<TrackStamp> cam1 = {}, const vio::CameraModel* model1 = nullptr);
+  std::size_t size() const { return cam0_.size(); }
+  std::int64_t stamp(std::size_t i) const { return cam0_.at(i).t_ns; }
+  /// Frames must be requested in order (track lengths depend on the previous frame).
+  vio::FeatureFrame frame(std::size_t i);
+
+ private:
+  std::vector<TrackStamp> cam0_, cam1_;
+  const vio::CameraModel* model0_;
+  const vio::CameraModel* model1_;
+  std::size_t cam1Next_ = 0;
+  std::vector<std::pair<std::uint64_t, int>> lengths_;  ///< sorted by id: track length so far
+};
+
+}  // namespace gvins::fusion

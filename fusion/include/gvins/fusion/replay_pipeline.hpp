@@ -1,0 +1,138 @@
+// The replay pipeline behind gvins-replay: dataset → front end (own thread) → estimator → GNSS
+// fusion → output files, with timing, progress and a summary.
+//
+// Inputs: a dataset folder in the EuRoC/ASL layout (vio/euroc_dataset.hpp) as recorded by EuRoC
+// or written by gvins-sim; with camN/features.csv (feature-only simulated datasets) the tracks
+// replace the image front end. GNSS (gnss/rover.obs, gnss/base.obs, the navigation file) is read
+// when a GNSS client is given.
+//
+// Order of work, one consumer thread: for each camera frame (in time order) every IMU sample up to
+// the frame time is added, the frame is processed, the pose and its covariance are written, then
+// every rover epoch whose time tag is <= the newest state time is handed to the GNSS client with
+// the base epoch at or before it. Images are decoded on a loader thread and tracked on the front
+// end thread (FrontendThread), so loading, tracking and estimation overlap.
+//
+// The estimator and the GNSS fusion are reached through the small interfaces below, so that the
+// pipeline is tested with test doubles and gvins-replay binds the SRI-SWF estimator and
+// GnssFusion (replay_sri_swf.hpp).
+//
+// Outputs in the output folder: trajectory.tum (IMU pose in the VIO frame at every frame once
+// initialised), trajectory.cov.csv (pose_covariance_csv.hpp), timing.csv (per frame: front-end,
+// estimator and GNSS ms); with GNSS: global.pos (RTKLIB layout), global_ecef.csv, track.kml,
+// gnss_epochs.csv (satellite use per epoch). docs/replay.md describes the columns.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <iosfwd>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "gvins/base/gnss_time.hpp"
+#include "gvins/base/observation.hpp"
+#include "gvins/vio/feature_frame.hpp"
+#include "gvins/vio/frontend.hpp"
+#include "gvins/vio/imu_sample.hpp"
+#include "gvins/vio/imu_state.hpp"
+#include "gvins/vio/pose_covariance_csv.hpp"
+
+namespace gvins {
+class EphemerisStore;
+}
+
+namespace gvins::fusion {
+
+/// What the pipeline needs from a VIO estimator (SriSwfEstimator's driver API).
+class ReplayEstimator {
+ public:
+  struct FrameOutcome {
+    bool initialized = false;
+    bool updated = false;
+    double estimator_ms = 0.0;
+    int msckf_features = 0;
+    int slam_features = 0;
+  };
+  virtual ~ReplayEstimator() = default;
+  virtual void addImu(const vio::ImuSample& s) = 0;
+  virtual FrameOutcome processFrame(const vio::FeatureFrame& f) = 0;
+  virtual bool initialized() const = 0;
+  virtual vio::ImuState newestImuState() const = 0;
+  virtual vio::Matrix6d poseCovariance() const = 0;
+};
+
+/// Result of one GNSS epoch as the outputs need it.
+struct ReplayGnssOutcome {
+  std::string stage;                     ///< fusion stage name
+  int psrUsed = 0, psrRejected = 0, doppUsed = 0, doppRejected = 0;
+  int dpsrUsed = 0, dpsrRejected = 0, ddcpUsed = 0, ddcpRejected = 0;
+  int velUsed = 0, velRejected = 0;
+  bool updated = false, rtkFixed = false, reset = false;
+  double chi2 = 0.0;
+  int dof = 0;
+  std::optional<Eigen::Vector3d> antennaEcef, antennaVelocityEcef;
+  Eigen::Matrix3d antennaCovarianceEcef = Eigen::Matrix3d::Zero();  ///< zero if unknown
+};
+
+/// What the pipeline needs from the GNSS fusion.
+class ReplayGnss {
+ public:
+  virtual ~ReplayGnss() = default;
+  virtual void setBasePosition(const Eigen::Vector3d& ecef) = 0;
+  virtual ReplayGnssOutcome processEpoch(const ObsEpoch& rover, const ObsEpoch* base, const EphemerisStore& nav) = 0;
+};
+
+enum class ImuGapPolicy { Error, Warn };
+
+struct ReplayOptions {
+  std::string outDir;
+  vio::FrontendConfig frontend;
+  /// Images that cannot be decoded: error (default) or skip the frame and count it.
+  bool skipBadImages = false;
+  /// Listed images whose file is missing: error at open (default) or drop and count.
+  bool skipMissingImages = false;
+  /// Gaps in the IMU log longer than this (s) between two processed frames are an error, or
+  /// (Warn) counted and reported.
+  double maxImuGap_s = 0.05;
+  ImuGapPolicy imuGapPolicy = ImuGapPolicy::Error;
+  /// Replay only [start, start + duration] s after the first frame (duration <= 0: to the end).
+  double start_s = 0.0, duration_s = 0.0;
+  /// Use camN/features.csv when present instead of images (auto), or force images.
+  bool useFeatureTracks = true;
+  /// GNSS inputs; empty: <dataset>/gnss/rover.obs, base.obs and the navigation file found there.
+  std::string roverObs, baseObs, navFile;
+  std::optional<Eigen::Vector3d> basePosition;  ///< default: base.obs header position
+  /// GPST (ns since the GPS epoch) = sensor stamp + this. 0 for gvins-sim datasets, whose sensor
+  /// stamps are GPST; set it to replay GNSS files against a recording stamped on another clock.
+  std::int64_t sensorToGpst_ns = 0;
+  std::string modeName = "vio";  ///< for the summary and output headers
+  bool progress = true;
+  /// Evaluate against the dataset's ground truth at the end (table + SVG plots in outDir).
+  bool evaluate = true;
+};
+
+struct ReplaySummary {
+  std::size_t frames = 0, framesProcessed = 0, framesInitialized = 0, framesUpdated = 0;
+  std::size_t imuSamples = 0;
+  std::size_t skippedBadImages = 0, skippedMissingImages = 0;
+  std::size_t imuGaps = 0;
+  double largestImuGap_s = 0.0;
+  bool featureTracks = false;
+  double datasetSeconds = 0.0, wallSeconds = 0.0;
+  double frontendMsMean = 0.0, frontendMsMax = 0.0, estimatorMsMean = 0.0, estimatorMsMax = 0.0;
+  double gnssMsMean = 0.0;  ///< per epoch
+  std::size_t gnssEpochs = 0, gnssEpochsUpdated = 0, gnssEpochsFixed = 0, gnssEpochsSkipped = 0;
+  double realTimeFactor() const { return wallSeconds > 0.0 ? datasetSeconds / wallSeconds : 0.0; }
+  std::vector<std::string> files;
+  std::string evaluationTable;  ///< printEvaluation output, empty without ground truth
+  void print(std::ostream& os) const;
+};
+
+/// Runs the whole replay. Throws gvins::ParseError for dataset problems (file, line, field),
+/// std::runtime_error for output problems. `gnss` may be null (VIO only).
+ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& estimator, ReplayGnss* gnss,
+                        const ReplayOptions& options);
+
+}  // namespace gvins::fusion

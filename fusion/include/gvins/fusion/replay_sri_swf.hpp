@@ -1,0 +1,59 @@
+// Binds the SRI-SWF estimator (vio/sri_swf_estimator.hpp) and the GNSS fusion
+// (fusion/gnss_fusion.hpp) to the replay pipeline's interfaces (replay_pipeline.hpp).
+#pragma once
+
+#include <memory>
+
+#include "gvins/fusion/gnss_fusion.hpp"
+#include "gvins/fusion/replay_pipeline.hpp"
+#include "gvins/vio/sri_swf_estimator.hpp"
+
+namespace gvins::fusion {
+
+template <typename Scalar>
+class SriSwfReplayEstimator final : public ReplayEstimator {
+ public:
+  explicit SriSwfReplayEstimator(const vio::SriSwfConfig& config) : est_(config) {}
+  void addImu(const vio::ImuSample& s) override { est_.addImu(s); }
+  FrameOutcome processFrame(const vio::FeatureFrame& f) override {
+    const vio::FrameResult r = est_.processFrame(f);
+    return {r.initialized, r.updated, r.estimator_ms, r.msckf_features, r.slam_features};
+  }
+  bool initialized() const override { return est_.initialized(); }
+  vio::ImuState newestImuState() const override { return est_.newestImuState(); }
+  vio::Matrix6d poseCovariance() const override { return est_.poseCovariance(); }
+  vio::SriSwfEstimator<Scalar>& estimator() { return est_; }
+
+ private:
+  vio::SriSwfEstimator<Scalar> est_;
+};
+
+template <typename Scalar>
+class GnssFusionReplayClient final : public ReplayGnss {
+ public:
+  GnssFusionReplayClient(const GnssFusionConfig& config, vio::SriSwfEstimator<Scalar>& est)
+      : fusion_(config), est_(est) {}
+  void setBasePosition(const Eigen::Vector3d& ecef) override { fusion_.setBasePosition(ecef); }
+  ReplayGnssOutcome processEpoch(const ObsEpoch& rover, const ObsEpoch* base, const EphemerisStore& nav) override {
+    const GnssEpochReport r = fusion_.processEpoch(est_, rover, base, nav);
+    ReplayGnssOutcome o;
+    o.stage = toString(r.stage);
+    o.psrUsed = r.psr.used, o.psrRejected = r.psr.rejected;
+    o.doppUsed = r.dopp.used, o.doppRejected = r.dopp.rejected;
+    o.dpsrUsed = r.dpsr.used, o.dpsrRejected = r.dpsr.rejected;
+    o.ddcpUsed = r.ddcp.used, o.ddcpRejected = r.ddcp.rejected;
+    o.velUsed = r.vel.used, o.velRejected = r.vel.rejected;
+    o.updated = r.updated, o.rtkFixed = r.rtkFixed, o.reset = r.reset;
+    o.chi2 = r.chi2, o.dof = r.dof;
+    o.antennaEcef = r.antennaEcef;
+    o.antennaVelocityEcef = r.antennaVelocityEcef;
+    return o;
+  }
+  GnssFusion<Scalar>& fusion() { return fusion_; }
+
+ private:
+  GnssFusion<Scalar> fusion_;
+  vio::SriSwfEstimator<Scalar>& est_;
+};
+
+}  // namespace gvins::fusion

@@ -1,0 +1,122 @@
+#include "gvins/fusion/replay_feature_tracks.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+
+#include "gvins/base/line_reader.hpp"
+#include "gvins/base/text_fields.hpp"
+
+namespace gvins::fusion {
+
+namespace {
+
+std::int64_t parseStamp(std::string_view s, const TextLocation& where) {
+  s = trim(s);
+  std::int64_t v = 0;
+  const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (s.empty() || r.ec != std::errc() || r.ptr != s.data() + s.size() || v < 0)
+    throwParseError(where, "timestamp", "not a non-negative integer nanosecond stamp: '" + std::string(s) + "'");
+  return v;
+}
+
+std::uint64_t parseId(std::string_view s, const TextLocation& where) {
+  s = trim(s);
+  std::uint64_t v = 0;
+  const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (s.empty() || r.ec != std::errc() || r.ptr != s.data() + s.size())
+    throwParseError(where, "landmark_id", "not an unsigned integer: '" + std::string(s) + "'");
+  return v;
+}
+
+std::vector<TrackStamp> parse(LineReader& reader) {
+  std::vector<TrackStamp> out;
+  std::string line;
+  std::vector<std::string_view> f;
+  while (reader.next(line)) {
+    std::string_view l = line;
+    if (!l.empty() && l.back() == '\r') l.remove_suffix(1);
+    const std::string_view t = trim(l);
+    if (t.empty() || t.front() == '#') continue;
+    const TextLocation where = reader.location();
+    f.clear();
+    std::size_t start = 0;
+    for (;;) {
+      const std::size_t c = l.find(',', start);
+      f.push_back(l.substr(start, c == std::string_view::npos ? std::string_view::npos : c - start));
+      if (c == std::string_view::npos) break;
+      start = c + 1;
+    }
+    static const char* const kNames[] = {"timestamp", "landmark_id", "u", "v"};
+    if (f.size() != 4)
+      throwParseError(where, f.size() < 4 ? kNames[f.size()] : "line",
+                      "expected 4 fields (timestamp, landmark_id, u, v), found " + std::to_string(f.size()));
+    const std::int64_t stamp = parseStamp(f[0], where);
+    TrackObservation o;
+    o.id = parseId(f[1], where);
+    o.pixel = {parseDouble(trim(f[2]), where, "u"), parseDouble(trim(f[3]), where, "v")};
+    if (!std::isfinite(o.pixel.x()) || !std::isfinite(o.pixel.y()))
+      throwParseError(where, std::isfinite(o.pixel.x()) ? "v" : "u", "pixel coordinate is not finite");
+    if (out.empty() || stamp > out.back().t_ns) {
+      out.push_back({stamp, {}});
+    } else if (stamp < out.back().t_ns) {
+      throwParseError(where, "timestamp", "time stamp before the previous one");
+    }
+    for (const TrackObservation& p : out.back().obs)
+      if (p.id == o.id) throwParseError(where, "landmark_id", "landmark " + std::to_string(o.id) + " listed twice at one stamp");
+    out.back().obs.push_back(o);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<TrackStamp> readFeatureTracksCsv(const std::string& path) {
+  LineReader r(path);
+  return parse(r);
+}
+
+std::vector<TrackStamp> parseFeatureTracksCsv(std::string_view text, const std::string& name) {
+  LineReader r(text, name);
+  return parse(r);
+}
+
+FeatureTrackFrames::FeatureTrackFrames(std::vector<TrackStamp> cam0, const vio::CameraModel& model0,
+                                       std::vector<TrackStamp> cam1, const vio::CameraModel* model1)
+    : cam0_(std::move(cam0)), cam1_(std::move(cam1)), model0_(&model0), model1_(model1) {}
+
+vio::FeatureFrame FeatureTrackFrames::frame(std::size_t i) {
+  const TrackStamp& s = cam0_.at(i);
+  vio::FeatureFrame f;
+  f.t_ns = s.t_ns;
+  f.index = i;
+  while (cam1Next_ < cam1_.size() && cam1_[cam1Next_].t_ns < s.t_ns) ++cam1Next_;
+  const TrackStamp* right =
+      (model1_ && cam1Next_ < cam1_.size() && cam1_[cam1Next_].t_ns == s.t_ns) ? &cam1_[cam1Next_] : nullptr;
+  std::vector<std::pair<std::uint64_t, int>> lengths;
+  lengths.reserve(s.obs.size());
+  for (const TrackObservation& o : s.obs) {
+    vio::FeatureObservation fo;
+    fo.id = o.id;
+    const auto it = std::lower_bound(lengths_.begin(), lengths_.end(), std::make_pair(o.id, 0));
+    fo.trackLength = (it != lengths_.end() && it->first == o.id) ? it->second + 1 : 1;
+    fo.pixel0 = o.pixel;
+    fo.normalized0 = model0_->undistort(o.pixel);
+    if (right) {
+      for (const TrackObservation& r : right->obs) {
+        if (r.id != o.id) continue;
+        fo.stereo = true;
+        fo.pixel1 = r.pixel;
+        fo.normalized1 = model1_->undistort(r.pixel);
+        break;
+      }
+    }
+    lengths.emplace_back(o.id, fo.trackLength);
+    f.features.push_back(fo);
+  }
+  std::sort(lengths.begin(), lengths.end());
+  lengths_ = std::move(lengths);
+  return f;
+}
+
+}  // namespace gvins::fusion

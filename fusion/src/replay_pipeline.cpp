@@ -1,0 +1,452 @@
+#include "gvins/fusion/replay_pipeline.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cinttypes>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "gvins/base/geodetic.hpp"
+#include "gvins/base/parse_error.hpp"
+#include "gvins/base/rinex_obs_reader.hpp"
+#include "gvins/ephemeris/ephemeris_store.hpp"
+#include "gvins/ephemeris/rinex_nav.hpp"
+#include "gvins/fusion/replay_feature_tracks.hpp"
+#include "gvins/gnss/pos_writer.hpp"
+#include "gvins/vio/camera_model.hpp"
+#include "gvins/vio/euroc_dataset.hpp"
+#include "gvins/vio/frontend_thread.hpp"
+#include "gvins/vio/trajectory_metrics.hpp"
+#include "gvins/vio/tum_trajectory.hpp"
+
+namespace gvins::fusion {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double msSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+GpsTime gpsFromNs(std::int64_t t_ns) {
+  return GpsTime::fromSeconds(t_ns / 1'000'000'000, static_cast<double>(t_ns % 1'000'000'000) * 1e-9);
+}
+
+class OutFile {
+ public:
+  explicit OutFile(const fs::path& p) : path_(p.string()), f_(p, std::ios::binary) {
+    if (!f_) throw std::runtime_error("cannot create output file " + path_);
+  }
+  std::ofstream& out() { return f_; }
+  void close() {
+    f_.close();
+    if (!f_) throw std::runtime_error("error writing output file " + path_);
+  }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  std::ofstream f_;
+};
+
+/// The navigation file of a gvins-sim gnss/ folder: the first regular file that is neither an
+/// observation file nor the RTCM stream.
+std::string findNavFile(const fs::path& dir) {
+  std::vector<fs::path> c;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    if (!e.is_regular_file()) continue;
+    const std::string n = e.path().filename().string();
+    if (n == "rover.obs" || n == "base.obs" || n.find(".rtcm") != std::string::npos) continue;
+    std::string lower = n;
+    for (char& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    const bool navLike = lower.find("nav") != std::string::npos || lower.ends_with(".rnx") ||
+                         (lower.size() > 3 && lower[lower.size() - 4] == '.' && (lower.back() == 'n' || lower.back() == 'p' || lower.back() == 'g'));
+    if (navLike) c.push_back(e.path());
+  }
+  std::sort(c.begin(), c.end());
+  return c.empty() ? std::string() : c.front().string();
+}
+
+struct GnssInputs {
+  std::unique_ptr<RinexObsReader> rover, base;
+  EphemerisStore nav;
+  ObsEpoch nextRover, nextBase, currentBase;
+  bool haveRover = false, haveBase = false, haveCurrentBase = false;
+};
+
+void writeKml(const fs::path& path, const std::vector<Geodetic>& pts, const std::string& name) {
+  OutFile f(path);
+  auto& o = f.out();
+  o << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<kml xmlns=\"http://www.opengis.net/kml/2.2\">\n<Document>\n"
+    << "<name>" << name << "</name>\n<Style id=\"track\"><LineStyle><color>ff0000ff</color><width>2</width></LineStyle></Style>\n"
+    << "<Placemark><name>antenna track</name><styleUrl>#track</styleUrl><LineString><altitudeMode>absolute</altitudeMode><coordinates>\n";
+  char b[96];
+  constexpr double kDeg = 180.0 / 3.14159265358979323846;
+  for (const Geodetic& g : pts) {
+    std::snprintf(b, sizeof b, "%.9f,%.9f,%.3f\n", g.lon * kDeg, g.lat * kDeg, g.height);
+    o << b;
+  }
+  o << "</coordinates></LineString></Placemark>\n</Document>\n</kml>\n";
+  f.close();
+}
+
+}  // namespace
+
+void ReplaySummary::print(std::ostream& os) const {
+  char b[200];
+  os << "------------------------------------------------------------\n";
+  auto row = [&](const char* k, const std::string& v) {
+    std::snprintf(b, sizeof b, "%-30s %s\n", k, v.c_str());
+    os << b;
+  };
+  auto f = [&](const char* fmt, double v) {
+    std::snprintf(b, sizeof b, fmt, v);
+    return std::string(b);
+  };
+  row("camera input", featureTracks ? "simulated feature tracks" : "images (front end thread)");
+  row("frames", std::to_string(framesProcessed) + " processed of " + std::to_string(frames) + ", " +
+                    std::to_string(framesInitialized) + " initialised, " + std::to_string(framesUpdated) + " with visual update");
+  row("IMU samples", std::to_string(imuSamples));
+  row("skipped frames", std::to_string(skippedBadImages) + " unreadable images, " + std::to_string(skippedMissingImages) +
+                            " missing images");
+  row("IMU gaps", std::to_string(imuGaps) + " (largest " + f("%.3f", largestImuGap_s) + " s)");
+  row("front end [ms/frame]", f("mean %.2f", frontendMsMean) + f(", max %.2f", frontendMsMax));
+  row("estimator [ms/frame]", f("mean %.2f", estimatorMsMean) + f(", max %.2f", estimatorMsMax));
+  if (gnssEpochs + gnssEpochsSkipped > 0) {
+    row("GNSS epochs", std::to_string(gnssEpochs) + " processed (" + std::to_string(gnssEpochsUpdated) + " updated, " +
+                           std::to_string(gnssEpochsFixed) + " RTK fixed), " + std::to_string(gnssEpochsSkipped) +
+                           " before VIO initialisation");
+    row("GNSS [ms/epoch]", f("mean %.3f", gnssMsMean));
+  }
+  row("dataset / wall time [s]", f("%.2f", datasetSeconds) + f(" / %.2f", wallSeconds));
+  row("real-time factor", f("%.2fx", realTimeFactor()));
+  os << "------------------------------------------------------------\n";
+  if (!evaluationTable.empty()) os << "accuracy against the dataset ground truth (4-DoF aligned):\n" << evaluationTable;
+}
+
+ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, ReplayGnss* gnss, const ReplayOptions& opt) {
+  const auto wall0 = Clock::now();
+  ReplaySummary sum;
+  if (opt.outDir.empty()) throw std::invalid_argument("runReplay: no output folder");
+  std::error_code ec;
+  fs::create_directories(opt.outDir, ec);
+  if (!fs::is_directory(opt.outDir)) throw std::runtime_error("cannot create output folder " + opt.outDir);
+  const fs::path out(opt.outDir);
+
+  fs::path mav0 = fs::path(dataset) / "mav0";
+  if (!fs::is_directory(mav0)) mav0 = fs::path(dataset);
+  const bool tracks = opt.useFeatureTracks && fs::exists(mav0 / "cam0" / "features.csv");
+  vio::EurocOptions eo;
+  eo.checkImageFiles = !tracks;
+  eo.skipMissingImages = opt.skipMissingImages;
+  const vio::EurocDataset ds(dataset, eo);
+  sum.featureTracks = tracks;
+  sum.skippedMissingImages = ds.report().missingImages[0] + ds.report().missingImages[1];
+  if (ds.cameraCount() < 1) throw ParseError(mav0.string(), 0, "cam0", "dataset has no camera");
+  const auto& imu = ds.imu();
+  if (imu.size() < 2) throw ParseError((mav0 / "imu0" / "data.csv").string(), 0, "imu0", "fewer than 2 IMU samples");
+
+  // Frame range.
+  const auto& frames = ds.frames();
+  sum.frames = frames.size();
+  if (frames.empty()) throw ParseError((mav0 / "cam0" / "data.csv").string(), 0, "cam0", "no camera frames");
+  const std::int64_t tFirst = frames.front().t_ns + static_cast<std::int64_t>(opt.start_s * 1e9);
+  const std::int64_t tLast = opt.duration_s > 0.0 ? tFirst + static_cast<std::int64_t>(opt.duration_s * 1e9)
+                                                  : std::numeric_limits<std::int64_t>::max();
+  std::vector<std::size_t> sel;
+  for (std::size_t i = 0; i < frames.size(); ++i)
+    if (frames[i].t_ns >= tFirst && frames[i].t_ns <= tLast) sel.push_back(i);
+  if (sel.empty()) throw std::invalid_argument("no frames in the requested time range");
+
+  // GNSS inputs.
+  GnssInputs g;
+  if (gnss) {
+    const fs::path gdir = fs::path(dataset) / "gnss";
+    const std::string roverPath = !opt.roverObs.empty() ? opt.roverObs : (gdir / "rover.obs").string();
+    std::string basePath = !opt.baseObs.empty() ? opt.baseObs : (gdir / "base.obs").string();
+    const std::string navPath = !opt.navFile.empty() ? opt.navFile : findNavFile(gdir);
+    if (!fs::exists(roverPath)) throw ParseError(roverPath, 0, "rover", "GNSS mode needs the rover observation file");
+    if (navPath.empty()) throw ParseError(gdir.string(), 0, "navigation", "no navigation file in the gnss folder (use --nav)");
+    g.nav.add(readRinexNav(navPath));
+    RinexObsReaderOptions ro;
+    ro.skipBadEpochs = true;
+    g.rover = std::make_unique<RinexObsReader>(roverPath, ro);
+    if (fs::exists(basePath)) {
+      g.base = std::make_unique<RinexObsReader>(basePath, ro);
+      const auto& hp = g.base->header().station.approxPosition;
+      if (opt.basePosition) {
+        gnss->setBasePosition(*opt.basePosition);
+      } else if (hp && hp->norm() > 1e6) {
+        gnss->setBasePosition(*hp);
+      } else {
+        throw ParseError(basePath, 0, "APPROX POSITION XYZ", "base position missing in the header (use --base-position)");
+      }
+    }
+    g.haveRover = g.rover->next(g.nextRover);
+    if (g.base) g.haveBase = g.base->next(g.nextBase);
+  }
+
+  // Outputs.
+  vio::TumTrajectoryWriter tum((out / "trajectory.tum").string(),
+                               "t x y z qx qy qz qw  (IMU pose in the VIO world frame; gvins-replay " + opt.modeName + ")");
+  vio::PoseCovarianceWriter cov((out / "trajectory.cov.csv").string());
+  OutFile timing(out / "timing.csv");
+  timing.out() << "# t [ns],frame,features,frontend_ms,estimator_ms,gnss_ms,gnss_epochs,initialized,updated,msckf_features,slam_features\n";
+  std::unique_ptr<OutFile> posFile, ecefFile, epochFile;
+  std::unique_ptr<PosWriter> posWriter;
+  std::vector<Geodetic> kml;
+  if (gnss) {
+    posFile = std::make_unique<OutFile>(out / "global.pos");
+    PosWriterOptions po;
+    po.headerFields = {{"mode", opt.modeName}, {"dataset", dataset}};
+    posWriter = std::make_unique<PosWriter>(posFile->out(), po);
+    ecefFile = std::make_unique<OutFile>(out / "global_ecef.csv");
+    ecefFile->out() << "# gps_week,tow [s],x [m],y [m],z [m],vx [m/s],vy [m/s],vz [m/s],rtk_fixed  (GNSS antenna, ECEF)\n";
+    epochFile = std::make_unique<OutFile>(out / "gnss_epochs.csv");
+    epochFile->out() << "# gps_week,tow [s],stage,psr_used,psr_rejected,dopp_used,dopp_rejected,dpsr_used,dpsr_rejected,"
+                        "ddcp_used,ddcp_rejected,vel_used,vel_rejected,updated,rtk_fixed,reset,chi2,dof,gnss_ms\n";
+  }
+  std::vector<vio::TumPose> poses;
+  std::vector<vio::PoseCovariance> covs;
+
+  // Camera input: feature tracks, or images through the loader and front end threads.
+  std::unique_ptr<FeatureTrackFrames> trackFrames;
+  std::unique_ptr<vio::CameraModel> model0, model1;
+  std::unique_ptr<vio::FrontendThread> fe;
+  std::thread loader;
+  std::exception_ptr loaderError;
+  std::mutex loaderMutex;
+  std::atomic<std::size_t> badImages{0};
+  struct Join {
+    std::unique_ptr<vio::FrontendThread>& fe;
+    std::thread& t;
+    ~Join() {
+      if (fe) fe->stop();
+      if (t.joinable()) t.join();
+    }
+  } join{fe, loader};
+  std::vector<std::size_t> trackIndex;  // tracks: the selected stamp indices
+  if (tracks) {
+    model0 = std::make_unique<vio::CameraModel>(ds.cameraCalibration(0).intrinsics);
+    std::vector<TrackStamp> c1;
+    if (ds.cameraCount() > 1 && fs::exists(mav0 / "cam1" / "features.csv")) {
+      model1 = std::make_unique<vio::CameraModel>(ds.cameraCalibration(1).intrinsics);
+      c1 = readFeatureTracksCsv((mav0 / "cam1" / "features.csv").string());
+    }
+    trackFrames = std::make_unique<FeatureTrackFrames>(readFeatureTracksCsv((mav0 / "cam0" / "features.csv").string()),
+                                                       *model0, std::move(c1), model1.get());
+    for (std::size_t i = 0; i < trackFrames->size(); ++i)
+      if (trackFrames->stamp(i) >= tFirst && trackFrames->stamp(i) <= tLast) trackIndex.push_back(i);
+  } else {
+    const bool stereo = ds.cameraCount() > 1 && opt.frontend.useStereo;
+    fe = std::make_unique<vio::FrontendThread>(
+        vio::StereoFrontend(opt.frontend, ds.cameraCalibration(0), stereo ? &ds.cameraCalibration(1) : nullptr));
+    loader = std::thread([&, stereo] {
+      try {
+        for (std::size_t k : sel) {
+          const vio::EurocFrame& fr = frames[k];
+          vio::StereoImages im;
+          im.t_ns = fr.t_ns;
+          try {
+            im.left = ds.loadImage(0, fr.cam0);
+            if (stereo && fr.cam1) im.right = ds.loadImage(1, *fr.cam1);
+          } catch (const ParseError&) {
+            if (!opt.skipBadImages) throw;
+            ++badImages;
+            continue;
+          }
+          if (!fe->push(std::move(im))) return;
+        }
+        fe->finish();
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(loaderMutex);
+        loaderError = std::current_exception();
+        fe->stop();
+      }
+    });
+  }
+
+  // Main loop.
+  std::size_t imuNext = 0;
+  const std::int64_t imuStart = opt.start_s > 0.0 ? tFirst - 2'000'000'000 : imu.front().t_ns;
+  while (imuNext < imu.size() && imu[imuNext].t_ns < imuStart) ++imuNext;
+  std::int64_t lastImu = -1;
+  double feSum = 0.0, estSum = 0.0, gnssSum = 0.0;
+  std::int64_t firstT = -1, lastT = -1;
+  auto lastProgress = Clock::now();
+  const std::size_t total = tracks ? trackIndex.size() : sel.size();
+  std::size_t cursor = 0;
+  const std::string imuFile = (mav0 / "imu0" / "data.csv").string();
+  for (;;) {
+    std::optional<vio::FeatureFrame> frame;
+    if (tracks) {
+      if (cursor >= trackIndex.size()) break;
+      frame = trackFrames->frame(trackIndex[cursor++]);
+    } else {
+      frame = fe->pop();
+      if (!frame) break;
+    }
+    // IMU up to the first sample at or after the frame time.
+    while (imuNext < imu.size()) {
+      const vio::ImuSample& s = imu[imuNext];
+      if (lastImu >= 0) {
+        const double gap = static_cast<double>(s.t_ns - lastImu) * 1e-9;
+        if (gap > opt.maxImuGap_s) {
+          ++sum.imuGaps;
+          sum.largestImuGap_s = std::max(sum.largestImuGap_s, gap);
+          if (opt.imuGapPolicy == ImuGapPolicy::Error) {
+            char b[160];
+            std::snprintf(b, sizeof b, "IMU gap of %.3f s before the sample at %" PRId64 " ns (limit %.3f s; --imu-gaps warn to continue)",
+                          gap, s.t_ns, opt.maxImuGap_s);
+            throw ParseError(imuFile, 0, "timestamp", b);
+          }
+        }
+      }
+      est.addImu(s);
+      lastImu = s.t_ns;
+      ++sum.imuSamples;
+      ++imuNext;
+      if (s.t_ns >= frame->t_ns) break;
+    }
+    const ReplayEstimator::FrameOutcome r = est.processFrame(*frame);
+    ++sum.framesProcessed;
+    if (firstT < 0) firstT = frame->t_ns;
+    lastT = frame->t_ns;
+    feSum += frame->timing.total;
+    sum.frontendMsMax = std::max(sum.frontendMsMax, frame->timing.total);
+    estSum += r.estimator_ms;
+    sum.estimatorMsMax = std::max(sum.estimatorMsMax, r.estimator_ms);
+    if (r.updated) ++sum.framesUpdated;
+    const bool init = est.initialized();
+    if (init) {
+      ++sum.framesInitialized;
+      const vio::ImuState s = est.newestImuState();
+      const vio::TumPose p{s.t_ns, s.p_WI, s.R_WI};
+      if (poses.empty() || p.t_ns > poses.back().t_ns) {
+        tum.write(p);
+        const vio::Matrix6d P = est.poseCovariance();
+        cov.write(s.t_ns, P);
+        poses.push_back(p);
+        covs.push_back({s.t_ns, 0.5 * (P + P.transpose())});
+      }
+    }
+    // GNSS epochs up to the newest state.
+    double gnssMs = 0.0;
+    int gnssCount = 0;
+    if (gnss) {
+      const std::int64_t tState = init ? est.newestImuState().t_ns : frame->t_ns;
+      const GpsTime limit = gpsFromNs(tState + opt.sensorToGpst_ns);
+      while (g.haveRover && g.nextRover.time <= limit) {
+        if (!init) {
+          ++sum.gnssEpochsSkipped;
+        } else {
+          while (g.haveBase && g.nextBase.time <= g.nextRover.time) {
+            std::swap(g.currentBase, g.nextBase);
+            g.haveCurrentBase = true;
+            g.haveBase = g.base->next(g.nextBase);
+          }
+          const auto t0 = Clock::now();
+          const ReplayGnssOutcome o = gnss->processEpoch(g.nextRover, g.haveCurrentBase ? &g.currentBase : nullptr, g.nav);
+          const double ms = msSince(t0);
+          gnssMs += ms;
+          ++gnssCount;
+          ++sum.gnssEpochs;
+          if (o.updated) ++sum.gnssEpochsUpdated;
+          if (o.rtkFixed) ++sum.gnssEpochsFixed;
+          const GpsTime& t = g.nextRover.time;
+          char b[400];
+          std::snprintf(b, sizeof b, "%d,%.3f,%s,%d,%d,%d,%d,%d,%d,%d,%d,%d,%d,%d,%d,%d,%.3f,%d,%.3f\n", t.week(), t.tow(),
+                        o.stage.c_str(), o.psrUsed, o.psrRejected, o.doppUsed, o.doppRejected, o.dpsrUsed, o.dpsrRejected,
+                        o.ddcpUsed, o.ddcpRejected, o.velUsed, o.velRejected, o.updated ? 1 : 0, o.rtkFixed ? 1 : 0,
+                        o.reset ? 1 : 0, o.chi2, o.dof, ms);
+          epochFile->out() << b;
+          if (o.antennaEcef) {
+            PositionSolution ps;
+            ps.time = t;
+            ps.position = *o.antennaEcef;
+            ps.positionCovariance = o.antennaCovarianceEcef;
+            ps.quality = o.rtkFixed ? SolutionQuality::Fix
+                                    : ((o.dpsrUsed + o.ddcpUsed) > 0 ? SolutionQuality::Float : SolutionQuality::Single);
+            ps.numSatellites = std::max({o.psrUsed, o.doppUsed, o.dpsrUsed, o.ddcpUsed});
+            ps.velocity = o.antennaVelocityEcef;
+            posWriter->write(ps);
+            const Eigen::Vector3d v = o.antennaVelocityEcef ? *o.antennaVelocityEcef : Eigen::Vector3d::Zero();
+            std::snprintf(b, sizeof b, "%d,%.3f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%d\n", t.week(), t.tow(), ps.position.x(),
+                          ps.position.y(), ps.position.z(), v.x(), v.y(), v.z(), o.rtkFixed ? 1 : 0);
+            ecefFile->out() << b;
+            kml.push_back(ecefToGeodetic(ps.position));
+          }
+        }
+        g.haveRover = g.rover->next(g.nextRover);
+      }
+      gnssSum += gnssMs;
+    }
+    char b[256];
+    std::snprintf(b, sizeof b, "%" PRId64 ",%" PRIu64 ",%zu,%.3f,%.3f,%.3f,%d,%d,%d,%d,%d\n", frame->t_ns, frame->index,
+                  frame->features.size(), frame->timing.total, r.estimator_ms, gnssMs, gnssCount, init ? 1 : 0,
+                  r.updated ? 1 : 0, r.msckf_features, r.slam_features);
+    timing.out() << b;
+    if (opt.progress && (Clock::now() - lastProgress > std::chrono::seconds(1) || sum.framesProcessed == total)) {
+      lastProgress = Clock::now();
+      const double wall = msSince(wall0) * 1e-3;
+      const double data = static_cast<double>(lastT - firstT) * 1e-9;
+      std::fprintf(stderr, "\r[gvins-replay] frame %zu/%zu  t %.1f s  %s  %.1fx real time   ", sum.framesProcessed, total,
+                   data, init ? "initialised" : "initialising", wall > 0 ? data / wall : 0.0);
+      std::fflush(stderr);
+    }
+  }
+  if (opt.progress) std::fputc('\n', stderr);
+  if (loader.joinable()) loader.join();
+  {
+    std::lock_guard<std::mutex> lock(loaderMutex);
+    if (loaderError) std::rethrow_exception(loaderError);
+  }
+  sum.skippedBadImages = badImages.load();
+
+  tum.close();
+  cov.close();
+  timing.close();
+  sum.files = {(out / "trajectory.tum").string(), (out / "trajectory.cov.csv").string(), timing.path()};
+  if (gnss) {
+    posWriter->finish();
+    posFile->close();
+    ecefFile->close();
+    epochFile->close();
+    writeKml(out / "track.kml", kml, "gvins-replay " + opt.modeName);
+    sum.files.insert(sum.files.end(), {posFile->path(), ecefFile->path(), (out / "track.kml").string(), epochFile->path()});
+  }
+  const double n = static_cast<double>(std::max<std::size_t>(sum.framesProcessed, 1));
+  sum.frontendMsMean = feSum / n;
+  sum.estimatorMsMean = estSum / n;
+  sum.gnssMsMean = sum.gnssEpochs ? gnssSum / static_cast<double>(sum.gnssEpochs) : 0.0;
+  sum.datasetSeconds = firstT >= 0 ? static_cast<double>(lastT - firstT) * 1e-9 : 0.0;
+  sum.wallSeconds = msSince(wall0) * 1e-3;
+
+  if (opt.evaluate && ds.hasGroundTruth() && poses.size() >= 2) {
+    vio::EvaluationOptions eo2;
+    eo2.alignment = vio::AlignmentKind::Yaw4Dof;
+    try {
+      const auto r = vio::evaluateTrajectory(vio::toTrajectorySamples(poses), vio::toTrajectorySamples(ds.groundTruth()), covs, eo2);
+      std::ostringstream os;
+      vio::printEvaluation(os, r);
+      sum.evaluationTable = os.str();
+      for (const auto& f : vio::writeEvaluationPlots(r, (out / "eval_").string())) sum.files.push_back(f);
+    } catch (const std::invalid_argument& e) {
+      sum.evaluationTable = std::string("not evaluated: ") + e.what() + "\n";
+    }
+  }
+  return sum;
+}
+
+}  // namespace gvins::fusion
