@@ -1,6 +1,7 @@
 // Conversions between GVINS bag messages and our types; see rosbag_convert.hpp.
 #include "gvins/fusion/rosbag_convert.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -175,6 +176,9 @@ ObsEpoch toObsEpoch(const ros::GnssMeasMsg& msg, std::string_view source, BagCon
       if (measured(o.dopp[j])) s.setDoppler(o.dopp[j]);
       if (measured(o.cn0[j])) s.setSnr(o.cn0[j]);
       s.lli = static_cast<std::uint8_t>(o.lli[j] & 0x07);
+      // The layout has no signal strength indicator: derive it from C/N0 as RINEX 3.04 (5.7)
+      // maps dB-Hz to 1..9 (min(max(floor(C/N0 / 6), 1), 9)).
+      if (s.hasSnr()) s.ssi = static_cast<std::uint8_t>(std::clamp(std::floor(s.snr / 6.0), 1.0, 9.0));
       so->signals.push_back(s);
     }
   }

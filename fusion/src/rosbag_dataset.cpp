@@ -150,7 +150,7 @@ std::string BagConversionSummary::text() const {
     << "  images               " << images << "\n"
     << "  GNSS epochs          " << gnssEpochs << "\n"
     << "  ephemerides          " << ephemerides << "\n"
-    << "  skipped satellites   " << convert.unknownSatellites << "\n"
+    << "  skipped satellites   " << convert.unknownSatellites << " (no gnss_comm number: QZSS/SBAS/NavIC)\n"
     << "  skipped signals      " << convert.unknownSignals + convert.duplicateSignals + convert.glonassNoChannel
     << "\n";
   return s.str();

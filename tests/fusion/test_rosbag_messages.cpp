@@ -231,6 +231,8 @@ TEST(RosbagConvert, ObsMessageToEpochKeepsEveryValue) {
   EXPECT_EQ(g2->carrierPhase, 8.6e7 + 0.5);
   EXPECT_EQ(g2->doppler, -960.125);
   EXPECT_EQ(g1->snr, 45.0);
+  EXPECT_EQ(g1->ssi, 7);  // RINEX 3.04 5.7: 42-47 dB-Hz -> 7
+  EXPECT_EQ(g2->ssi, 6);  // 36-41 dB-Hz -> 6
   EXPECT_TRUE(g2->lossOfLock());
   EXPECT_FALSE(g1->lossOfLock());
   // Inconsistent arrays are named.

@@ -15,7 +15,8 @@
 //   ICD tauN, `freqo` the FDMA channel.
 // * A value of exactly 0 means "not measured" for psr, cp, dopp and CN0 (the u-blox driver of
 //   GVINS leaves unmeasured entries at 0); status bit 0/1 mark a valid pseudorange/phase.
-//   Our writer sets them accordingly.
+//   Our writer sets them accordingly. The RINEX signal strength indicator is not carried; the
+//   reader derives it from C/N0 with the RINEX 3.04 mapping.
 #pragma once
 
 #include <cstdint>
