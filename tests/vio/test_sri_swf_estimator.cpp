@@ -261,13 +261,14 @@ TEST(SriSwfSimulation, StereoCircleDriftNeesAndFloat) {
   EXPECT_LT(np, 6.0);
 }
 
-TEST(SriSwfSimulation, StandstillInitialisesAndStays) {
+void standstill(bool mono) {
   test::SimScene sc;
   sc.moving = false;
   sc.duration = 12.0;
   sc.build();
   SriSwfConfig cfg = sc.config();
   cfg.init_in_motion = false;  // must be the static path
+  if (mono) cfg.cameras.resize(1);
   SriSwfEstimator<double> est(cfg);
   std::size_t k = 0;
   int init_frame = -1;
@@ -290,12 +291,15 @@ TEST(SriSwfSimulation, StandstillInitialisesAndStays) {
   ASSERT_GE(init_frame, 0);
   EXPECT_LE(init_frame, 25);  // one init window (1 s) at 20 Hz
   const ImuState e = est.newestImuState();
-  std::fprintf(stderr, "  standstill: init at frame %d, position change %.4f m, speed %.4f m/s\n", init_frame,
+  std::fprintf(stderr, "  standstill (%s): init at frame %d, position change %.4f m, speed %.4f m/s\n", mono ? "mono" : "stereo", init_frame,
                (e.p_WI - p0).norm(), e.v_WI.norm());
   EXPECT_LT((e.p_WI - p0).norm(), 0.02);
   EXPECT_LT(e.v_WI.norm(), 0.01);
   EXPECT_LT((e.bg - sc.truth(e.t_ns).bg).norm(), 2e-3);
 }
+
+TEST(SriSwfSimulation, StandstillInitialisesAndStaysStereo) { standstill(false); }
+TEST(SriSwfSimulation, StandstillInitialisesAndStaysMono) { standstill(true); }
 
 // ------------------------------------------------------------------ EstimatorBackend contract
 TEST(SriSwfBackend, ClientBlocksPropagateMarginalizeAndGatedUpdate) {

@@ -75,6 +75,7 @@ struct SriSwfEstimator<Scalar>::Impl {
 
   const SriSwfConfig& cfg;
   Filter f;
+  Filter backup;  // speculative joint SLAM update
   ImuPropagator prop;
   std::vector<ImuSample> imu;
   bool initialized = false;
@@ -87,6 +88,7 @@ struct SriSwfEstimator<Scalar>::Impl {
   std::unordered_map<std::uint64_t, Track> tracks;
   std::unordered_map<std::uint64_t, Slam> slam;
   std::deque<FeatureFrame> init_frames;
+  std::deque<FeatureFrame> recent;  // frames of the last init_window (zero-velocity detection)
   std::unordered_map<std::uint64_t, PoseEstimate> pose_cache;
   mutable std::vector<double> chi2_thr;
 
@@ -196,23 +198,25 @@ struct SriSwfEstimator<Scalar>::Impl {
     initialized = true;
   }
 
-  bool tryStatic(const FeatureFrame& frame) {
+  /// Standstill test over the last init_window: accelerometer/gyro spread and the median feature
+  /// displacement against the oldest frame of `frames` in the window (at least half a window old).
+  bool staticCheck(const FeatureFrame& frame, const std::deque<FeatureFrame>& frames, Eigen::Vector3d& ma,
+                   Eigen::Vector3d& mg, int& n) const {
     const std::int64_t t1 = frame.t_ns;
     const std::int64_t t0 = t1 - static_cast<std::int64_t>(cfg.init_window * 1e9);
     if (!imuCovers(t0, t1)) return false;
-    // Oldest buffered frame inside the window for the parallax test; it must be at least half a
-    // window old.
     const FeatureFrame* ref = nullptr;
-    for (const FeatureFrame& fr : init_frames) {
+    for (const FeatureFrame& fr : frames) {
       if (fr.t_ns >= t0) {
         ref = &fr;
         break;
       }
     }
     if (!ref || static_cast<double>(t1 - ref->t_ns) < 0.5e9 * cfg.init_window) return false;
-    Eigen::Vector3d ma = Eigen::Vector3d::Zero(), mg = Eigen::Vector3d::Zero();
+    ma.setZero();
+    mg.setZero();
     Eigen::Vector3d sa = Eigen::Vector3d::Zero(), sg = Eigen::Vector3d::Zero();
-    int n = 0;
+    n = 0;
     for (const ImuSample& s : imu) {
       if (s.t_ns < t0 || s.t_ns > t1) continue;
       ma += s.accel;
@@ -236,8 +240,14 @@ struct SriSwfEstimator<Scalar>::Impl {
       auto it = refpx.find(o.id);
       if (it != refpx.end()) par.push_back((o.pixel0 - it->second).norm());
     }
-    if (par.size() < 5 || median(par) > cfg.static_max_parallax) return false;
+    return par.size() >= 5 && median(par) <= cfg.static_max_parallax;
+  }
 
+  bool tryStatic(const FeatureFrame& frame) {
+    Eigen::Vector3d ma, mg;
+    int n = 0;
+    if (!staticCheck(frame, init_frames, ma, mg, n)) return false;
+    const std::int64_t t1 = frame.t_ns;
     ImuState s;
     s.t_ns = t1;
     s.R_WI = Eigen::Quaterniond::FromTwoVectors(ma.normalized(), Eigen::Vector3d::UnitZ()).toRotationMatrix();
@@ -510,6 +520,62 @@ struct SriSwfEstimator<Scalar>::Impl {
     return true;
   }
 
+  /// Stacks whitened measurements without nuisance columns into one (single allocation).
+  static void stackAll(const std::vector<Meas>& ms, Meas& out) {
+    int rows = 0;
+    for (const Meas& m : ms) rows += m.rows();
+    out.reset(rows);
+    int r0 = 0;
+    for (const Meas& m : ms) {
+      for (int i = 0; i < m.numBlocks(); ++i) {
+        out.jacobian(m.blockId(i), m.blockDim(i)).middleRows(r0, m.rows()) = m.jacobianAt(i);
+      }
+      out.residual().segment(r0, m.rows()) = m.residual();
+      r0 += m.rows();
+    }
+    out.setWhitened();
+  }
+
+  // Window covariance for gating MSCKF-type rows (clones and extrinsics only): one marginal
+  // covariance per frame (trailing block of R), then χ² = zᵀ(I + H P Hᵀ)⁻¹z per feature, which
+  // is cheaper than SriFilter::chiSquare's per-feature triangular solve and QR. Valid when r = 0
+  // (right after correct()).
+  Eigen::MatrixXd Pw;
+  std::unordered_map<std::uint64_t, int> pw_off;
+  void windowCovariance() {
+    std::vector<BlockId> ids;
+    pw_off.clear();
+    int off = 0;
+    for (const Clone& c : clones) {
+      ids.push_back(c.id);
+      pw_off[c.id.value] = off;
+      off += 6;
+    }
+    for (BlockId e : ext_ids) {
+      ids.push_back(e);
+      pw_off[e.value] = off;
+      off += 6;
+    }
+    Pw = f.covariance(ids).template cast<double>();
+  }
+  bool gateWindow(const Meas& m) const {
+    if (cfg.chi2_probability >= 1.0) return true;
+    const int rows = m.rows();
+    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(rows, Pw.cols());
+    for (int i = 0; i < m.numBlocks(); ++i) {
+      H.middleCols(pw_off.at(m.blockId(i).value), m.blockDim(i)) = m.jacobianAt(i).template cast<double>();
+    }
+    const Eigen::MatrixXd HP = H * Pw;
+    Eigen::MatrixXd S(rows, rows);
+    S.noalias() = HP * H.transpose();
+    S.diagonal().array() += 1.0;
+    const Eigen::LLT<Eigen::MatrixXd> llt(S);
+    if (llt.info() != Eigen::Success) return false;
+    const Eigen::VectorXd z = m.residual().template cast<double>();
+    const double chi2 = llt.matrixL().solve(z).squaredNorm();
+    return chi2 <= chi2Threshold(rows);
+  }
+
   bool gate(const Meas& m) const {
     if (cfg.chi2_probability >= 1.0) return true;
     const auto c = f.chiSquare(m);
@@ -604,7 +670,39 @@ struct SriSwfEstimator<Scalar>::Impl {
       res.slam_features = static_cast<int>(slam.size());
       return res;
     }
+    const BlockId previous_pose = newest.pose;
     propagateTo(frame.t_ns);
+    // Zero-velocity update at a detected standstill (as at the static initialisation): v = 0 and
+    // no displacement since the previous clone. Without it a mono rig at rest has no
+    // triangulable features and drifts with the IMU.
+    recent.push_back(frame);
+    while (!recent.empty() && frame.t_ns - recent.front().t_ns > static_cast<std::int64_t>(cfg.init_window * 1.5e9)) {
+      recent.pop_front();
+    }
+    if (cfg.zero_velocity_update) {
+      Eigen::Vector3d ma, mg;
+      int n = 0;
+      if (staticCheck(frame, recent, ma, mg, n)) {
+        const ImuState s = newestState();
+        const PoseEstimate prev = poseOf(f.estimate(previous_pose));
+        Meas z(6);
+        const double sv = cfg.zero_velocity_sigma;
+        const double sp = sv * static_cast<double>(frame.t_ns - recent[recent.size() - 2].t_ns) * 1e-9;
+        z.jacobian(newest.extra, 9).block(0, 0, 3, 3).setIdentity();
+        z.jacobian(newest.pose, 6).block(3, 3, 3, 3).setIdentity();
+        z.jacobian(previous_pose, 6).block(3, 3, 3, 3) = -Eigen::Matrix<Scalar, 3, 3>::Identity();
+        z.residual().head(3) = (-s.v_WI).template cast<Scalar>();
+        z.residual().tail(3) = (prev.p_WI - s.p_WI).template cast<Scalar>();
+        Eigen::Matrix<Scalar, 6, 1> sd;
+        sd << Eigen::Matrix<Scalar, 3, 1>::Constant(Scalar(sv)), Eigen::Matrix<Scalar, 3, 1>::Constant(Scalar(sp));
+        z.whitenStdDevs(sd);
+        if (gate(z)) {
+          f.update(z);
+          res.updated = true;
+          res.zero_velocity = true;
+        }
+      }
+    }
     for (auto& [id, s] : slam) s.seen = false;
     addObservations(frame);
     const bool dropping = static_cast<int>(clones.size()) > cfg.window;
@@ -612,34 +710,54 @@ struct SriSwfEstimator<Scalar>::Impl {
     std::unordered_set<std::uint64_t> observed;
     for (const FeatureObservation& o : frame.features) observed.insert(o.id);
 
-    // 1. SLAM re-observations (newest clone).
+    // 1. SLAM re-observations (newest clone). The update's post-fit residual ‖e‖² equals the
+    // innovation χ² (docs/sri_core.md §5), so all rows are applied at once to a backup copy of
+    // the filter and kept if the joint χ² passes; only otherwise is every feature tested on its
+    // own (SriFilter::chiSquare, a triangular solve from the feature's column each).
     Meas total;
-    bool have_total = false;
-    auto addTotal = [&](const Meas& m) {
-      if (!have_total) {
-        total = m;
-        have_total = true;
-      } else {
-        total.stack(m);
-      }
-    };
+    std::vector<Meas> parts;
     std::vector<BlockId> lost_slam;
     {
-      std::vector<std::uint64_t> sids;
-      for (auto& [id, s] : slam) sids.push_back(id);
-      std::sort(sids.begin(), sids.end());
-      Meas m;
+      std::vector<std::uint64_t> part_ids;
       for (const FeatureObservation& o : frame.features) {
         auto it = slam.find(o.id);
         if (it == slam.end()) continue;
         std::vector<Obs> obs{{newest.pose, 0, o.normalized0}};
         if (stereo() && o.stereo) obs.push_back({newest.pose, 1, o.normalized1});
-        if (slamRows(it->second, obs, m) && gate(m)) {
-          addTotal(m);
+        parts.emplace_back();
+        if (slamRows(it->second, obs, parts.back())) {
+          part_ids.push_back(o.id);
         } else {
-          it->second.seen = false;  // treat as lost
+          parts.pop_back();
+          it->second.seen = false;  // behind the camera: treat as lost
         }
       }
+      if (!parts.empty()) {
+        stackAll(parts, total);
+        backup = f;
+        const sri::UpdateResult<Scalar> u = f.update(total);
+        if (static_cast<double>(u.chi2) <= chi2Threshold(u.dof)) {
+          res.updated = true;
+        } else {
+          f = backup;
+          std::vector<Meas> kept;
+          for (std::size_t k = 0; k < parts.size(); ++k) {
+            if (gate(parts[k])) {
+              kept.push_back(std::move(parts[k]));
+            } else {
+              slam[part_ids[k]].seen = false;
+            }
+          }
+          if (!kept.empty()) {
+            stackAll(kept, total);
+            f.update(total);
+            res.updated = true;
+          }
+        }
+      }
+      std::vector<std::uint64_t> sids;
+      for (auto& [id, s] : slam) sids.push_back(id);
+      std::sort(sids.begin(), sids.end());
       for (std::uint64_t id : sids) {
         if (!slam[id].seen) {
           lost_slam.push_back(slam[id].block);
@@ -647,10 +765,12 @@ struct SriSwfEstimator<Scalar>::Impl {
         }
       }
     }
-    if (have_total) {
-      f.update(total);
-      res.updated = true;
+
+    if (res.updated) {
+      f.correct();
     }
+    pose_cache.clear();
+    windowCovariance();
 
     // 2. Candidates: lost tracks and window-long tracks.
     struct Cand {
@@ -683,7 +803,7 @@ struct SriSwfEstimator<Scalar>::Impl {
       }
     }
     // 2b. MSCKF updates.
-    have_total = false;
+    parts.clear();
     Meas m;
     for (std::uint64_t id : msckf_ids) {
       const Track& tr = tracks[id];
@@ -691,11 +811,12 @@ struct SriSwfEstimator<Scalar>::Impl {
       if (!triangulate(tr.obs, p)) continue;
       featureRows(tr.obs, p, m);
       m.projectNuisance();
-      if (!gate(m)) continue;
-      addTotal(m);
+      if (!gateWindow(m)) continue;
+      parts.push_back(m);
       ++res.msckf_features;
     }
-    if (have_total) {
+    if (!parts.empty()) {
+      stackAll(parts, total);
       total.compress();
       f.update(total);
       res.updated = true;
@@ -708,7 +829,7 @@ struct SriSwfEstimator<Scalar>::Impl {
       if (!triangulate(tr.obs, p)) continue;
       featureRows(tr.obs, p, m);
       m.projectNuisance();
-      if (!gate(m)) continue;
+      if (!gateWindow(m)) continue;
       const Eigen::Vector3d f0 = inverseDepthOf(p, pose(newest.pose), ext(0));
       Slam s;
       s.block = f.addBlock(BlockSpec::vector("slam", 3), BlockEstimate<Scalar>::fromVector(f0.cast<Scalar>()),

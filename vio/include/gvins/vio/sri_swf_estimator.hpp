@@ -73,6 +73,11 @@ struct SriSwfConfig {
   double init_velocity_sigma = 0.05;   ///< m/s static (in motion: 3× this)
   double init_gyro_bias_sigma = 0.02;  ///< rad/s when not estimated from a standstill
   double init_accel_bias_sigma = 0.1;  ///< m/s²
+  /// Zero-velocity update when the standstill test of the initialisation passes again (IMU spread
+  /// and median parallax over init_window): v = 0 (σ) and no displacement since the previous
+  /// clone (σ · frame interval).
+  bool zero_velocity_update = true;
+  double zero_velocity_sigma = 0.005;  ///< m/s
 
   // ---- online calibration
   bool calibrate_extrinsics = false;
@@ -94,7 +99,7 @@ struct SriSwfConfig {
 ///   min_baseline_ratio, chi2_probability, max_msckf_per_frame, reanchor_sigma,
 ///   init: {window, static_max_accel_std, static_max_gyro_std, static_max_parallax, in_motion,
 ///          motion_frames, position_sigma, yaw_sigma, tilt_sigma, velocity_sigma,
-///          gyro_bias_sigma, accel_bias_sigma},
+///          gyro_bias_sigma, accel_bias_sigma}, zero_velocity_update, zero_velocity_sigma,
 ///   calibrate_extrinsics, extrinsic_rotation_sigma, extrinsic_translation_sigma,
 ///   calibrate_time_offset, precision: double | float,
 ///   cameras: [<EuRoC camera sensor.yaml path>, ...]  or  camchain: <Kalibr camchain path>
@@ -111,6 +116,7 @@ struct FrameResult {
   double estimator_ms = 0;   ///< wall-clock time of processFrame
   int msckf_features = 0;    ///< MSCKF features used in the update
   int slam_features = 0;     ///< SLAM features in the state after the frame
+  bool zero_velocity = false;  ///< a zero-velocity update was applied (standstill detected)
 };
 
 template <typename Scalar>
