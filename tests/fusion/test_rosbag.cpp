@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "gvins/base/parse_error.hpp"
 #include "gvins/base/rinex_obs_reader.hpp"
@@ -374,5 +375,39 @@ TEST_F(RosbagFile, GvinsBagTool) {
   EXPECT_NE(bad.find("bad.bag"), std::string::npos) << bad;
   EXPECT_EQ(run("to-dataset " + bag, dir / "args.txt"), 2);
   EXPECT_EQ(run("frobnicate", dir / "args.txt"), 2);
+  fs::remove_all(dir);
+}
+
+TEST_F(RosbagFile, CompressedImagesAndForeignTopics) {
+  const fs::path dir = tempDir("compressed_image");
+  const std::string bag = (dir / "c.bag").string();
+  vio::EurocDataset data(kEuroc);
+  const cv::Mat ref = data.loadImage(0, 3);
+  std::vector<std::uint8_t> png;
+  ASSERT_TRUE(cv::imencode(".png", ref, png));
+  {
+    BagWriter w(bag);
+    ros::CompressedImageMsg m;
+    m.header.stamp = toRosTime(data.cameraEntries(0)[3].t_ns);
+    m.format = "mono8; png compressed";
+    m.data = png;
+    w.write("/cam0/image_raw/compressed", ros::compressedImageType(), m.header.stamp, ros::serialize(m));
+    // A topic the reader does not know (e.g. the u-blox driver's time pulse) is skipped and counted.
+    w.write("/ublox_driver/time_pulse_info", ros::MessageType{"gnss_comm/GnssTimePulseInfoMsg", "*", ""},
+            m.header.stamp, std::vector<std::uint8_t>(13, 0));
+    m.data.resize(m.data.size() / 2);  // a broken PNG
+    m.header.stamp.sec += 1;
+    w.write("/cam0/image_raw/compressed", ros::compressedImageType(), m.header.stamp, ros::serialize(m));
+    w.close();
+  }
+  GvinsBagReader r(bag);
+  GvinsBagItem item;
+  ASSERT_TRUE(r.next(item));
+  EXPECT_EQ(item.kind, GvinsBagItem::Kind::Image);
+  EXPECT_EQ(item.camera, 0);
+  EXPECT_EQ(item.image_t_ns, data.cameraEntries(0)[3].t_ns);
+  EXPECT_EQ(cv::norm(item.image, ref, cv::NORM_INF), 0.0);
+  EXPECT_THROW(r.next(item), ParseError);  // the broken PNG, after skipping the time pulse
+  EXPECT_EQ(r.stats().skippedTopics.at("/ublox_driver/time_pulse_info"), 1);
   fs::remove_all(dir);
 }
