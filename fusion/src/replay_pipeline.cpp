@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <atomic>
+#include <charconv>
 #include <chrono>
+#include <cmath>
 #include <cinttypes>
 #include <cstdio>
 #include <exception>
@@ -15,6 +17,9 @@
 #include <thread>
 
 #include "gvins/base/geodetic.hpp"
+#include "gvins/base/line_reader.hpp"
+#include "gvins/base/local_frame.hpp"
+#include "gvins/base/text_fields.hpp"
 #include "gvins/base/parse_error.hpp"
 #include "gvins/base/rinex_obs_reader.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
@@ -103,6 +108,55 @@ void writeKml(const fs::path& path, const std::vector<Geodetic>& pts, const std:
 
 }  // namespace
 
+namespace {
+std::vector<EcefTruthSample> parseEcefTruth(LineReader& r) {
+  std::vector<EcefTruthSample> out;
+  std::string line;
+  while (r.next(line)) {
+    std::string_view l = line;
+    if (!l.empty() && l.back() == '\r') l.remove_suffix(1);
+    const std::string_view t = trim(l);
+    if (t.empty() || t.front() == '#') continue;
+    const TextLocation where = r.location();
+    std::vector<std::string_view> f;
+    std::size_t start = 0;
+    for (;;) {
+      const std::size_t c = l.find(',', start);
+      f.push_back(trim(l.substr(start, c == std::string_view::npos ? std::string_view::npos : c - start)));
+      if (c == std::string_view::npos) break;
+      start = c + 1;
+    }
+    if (f.size() < 14)
+      throwParseError(where, f.size() < 12 ? "line" : (f.size() == 12 ? "antenna_E_y" : "antenna_E_z"),
+                      "expected at least 14 fields (antenna position in columns 12-14), found " + std::to_string(f.size()));
+    EcefTruthSample s;
+    {
+      const std::string_view st = f[0];
+      const auto res = std::from_chars(st.data(), st.data() + st.size(), s.t_ns);
+      if (st.empty() || res.ec != std::errc() || res.ptr != st.data() + st.size() || s.t_ns < 0)
+        throwParseError(where, "timestamp", "not a non-negative integer nanosecond stamp: '" + std::string(st) + "'");
+    }
+    s.antenna = {parseDouble(f[11], where, "antenna_E_x"), parseDouble(f[12], where, "antenna_E_y"),
+                 parseDouble(f[13], where, "antenna_E_z")};
+    if (!s.antenna.allFinite()) throwParseError(where, "antenna_E_x", "antenna position is not finite");
+    if (!out.empty() && s.t_ns <= out.back().t_ns)
+      throwParseError(where, "timestamp", "time stamps must increase strictly");
+    out.push_back(s);
+  }
+  return out;
+}
+}  // namespace
+
+std::vector<EcefTruthSample> readEcefTruthCsv(const std::string& path) {
+  LineReader r(path, 16384);
+  return parseEcefTruth(r);
+}
+
+std::vector<EcefTruthSample> parseEcefTruthCsv(std::string_view text, const std::string& name) {
+  LineReader r(text, name, 16384);
+  return parseEcefTruth(r);
+}
+
 void ReplaySummary::print(std::ostream& os) const {
   char b[200];
   os << "------------------------------------------------------------\n";
@@ -133,6 +187,8 @@ void ReplaySummary::print(std::ostream& os) const {
   row("real-time factor", f("%.2fx", realTimeFactor()));
   os << "------------------------------------------------------------\n";
   if (!evaluationTable.empty()) os << "accuracy against the dataset ground truth (4-DoF aligned):\n" << evaluationTable;
+  if (!globalEvaluationTable.empty())
+    os << "GNSS antenna (global.pos) against the true antenna track, ENU, no alignment:\n" << globalEvaluationTable;
 }
 
 ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, ReplayGnss* gnss, const ReplayOptions& opt) {
@@ -219,6 +275,10 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
   }
   std::vector<vio::TumPose> poses;
   std::vector<vio::PoseCovariance> covs;
+  std::vector<EcefTruthSample> antennaTrack;  // GNSS solutions, stamped on the sensor clock
+  auto gnssStamp = [&](const GpsTime& t) {
+    return t.wholeSeconds() * 1'000'000'000 + static_cast<std::int64_t>(std::llround(t.fraction() * 1e9)) - opt.sensorToGpst_ns;
+  };
 
   // Camera input: feature tracks, or images through the loader and front end threads.
   std::unique_ptr<FeatureTrackFrames> trackFrames;
@@ -386,6 +446,7 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
                           ps.position.y(), ps.position.z(), v.x(), v.y(), v.z(), o.rtkFixed ? 1 : 0);
             ecefFile->out() << b;
             kml.push_back(ecefToGeodetic(ps.position));
+            antennaTrack.push_back({gnssStamp(t), ps.position});
           }
         }
         g.haveRover = g.rover->next(g.nextRover);
@@ -444,6 +505,37 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
       for (const auto& f : vio::writeEvaluationPlots(r, (out / "eval_").string())) sum.files.push_back(f);
     } catch (const std::invalid_argument& e) {
       sum.evaluationTable = std::string("not evaluated: ") + e.what() + "\n";
+    }
+  }
+  const fs::path ecefTruth = fs::path(dataset) / "truth" / "groundtruth_ecef.csv";
+  if (opt.evaluate && gnss && antennaTrack.size() >= 2 && fs::exists(ecefTruth)) {
+    const auto truth = readEcefTruthCsv(ecefTruth.string());
+    if (!truth.empty()) {
+      const Eigen::Vector3d origin = truth.front().antenna;
+      std::vector<vio::TrajectorySample> ref, track;
+      for (const auto& x : truth) ref.push_back({x.t_ns, Eigen::Matrix3d::Identity(), ecefToEnu(x.antenna, origin), std::nullopt});
+      for (const auto& x : antennaTrack) track.push_back({x.t_ns, Eigen::Matrix3d::Identity(), ecefToEnu(x.antenna, origin), std::nullopt});
+      vio::EvaluationOptions eo3;
+      eo3.alignment = vio::AlignmentKind::None;
+      try {
+        const auto r = vio::evaluateTrajectory(track, ref, {}, eo3);
+        std::ostringstream os;
+        vio::printEvaluation(os, r);
+        double h = 0.0, v = 0.0;
+        for (std::size_t i = 0; i < r.reference.size(); ++i) {
+          const Eigen::Vector3d e = r.estimateAligned[i] - r.reference[i];
+          h += e.head<2>().squaredNorm();
+          v += e.z() * e.z();
+        }
+        const double m = static_cast<double>(std::max<std::size_t>(r.reference.size(), 1));
+        char b[160];
+        std::snprintf(b, sizeof b, "horizontal RMS %.4f m, vertical RMS %.4f m over %zu epochs\n", std::sqrt(h / m),
+                      std::sqrt(v / m), r.reference.size());
+        sum.globalEvaluationTable = os.str() + b;
+        for (const auto& f : vio::writeEvaluationPlots(r, (out / "eval_global_").string())) sum.files.push_back(f);
+      } catch (const std::invalid_argument& e) {
+        sum.globalEvaluationTable = std::string("not evaluated: ") + e.what() + "\n";
+      }
     }
   }
   return sum;

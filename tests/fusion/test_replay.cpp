@@ -78,6 +78,7 @@ class StubEstimator : public ReplayEstimator {
   std::vector<std::size_t> featureCounts;
   bool orderOk = true;
   double zNoise = 0.0;         ///< ±zNoise alternating on z
+  std::int64_t stateStride = 0;  ///< reported state time = frame time + (frames − 1)·stride
   vio::Matrix6d P = (Eigen::Matrix<double, 6, 1>() << 1e-4, 2e-4, 3e-4, 0.01, 0.02, 0.03).finished().asDiagonal();
 
   static Eigen::Vector3d truthP(std::int64_t t) {
@@ -110,7 +111,7 @@ class StubEstimator : public ReplayEstimator {
   bool initialized() const override { return frameTimes.size() >= 3; }
   vio::ImuState newestImuState() const override {
     vio::ImuState s;
-    s.t_ns = frameTimes.back();
+    s.t_ns = frameTimes.back() + static_cast<std::int64_t>(frameTimes.size() - 1) * stateStride;
     s.p_WI = truthP(frameTimes.back());
     s.p_WI.z() += (frameTimes.size() % 2 == 0 ? zNoise : -zNoise);
     s.R_WI = truthR(frameTimes.back());
@@ -244,13 +245,24 @@ TEST(Replay, GnssEpochsHandedOverUpToTheNewestState) {
   // Frame 0 (not initialised, 100 ms earlier) passes rover[0]: skipped. Frame 2 hands over
   // rover[1]; the frames span 1.15 s and rover[2] is 30 s later.
   StubGnss gnss;
-  ReplayOptions o = quietOptions(scratch("gnss") / "out");
+  // A true antenna track 0.5 m from the stub's constant solution (ECEF offset (0.3, 0, -0.4)):
+  // the global accuracy table must show exactly 0.5 m.
+  const fs::path d = copyV101("gnss");
+  fs::create_directories(d / "truth");
+  std::ostringstream tr;
+  tr.precision(15);
+  tr << "#timestamp [ns],p_E_x,p_E_y,p_E_z,v_E_x,v_E_y,v_E_z,q_w,q_x,q_y,q_z,antenna_E_x,antenna_E_y,antenna_E_z\n";
+  const Eigen::Vector3d trueAntenna = gnss.antenna + Eigen::Vector3d(0.3, 0.0, -0.4);
+  for (std::int64_t t = stamps.front() - 100'000'000; t <= stamps.back(); t += 5'000'000)
+    tr << t << ",0,0,0,0,0,0,1,0,0,0," << trueAntenna.x() << "," << trueAntenna.y() << "," << trueAntenna.z() << "\n";
+  writeText(d / "truth" / "groundtruth_ecef.csv", tr.str());
+  ReplayOptions o = quietOptions(d.parent_path() / "out");
   o.sensorToGpst_ns = ns(rover[1].time) + 10'000'000 - stamps[2];
   o.roverObs = (g / "07590920.05o.gz").string();
   o.baseObs = (g / "30400920.05o.gz").string();
   o.navFile = (g / "07590920.05n.gz").string();
   o.modeName = "vio+dopp+psr";
-  const ReplaySummary s = runReplay(kV101.string(), est, &gnss, o);
+  const ReplaySummary s = runReplay(d.string(), est, &gnss, o);
   ASSERT_EQ(gnss.rover.size(), 1u);
   EXPECT_EQ(gnss.rover[0], rover[1].time);
   EXPECT_EQ(s.gnssEpochs, 1u);
@@ -273,6 +285,67 @@ TEST(Replay, GnssEpochsHandedOverUpToTheNewestState) {
   EXPECT_EQ(lines(fs::path(o.outDir) / "global_ecef.csv").size(), 1u);
   const auto kml = lines(fs::path(o.outDir) / "track.kml");
   EXPECT_EQ(std::count_if(kml.begin(), kml.end(), [](const std::string& l) { return std::count(l.begin(), l.end(), ',') == 2; }), 1);
+  // One epoch only: the evaluation needs two, so it says why it could not evaluate.
+  EXPECT_TRUE(s.globalEvaluationTable.empty()) << s.globalEvaluationTable;
+}
+
+TEST(Replay, GlobalAccuracyAgainstEcefTruth) {
+  // The stub's state time advances 30 s per frame (GEONET epochs are 30 s apart), so frames 2..23
+  // hand over one rover epoch each. The true antenna track (at the epochs' sensor stamps) is 0.5 m
+  // from the stub's constant solution: the global accuracy table must show exactly 0.5 m.
+  const fs::path g = kData / "gnss" / "geonet_0759_3040_2005";
+  const auto rover = readRinexObs((g / "07590920.05o.gz").string());
+  const auto stamps = cameraStamps(kV101 / "mav0" / "cam0" / "data.csv");
+  const auto ns = [](const GpsTime& t) {
+    return t.wholeSeconds() * 1'000'000'000LL + static_cast<std::int64_t>(std::llround(t.fraction() * 1e9));
+  };
+  StubEstimator est;
+  est.stateStride = 30'000'000'000LL;
+  StubGnss gnss;
+  ReplayOptions o = quietOptions(scratch("global") / "out");
+  o.sensorToGpst_ns = ns(rover[0].time) + 10'000'000 - stamps[2] - 2 * est.stateStride;
+  o.roverObs = (g / "07590920.05o.gz").string();
+  o.navFile = (g / "07590920.05n.gz").string();
+  const fs::path d = copyV101("global_ds");
+  fs::create_directories(d / "truth");
+  std::ostringstream tr;
+  tr.precision(15);
+  tr << "#timestamp [ns],p_E_x,p_E_y,p_E_z,v_E_x,v_E_y,v_E_z,q_w,q_x,q_y,q_z,antenna_E_x,antenna_E_y,antenna_E_z\n";
+  const Eigen::Vector3d trueAntenna = gnss.antenna + Eigen::Vector3d(0.3, 0.0, -0.4);
+  for (const auto& e : rover)
+    tr << ns(e.time) - o.sensorToGpst_ns << ",0,0,0,0,0,0,1,0,0,0," << trueAntenna.x() << "," << trueAntenna.y() << ","
+       << trueAntenna.z() << "\n";
+  writeText(d / "truth" / "groundtruth_ecef.csv", tr.str());
+  const ReplaySummary s = runReplay(d.string(), est, &gnss, o);
+  // Epochs handed over: those up to the last state time, counted from the file independently.
+  const std::int64_t lastState = stamps.back() + 23 * est.stateStride + o.sensorToGpst_ns;
+  const auto expected = std::count_if(rover.begin(), rover.end(), [&](const ObsEpoch& e) { return ns(e.time) <= lastState; });
+  EXPECT_EQ(static_cast<std::ptrdiff_t>(s.gnssEpochs), expected);
+  EXPECT_GE(s.gnssEpochs, 20u);
+  EXPECT_NE(s.globalEvaluationTable.find("position [m]         0.5000     0.5000"), std::string::npos)
+      << s.globalEvaluationTable;
+  EXPECT_TRUE(fs::exists(fs::path(o.outDir) / "eval_global_trajectory_top.svg"));
+  // No base file given and none in the dataset: no base epochs.
+  EXPECT_TRUE(gnss.base.empty());
+}
+
+TEST(ReplayParsers, EcefTruth) {
+  const auto t = parseEcefTruthCsv("#h\n100,0,0,0,0,0,0,1,0,0,0,1.5,2.5,3.5\n200,0,0,0,0,0,0,1,0,0,0,1,2,3,9,9\r\n", "g.csv");
+  ASSERT_EQ(t.size(), 2u);
+  EXPECT_EQ(t[0].antenna, Eigen::Vector3d(1.5, 2.5, 3.5));
+  EXPECT_EQ(t[1].t_ns, 200);
+  auto err = [](const std::string& text) { return expectParseError([&] { parseEcefTruthCsv(text, "g.csv"); }); };
+  ParseError e = err("100,0,0,0,0,0,0,1,0,0,0,1,2\n");
+  EXPECT_EQ(e.field(), "antenna_E_z");
+  EXPECT_EQ(e.line(), 1);
+  e = err("100,0,0,0,0,0,0,1,0,0,0,1,x,3\n");
+  EXPECT_EQ(e.field(), "antenna_E_y");
+  e = err("100,0,0,0,0,0,0,1,0,0,0,1,2,3\n100,0,0,0,0,0,0,1,0,0,0,1,2,3\n");
+  EXPECT_EQ(e.field(), "timestamp");
+  EXPECT_EQ(e.line(), 2);
+  e = err("-5,0,0,0,0,0,0,1,0,0,0,1,2,3\n");
+  EXPECT_EQ(e.field(), "timestamp");
+  EXPECT_THROW(readEcefTruthCsv("/nonexistent/groundtruth_ecef.csv"), ParseError);
 }
 
 TEST(Replay, MissingFilesAreParseErrorsNamingThem) {

@@ -27,6 +27,7 @@
 #include <iosfwd>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
@@ -127,8 +128,22 @@ struct ReplaySummary {
   double realTimeFactor() const { return wallSeconds > 0.0 ? datasetSeconds / wallSeconds : 0.0; }
   std::vector<std::string> files;
   std::string evaluationTable;  ///< printEvaluation output, empty without ground truth
+  /// GNSS modes with DATASET/truth/groundtruth_ecef.csv: accuracy of the GNSS antenna solutions
+  /// (global_ecef.csv) against the true antenna track, in ENU at the first truth point, no
+  /// alignment (rotation rows are meaningless there: the antenna has no orientation).
+  std::string globalEvaluationTable;
   void print(std::ostream& os) const;
 };
+
+/// Antenna track of a gvins-sim ECEF truth file (truth/groundtruth_ecef.csv: t [ns], IMU
+/// position/velocity/orientation, then antenna_E_x/y/z in columns 12-14, ...). Throws ParseError
+/// (file, line, field) on malformed rows or stamps that do not increase.
+struct EcefTruthSample {
+  std::int64_t t_ns = 0;
+  Eigen::Vector3d antenna = Eigen::Vector3d::Zero();
+};
+std::vector<EcefTruthSample> readEcefTruthCsv(const std::string& path);
+std::vector<EcefTruthSample> parseEcefTruthCsv(std::string_view text, const std::string& name);
 
 /// Runs the whole replay. Throws gvins::ParseError for dataset problems (file, line, field),
 /// std::runtime_error for output problems. `gnss` may be null (VIO only).
