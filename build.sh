@@ -15,6 +15,7 @@ JOBS=${JOBS:-$(nproc)}
 PACKAGES=(build-essential cmake ninja-build pkg-config
           zlib1g-dev libeigen3-dev libsuitesparse-dev libopencv-dev libyaml-cpp-dev
           libgtest-dev libgmock-dev libbenchmark-dev
+          librosbag-storage-dev
           clang libclang-rt-14-dev rtklib)
 
 install_deps() {
