@@ -115,16 +115,19 @@ bool GnssConstellation::bracket(const Sat& s, const GpsTime& t, int& i, int& j, 
   }
   i = k - 1;
   j = k;
-  const bool inI = t - r[i].ref <= r[i].halfWindow;
-  const bool inJ = r[j].ref - t <= r[j].halfWindow;
-  if (!inI && !inJ) return false;
-  if (!inI) {
-    i = j;
-    return true;
-  }
-  if (!inJ) {
-    j = i;
-    return true;
+  // Consecutive records close enough to cover the gap between them together are always blended
+  // (even where one of them is already past its own validity window: a smooth truth matters more
+  // than that record's last metre); across a longer gap each record serves its own window.
+  if (r[j].ref - r[i].ref > r[i].halfWindow + r[j].halfWindow) {
+    if (t - r[i].ref <= r[i].halfWindow) {
+      j = i;
+      return true;
+    }
+    if (r[j].ref - t <= r[j].halfWindow) {
+      i = j;
+      return true;
+    }
+    return false;
   }
   const double span = r[j].ref - r[i].ref;
   const double u = (t - r[i].ref) / span;

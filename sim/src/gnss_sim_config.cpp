@@ -8,6 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "gvins/base/parse_error.hpp"
+#include "gvins/rtcm/msm_signals.hpp"
 
 namespace gvins::sim {
 
@@ -150,6 +151,9 @@ class Reader {
     const bool band = s == System::Glonass ? (c->band == '1' || c->band == '2') : isKnownBand(s, c->band);
     if (!band || (s != System::Glonass && !carrierFrequency(s, c->band)))
       fail(n, key, "band " + std::string(1, c->band) + " does not exist for " + std::string(systemName(s)));
+    // Only signals a real receiver reports (those with an RTCM MSM signal ID, RTCM 10403.3
+    // tables 3.5-91 to 3.5-108), so every simulated signal also goes into the base's RTCM stream.
+    if (!rtcm::msmSignalId(s, *c)) fail(n, key, t + " is not a signal of " + std::string(systemName(s)));
     return *c;
   }
   template <class F>
@@ -162,9 +166,7 @@ class Reader {
       const auto s = t.size() == 3 ? systemFromLetter(t[0]) : std::nullopt;
       if (!s) fail(it->first, full, "'" + t + "' is not a system letter and signal code such as G2W");
       const auto c = ObsCode::parse(t.substr(1));
-      const bool band = c && (*s == System::Glonass ? (c->band == '1' || c->band == '2')
-                                                     : isKnownBand(*s, c->band) && carrierFrequency(*s, c->band));
-      if (!band) fail(it->first, full, "'" + t + "' is not a signal of " + std::string(systemName(*s)));
+      if (!c || !rtcm::msmSignalId(*s, *c)) fail(it->first, full, "'" + t + "' is not a signal of " + std::string(systemName(*s)));
       f(*s, *c, full, it->second);
     }
   }

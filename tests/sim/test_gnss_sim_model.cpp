@@ -13,6 +13,8 @@
 #include "gvins/gnss/sagnac.hpp"
 #include "gvins/gnss/troposphere.hpp"
 #include "gvins/sim/gnss_epoch_generator.hpp"
+#include "gvins/sim/gnss_random_field.hpp"
+#include "gvins/sim/gnss_receiver_clock.hpp"
 #include "test_gnss_support.hpp"
 
 namespace gvins::sim {
@@ -149,6 +151,239 @@ TEST(GnssSimModel, PseudorangeMinusGeometryAndModelsEqualsSimulatedErrors) {
   for (System s : {System::Gps, System::Glonass, System::Galileo, System::BeiDou, System::Qzss}) {
     EXPECT_GT(perSystem[s], 0) << systemName(s);
   }
+}
+
+
+/// Noise-free receivers with a deterministic clock (for rates and differences).
+GnssSimConfig quietConfig() {
+  GnssSimConfig c;
+  for (GnssReceiverConfig* r : {&c.rover, &c.base.receiver}) {
+    r->noise = {0.0, 0.0, 0.0};
+    r->multipath = {0.0, 0.0, 10.0};
+    r->nlos.ratePerMinute = 0.0;
+    r->blockage.ratePerMinute = 0.0;
+    r->slips.ratePerMinute = 0.0;
+    r->clock.h0 = 0.0;
+    r->clock.hMinus2 = 0.0;
+    r->cn0.noise = 0.0;
+  }
+  return c;
+}
+
+/// Checks -(L_k - L_k-1) / dt against the mean Doppler of the two epochs for every continuous
+/// arc; returns the largest difference in m/s.
+double dopplerVersusPhaseRate(const std::vector<GnssSimEpoch>& epochs, int* pairs) {
+  double worst = 0.0;
+  for (std::size_t k = 1; k < epochs.size(); ++k) {
+    const ObsEpoch& a = epochs[k - 1].obs;
+    const ObsEpoch& b = epochs[k].obs;
+    const double dt = b.time - a.time;
+    for (std::size_t i = 0; i < b.sats.size(); ++i) {
+      const SatObs* sa = a.find(b.sats[i].sat);
+      if (!sa) continue;
+      for (std::size_t j = 0; j < b.sats[i].signals.size(); ++j) {
+        const SignalObs& gb = b.sats[i].signals[j];
+        const SignalObs* ga = sa->find(gb.code);
+        if (!ga || (gb.lli & 1) || epochs[k].truth.sats[i].signals[j].arcStart) continue;
+        const double lambda = epochs[k].truth.sats[i].signals[j].wavelength;
+        const double rate = -(gb.carrierPhase - ga->carrierPhase) / dt;
+        worst = std::max(worst, std::abs(rate - 0.5 * (gb.doppler + ga->doppler)) * lambda);
+        ++*pairs;
+      }
+    }
+  }
+  return worst;
+}
+
+TEST(GnssSimModel, DopplerIsTheRateOfTheCarrierPhase) {
+  // Static antenna: the phase-rate over 0.2 s equals the mean Doppler to the curvature of the
+  // range (1e-5 m/s); a moving one (8 m/s on an 80 m circle, 0.8 m/s^2): to its jerk.
+  for (const double speed : {0.0, 8.0}) {
+    GnssSimConfig cfg = quietConfig();
+    cfg.rover.rate = 5.0;
+    cfg.base.enabled = false;
+    const CircleTrajectory traj(10.0, 80.0, 40.0, speed);
+    GnssEpochGenerator gen(cfg, nagoyaNav(), traj, nagoyaFrame(), Eigen::Vector3d(0.2, 0.0, 0.1), 3);
+    std::vector<GnssSimEpoch> epochs;
+    while (auto e = gen.next()) epochs.push_back(std::move(*e));
+    int pairs = 0;
+    const double worst = dopplerVersusPhaseRate(epochs, &pairs);
+    EXPECT_GT(pairs, 3000);
+    EXPECT_LT(worst, speed == 0.0 ? 2e-4 : 5e-3) << "speed " << speed;
+    // The clock drift is in every Doppler: c * drift is tens of m/s for a 0.1 ppm oscillator.
+    EXPECT_GT(std::abs(epochs.front().truth.clockDrift), 1e-10);
+  }
+}
+
+TEST(GnssSimModel, ReceiverClockFollowsItsAllanVariance) {
+  // Overlapping Allan variance of the simulated clock phase against the power-law model
+  // sigma_y^2(tau) = h0 / (2 tau) + (2 pi^2 / 3) h_-2 tau (NIST Technical Note 1337, table 2 of
+  // Barnes et al. for white and random-walk frequency noise).
+  GnssClockConfig c;
+  c.h0 = 1e-21;
+  c.hMinus2 = 1e-22;
+  GnssReceiverClock clock(c, 5);
+  const GpsTime t0 = nagoyaFrame().startTime;
+  const int n = 40000;
+  std::vector<double> x(n);
+  for (int i = 0; i < n; ++i) {
+    clock.advanceToTag(t0 + static_cast<double>(i));
+    x[static_cast<std::size_t>(i)] = clock.bias();
+  }
+  for (int m : {1, 10, 100}) {
+    double sum = 0.0;
+    int count = 0;
+    for (int i = 0; i + 2 * m < n; ++i, ++count) {
+      const double d = x[static_cast<std::size_t>(i + 2 * m)] - 2.0 * x[static_cast<std::size_t>(i + m)] + x[static_cast<std::size_t>(i)];
+      sum += d * d;
+    }
+    const double tau = m;
+    const double avar = sum / (2.0 * tau * tau * count);
+    const double model = c.h0 / (2.0 * tau) + 2.0 * constants::kPi * constants::kPi / 3.0 * c.hMinus2 * tau;
+    EXPECT_NEAR(avar / model, 1.0, m == 100 ? 0.25 : 0.1) << "tau " << tau;
+  }
+  // Inter-system biases: constant, GPS the reference.
+  EXPECT_EQ(clock.isb(System::Gps), 0.0);
+  EXPECT_NE(clock.isb(System::Glonass), 0.0);
+}
+
+TEST(GnssSimModel, RandomFieldsHaveTheConfiguredCovariance) {
+  // Correlation of values at separations of 0.25, 1 and 2 correlation lengths over 600 random
+  // realisations: exp(-d^2/L^2) or exp(-d/L) within sampling error.
+  for (const auto cov : {GnssRandomFieldConfig::Covariance::Gaussian, GnssRandomFieldConfig::Covariance::Exponential}) {
+    GnssRandomFieldConfig fc{2.0, 10e3, cov, 0.0};
+    const double ds[] = {0.0, 2.5e3, 10e3, 20e3};
+    double sxx = 0.0, sxy[4] = {0, 0, 0, 0};
+    const int runs = 600;
+    for (int r = 0; r < runs; ++r) {
+      const GnssRandomField f(fc, 1000 + static_cast<std::uint64_t>(r));
+      const Eigen::Vector2d p0(1234.0, -567.0);
+      const double v0 = f.value(p0, 0.0);
+      sxx += v0 * v0;
+      for (int k = 0; k < 4; ++k) {
+        const double a = 0.7 * k;  // several directions
+        sxy[k] += v0 * f.value(p0 + ds[k] * Eigen::Vector2d(std::cos(a), std::sin(a)), 0.0);
+      }
+    }
+    EXPECT_NEAR(std::sqrt(sxx / runs), 2.0, 0.15);
+    for (int k = 1; k < 4; ++k) {
+      const double d = ds[k] / fc.correlationLength;
+      const double model = cov == GnssRandomFieldConfig::Covariance::Gaussian ? std::exp(-d * d) : std::exp(-d);
+      EXPECT_NEAR(sxy[k] / sxx, model, 0.1) << "separation " << ds[k];
+    }
+  }
+  // Frozen flow: the field moves with the wind.
+  const GnssRandomField f({1.0, 5e3, GnssRandomFieldConfig::Covariance::Gaussian, 20.0}, 9);
+  const Eigen::Vector2d p(100.0, 200.0);
+  EXPECT_NEAR(f.value(p + f.wind() * 30.0, 30.0), f.value(p, 0.0), 1e-12);
+  EXPECT_NEAR(f.wind().norm(), 20.0, 1e-12);
+}
+
+TEST(GnssSimModel, AtmosphereErrorsCancelInDoubleDifferencesMoreTheCloserTheBase) {
+  // Static rover at the origin, base at 0.5, 3 and 20 km: double differences (rover - base,
+  // satellite - reference satellite) of the atmospheric errors the models leave are millimetres
+  // at short range and grow with the distance, while the undifferenced errors are decimetres to
+  // metres.
+  std::vector<double> ddRms;
+  double undiffRms = 0.0;
+  for (const double distance : {500.0, 3000.0, 20000.0}) {
+    GnssSimConfig cfg = quietConfig();
+    cfg.rover.rate = 1.0;
+    cfg.base.distance = distance;
+    const CircleTrajectory traj(60.0, 0.0, 0.0, 0.0);
+    GnssEpochGenerator gen(cfg, nagoyaNav(), traj, nagoyaFrame(), Eigen::Vector3d::Zero(), 11);
+    std::map<std::int64_t, std::map<SatId, double>> rover, base;  // tag -> sat -> L1 error (m)
+    double u2 = 0.0;
+    int un = 0;
+    while (auto e = gen.next()) {
+      for (const GnssSatelliteTruth& st : e->truth.sats) {
+        if (st.sat.system != System::Gps || st.azel.elevation < 15.0 * constants::kDegToRad) continue;
+        const double err = (st.troposphere - st.troposphereModel) - (st.ionosphereL1 - st.ionosphereModelL1);
+        (e->role == GnssReceiverRole::Rover ? rover : base)[e->obs.time.wholeSeconds()][st.sat] = err;
+        u2 += err * err;
+        ++un;
+      }
+    }
+    double s2 = 0.0;
+    int n = 0;
+    for (const auto& [tag, rs] : rover) {
+      const auto bit = base.find(tag);
+      if (bit == base.end()) continue;
+      const auto& bs = bit->second;
+      std::optional<double> ref;
+      for (const auto& [sat, er] : rs) {
+        const auto b = bs.find(sat);
+        if (b == bs.end()) continue;
+        const double sd = er - b->second;
+        if (!ref) {
+          ref = sd;
+          continue;
+        }
+        s2 += (sd - *ref) * (sd - *ref);
+        ++n;
+      }
+    }
+    ASSERT_GT(n, 200);
+    ddRms.push_back(std::sqrt(s2 / n));
+    undiffRms = std::sqrt(u2 / un);
+  }
+  std::printf("DD atmosphere error RMS: %.4f m at 0.5 km, %.4f m at 3 km, %.4f m at 20 km; undifferenced %.3f m\n",
+              ddRms[0], ddRms[1], ddRms[2], undiffRms);
+  EXPECT_LT(ddRms[0], ddRms[1]);
+  EXPECT_LT(ddRms[1], ddRms[2]);
+  EXPECT_LT(ddRms[1], 0.02);
+  EXPECT_GT(undiffRms, 10.0 * ddRms[1]);
+}
+
+TEST(GnssSimModel, TrueOrbitsAreContinuousAndCloseToEveryBroadcastRecord) {
+  // Blended records: no jump where the nearest record changes (Galileo every 10 min, GLONASS
+  // every 30 min), velocity = derivative of position, and within metres of whatever record a
+  // user's EphemerisStore selects.
+  GnssSimConfig cfg;
+  cfg.satelliteErrors.sisre.fill(0.0);
+  const LocalFrame frame = nagoyaFrame();
+  EphemerisStore store;
+  store.add(nagoyaNav());
+  const GnssConstellation con(store, cfg, frame.startTime, frame.startTime + 3600.0, 1);
+  ASSERT_GT(con.satellites().size(), 60u);
+  double worstJump = 0.0, worstVel = 0.0, worstBroadcast = 0.0, worstClock = 0.0;
+  for (SatId sat : con.satellites()) {
+    for (double t = 0.0; t <= 3600.0; t += 20.0) {
+      const GpsTime at = frame.startTime + t;
+      const auto a = con.state(sat, at);
+      const auto b = con.state(sat, at + 0.5);
+      const auto c = con.state(sat, at - 0.5);
+      if (!a || !b || !c) continue;
+      worstVel = std::max(worstVel, ((b->position - c->position) - a->velocity).norm());
+      // One record at the three instants (the store may switch records between them).
+      std::optional<SatelliteState> s, sb, sc;
+      if (sat.system == System::Glonass) {
+        if (const GlonassEphemeris* g = store.selectGlonass(sat, at)) {
+          s = glonassSatelliteState(*g, at);
+          sb = glonassSatelliteState(*g, at + 0.5);
+          sc = glonassSatelliteState(*g, at - 0.5);
+        }
+      } else if (const KeplerEphemeris* k = store.selectKepler(sat, at)) {
+        s = keplerSatelliteState(*k, at);
+        sb = keplerSatelliteState(*k, at + 0.5);
+        sc = keplerSatelliteState(*k, at - 0.5);
+      }
+      if (!s) continue;
+      // The second difference over +-0.5 s is the acceleration times 0.25 s^2 (~0.15 m); the
+      // blend must not add a kink to it.
+      worstJump = std::max(worstJump, ((b->position - 2.0 * a->position + c->position) -
+                                       (sb->position - 2.0 * s->position + sc->position)).norm());
+      worstBroadcast = std::max(worstBroadcast, (s->position - a->position).norm());
+      worstClock = std::max(worstClock, kC * std::abs(s->clockBias - a->clock));
+    }
+  }
+  std::printf("blended truth: max second difference beyond the record's %.2e m, max velocity error %.2e m/s, max distance to the "
+              "selected record %.2f m (clock %.2f m)\n",
+              worstJump, worstVel, worstBroadcast, worstClock);
+  EXPECT_LT(worstJump, 1e-4);
+  EXPECT_LT(worstVel, 1e-3);
+  EXPECT_LT(worstBroadcast, 10.0);
+  EXPECT_LT(worstClock, 10.0);
 }
 
 }  // namespace

@@ -77,8 +77,9 @@ class GnssRandom {
   double normal(double sigma) { return sigma * normal(); }
   /// Exponential with the given mean.
   double exponential(double mean) { return -mean * std::log1p(-uniform()); }
-  /// Uniform integer in [lo, hi].
+  /// Uniform integer in [lo, hi] (lo when hi <= lo).
   std::int64_t integer(std::int64_t lo, std::int64_t hi) {
+    if (hi <= lo) return lo;
     const std::uint64_t span = static_cast<std::uint64_t>(hi - lo) + 1;
     return lo + static_cast<std::int64_t>(next() % span);
   }
