@@ -1,0 +1,80 @@
+// A gvins-sim scenario: where and when, the motion, the IMU, the cameras (rendered images or
+// feature tracks), the scene, the GNSS antenna lever arm and the GNSS simulation (the `gnss:`
+// section, parsed by parseGnssSimConfig). One YAML file describes one scenario; every key is
+// optional on top of defaultScenario() and unknown keys are errors. The format is documented in
+// docs/dataset_format.md ("Scenario files") and config/*.yaml are examples.
+//
+// Every malformed scenario throws gvins::ParseError naming the file, the line and the key
+// (e.g. "trajectory.speed_mps").
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "gvins/sim/camera_renderer.hpp"
+#include "gvins/sim/feature_simulator.hpp"
+#include "gvins/sim/flight_pattern.hpp"
+#include "gvins/sim/gnss_sim_config.hpp"
+#include "gvins/sim/ground_texture.hpp"
+#include "gvins/sim/imu_simulator.hpp"
+#include "gvins/sim/local_frame.hpp"
+#include "gvins/sim/recorded_trajectory.hpp"
+#include "gvins/vio/sensor_yaml.hpp"
+
+namespace gvins::sim {
+
+enum class TrajectoryKind { Flight, Recorded };
+enum class CameraOutput { Images, Features };
+
+struct Scenario {
+  std::string name = "default";
+  std::string description;
+  std::string file;          ///< where it was read from ("" for built-in)
+  std::string text;          ///< the YAML text it was read from ("" for built-in)
+  std::uint64_t seed = 1;    ///< default seed (gvins-sim --seed overrides)
+  LocalFrame frame;          ///< origin = ground at the take-off point, start of the flight
+
+  TrajectoryKind trajectory = TrajectoryKind::Flight;
+  FlightSpec flight;
+  RecordedTrajectoryConfig recorded;
+
+  ImuSimConfig imu;
+  double cameraRate = 20.0;  ///< Hz
+  CameraOutput output = CameraOutput::Images;
+  int pngCompression = 1;    ///< 0-9 (zlib level)
+  std::vector<vio::CameraCalibration> cameras;
+  ImagingConfig imaging;
+  FeatureSimConfig features;
+  GroundTextureConfig texture;  ///< texture.seed is replaced by one derived from the run's seed
+
+  Eigen::Vector3d leverArm = Eigen::Vector3d(0.08, 0.0, 0.18);  ///< GNSS antenna in the IMU frame, m
+  std::optional<GnssSimConfig> gnss;  ///< no GNSS when absent
+};
+
+/// The built-in default: a two-minute stereo UAV survey (lawnmower, 40 m, 8 m/s) near the
+/// Nagoya GNSS data of 2024-06-24 08:20 GPST, with a base station 3 km away and the bundled
+/// navigation file (config/default.yaml is the same scenario as a file).
+Scenario defaultScenario();
+
+/// Reads a scenario file / text on top of defaultScenario(). Relative paths are relative to the
+/// file's folder.
+Scenario loadScenario(const std::string& path);
+Scenario parseScenario(const std::string& text, const std::string& file);
+
+/// The EuRoC MAV cam0/cam1 intrinsics and radial-tangential distortion (V1_01 sensor.yaml),
+/// mounted looking down (image up = body forward) at `position_m` in the body frame.
+vio::CameraCalibration downwardCamera(const std::string& name, const Eigen::Vector3d& position,
+                                      const Eigen::Vector3d& mountRpyDeg = Eigen::Vector3d::Zero(),
+                                      bool cam1Intrinsics = false);
+/// Rotation R_BC of a camera looking down (image up = body x) or forward (image right = -body y),
+/// followed by small mount angles (deg): R_look Rz(yaw) Ry(pitch) Rx(roll).
+Eigen::Matrix3d cameraMountRotation(bool lookDown, const Eigen::Vector3d& mountRpyDeg);
+
+/// Path of the navigation file bundled with the sources (tests/data/gnss/nagoya_static_2024).
+std::string bundledNavigationFile();
+
+}  // namespace gvins::sim

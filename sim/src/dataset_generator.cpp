@@ -1,0 +1,475 @@
+#include "gvins/sim/dataset_generator.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <iomanip>
+#include <map>
+#include <mutex>
+#include <ostream>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "gvins/sim/dataset_writer.hpp"
+#include "gvins/sim/gnss_simulator.hpp"
+#include "gvins/sim/random.hpp"
+
+namespace gvins::sim {
+namespace fs = std::filesystem;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+/// Prints "<what> k/n (p %)" at most once a second (thread-safe).
+class Progress {
+ public:
+  Progress(std::ostream* os, std::string what, std::size_t total) : os_(os), what_(std::move(what)), total_(total) {}
+  void step() {
+    const std::size_t k = ++done_;
+    if (!os_) return;
+    std::lock_guard<std::mutex> lock(m_);
+    if (k != total_ && since(last_) < 1.0) return;
+    last_ = Clock::now();
+    *os_ << "[gvins-sim] " << what_ << " " << k << "/" << total_ << " (" << std::fixed << std::setprecision(0)
+         << 100.0 * static_cast<double>(k) / static_cast<double>(std::max<std::size_t>(total_, 1)) << " %, "
+         << std::setprecision(1) << static_cast<double>(k) / std::max(since(start_), 1e-9) << "/s)\n"
+         << std::defaultfloat << std::flush;
+  }
+
+ private:
+  std::ostream* os_;
+  std::string what_;
+  std::size_t total_;
+  std::atomic<std::size_t> done_{0};
+  std::mutex m_;
+  Clock::time_point start_ = Clock::now(), last_ = Clock::now();
+};
+
+std::string gpstString(const GpsTime& t) { return t.toString(9); }
+
+double medianCameraHeight(const Trajectory& tr, const vio::CameraCalibration& cam) {
+  std::vector<double> z;
+  for (double t = 0.0; t <= tr.duration(); t += std::max(tr.duration() / 200.0, 0.05)) {
+    const TrajectoryState s = tr.evaluate(t);
+    z.push_back((s.p_WB + s.R_WB * cam.T_BS.topRightCorner<3, 1>()).z());
+  }
+  std::nth_element(z.begin(), z.begin() + static_cast<long>(z.size() / 2), z.end());
+  return std::max(z[z.size() / 2], 0.5);
+}
+
+void writeList(TextFile& f, const Eigen::Vector3d& v) {
+  f << "[";
+  f.num(v.x()) << ", ";
+  f.num(v.y()) << ", ";
+  f.num(v.z()) << "]";
+}
+
+std::string yamlQuoted(const std::string& s) {
+  std::string o = "\"";
+  for (const char c : s) {
+    if (c == '"' || c == '\\') o += '\\';
+    if (c == '\n') {
+      o += "\\n";
+      continue;
+    }
+    o += c;
+  }
+  return o + "\"";
+}
+
+}  // namespace
+
+std::unique_ptr<Trajectory> buildTrajectory(const Scenario& sc, std::uint64_t seed) {
+  if (sc.trajectory == TrajectoryKind::Recorded) return std::make_unique<RecordedTrajectory>(sc.recorded);
+  FlightSpec f = sc.flight;
+  f.gravity = flatGravity(sc.imu, sc.frame);
+  return buildFlight(f, seed);
+}
+
+void GenerationSummary::print(std::ostream& os) const {
+  const auto flags = os.flags();
+  os << "gvins-sim summary\n";
+  os << "  scenario            " << scenario << " (seed " << seed << ")\n";
+  os << "  start (GPST)        " << startGpst << "\n";
+  os << std::fixed << std::setprecision(1);
+  os << "  duration            " << duration << " s, path " << pathLength << " m, max speed " << std::setprecision(2)
+     << maxSpeed << " m/s, max height " << std::setprecision(1) << maxHeight << " m\n";
+  os << "  IMU                 " << imuSamples << " samples at " << std::setprecision(0) << imuRate << " Hz\n";
+  if (cameras > 0) {
+    os << "  cameras             " << cameras << " x " << framesPerCamera << " frames, "
+       << (images ? "rendered images" : "feature tracks") << "\n";
+    os << std::setprecision(2);
+    if (images)
+      os << "  rendering           " << meanBlurSamples << " sub-exposures per image, " << textureTiles
+         << " texture tiles\n";
+    else
+      os << "  features            " << featureObservations << " observations of " << landmarks << " landmarks, "
+         << meanFeaturesPerImage << " per image\n";
+  }
+  os << std::setprecision(1);
+  os << "  time                trajectory+IMU " << secondsTrajectoryImu << " s, cameras " << secondsCameras
+     << " s, GNSS " << secondsGnss << " s, total " << secondsTotal << " s\n";
+  os << "  written             " << std::setprecision(1) << static_cast<double>(bytes) / 1e6 << " MB\n";
+  os.flags(flags);
+  if (!gnssSummary.empty()) os << gnssSummary;
+}
+
+GenerationSummary generateDataset(const Scenario& sc, const fs::path& dir, const GenerationOptions& opt) {
+  const auto tStart = Clock::now();
+  GenerationSummary sum;
+  sum.scenario = sc.name;
+  sum.seed = opt.seed;
+  sum.startGpst = gpstString(sc.frame.startTime);
+  const std::uint64_t seed = opt.seed;
+  std::ostream* log = opt.progress;
+  if (std::abs(sc.frame.startTime.fraction() * 1e9 - std::round(sc.frame.startTime.fraction() * 1e9)) > 1e-3)
+    throw std::invalid_argument("the start time must be a whole nanosecond");
+
+  // ---- trajectory and IMU
+  if (log) *log << "[gvins-sim] scenario '" << sc.name << "', seed " << seed << " -> " << dir.string() << "\n";
+  const std::unique_ptr<Trajectory> traj = buildTrajectory(sc, seed);
+  const double duration = traj->duration();
+  sum.duration = duration;
+  const fs::path mav0 = dir / "mav0";
+  const fs::path truthDir = dir / "truth";
+  fs::create_directories(mav0 / "imu0");
+  fs::create_directories(mav0 / "state_groundtruth_estimate0");
+  fs::create_directories(truthDir);
+
+  std::vector<vio::ImuSample> imu;
+  std::vector<TruthRow> truth;
+  double gravity = 9.81;
+  std::string imuSource = "simulated";
+  if (sc.trajectory == TrajectoryKind::Flight) {
+    const SimulatedImu sim = simulateImu(*traj, sc.frame, sc.imu, seed);
+    gravity = sim.gravity;
+    imu = sim.samples;
+    truth.resize(imu.size());
+    for (std::size_t i = 0; i < imu.size(); ++i) {
+      truth[i].t_ns = imu[i].t_ns;
+      truth[i].state = traj->evaluate(sc.frame.flightTimeOfStamp(imu[i].t_ns));
+      truth[i].bg = sim.gyroBias[i];
+      truth[i].ba = sim.accelBias[i];
+    }
+    sum.imuRate = sc.imu.rateHz;
+  } else {
+    const auto& rec = static_cast<const RecordedTrajectory&>(*traj);
+    imuSource = "recorded: " + sc.recorded.imuCsv;
+    gravity = 9.81;  // the recording's processing convention (EuRoC)
+    for (const vio::ImuSample& m : rec.imuSamples()) {
+      const std::int64_t off = m.t_ns - rec.startStamp();
+      if (off < 0 || static_cast<double>(off) * 1e-9 > duration) continue;
+      vio::ImuSample s = m;
+      s.t_ns = sc.frame.startStampNs() + off;
+      imu.push_back(s);
+      TruthRow row;
+      row.t_ns = s.t_ns;
+      row.state = traj->evaluate(static_cast<double>(off) * 1e-9);
+      rec.biases(row.state.t, row.bg, row.ba);
+      truth.push_back(row);
+    }
+    sum.imuRate = imu.size() > 1 ? 1e9 * static_cast<double>(imu.size() - 1) /
+                                       static_cast<double>(imu.back().t_ns - imu.front().t_ns)
+                                 : 0.0;
+  }
+  sum.imuSamples = imu.size();
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    if (i > 0) sum.pathLength += (truth[i].state.p_WB - truth[i - 1].state.p_WB).norm();
+    sum.maxSpeed = std::max(sum.maxSpeed, truth[i].state.v_WB.norm());
+    sum.maxHeight = std::max(sum.maxHeight, truth[i].state.p_WB.z());
+  }
+  vio::ImuNoise noise = sc.imu.noise;
+  noise.rate_hz = sum.imuRate;
+  writeImuCsv(mav0 / "imu0" / "data.csv", imu);
+  writeImuSensorYaml(mav0 / "imu0" / "sensor.yaml", noise, std::round(sum.imuRate),
+                     sc.trajectory == TrajectoryKind::Flight ? "gvins-sim IMU (noise model of this file)"
+                                                            : "recorded IMU driving gvins-sim");
+  writeGroundTruthCsv(mav0 / "state_groundtruth_estimate0" / "data.csv", truth);
+  writeEcefTruthCsv(truthDir / "groundtruth_ecef.csv", truth, sc.frame, sc.leverArm);
+  sum.secondsTrajectoryImu = since(tStart);
+  if (log) *log << "[gvins-sim] trajectory " << std::fixed << std::setprecision(1) << duration << " s, "
+                << imu.size() << " IMU samples\n" << std::defaultfloat;
+
+  // ---- cameras
+  const auto tCam = Clock::now();
+  const bool features = opt.featuresOnly || sc.output == CameraOutput::Features;
+  sum.images = !features;
+  sum.cameras = static_cast<int>(sc.cameras.size());
+  std::vector<std::int64_t> stamps;
+  std::vector<double> times;
+  if (!sc.cameras.empty()) {
+    const auto nFrames = static_cast<std::size_t>(std::floor(duration * sc.cameraRate + 1e-9)) + 1;
+    for (std::size_t k = 0; k < nFrames; ++k) {
+      const std::int64_t off = std::llround(static_cast<double>(k) * 1e9 / sc.cameraRate);
+      stamps.push_back(sc.frame.startStampNs() + off);
+      times.push_back(static_cast<double>(off) * 1e-9);
+    }
+  }
+  sum.framesPerCamera = stamps.size();
+  const std::size_t nCams = sc.cameras.size();
+  for (std::size_t c = 0; c < nCams; ++c) {
+    const fs::path camDir = mav0 / ("cam" + std::to_string(c));
+    fs::create_directories(camDir);
+    vio::CameraCalibration cal = sc.cameras[c];
+    cal.rate_hz = sc.cameraRate;
+    writeCameraSensorYaml(camDir / "sensor.yaml", cal, sc.cameraRate,
+                          features ? "gvins-sim camera (feature tracks in features.csv, no images)"
+                                   : "gvins-sim rendered camera");
+    writeCameraCsv(camDir / "data.csv", stamps);
+    // True camera poses at the stamps.
+    std::vector<Eigen::Matrix3d> R(stamps.size());
+    std::vector<Eigen::Vector3d> p(stamps.size());
+    const Eigen::Matrix3d R_BC = cal.T_BS.topLeftCorner<3, 3>();
+    const Eigen::Vector3d p_BC = cal.T_BS.topRightCorner<3, 1>();
+    for (std::size_t k = 0; k < stamps.size(); ++k) {
+      const TrajectoryState s = traj->evaluate(times[k]);
+      R[k] = s.R_WB * R_BC;
+      p[k] = s.p_WB + s.R_WB * p_BC;
+    }
+    writeCameraPosesCsv(truthDir / ("cam" + std::to_string(c) + "_poses.csv"), stamps, R, p);
+  }
+
+  if (nCams > 0 && features) {
+    double density = sc.features.densityPerM2;
+    if (!(density > 0.0))
+      density = autoLandmarkDensity(sc.cameras[0].intrinsics, medianCameraHeight(*traj, sc.cameras[0]),
+                                    sc.features.landmarksPerImage);
+    const LandmarkField field(density, sc.features.heightSigma, hashCombine(seed, nameHash("landmarks")));
+    std::map<std::uint64_t, Eigen::Vector3d> seen;
+    Progress prog(log, "feature frames", stamps.size() * nCams);
+    for (std::size_t c = 0; c < nCams; ++c) {
+      const FeatureSimulator fsim(sc.cameras[c], sc.features, field, sc.imaging.lineTime);
+      const std::string cam = "cam" + std::to_string(c);
+      TextFile obs(mav0 / cam / "features.csv");
+      TextFile tru(truthDir / (cam + "_features.csv"));
+      obs << "#timestamp [ns],landmark_id,u [px],v [px]\n";
+      tru << "#timestamp [ns],landmark_id,u_true [px],v_true [px],outlier\n";
+      for (std::size_t k = 0; k < stamps.size(); ++k) {
+        const auto o = fsim.observe(*traj, times[k], hash4(seed, 0xFEA7, static_cast<std::int64_t>(c), static_cast<std::int64_t>(k)));
+        for (const FeatureObservation& f : o) {
+          obs.integer(stamps[k]).put(',').unsignedInteger(f.landmark).put(',').fixed(f.pixel.x(), 4).put(',').fixed(f.pixel.y(), 4).put('\n');
+          tru.integer(stamps[k]).put(',').unsignedInteger(f.landmark).put(',').fixed(f.truePixel.x(), 6).put(',').fixed(f.truePixel.y(), 6).put(',').integer(f.outlier ? 1 : 0).put('\n');
+          seen.emplace(f.landmark, f.p_W);
+        }
+        sum.featureObservations += o.size();
+        prog.step();
+      }
+      obs.close();
+      tru.close();
+    }
+    TextFile lm(truthDir / "landmarks.csv");
+    lm << "#landmark_id,p_W_x [m],p_W_y [m],p_W_z [m]\n";
+    for (const auto& [id, pw] : seen) {
+      lm.unsignedInteger(id).put(',').num(pw.x()).put(',').num(pw.y()).put(',').num(pw.z()).put('\n');
+    }
+    lm.close();
+    sum.landmarks = seen.size();
+    sum.meanFeaturesPerImage = static_cast<double>(sum.featureObservations) / static_cast<double>(std::max<std::size_t>(stamps.size() * nCams, 1));
+  } else if (nCams > 0) {
+    GroundTextureConfig tc = sc.texture;
+    tc.seed = hashCombine(seed, nameHash("texture"));
+    const GroundTexture texture(tc);
+    std::vector<std::unique_ptr<CameraRenderer>> renderers;
+    std::vector<std::vector<double>> gains;
+    for (std::size_t c = 0; c < nCams; ++c) {
+      renderers.push_back(std::make_unique<CameraRenderer>(sc.cameras[c], sc.imaging, texture));
+      gains.push_back(exposureGains(stamps.size(), sc.imaging, hashCombine(seed, 0x6A1 + c)));
+      fs::create_directories(mav0 / ("cam" + std::to_string(c)) / "data");
+    }
+    const std::size_t total = stamps.size() * nCams;
+    int threads = opt.threads > 0 ? opt.threads : static_cast<int>(std::thread::hardware_concurrency());
+    threads = std::clamp(threads, 1, 64);
+    std::atomic<std::size_t> next{0};
+    std::atomic<std::size_t> blurSum{0};
+    std::exception_ptr error;
+    std::mutex errorMutex;
+    Progress prog(log, "images", total);
+    const std::vector<int> pngParams = {cv::IMWRITE_PNG_COMPRESSION, sc.pngCompression};
+    auto worker = [&] {
+      std::vector<std::uint8_t> buf;
+      for (;;) {
+        const std::size_t i = next++;
+        if (i >= total) return;
+        {
+          std::lock_guard<std::mutex> lock(errorMutex);
+          if (error) return;
+        }
+        try {
+          const std::size_t k = i / nCams, c = i % nCams;
+          const CameraRenderer& r = *renderers[c];
+          blurSum += static_cast<std::size_t>(r.blurSamples(*traj, times[k]));
+          const cv::Mat img = r.render(*traj, times[k], gains[c][k],
+                                       hash4(seed, 0x1A6E, static_cast<std::int64_t>(c), static_cast<std::int64_t>(k)));
+          if (!cv::imencode(".png", img, buf, pngParams)) throw std::runtime_error("PNG encoding failed");
+          const fs::path file = mav0 / ("cam" + std::to_string(c)) / "data" / (std::to_string(stamps[k]) + ".png");
+          std::FILE* f = std::fopen(file.string().c_str(), "wb");
+          if (!f) throw std::runtime_error("cannot create " + file.string());
+          const bool ok = std::fwrite(buf.data(), 1, buf.size(), f) == buf.size();
+          if (std::fclose(f) != 0 || !ok) throw std::runtime_error("write error on " + file.string());
+          prog.step();
+        } catch (...) {
+          std::lock_guard<std::mutex> lock(errorMutex);
+          if (!error) error = std::current_exception();
+          return;
+        }
+      }
+    };
+    std::vector<std::thread> pool;
+    for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+    worker();
+    for (auto& t : pool) t.join();
+    if (error) std::rethrow_exception(error);
+    sum.meanBlurSamples = static_cast<double>(blurSum.load()) / static_cast<double>(std::max<std::size_t>(total, 1));
+    sum.textureTiles = texture.tilesGenerated();
+  }
+  sum.secondsCameras = since(tCam);
+
+  // ---- GNSS
+  const auto tGnss = Clock::now();
+  std::vector<fs::path> gnssFiles;
+  if (sc.gnss && opt.gnss) {
+    GnssSimulator gsim(*sc.gnss);
+    gsim.setProgressStream(log);
+    const GnssSimSummary g = gsim.run(*traj, sc.frame, sc.leverArm, seed, dir);
+    std::ostringstream os;
+    g.print(os);
+    sum.gnssSummary = os.str();
+    gnssFiles = g.files;
+  }
+  sum.secondsGnss = since(tGnss);
+
+  // ---- dataset.yaml
+  {
+    const GpsTime t0 = sc.frame.startTime;
+    const Eigen::Vector3d oe = sc.frame.originEcef();
+    const Eigen::Matrix3d R = sc.frame.rotationEcefFromW();
+    TextFile f(dir / "dataset.yaml");
+    f << "# SRI-GVINS simulated dataset written by gvins-sim; layout and conventions: docs/dataset_format.md\n";
+    f << "format: gvins-sim-dataset\nformat_version: 1\n";
+      f << "scenario: " << yamlQuoted(sc.name) << "\ndescription: " << yamlQuoted(sc.description) << "\nseed: " << std::to_string(seed);
+    f << "\ntime:\n  convention: \"sensor stamps (imu0, cam*, features, ground truth) are GPST nanoseconds since "
+         "1980-01-06 00:00:00 GPST; GNSS epochs are GPST receiver time tags (see gnss/)\"\n";
+    f << "  start_gpst: \"" << gpstString(t0) << "\"\n  start_ns: ";
+    f.integer(sc.frame.startStampNs()) << "\n  gps_week: ";
+    f.integer(t0.week()) << "\n  gps_tow_s: ";
+    f.num(t0.tow()) << "\n  duration_s: ";
+    f.num(duration) << "\n";
+    f << "local_frame:\n  type: ENU\n  origin_latitude_deg: ";
+    f.num(sc.frame.origin.lat * 180.0 / 3.14159265358979323846) << "\n  origin_longitude_deg: ";
+    f.num(sc.frame.origin.lon * 180.0 / 3.14159265358979323846) << "\n  origin_height_m: ";
+    f.num(sc.frame.origin.height) << "\n  origin_ecef_m: ";
+    writeList(f, oe);
+    f << "\n  R_ecef_local: [";
+    for (int i = 0; i < 9; ++i) {
+      f.num(R(i / 3, i % 3));
+      if (i < 8) f << ", ";
+    }
+    f << "]  # row-major; p_ecef = origin_ecef + R p_local\n  ground_plane_z_m: 0\n";
+    f << "gravity:\n  model: " << (sc.imu.earth == EarthModel::Rotating && sc.trajectory == TrajectoryKind::Flight ? "rotating" : "flat")
+      << "  # flat: the IMU measures R^T (a + g e_z); rotating: Earth rate and normal gravity included\n  magnitude_mps2: ";
+    f.num(gravity) << "\n";
+    f << "body_frame: \"IMU frame (x forward, y left, z up); ground truth is the pose of this frame in the local frame\"\n";
+    f << "lever_arm_m: ";
+    writeList(f, sc.leverArm);
+    f << "  # GNSS antenna phase centre in the body (IMU) frame\n";
+    f << "trajectory:\n  type: " << (sc.trajectory == TrajectoryKind::Flight ? "flight" : "recorded") << "\n";
+    if (sc.trajectory == TrajectoryKind::Flight) {
+      f << "  pattern: " << toString(sc.flight.pattern) << "\n  height_m: ";
+      f.num(sc.flight.height) << "\n  length_m: ";
+      f.num(sc.flight.length) << "\n  speed_mps: ";
+      f.num(sc.flight.speed) << "\n";
+    } else {
+      f << "  imu_csv: " << yamlQuoted(sc.recorded.imuCsv) << "\n  groundtruth_csv: " << yamlQuoted(sc.recorded.groundTruthCsv) << "\n";
+    }
+    f << "  path_length_m: ";
+    f.num(sum.pathLength) << "\n  max_speed_mps: ";
+    f.num(sum.maxSpeed) << "\n";
+    f << "imu:\n  folder: mav0/imu0\n  source: " << yamlQuoted(imuSource) << "\n  rate_hz: ";
+    f.num(sum.imuRate) << "\n  samples: ";
+    f.integer(static_cast<std::int64_t>(imu.size())) << "\n  gyroscope_noise_density: ";
+    f.num(noise.gyroscope_noise_density) << "\n  gyroscope_random_walk: ";
+    f.num(noise.gyroscope_random_walk) << "\n  accelerometer_noise_density: ";
+    f.num(noise.accelerometer_noise_density) << "\n  accelerometer_random_walk: ";
+    f.num(noise.accelerometer_random_walk) << "\n";
+    if (sc.trajectory == TrajectoryKind::Flight) {
+      f << "  white_noise: " << (sc.imu.whiteNoise ? "true" : "false") << "\n  bias_random_walk: "
+        << (sc.imu.biasRandomWalk ? "true" : "false") << "\n";
+    }
+    if (!truth.empty()) {
+      f << "  initial_gyro_bias_radps: ";
+      writeList(f, truth.front().bg);
+      f << "\n  initial_accel_bias_mps2: ";
+      writeList(f, truth.front().ba);
+      f << "\n";
+    }
+    f << "cameras:\n  output: " << (features ? "features" : "images") << "\n  rate_hz: ";
+    f.num(sc.cameraRate) << "\n  frames: ";
+    f.integer(static_cast<std::int64_t>(stamps.size()))
+        << "\n  stamp: \"mid-exposure of the centre row\"\n  exposure_s: ";
+    f.num(sc.imaging.exposure) << "\n  line_time_s: ";
+    f.num(sc.imaging.lineTime) << "\n";
+    if (features) {
+      f << "  pixel_noise_px: ";
+      f.num(sc.features.pixelNoise) << "\n  outlier_rate: ";
+      f.num(sc.features.outlierRate) << "\n";
+    }
+    f << "  list:";
+    if (nCams == 0) f << " []";
+    f << "\n";
+    for (std::size_t c = 0; c < nCams; ++c) {
+      const std::string cam = "cam" + std::to_string(c);
+      f << "    - name: " << cam << "\n      folder: mav0/" << cam << "\n      sensor_yaml: mav0/" << cam
+        << "/sensor.yaml\n      " << (features ? "features: mav0/" + cam + "/features.csv" : "images: mav0/" + cam + "/data")
+        << "\n      poses: truth/" << cam << "_poses.csv\n";
+      // The calibration once more (the same numbers as sensor.yaml), so dataset.yaml alone
+      // describes the rig.
+      const vio::CameraIntrinsics& k = sc.cameras[c].intrinsics;
+      f << "      resolution: [";
+      f.integer(k.width) << ", ";
+      f.integer(k.height) << "]\n      intrinsics: [";
+      f.num(k.fx) << ", ";
+      f.num(k.fy) << ", ";
+      f.num(k.cx) << ", ";
+      f.num(k.cy) << "]  # fu, fv, cu, cv\n      distortion_model: "
+                  << (k.model == vio::DistortionModel::Equidistant ? "equidistant" : "radial-tangential")
+                  << "\n      distortion_coefficients: [";
+      for (int i = 0; i < 4; ++i) {
+        f.num(k.model == vio::DistortionModel::None ? 0.0 : k.distortion[static_cast<std::size_t>(i)]);
+        f << (i < 3 ? ", " : "]\n");
+      }
+      f << "      T_BS: [";
+      for (int i = 0; i < 16; ++i) {
+        f.num(sc.cameras[c].T_BS(i / 4, i % 4));
+        f << (i < 15 ? ", " : "]  # row-major 4x4, camera in the body (IMU) frame: p_B = T_BS p_C\n");
+      }
+    }
+    f << "groundtruth:\n  local: mav0/state_groundtruth_estimate0/data.csv\n  ecef: truth/groundtruth_ecef.csv\n";
+    if (features && nCams > 0) f << "  landmarks: truth/landmarks.csv\n";
+    f << "gnss:";
+    if (gnssFiles.empty()) {
+      f << " null\n";
+    } else {
+      f << "\n  folder: gnss\n  files:\n";
+      for (const fs::path& p : gnssFiles) f << "    - " << yamlQuoted(fs::relative(p, dir).generic_string()) << "\n";
+    }
+    f.close();
+  }
+  if (!sc.text.empty()) {
+    TextFile s(dir / "scenario.yaml");
+    s << sc.text;
+    s.close();
+  }
+  std::error_code ec;
+  for (auto it = fs::recursive_directory_iterator(dir, ec); !ec && it != fs::recursive_directory_iterator(); it.increment(ec))
+    if (it->is_regular_file(ec)) sum.bytes += it->file_size(ec);
+  sum.secondsTotal = since(tStart);
+  return sum;
+}
+
+}  // namespace gvins::sim

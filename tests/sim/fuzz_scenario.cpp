@@ -1,0 +1,18 @@
+// libFuzzer target: gvins-sim scenario YAML (parseScenario, including the `gnss:` section read
+// by parseGnssSimConfig). Any exception other than gvins::ParseError, any crash or hang is a bug.
+// Parsing opens no file: paths in the scenario are only resolved, not read.
+#include <cstdint>
+#include <string>
+
+#include "gvins/base/parse_error.hpp"
+#include "gvins/sim/scenario.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  try {
+    const gvins::sim::Scenario sc = gvins::sim::parseScenario(text, "fuzz.yaml");
+    (void)sc;
+  } catch (const gvins::ParseError&) {
+  }
+  return 0;
+}
