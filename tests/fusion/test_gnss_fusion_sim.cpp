@@ -1,0 +1,228 @@
+// GNSS/INS end-to-end on simulated data: a multirotor figure-eight (gvins::sim flight, attitude
+// wobble), its IMU (ADIS16448-class noise, random turn-on biases) and its GNSS rover (5 Hz) and
+// base (1 Hz, 3 km) epochs over the real Nagoya broadcast ephemerides with every default error
+// source. The test backend (imu_gnss_test_backend.hpp) stands in for the VIO: its world frame W'
+// is the simulator's ENU frame rotated by 40° in yaw and shifted, so the fusion has to find the
+// frame. The driver hands each GNSS epoch over once the IMU state is 100 ms newer (GNSS latency),
+// so every update goes through the IMU integration terms. Accuracies are against the simulated
+// antenna truth, after the first 20 s of tight coupling.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <memory>
+
+#include "gvins/base/constants.hpp"
+#include "gvins/ephemeris/ephemeris_store.hpp"
+#include "gvins/ephemeris/rinex_nav.hpp"
+#include "gvins/fusion/gnss_fusion.hpp"
+#include "gvins/sim/flight_pattern.hpp"
+#include "gvins/sim/gnss_epoch_generator.hpp"
+#include "gvins/sim/imu_simulator.hpp"
+#include "gvins/vio/so3.hpp"
+#include "imu_gnss_test_backend.hpp"
+
+namespace gvins::fusion {
+namespace {
+
+using Eigen::Vector3d;
+constexpr double kYaw0 = 40.0 * constants::kDegToRad;  // W' = Rz(kYaw0) W + kShift
+const Vector3d kShift(5.0, -3.0, 2.0);
+const Vector3d kLever(0.10, -0.05, 0.20);
+constexpr std::int64_t kLatencyNs = 100000000;
+
+struct Scenario {
+  sim::LocalFrame frame;
+  std::unique_ptr<sim::SplineTrajectory> traj;
+  sim::SimulatedImu imu;
+  EphemerisStore nav;
+  std::vector<sim::GnssSimEpoch> epochs;  // rover and base, in tag order
+  Vector3d basePosition;
+};
+
+const Scenario& scenario() {
+  static const std::unique_ptr<Scenario> s = [] {
+    auto sc = std::make_unique<Scenario>();
+    sc->frame.origin = geodeticFromDegrees(35.134707705, 136.977577939, 104.853);
+    CalendarTime c;
+    c.year = 2024;
+    c.month = 6;
+    c.day = 24;
+    c.hour = 8;
+    c.minute = 20;
+    sc->frame.startTime = GpsTime::fromCalendar(c);
+    sim::FlightSpec f;
+    f.pattern = sim::FlightPattern::FigureEight;
+    f.length = 500.0;
+    f.speed = 6.0;
+    f.height = 30.0;
+    f.laps = 1;
+    f.takeoffLanding = false;
+    f.hoverStart = 2.0;
+    f.hoverEnd = 2.0;
+    f.wobbleDeg = 3.0;
+    sc->traj = sim::buildFlight(f, 5);
+    sim::ImuSimConfig ic;
+    sc->imu = sim::simulateImu(*sc->traj, sc->frame, ic, 17);
+    const NavData nav = readRinexNav(std::string(GVINS_TEST_DATA) + "/gnss/nagoya_static_2024/base.nav.gz");
+    sc->nav.add(nav);
+    sim::GnssSimConfig gc;
+    gc.rover.rate = 5.0;
+    sim::GnssEpochGenerator gen(gc, nav, *sc->traj, sc->frame, kLever, 2024);
+    while (auto e = gen.next()) sc->epochs.push_back(std::move(*e));
+    gen.finish();
+    sc->basePosition = gen.basePosition();
+    std::fprintf(stderr, "scenario: %.1f s flight, %zu IMU samples, %zu GNSS epochs\n", sc->traj->duration(),
+                 sc->imu.samples.size(), sc->epochs.size());
+    return sc;
+  }();
+  return *s;
+}
+
+/// Truth in W' of the IMU at flight time t.
+vio::ImuState truthState(const Scenario& sc, std::size_t k) {
+  const double t = sc.frame.flightTimeOfStamp(sc.imu.samples[k].t_ns);
+  const sim::TrajectoryState ts = sc.traj->evaluate(t);
+  const Eigen::Matrix3d Rz = yawRotation(kYaw0);
+  vio::ImuState s;
+  s.t_ns = sc.imu.samples[k].t_ns;
+  s.R_WI = Rz * ts.R_WB;
+  s.p_WI = Rz * ts.p_WB + kShift;
+  s.v_WI = Rz * ts.v_WB;
+  return s;  // biases left at zero: unknown to the filter
+}
+
+struct RunResult {
+  double posRms = 0.0, horRms = 0.0, velRms = 0.0, clockErr = 0.0;
+  int epochs = 0;
+  double tightAfter = -1.0;  // s of flight when the frame converged
+  double yawError = 0.0, yawSigma = 0.0;
+  GnssTypeCount psr, dopp, dpsr, ddcp, vel;
+  int fixedEpochs = 0;
+  Vector3d lever = Vector3d::Zero();
+  double meanMicros = 0.0;
+};
+
+template <typename Scalar>
+RunResult run(GnssFusionConfig cfg) {
+  const Scenario& sc = scenario();
+  Eigen::Matrix<double, 15, 1> sigma;
+  sigma << Vector3d::Constant(1e-3), Vector3d::Constant(1e-3), Vector3d::Constant(0.05), Vector3d::Constant(0.02),
+      Vector3d::Constant(0.1);
+  vio::ImuNoise noise = sim::ImuSimConfig{}.noise;
+  noise.rate_hz = 200.0;
+  testing::ImuGnssTestBackend<Scalar> be(noise, sc.imu.gravity, sc.imu.samples, truthState(sc, 2), sigma);
+  cfg.basePosition = sc.basePosition;
+  GnssFusion<Scalar> fusion(cfg);
+  const ObsEpoch* base = nullptr;
+  RunResult out;
+  double p2 = 0, h2 = 0, v2 = 0, c2 = 0, micros = 0;
+  int n = 0, nAll = 0;
+  std::optional<GpsTime> tight;
+  for (const sim::GnssSimEpoch& e : sc.epochs) {
+    if (e.role == sim::GnssReceiverRole::Base) {
+      base = &e.obs;
+      continue;
+    }
+    const double tf = sc.frame.flightTime(e.obs.time);
+    if (tf < 0.2 || tf > sc.traj->duration() - 0.5) continue;
+    const std::int64_t target = sc.frame.stampNs(tf) + kLatencyNs;
+    while (be.newestTime() < target) be.propagateTo(std::min(be.newestTime() + 50000000, target));
+    const GnssEpochReport r = fusion.processEpoch(be, e.obs, base, sc.nav);
+    micros += r.elapsedMicroseconds;
+    ++nAll;
+    if (r.stage == GnssFusionStage::kTight && !tight) {
+      tight = e.obs.time;
+      out.tightAfter = tf;
+    }
+    if (!tight || e.obs.time - *tight < 20.0 || !r.antennaEcef) continue;
+    const Eigen::Matrix3d R_NE = fusion.anchor().R_EN.transpose();
+    const Vector3d d = R_NE * (*r.antennaEcef - e.truth.antennaPosition);
+    p2 += d.squaredNorm();
+    h2 += d.head<2>().squaredNorm();
+    v2 += (*r.antennaVelocityEcef - e.truth.antennaVelocity).squaredNorm();
+    if (const auto c = fusion.clocks(be)) {
+      c2 += std::pow((*c)[0] - constants::kSpeedOfLight * e.truth.systemClockBias[0], 2);
+    }
+    auto add = [](GnssTypeCount& a, const GnssTypeCount& b) {
+      a.used += b.used;
+      a.rejected += b.rejected;
+    };
+    add(out.psr, r.psr);
+    add(out.dopp, r.dopp);
+    add(out.dpsr, r.dpsr);
+    add(out.ddcp, r.ddcp);
+    add(out.vel, r.vel);
+    out.fixedEpochs += r.rtkFixed;
+    ++n;
+  }
+  out.epochs = n;
+  if (n) {
+    out.posRms = std::sqrt(p2 / n);
+    out.horRms = std::sqrt(h2 / n);
+    out.velRms = std::sqrt(v2 / n);
+    out.clockErr = std::sqrt(c2 / n);
+  }
+  out.lever = fusion.leverArm(be);
+  if (const auto fr = fusion.frame(be)) out.yawError = std::remainder(fr->x() + kYaw0, 2 * constants::kPi);
+  out.meanMicros = nAll ? micros / nAll : 0.0;
+  std::fprintf(stderr,
+               "%-28s tight after %5.1f s (yaw err %6.2f deg) | %4d epochs: pos RMS %7.3f m (hor %7.3f) vel RMS "
+               "%6.3f m/s clock %7.2f m | psr %d/%d dopp %d/%d dpsr %d/%d ddcp %d/%d vel %d/%d fixed %d | %.0f us\n",
+               toString(cfg.mode), out.tightAfter, out.yawError / constants::kDegToRad, n, out.posRms, out.horRms,
+               out.velRms, out.clockErr, out.psr.used, out.psr.rejected, out.dopp.used, out.dopp.rejected,
+               out.dpsr.used, out.dpsr.rejected, out.ddcp.used, out.ddcp.rejected, out.vel.used, out.vel.rejected,
+               out.fixedEpochs, out.meanMicros);
+  return out;
+}
+
+GnssFusionConfig mode(GnssFusionMode m) {
+  GnssFusionConfig c;
+  c.mode = m;
+  c.leverArm = kLever;
+  return c;
+}
+
+TEST(GnssFusionSim, FrameInitialisationConvergesAndPseudorangeFusion) {
+  const RunResult r = run<double>(mode(GnssFusionMode::kDoppPsr));
+  ASSERT_GT(r.tightAfter, 0.0) << "frame never converged";
+  EXPECT_LT(r.tightAfter, 30.0);
+  // Final frame yaw vs the simulated 40° rotation of W' (measured 4.2°): without vision the test
+  // backend's own yaw drifts with the gyro bias, and the frame yaw absorbs that drift.
+  EXPECT_LT(std::abs(r.yawError), 6.0 * constants::kDegToRad);
+  ASSERT_GT(r.epochs, 100);
+  // Measured (seed 2024): horizontal 0.6 m, 3-D 5.8 m: a vertical/clock bias of ~6 m remains
+  // (open issue, docs/gnss_fusion.md); the bounds below are what is reached today.
+  EXPECT_LT(r.horRms, 1.5);
+  EXPECT_LT(r.posRms, 8.0);
+  EXPECT_LT(r.velRms, 0.1);
+  EXPECT_LT(r.clockErr, 10.0);
+  EXPECT_GT(r.psr.used, 5 * r.epochs);
+}
+
+TEST(GnssFusionSim, ModesTable) {
+  std::map<GnssFusionMode, RunResult> r;
+  for (GnssFusionMode m : {GnssFusionMode::kGpsVel, GnssFusionMode::kDopp, GnssFusionMode::kDoppPsrNoInt,
+                           GnssFusionMode::kDoppDpsr, GnssFusionMode::kDoppDdcp}) {
+    r[m] = run<double>(mode(m));
+  }
+  const RunResult f = run<float>(mode(GnssFusionMode::kDoppPsr));
+  const RunResult psr = run<double>(mode(GnssFusionMode::kDoppPsr));
+  for (const auto& [m, x] : r) EXPECT_GT(x.tightAfter, 0.0) << toString(m);
+  // Measured (seed 2024): gpsvel 0.44 m/s, dopp 0.049 m/s; psr 0.050 m/s vs 0.072 m/s without the
+  // integration to the measurement time (100 ms latency); dpsr 0.24 m 3-D; ddcp 1.4 cm (RTK fixed
+  // every epoch); float psr as double.
+  EXPECT_LT(r[GnssFusionMode::kGpsVel].velRms, 0.6);
+  EXPECT_LT(r[GnssFusionMode::kDopp].velRms, 0.08);
+  EXPECT_LT(psr.velRms, 0.8 * r[GnssFusionMode::kDoppPsrNoInt].velRms);
+  EXPECT_LT(r[GnssFusionMode::kDoppDpsr].posRms, 0.5);
+  EXPECT_LT(r[GnssFusionMode::kDoppDdcp].posRms, 0.05);
+  EXPECT_GT(r[GnssFusionMode::kDoppDdcp].ddcp.used, 10 * r[GnssFusionMode::kDoppDdcp].epochs);
+  EXPECT_LT(r[GnssFusionMode::kDoppDdcp].posRms, 0.2 * r[GnssFusionMode::kDoppDpsr].posRms);
+  EXPECT_LT(f.horRms, 1.5);
+  EXPECT_NEAR(f.horRms, psr.horRms, 0.2);
+}
+
+}  // namespace
+}  // namespace gvins::fusion
