@@ -201,6 +201,62 @@ TEST(GnssFusionSim, FrameInitialisationConvergesAndPseudorangeFusion) {
   EXPECT_GT(r.psr.used, 5 * r.epochs);
 }
 
+// Residuals at the simulated truth (state, frame, lever arm, true receiver clocks) equal the
+// simulated error terms that the models do not contain.
+TEST(GnssFusionSim, ResidualsAtTruthAreTheSimulatedErrors) {
+  const Scenario& sc = scenario();
+  GnssFusion<double> fusion(mode(GnssFusionMode::kDoppPsr));
+  double d2 = 0.0, r2 = 0.0, dd2 = 0.0;
+  int n = 0, nd = 0;
+  for (const sim::GnssSimEpoch& e : sc.epochs) {
+    if (e.role != sim::GnssReceiverRole::Rover || n > 2000) continue;
+    const double tf = sc.frame.flightTime(e.truth.time);
+    const sim::TrajectoryState ts = sc.traj->evaluate(tf);
+    GnssStateValues s;
+    s.newest.t_ns = sc.frame.stampNs(tf);
+    s.newest.R_WI = ts.R_WB;
+    s.newest.p_WI = ts.p_WB;
+    s.newest.v_WI = ts.v_WB;
+    s.omegaMeasured = ts.omega_B;
+    s.lever = kLever;
+    s.anchor = GnssAnchor::at(sc.frame.originEcef());  // N = the simulator's W
+    const AntennaKinematics k = antennaKinematics(s);
+    ASSERT_LT((k.x_E - e.truth.antennaPosition).norm(), 1e-3);
+    ASSERT_LT((k.u_E - e.truth.antennaVelocity).norm(), 1e-6);
+    for (const SatelliteModel& m : fusion.satelliteModels(e.obs, sc.nav, k.x_E)) {
+      std::size_t i = 0;
+      while (i < e.obs.sats.size() && !(e.obs.sats[i].sat == m.sat)) ++i;
+      ASSERT_LT(i, e.obs.sats.size());
+      const sim::GnssSatelliteTruth& st = e.truth.sats[i];
+      std::size_t j = 0;
+      while (j < st.signals.size() && !(st.signals[j].code == m.code)) ++j;
+      ASSERT_LT(j, st.signals.size());
+      const sim::GnssSignalTruth& g = st.signals[j];
+      const double clock = constants::kSpeedOfLight * e.truth.systemClockBias[static_cast<std::size_t>(systemIndex(m.sat.system))];
+      const double r = pseudorangeRow(m, k, clock).residual;
+      const Vector3d u = (st.satPosition - e.truth.antennaPosition).normalized();
+      const double predicted = (st.troposphere - m.troposphere) + (g.ionosphere - m.ionosphere) + st.shapiro +
+                               g.multipathCode + st.nlosBias + g.codeNoise + g.interFrequencyBias +
+                               u.dot(st.orbitError) - constants::kSpeedOfLight * st.clockError;
+      d2 += std::pow(r - predicted, 2);
+      r2 += r * r;
+      ++n;
+      if (m.hasDoppler) {
+        const double dr = dopplerRow(m, k, constants::kSpeedOfLight * e.truth.clockDrift).residual;
+        dd2 += dr * dr;
+        ++nd;
+      }
+    }
+  }
+  ASSERT_GT(n, 500);
+  const double modelRms = std::sqrt(d2 / n), rms = std::sqrt(r2 / n), doppRms = std::sqrt(dd2 / nd);
+  std::fprintf(stderr, "psr residual at truth: RMS %.3f m, minus the simulated error terms %.3f m; Doppler %.4f m/s\n",
+               rms, modelRms, doppRms);
+  EXPECT_LT(modelRms, 0.1);  // measured 0.019 m (our troposphere/satellite-state evaluation vs the simulator)
+  EXPECT_LT(rms, 5.0);
+  EXPECT_LT(doppRms, 0.2);
+}
+
 TEST(GnssFusionSim, ModesTable) {
   std::map<GnssFusionMode, RunResult> r;
   for (GnssFusionMode m : {GnssFusionMode::kGpsVel, GnssFusionMode::kDopp, GnssFusionMode::kDoppPsrNoInt,
