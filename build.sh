@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SRI-GVINS build entry point. Installs missing Debian packages, configures, builds, then:
-#   ./build.sh demo        run the main job on the bundled default data and print its result
+#   ./build.sh demo [--images] [--mode M]  simulate the bundled short flight, run gvins-replay on it
 #   ./build.sh test        run every test (unit, integration, fuzz-corpus replay)
 #   ./build.sh sanitize    build and run the tests again under AddressSanitizer + UBSan
 #   ./build.sh fuzz [S]    build the libFuzzer targets with clang and run each for S seconds (default 20)
@@ -52,7 +52,9 @@ case "$cmd" in
     ;;
   demo)
     install_deps
-    configure_build "${BUILD_DIR:-build}"
+    # Only the two tools the demo runs (the full build is `./build.sh build` or `test`).
+    cmake -S "$ROOT" -B "${BUILD_DIR:-build}" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+    cmake --build "${BUILD_DIR:-build}" -j "$JOBS" --target gvins-sim gvins-replay gvins-eval
     exec "$ROOT/apps/demo.sh" "${BUILD_DIR:-build}" "$@"
     ;;
   test)
