@@ -545,8 +545,11 @@ struct SriSwfEstimator<Scalar>::Impl {
   // zero before the first block it touches (s), so G = H[:, s:] U[s:, s:] (a triangular
   // product) and I + G Gᵀ a rank update: about half the flops of H Pw Hᵀ, and fewer for short
   // tracks on the newest clones. Cheaper than SriFilter::chiSquare's per-feature triangular
-  // solve and QR. Valid when r = 0 (right after correct()).
+  // solve and QR. Valid when r = 0 (right after correct()). Two exact bounds decide most
+  // features without G: I ≤ I + G Gᵀ ≤ (1 + ‖H‖²_F tr(Pw)) I, so χ² ≤ ‖z‖² (accept when ‖z‖² is
+  // below the threshold) and χ² ≥ ‖z‖² / (1 + ‖H‖²_F tr(Pw)) (reject when that is above it).
   Eigen::MatrixXd Pw, Uw;
+  double pw_trace = 0.0;
   bool uw_ok = false;
   std::unordered_map<std::uint64_t, int> pw_off;
   mutable Eigen::MatrixXd gate_H, gate_G, gate_S;
@@ -569,10 +572,17 @@ struct SriSwfEstimator<Scalar>::Impl {
     const Eigen::LLT<Eigen::MatrixXd> llt(Pw.reverse());  // J Pw J = L Lᵀ → Pw = (JLJ)(JLJ)ᵀ
     uw_ok = llt.info() == Eigen::Success;
     if (uw_ok) Uw = Eigen::MatrixXd(llt.matrixL()).reverse();
+    pw_trace = Pw.trace();
   }
   bool gateWindow(const Meas& m) const {
     if (cfg.chi2_probability >= 1.0) return true;
     const int rows = m.rows();
+    const double thr = chi2Threshold(rows);
+    const double zz = static_cast<double>(m.residual().squaredNorm());
+    if (zz <= thr) return true;
+    double hh = 0.0;
+    for (int i = 0; i < m.numBlocks(); ++i) hh += static_cast<double>(m.jacobianAt(i).squaredNorm());
+    if (zz > thr * (1.0 + hh * pw_trace)) return false;
     const int d = static_cast<int>(Pw.cols());
     int s0 = d;
     for (int i = 0; i < m.numBlocks(); ++i) s0 = std::min(s0, pw_off.at(m.blockId(i).value));
@@ -594,7 +604,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     if (llt.info() != Eigen::Success) return false;
     gate_z = m.residual().template cast<double>();
     llt.matrixL().solveInPlace(gate_z);
-    return gate_z.squaredNorm() <= chi2Threshold(rows);
+    return gate_z.squaredNorm() <= thr;
   }
 
   bool gate(const Meas& m) const {
