@@ -1,4 +1,5 @@
-// Encoder round trips: MSM4/MSM7 of real observations of all six systems, 1005/1006 and every
+// Encoder round trips: MSM4/MSM7 of real observations of all six systems (from RTCM logs and from
+// a RINEX file whose values lie off the message grid), 1005/1006 and every
 // ephemeris message decode back to the same values within the message resolution; decoded
 // ephemerides agree with RTKLIB's navigation file and feed the same EphemerisStore as RINEX.
 #include <gtest/gtest.h>
@@ -7,6 +8,7 @@
 #include <set>
 
 #include "gvins/base/constants.hpp"
+#include "gvins/base/rinex_obs_reader.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "gvins/rtcm/decoder.hpp"
@@ -68,25 +70,21 @@ struct RoundTripStats {
   std::set<int> systems;
 };
 
-/// Encodes every epoch of a source as MSM`type`, decodes it and compares signal by signal.
-void roundTrip(const Source& src, int type, RoundTripStats& st) {
-  Decoder original([&] {
-    DecoderOptions o;
-    o.referenceTime = src.ref;
-    return o;
-  }());
-  const Items in = decode(readBytes(dataDir() / "rtcm" / src.file), src.ref, &original);
-  ASSERT_FALSE(in.epochs.empty()) << src.file;
+/// Encodes every epoch as MSM`type`, decodes the stream and compares signal by signal.
+/// `name` labels failures; `channels` are the GLONASS FDMA channels of the input.
+void roundTripEpochs(const std::vector<ObsEpoch>& inEpochs, const GlonassChannels& channels, const GpsTime& ref,
+                     const std::string& name, int type, RoundTripStats& st) {
+  ASSERT_FALSE(inEpochs.empty()) << name;
   Encoder enc(1234);
-  enc.setGlonassChannels(original.glonassChannels());
+  enc.setGlonassChannels(channels);
   std::vector<std::uint8_t> stream;
-  for (const ObsEpoch& e : in.epochs) {
+  for (const ObsEpoch& e : inEpochs) {
     const auto f = enc.msm(e, type);
     stream.insert(stream.end(), f.begin(), f.end());
   }
   DecoderOptions o;
-  o.referenceTime = src.ref;
-  o.glonassChannels = original.glonassChannels();  // MSM4 carries no channel numbers
+  o.referenceTime = ref;
+  o.glonassChannels = channels;  // MSM4 carries no channel numbers
   Decoder dec(o);
   dec.feed(stream);
   dec.finish();
@@ -96,12 +94,12 @@ void roundTrip(const Source& src, int type, RoundTripStats& st) {
   }
   EXPECT_EQ(dec.stats().malformed, 0);
   EXPECT_EQ(dec.stats().framing.crcFailures, 0);
-  ASSERT_EQ(out.size(), in.epochs.size()) << src.file;
+  ASSERT_EQ(out.size(), inEpochs.size()) << name;
 
   std::map<std::pair<int, std::string>, GpsTime> lastSeen;  // for the expected loss-of-lock flags
   const ObsEpoch* prev = nullptr;
   for (std::size_t i = 0; i < out.size(); ++i) {
-    const ObsEpoch& a = in.epochs[i];
+    const ObsEpoch& a = inEpochs[i];
     const ObsEpoch& b = out[i];
     ASSERT_EQ(b.time, a.time);
     for (const SatObs& sa : a.sats) {
@@ -110,19 +108,19 @@ void roundTrip(const Source& src, int type, RoundTripStats& st) {
         return msmSignalId(sa.sat.system, s.code).has_value() && (s.present & (SignalObs::kCode | SignalObs::kPhase));
       });
       if (!anyMsm) continue;
-      ASSERT_NE(sb, nullptr) << sa.sat.str() << " " << src.file;
+      ASSERT_NE(sb, nullptr) << sa.sat.str() << " " << name;
       st.systems.insert(systemIndex(sa.sat.system));
-      const std::optional<int> ch = sa.sat.system == System::Glonass ? original.glonassChannels().get(sa.sat.prn) : std::optional<int>();
+      const std::optional<int> ch = sa.sat.system == System::Glonass ? channels.get(sa.sat.prn) : std::optional<int>();
       for (const SignalObs& ga : sa.signals) {
         if (!msmSignalId(sa.sat.system, ga.code)) continue;
         const SignalObs* gb = sb->find(ga.code);
         ASSERT_NE(gb, nullptr) << sa.sat.str() << " " << ga.code.str();
         ++st.signals;
         const double lam = *carrierWavelength(sa.sat.system, ga.code.band, ch);
-        EXPECT_EQ(gb->hasCode(), ga.hasCode()) << src.file << " " << sa.sat.str() << " " << ga.code.str() << " epoch " << i
+        EXPECT_EQ(gb->hasCode(), ga.hasCode()) << name << " " << sa.sat.str() << " " << ga.code.str() << " epoch " << i
                                                << ": " << ga.pseudorange << " -> " << gb->pseudorange;
         if (ga.hasCode()) st.code = std::max(st.code, std::abs(gb->pseudorange - ga.pseudorange));
-        EXPECT_EQ(gb->hasPhase(), ga.hasPhase()) << src.file << " " << sa.sat.str() << " " << ga.code.str();
+        EXPECT_EQ(gb->hasPhase(), ga.hasPhase()) << name << " " << sa.sat.str() << " " << ga.code.str();
         if (ga.hasPhase()) st.phase = std::max(st.phase, std::abs(gb->carrierPhase - ga.carrierPhase) * lam);
         if (type == 7 && ga.hasDoppler()) {
           EXPECT_TRUE(gb->hasDoppler());
@@ -142,6 +140,17 @@ void roundTrip(const Source& src, int type, RoundTripStats& st) {
     }
     prev = &a;
   }
+}
+
+/// The same for the observation epochs decoded from an RTCM log.
+void roundTrip(const Source& src, int type, RoundTripStats& st) {
+  Decoder original([&] {
+    DecoderOptions o;
+    o.referenceTime = src.ref;
+    return o;
+  }());
+  const Items in = decode(readBytes(dataDir() / "rtcm" / src.file), src.ref, &original);
+  roundTripEpochs(in.epochs, original.glonassChannels(), src.ref, src.file, type, st);
 }
 
 const Source kSources[] = {
@@ -174,6 +183,52 @@ TEST(RoundTrip, Msm4AllSystems) {
   EXPECT_LE(st.code, std::ldexp(kLightMs, -25) + 1e-7);  // + rounding of the metre/ms conversions
   EXPECT_LE(st.phase, std::ldexp(kLightMs, -30) + 1e-7);
   EXPECT_LE(st.snr, 0.5 + 1e-12);
+}
+
+// The RTCM logs above carry values already on a message grid (an MSM7 Doppler decoded from MSM7
+// re-encodes exactly), so they cannot show how the encoder rounds Doppler and MSM7 C/N0. RINEX
+// values (code, phase and Doppler to 0.001 m, cycle and Hz) lie off that grid: a real Septentrio
+// rover file with GPS, GLONASS, Galileo, BeiDou and QZSS on three bands each, all with Doppler,
+// must come back within half a least significant bit of each MSM field (RTCM 10403.3 DF400,
+// DF401, DF404/DF405, DF406, DF403/DF408), and the largest errors must come close to that half
+// bit (the values really were rounded).
+TEST(RoundTrip, RinexObservationsOffTheMessageGrid) {
+  RinexObsReader r((dataDir() / "gnss/nagoya_static_2024/rover.obs.gz").string());
+  std::vector<ObsEpoch> epochs;
+  ObsEpoch e;
+  while (epochs.size() < 60 && r.next(e)) epochs.push_back(e);
+  ASSERT_EQ(epochs.size(), 60u);
+  const double halfCode7 = std::ldexp(kLightMs, -30), halfPhase7 = std::ldexp(kLightMs, -32);
+  const double halfCode4 = std::ldexp(kLightMs, -25), halfPhase4 = std::ldexp(kLightMs, -30);
+  {
+    RoundTripStats st;
+    roundTripEpochs(epochs, r.header().glonassChannels, epochs.front().time, "nagoya rover.obs", 7, st);
+    std::cerr << "MSM7 from RINEX: " << st.signals << " signals, max |dC| " << st.code << " m, |dL| " << st.phase
+              << " m, |dD| " << st.doppler << " m/s, |dS| " << st.snr << " dB-Hz\n";
+    EXPECT_EQ(st.systems, (std::set<int>{0, 1, 2, 3, 4}));  // GPS GLONASS Galileo BeiDou QZSS
+    EXPECT_GT(st.signals, 60 * 100);
+    EXPECT_LE(st.code, halfCode7 + 1e-7);
+    EXPECT_LE(st.phase, halfPhase7 + 1e-7);
+    EXPECT_LE(st.doppler, 0.00005 + 1e-9);
+    EXPECT_LE(st.snr, 1.0 / 32 + 1e-12);
+    EXPECT_GT(st.code, 0.8 * halfCode7);
+    EXPECT_GT(st.phase, 0.8 * halfPhase7);
+    EXPECT_GT(st.doppler, 0.8 * 0.00005);
+    EXPECT_GT(st.snr, 0.8 / 32);
+  }
+  {
+    RoundTripStats st;
+    roundTripEpochs(epochs, r.header().glonassChannels, epochs.front().time, "nagoya rover.obs", 4, st);
+    std::cerr << "MSM4 from RINEX: " << st.signals << " signals, max |dC| " << st.code << " m, |dL| " << st.phase
+              << " m, |dS| " << st.snr << " dB-Hz\n";
+    EXPECT_EQ(st.systems, (std::set<int>{0, 1, 2, 3, 4}));
+    EXPECT_LE(st.code, halfCode4 + 1e-7);
+    EXPECT_LE(st.phase, halfPhase4 + 1e-7);
+    EXPECT_LE(st.snr, 0.5 + 1e-12);
+    EXPECT_GT(st.code, 0.8 * halfCode4);
+    EXPECT_GT(st.phase, 0.8 * halfPhase4);
+    EXPECT_GT(st.snr, 0.4);
+  }
 }
 
 TEST(RoundTrip, PhaseFarFromCodeIsShiftedByWholeCyclesAndFlagged) {
