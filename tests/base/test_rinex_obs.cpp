@@ -1,5 +1,6 @@
 // RINEX observation reader and writer: real files (RINEX 3.04 Septentrio, RINEX 2.10 Trimble),
-// hand-made records for every format feature, round trips and malformed input.
+// hand-made records for every format feature (RINEX 2.11, 3.02, 3.05), round trips and malformed
+// input.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -336,6 +337,114 @@ TEST(RinexObs, Rinex302BeiDouBand1IsB1IAndScaleFactors) {
   EXPECT_DOUBLE_EQ(b1->carrierPhase, 114000000.456);
   EXPECT_DOUBLE_EQ(e.sats[1].find(oc("1C"))->snr, 45.5);  // 455.000 / 10
   EXPECT_EQ(r.stats().skippedSatellites, 1);             // X01: unknown system letter
+}
+
+// RINEX 3.05 (the newest 3.x): its LEAP SECONDS layout (current, future, week, day, system), the
+// 3.04/3.05 BeiDou-3 B1C/B2a codes (1P, 5P) next to B1I (2I), Galileo E5 AltBOC (8Q), QZSS L1C
+// (1L), NavIC L5 (5A), SYS / PHASE SHIFT with and without satellites, GLONASS slots and code-phase
+// biases with blank fields, RCV CLOCK OFFS APPL and an epoch with a receiver clock offset. Values
+// as written in the records below (RINEX 3.05 section 5 and tables A2-A15).
+TEST(RinexObs, Rinex305HeaderRecordsAndNewCodes) {
+  const std::string t =
+      "     3.05           OBSERVATION DATA    M                   RINEX VERSION / TYPE\n"
+      "sbf2rin-15.8.1                          20220101 000105 UTC PGM / RUN BY / DATE\n"
+      "TEST                                                        MARKER NAME\n"
+      "GEODETIC                                                    MARKER TYPE\n"
+       " -3817681.1213  3562839.4311  3650159.1593                  APPROX POSITION XYZ\n"
+      "        0.1000        0.0000        0.0000                  ANTENNA: DELTA H/E/N\n"
+      "G    5 C1C L1C D1C S1C C5Q                                  SYS / # / OBS TYPES\n"
+      "E    3 C1C C8Q L8Q                                          SYS / # / OBS TYPES\n"
+      "C    4 C1P L1P C5P C2I                                      SYS / # / OBS TYPES\n"
+      "R    2 C1C L1C                                              SYS / # / OBS TYPES\n"
+      "J    1 C1L                                                  SYS / # / OBS TYPES\n"
+      "I    1 C5A                                                  SYS / # / OBS TYPES\n"
+      "DBHZ                                                        SIGNAL STRENGTH UNIT\n"
+      "     1.000                                                  INTERVAL\n"
+      "  2022     1     1     0     0    0.0000000     GPS         TIME OF FIRST OBS\n"
+      "     1                                                      RCV CLOCK OFFS APPL\n"
+      "G L1C                                                       SYS / PHASE SHIFT\n"
+      "C L1P  0.25000  02 C19 C20                                  SYS / PHASE SHIFT\n"
+      "  2 R01  1 R02 -4                                           GLONASS SLOT / FRQ #\n"
+      " C1C  -71.940 C1P          C2C  -71.940 C2P                 GLONASS COD/PHS/BIS\n"
+      "    18    18  2185     7GPS                                 LEAP SECONDS\n"
+      "                                                            END OF HEADER\n"
+      "> 2022 01 01 00 00  0.0000000  0  6      -0.000012345678\n"
+      "G05  21000000.123   110354120.45617     -1234.567          45.250    21000001.789  \n"
+      "E11  23000000.250    23000002.500   174301234.125 8\n"
+      "C19  22500000.100   117166500.200    22500003.300                  \n"
+      "R02  20000000.000   106812500.000  \n"
+      "J02  37000000.750  \n"
+      "I05  36000000.500  \n"
+  ;
+  RinexObsReader r(std::string_view(t), "r305.obs");
+  const RinexObsHeader& h = r.header();
+  EXPECT_DOUBLE_EQ(h.version, 3.05);
+  EXPECT_EQ(h.markerType, "GEODETIC");
+  ASSERT_TRUE(h.station.approxPosition);
+  EXPECT_DOUBLE_EQ(h.station.approxPosition->x(), -3817681.1213);
+  EXPECT_DOUBLE_EQ(h.station.antennaDeltaHen[0], 0.1);
+  EXPECT_EQ(h.types(System::Gps).size(), 5u);
+  EXPECT_EQ(h.types(System::Galileo)[1], od("C8Q"));
+  ASSERT_EQ(h.types(System::BeiDou).size(), 4u);
+  EXPECT_EQ(h.types(System::BeiDou)[0], od("C1P"));  // B1C stays on band 1 from RINEX 3.03 on
+  EXPECT_EQ(h.types(System::BeiDou)[3], od("C2I"));
+  EXPECT_EQ(h.types(System::Qzss)[0], od("C1L"));
+  EXPECT_EQ(h.types(System::Navic)[0], od("C5A"));
+  EXPECT_EQ(h.leapSeconds.value_or(0), 18);
+  EXPECT_DOUBLE_EQ(h.interval.value_or(0.0), 1.0);
+  EXPECT_TRUE(h.receiverClockOffsetApplied);
+  EXPECT_EQ(h.timeSystem, "GPS");
+  ASSERT_TRUE(h.firstObs);
+  EXPECT_EQ(*h.firstObs, GpsTime::fromCalendar({2022, 1, 1, 0, 0, 0.0}));
+  ASSERT_EQ(h.phaseShifts.size(), 2u);
+  EXPECT_EQ(h.phaseShifts[0].system, System::Gps);
+  EXPECT_EQ(h.phaseShifts[0].obs, od("L1C"));
+  EXPECT_FALSE(h.phaseShifts[0].cycles);
+  EXPECT_TRUE(h.phaseShifts[0].satellites.empty());
+  EXPECT_DOUBLE_EQ(h.phaseShifts[1].cycles.value_or(0.0), 0.25);
+  ASSERT_EQ(h.phaseShifts[1].satellites.size(), 2u);
+  EXPECT_EQ(h.phaseShifts[1].satellites[1], SatId(System::BeiDou, 20));
+  EXPECT_EQ(h.glonassChannels.get(1).value_or(99), 1);
+  EXPECT_EQ(h.glonassChannels.get(2).value_or(99), -4);
+  ASSERT_EQ(h.glonassBiases.size(), 4u);
+  EXPECT_EQ(h.glonassBiases[1].obs, od("C1P"));
+  EXPECT_FALSE(h.glonassBiases[1].bias);
+  EXPECT_DOUBLE_EQ(h.glonassBiases[2].bias.value_or(0.0), -71.94);
+
+  ObsEpoch e;
+  ASSERT_TRUE(r.next(e));
+  EXPECT_EQ(e.time, GpsTime::fromCalendar({2022, 1, 1, 0, 0, 0.0}));
+  ASSERT_TRUE(e.receiverClockOffset);
+  EXPECT_DOUBLE_EQ(*e.receiverClockOffset, -0.000012345678);
+  ASSERT_EQ(e.sats.size(), 6u);
+  const SatObs* g = e.find(SatId(System::Gps, 5));
+  ASSERT_NE(g, nullptr);
+  const SignalObs* l1 = g->find(oc("1C"));
+  ASSERT_NE(l1, nullptr);
+  EXPECT_DOUBLE_EQ(l1->pseudorange, 21000000.123);
+  EXPECT_DOUBLE_EQ(l1->carrierPhase, 110354120.456);
+  EXPECT_EQ(l1->lli, 1);
+  EXPECT_EQ(l1->ssi, 7);
+  EXPECT_DOUBLE_EQ(l1->doppler, -1234.567);
+  EXPECT_DOUBLE_EQ(l1->snr, 45.25);
+  EXPECT_DOUBLE_EQ(g->find(oc("5Q"))->pseudorange, 21000001.789);
+  const SignalObs* e8 = e.find(SatId(System::Galileo, 11))->find(oc("8Q"));
+  ASSERT_NE(e8, nullptr);
+  EXPECT_DOUBLE_EQ(e8->pseudorange, 23000002.5);
+  EXPECT_DOUBLE_EQ(e8->carrierPhase, 174301234.125);
+  EXPECT_EQ(e8->ssi, 8);
+  const SatObs* c = e.find(SatId(System::BeiDou, 19));
+  ASSERT_NE(c, nullptr);
+  EXPECT_DOUBLE_EQ(c->find(oc("1P"))->carrierPhase, 117166500.2);
+  EXPECT_DOUBLE_EQ(c->find(oc("5P"))->pseudorange, 22500003.3);
+  const SignalObs* b1i = c->find(oc("2I"));
+  EXPECT_TRUE(b1i == nullptr || b1i->present == 0);  // blank field: no value
+  EXPECT_DOUBLE_EQ(e.find(SatId(System::Glonass, 2))->find(oc("1C"))->carrierPhase, 106812500.0);
+  EXPECT_DOUBLE_EQ(e.find(SatId(System::Qzss, 2))->find(oc("1L"))->pseudorange, 37000000.75);
+  ASSERT_NE(e.find(SatId(System::Navic, 5)), nullptr);
+  EXPECT_DOUBLE_EQ(e.find(SatId(System::Navic, 5))->find(oc("5A"))->pseudorange, 36000000.5);
+  EXPECT_FALSE(r.next(e));
+  EXPECT_EQ(r.stats().skippedSatellites, 0);
 }
 
 TEST(RinexObs, GlonassTimeSystemIsConvertedToGpst) {
