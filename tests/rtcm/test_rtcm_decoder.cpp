@@ -1,5 +1,6 @@
 // Decoder: RTKLIB's conversion of rtklib_testglo.rtcm3 observation by observation, the GMSD log
-// (MSM7 of four systems, GPS week rollover, BeiDou stamped in GPS time), every single-frame file,
+// (MSM7 of four systems, GPS week rollover, BeiDou stamped in GPS time; every system against
+// RTKLIB's conversion), every single-frame file,
 // malformed and hostile input.
 #include <gtest/gtest.h>
 
@@ -325,6 +326,80 @@ TEST(Decoder, GmsdBeidouMatchesRtklib14SecondsApart) {
   EXPECT_LE(maxD, 0.001);  // RINEX rounding and RTKLIB's own wavelength arithmetic
   // RTKLIB writes C/N0 rounded to 0.25 dB-Hz (its internal unit); MSM7 has 1/16 dB-Hz.
   EXPECT_LE(maxS, 0.125 + 1e-9);
+}
+
+TEST(Decoder, GmsdGpsGlonassQzssMsm7MatchRtklib) {
+  // RTKLIB keeps only BeiDou from the original log (above). Its conversion of the log without the
+  // BeiDou messages (reference/rtklib-2.4.3/make_gmsd_nobds.py: 1127 frames dropped, the
+  // multiple-message bit of each 1117 cleared) gives the GPS, GLONASS and QZSS MSM7 values across
+  // the week rollover. Ours, decoded from the unmodified log, must equal them at the same times:
+  // same satellites and signals, values within the RINEX rounding.
+  RinexObsReader ref((dataDir() / "reference/rtklib-2.4.3/rtcm_gmsd_nobds_convbin.obs.gz").string());
+  DecoderOptions opt;
+  opt.referenceTime = date(2012, 10, 13);
+  Decoder dec(opt);
+  const Decoded got = decodeAll(dec, readBytes(dataDir() / "rtcm/rtklib_GMSD7_20121014.rtcm3"));
+  std::map<std::int64_t, const ObsEpoch*> byTime;
+  for (const ObsEpoch& e : got.epochs) byTime[e.time.wholeSeconds()] = &e;
+  ObsEpoch r;
+  int epochs = 0;
+  std::int64_t values = 0, lliCompared = 0, lliGapOnlyOurs = 0;
+  std::map<System, std::int64_t> perSystem;
+  double maxC = 0, maxL = 0, maxD = 0, maxS = 0;
+  std::set<std::uint32_t> prevSignals;
+  auto trackKey = [](SatId sat, ObsCode c) { return static_cast<std::uint32_t>(satIndex(sat) * 65536 + c.band * 256 + c.attr); };
+  while (ref.next(r)) {
+    std::set<std::uint32_t> signals;
+    const auto it = byTime.find(r.time.wholeSeconds());
+    ASSERT_NE(it, byTime.end()) << r.time.toString();
+    const ObsEpoch& e = *it->second;
+    int others = 0;
+    for (const SatObs& s : e.sats) others += s.sat.system != System::BeiDou;
+    ASSERT_EQ(others, static_cast<int>(r.sats.size())) << r.time.toString();
+    for (const SatObs& rs : r.sats) {
+      const SatObs* os = e.find(rs.sat);
+      ASSERT_NE(os, nullptr) << rs.sat.str() << " " << r.time.toString();
+      ASSERT_EQ(os->signals.size(), rs.signals.size()) << rs.sat.str() << " " << r.time.toString();
+      for (const SignalObs& rg : rs.signals) {
+        const SignalObs* og = os->find(rg.code);
+        ASSERT_NE(og, nullptr) << rs.sat.str() << " " << rg.code.str();
+        // RTKLIB 2.4.3 writes Doppler only on the first band; we keep it on every signal.
+        EXPECT_EQ(og->present | SignalObs::kDoppler, rg.present | SignalObs::kDoppler) << rs.sat.str() << " " << rg.code.str();
+        if (rg.hasDoppler()) {
+          EXPECT_TRUE(og->hasDoppler()) << rs.sat.str() << " " << rg.code.str();
+          maxD = std::max(maxD, std::abs(og->doppler - rg.doppler));
+        }
+        if (rg.hasCode()) maxC = std::max(maxC, std::abs(og->pseudorange - rg.pseudorange));
+        if (rg.hasPhase()) maxL = std::max(maxL, std::abs(og->carrierPhase - rg.carrierPhase));
+        if (rg.hasSnr()) maxS = std::max(maxS, std::abs(og->snr - rg.snr));
+        if (epochs > 0 && rg.hasPhase()) {
+          ++lliCompared;
+          if ((og->lli & 1) != (rg.lli & 1)) {
+            // As for BeiDou: only re-acquisitions after a gap, flagged by us and not by RTKLIB.
+            const bool gap = !prevSignals.count(trackKey(rs.sat, rg.code));
+            EXPECT_TRUE(gap && (og->lli & 1)) << rs.sat.str() << " " << rg.code.str() << " " << r.time.toString();
+            ++lliGapOnlyOurs;
+          }
+        }
+        signals.insert(trackKey(rs.sat, rg.code));
+        values += std::popcount(rg.present);
+        perSystem[rs.sat.system] += std::popcount(rg.present);
+      }
+    }
+    prevSignals = std::move(signals);
+    ++epochs;
+  }
+  std::cerr << "GMSD GPS/GLONASS/QZSS vs RTKLIB: " << epochs << " epochs, " << values << " values (GPS "
+            << perSystem[System::Gps] << ", GLONASS " << perSystem[System::Glonass] << ", QZSS " << perSystem[System::Qzss]
+            << "), max |dC| " << maxC << " m, |dL| " << maxL << " cycles, |dD| " << maxD << " Hz, |dS| " << maxS
+            << " dB-Hz; LLI equal " << lliCompared - lliGapOnlyOurs << "/" << lliCompared << "\n";
+  EXPECT_EQ(epochs, 257);
+  for (System s : {System::Gps, System::Glonass, System::Qzss}) EXPECT_GT(perSystem[s], 1000) << systemName(s);
+  EXPECT_LE(lliGapOnlyOurs, 20);
+  EXPECT_LE(maxC, 0.0006);  // RINEX rounding (0.001)
+  EXPECT_LE(maxL, 0.0006);
+  EXPECT_LE(maxD, 0.001);   // RINEX rounding and RTKLIB's own wavelength arithmetic
+  EXPECT_LE(maxS, 0.125 + 1e-9);  // RTKLIB's 0.25 dB-Hz unit
 }
 
 TEST(Decoder, StreamThatNeverClearsTheMultipleMessageBit) {
