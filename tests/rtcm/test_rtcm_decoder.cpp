@@ -1,6 +1,7 @@
 // Decoder: RTKLIB's conversion of rtklib_testglo.rtcm3 observation by observation, the GMSD log
 // (MSM7 of four systems, GPS week rollover, BeiDou stamped in GPS time; every system against
-// RTKLIB's conversion), every single-frame file,
+// RTKLIB's conversion), Galileo and SBAS MSM7 of two single-epoch logs against RTKLIB, every
+// single-frame file,
 // malformed and hostile input.
 #include <gtest/gtest.h>
 
@@ -400,6 +401,96 @@ TEST(Decoder, GmsdGpsGlonassQzssMsm7MatchRtklib) {
   EXPECT_LE(maxL, 0.0006);
   EXPECT_LE(maxD, 0.001);   // RINEX rounding and RTKLIB's own wavelength arithmetic
   EXPECT_LE(maxS, 0.125 + 1e-9);  // RTKLIB's 0.25 dB-Hz unit
+}
+
+// One-epoch logs with Galileo and SBAS MSM7 (the GMSD log has neither): RTKLIB's conversions
+// (reference/rtklib-2.4.3/rtcm_uscl_msm7_convbin.obs.gz, rtcm_pyrtcm_rtcm3_convbin.obs.gz;
+// commands in tests/data/README.md) against ours at the same epoch time. RTKLIB writes the epochs
+// it closed (multiple-message bit clear); the logs also hold messages of other times, which it
+// drops and we report as epochs of their own, so only RTKLIB's epochs are compared, system by
+// system. The USCL log carries legacy, MSM6 and MSM7 observations of one epoch with values that
+// disagree (RTKLIB keeps the last, we the first); both decoders get its MSM7 frames only, the
+// frame selection of make_msm7_only.py.
+std::vector<std::uint8_t> msm7AndNonObservationFrames(const std::vector<std::uint8_t>& log) {
+  Framer f;
+  f.feed(log);
+  f.finish();
+  std::vector<std::uint8_t> out;
+  Frame fr;
+  while (f.next(fr)) {
+    const int t = fr.type();
+    const bool legacy = (t >= 1001 && t <= 1004) || (t >= 1009 && t <= 1012);
+    const bool lowMsm = t >= 1071 && t <= 1137 && t % 10 >= 1 && t % 10 <= 6;
+    if (legacy || lowMsm) continue;
+    const auto framed = Encoder::frame(fr.payload);
+    out.insert(out.end(), framed.begin(), framed.end());
+  }
+  return out;
+}
+
+TEST(Decoder, GalileoAndSbasMsm7MatchRtklibOnSingleEpochLogs) {
+  struct Case {
+    const char* log;
+    const char* ref;
+    GpsTime referenceTime;
+    std::set<System> systems;
+    bool msm7Only;
+  };
+  const Case cases[] = {
+      {"pyrtcm_pygpsdata-NTRIP-USCL00CHL0.log", "rtcm_uscl_msm7_convbin.obs.gz", date(2024, 3, 13),
+       {System::Gps, System::Glonass, System::Galileo, System::BeiDou, System::Sbas}, true},
+      {"pyrtcm_pygpsdata-RTCM3.log", "rtcm_pyrtcm_rtcm3_convbin.obs.gz", date(2020, 12, 29),
+       {System::Gps, System::Glonass, System::Galileo, System::BeiDou}, false},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.log);
+    DecoderOptions opt;
+    opt.referenceTime = c.referenceTime;
+    Decoder dec(opt);
+    const auto log = readBytes(dataDir() / "rtcm" / c.log);
+    const Decoded got = decodeAll(dec, c.msm7Only ? msm7AndNonObservationFrames(log) : log);
+    RinexObsReader ref((dataDir() / "reference/rtklib-2.4.3" / c.ref).string());
+    ObsEpoch r;
+    int epochs = 0;
+    std::map<System, std::int64_t> perSystem;
+    double maxC = 0, maxL = 0, maxD = 0, maxS = 0;
+    while (ref.next(r)) {
+      const auto it = std::find_if(got.epochs.begin(), got.epochs.end(), [&](const ObsEpoch& e) { return std::abs(e.time - r.time) < 1e-6; });
+      ASSERT_NE(it, got.epochs.end()) << r.time.toString();
+      std::map<System, int> oursPerSystem, theirsPerSystem;
+      for (const SatObs& s : it->sats) ++oursPerSystem[s.sat.system];
+      for (const SatObs& s : r.sats) ++theirsPerSystem[s.sat.system];
+      for (System s : c.systems) {
+        EXPECT_GT(theirsPerSystem[s], 0) << systemName(s);
+        EXPECT_EQ(oursPerSystem[s], theirsPerSystem[s]) << systemName(s);
+      }
+      for (const SatObs& rs : r.sats) {
+        const SatObs* os = it->find(rs.sat);
+        ASSERT_NE(os, nullptr) << rs.sat.str();
+        ASSERT_EQ(os->signals.size(), rs.signals.size()) << rs.sat.str();
+        for (const SignalObs& rg : rs.signals) {
+          const SignalObs* og = os->find(rg.code);
+          ASSERT_NE(og, nullptr) << rs.sat.str() << " " << rg.code.str();
+          EXPECT_EQ(og->present, rg.present) << rs.sat.str() << " " << rg.code.str();
+          if (rg.hasCode()) maxC = std::max(maxC, std::abs(og->pseudorange - rg.pseudorange));
+          if (rg.hasPhase()) maxL = std::max(maxL, std::abs(og->carrierPhase - rg.carrierPhase));
+          if (rg.hasDoppler()) maxD = std::max(maxD, std::abs(og->doppler - rg.doppler));
+          if (rg.hasSnr()) maxS = std::max(maxS, std::abs(og->snr - rg.snr));
+          perSystem[rs.sat.system] += std::popcount(rg.present);
+        }
+      }
+      ++epochs;
+    }
+    std::cerr << c.log << " vs RTKLIB: " << epochs << " epoch(s), values G " << perSystem[System::Gps] << " R "
+              << perSystem[System::Glonass] << " E " << perSystem[System::Galileo] << " C " << perSystem[System::BeiDou]
+              << " S " << perSystem[System::Sbas] << "; max |dC| " << maxC << " m, |dL| " << maxL << " cycles, |dD| "
+              << maxD << " Hz, |dS| " << maxS << " dB-Hz\n";
+    EXPECT_EQ(epochs, 1);
+    EXPECT_LE(maxC, 0.0006);  // RINEX rounding (0.001)
+    EXPECT_LE(maxL, 0.0006);
+    EXPECT_LE(maxD, 0.001);
+    EXPECT_LE(maxS, 0.125 + 1e-9);  // RTKLIB's 0.25 dB-Hz unit
+  }
 }
 
 TEST(Decoder, StreamThatNeverClearsTheMultipleMessageBit) {
