@@ -16,6 +16,8 @@
 #include <sstream>
 #include <thread>
 
+#include <sys/resource.h>
+
 #include "gvins/base/geodetic.hpp"
 #include "gvins/base/line_reader.hpp"
 #include "gvins/base/local_frame.hpp"
@@ -139,6 +141,12 @@ std::vector<EcefTruthSample> parseEcefTruth(LineReader& r) {
     s.antenna = {parseDouble(f[11], where, "antenna_E_x"), parseDouble(f[12], where, "antenna_E_y"),
                  parseDouble(f[13], where, "antenna_E_z")};
     if (!s.antenna.allFinite()) throwParseError(where, "antenna_E_x", "antenna position is not finite");
+    if (f.size() >= 17) {
+      const Eigen::Vector3d v(parseDouble(f[14], where, "antenna_v_E_x"), parseDouble(f[15], where, "antenna_v_E_y"),
+                              parseDouble(f[16], where, "antenna_v_E_z"));
+      if (!v.allFinite()) throwParseError(where, "antenna_v_E_x", "antenna velocity is not finite");
+      s.antennaVelocity = v;
+    }
     if (!out.empty() && s.t_ns <= out.back().t_ns)
       throwParseError(where, "timestamp", "time stamps must increase strictly");
     out.push_back(s);
@@ -155,6 +163,80 @@ std::vector<EcefTruthSample> readEcefTruthCsv(const std::string& path) {
 std::vector<EcefTruthSample> parseEcefTruthCsv(std::string_view text, const std::string& name) {
   LineReader r(text, name, 16384);
   return parseEcefTruth(r);
+}
+
+namespace {
+ReplaySummary::Accuracy accuracyOf(const vio::EvaluationResult& r) {
+  ReplaySummary::Accuracy a;
+  a.poses = r.matched;
+  a.positionRmse = r.translation.rmse;
+  a.rotationRmseDeg = r.rotation.rmse;
+  if (r.velocity.count > 0) a.velocityRmse = r.velocity.rmse;
+  if (r.bodyVelocity.count > 0) a.bodyVelocityRmse = r.bodyVelocity.rmse;
+  a.pathLength = r.pathLength;
+  for (const auto& seg : r.segments)
+    if (seg.count > 0) a.driftPercent = seg.driftPercent;
+  if (r.neesCount > 0) {
+    a.positionNees = r.positionNees;
+    a.orientationNees = r.orientationNees;
+  }
+  double h = 0.0, v = 0.0;
+  for (std::size_t i = 0; i < r.reference.size(); ++i) {
+    const Eigen::Vector3d e = r.estimateAligned[i] - r.reference[i];
+    h += e.head<2>().squaredNorm();
+    v += e.z() * e.z();
+  }
+  const double m = static_cast<double>(std::max<std::size_t>(r.reference.size(), 1));
+  a.horizontalRmse = std::sqrt(h / m);
+  a.verticalRmse = std::sqrt(v / m);
+  return a;
+}
+}  // namespace
+
+void ReplaySummary::writeMetrics(std::ostream& os) const {
+  auto kv = [&](const char* k, double v) {
+    char b[96];
+    std::snprintf(b, sizeof b, "%s,%.6g\n", k, v);
+    os << b;
+  };
+  os << "# gvins-replay figures: key,value (NaN: not evaluated); docs/replay.md\n";
+  kv("frames", static_cast<double>(framesProcessed));
+  kv("frames_initialized", static_cast<double>(framesInitialized));
+  kv("dataset_s", datasetSeconds);
+  kv("wall_s", wallSeconds);
+  kv("cpu_s", cpuSeconds);
+  kv("real_time_factor", realTimeFactor());
+  kv("frontend_ms_mean", frontendMsMean);
+  kv("estimator_ms_mean", estimatorMsMean);
+  kv("estimator_ms_median", estimatorMsMedian);
+  kv("gnss_ms_per_epoch", gnssMsMean);
+  kv("gnss_ms_per_frame", gnssMsPerFrame);
+  kv("gnss_epochs", static_cast<double>(gnssEpochs));
+  kv("gnss_epochs_updated", static_cast<double>(gnssEpochsUpdated));
+  kv("gnss_epochs_fixed", static_cast<double>(gnssEpochsFixed));
+  kv("frame_init_s", frameInitSeconds);
+  auto acc = [&](const std::string& p, const Accuracy& a) {
+    kv((p + "position_rmse_m").c_str(), a.positionRmse);
+    kv((p + "horizontal_rmse_m").c_str(), a.horizontalRmse);
+    kv((p + "vertical_rmse_m").c_str(), a.verticalRmse);
+    kv((p + "rotation_rmse_deg").c_str(), a.rotationRmseDeg);
+    kv((p + "velocity_rmse_mps").c_str(), a.velocityRmse);
+    kv((p + "body_velocity_rmse_mps").c_str(), a.bodyVelocityRmse);
+    kv((p + "start_aligned_position_rmse_m").c_str(), a.startAlignedPositionRmse);
+    kv((p + "path_m").c_str(), a.pathLength);
+    kv((p + "drift_percent").c_str(), a.driftPercent);
+    kv((p + "position_nees").c_str(), a.positionNees);
+    kv((p + "orientation_nees").c_str(), a.orientationNees);
+    kv((p + "poses").c_str(), static_cast<double>(a.poses));
+  };
+  acc("local_", local);
+  acc("global_", global);
+  const Eigen::Vector3d nan = Eigen::Vector3d::Constant(kNaN);
+  const Eigen::Vector3d l = leverArm.value_or(nan);
+  kv("lever_arm_x_m", l.x());
+  kv("lever_arm_y_m", l.y());
+  kv("lever_arm_z_m", l.z());
+  kv("lever_arm_error_m", leverArm && leverArmTruth ? (*leverArm - *leverArmTruth).norm() : kNaN);
 }
 
 void ReplaySummary::print(std::ostream& os) const {
@@ -176,14 +258,21 @@ void ReplaySummary::print(std::ostream& os) const {
                             " missing images");
   row("IMU gaps", std::to_string(imuGaps) + " (largest " + f("%.3f", largestImuGap_s) + " s)");
   row("front end [ms/frame]", f("mean %.2f", frontendMsMean) + f(", max %.2f", frontendMsMax));
-  row("estimator [ms/frame]", f("mean %.2f", estimatorMsMean) + f(", max %.2f", estimatorMsMax));
+  row("estimator [ms/frame]", f("mean %.2f", estimatorMsMean) + f(", median %.2f", estimatorMsMedian) +
+                                   f(", max %.2f", estimatorMsMax));
   if (gnssEpochs + gnssEpochsSkipped > 0) {
     row("GNSS epochs", std::to_string(gnssEpochs) + " processed (" + std::to_string(gnssEpochsUpdated) + " updated, " +
                            std::to_string(gnssEpochsFixed) + " RTK fixed), " + std::to_string(gnssEpochsSkipped) +
                            " before VIO initialisation");
-    row("GNSS [ms/epoch]", f("mean %.3f", gnssMsMean));
+    row("GNSS [ms/epoch]", f("mean %.3f", gnssMsMean) + f(" (%.3f ms per frame)", gnssMsPerFrame));
+    if (std::isfinite(frameInitSeconds)) row("frame initialised", f("%.1f s after the first frame", frameInitSeconds));
   }
-  row("dataset / wall time [s]", f("%.2f", datasetSeconds) + f(" / %.2f", wallSeconds));
+  if (leverArm) {
+    std::string t = f("%.3f", leverArm->x()) + f(" %.3f", leverArm->y()) + f(" %.3f m", leverArm->z());
+    if (leverArmTruth) t += f(" (error %.3f m)", (*leverArm - *leverArmTruth).norm());
+    row("lever arm", t);
+  }
+  row("dataset / wall / CPU time [s]", f("%.2f", datasetSeconds) + f(" / %.2f", wallSeconds) + f(" / %.2f", cpuSeconds));
   row("real-time factor", f("%.2fx", realTimeFactor()));
   os << "------------------------------------------------------------\n";
   if (!evaluationTable.empty()) os << "accuracy against the dataset ground truth (4-DoF aligned):\n" << evaluationTable;
@@ -274,8 +363,12 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
                         "ddcp_used,ddcp_rejected,vel_used,vel_rejected,updated,rtk_fixed,reset,chi2,dof,gnss_ms\n";
   }
   std::vector<vio::TumPose> poses;
+  std::vector<vio::TrajectorySample> localTrack;  // poses with the estimated velocity
   std::vector<vio::PoseCovariance> covs;
-  std::vector<EcefTruthSample> antennaTrack;  // GNSS solutions, stamped on the sensor clock
+  std::vector<double> estimatorMs;
+  // GNSS solutions, stamped on the sensor clock: all, and those after the frame initialisation.
+  std::vector<EcefTruthSample> antennaTrack, antennaTight;
+  std::int64_t firstTight = -1;
   auto gnssStamp = [&](const GpsTime& t) {
     return t.wholeSeconds() * 1'000'000'000 + static_cast<std::int64_t>(std::llround(t.fraction() * 1e9)) - opt.sensorToGpst_ns;
   };
@@ -386,6 +479,7 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
     feSum += frame->timing.total;
     sum.frontendMsMax = std::max(sum.frontendMsMax, frame->timing.total);
     estSum += r.estimator_ms;
+    estimatorMs.push_back(r.estimator_ms);
     sum.estimatorMsMax = std::max(sum.estimatorMsMax, r.estimator_ms);
     if (r.updated) ++sum.framesUpdated;
     const bool init = est.initialized();
@@ -398,6 +492,7 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
         const vio::Matrix6d P = est.poseCovariance();
         cov.write(s.t_ns, P);
         poses.push_back(p);
+        localTrack.push_back({s.t_ns, s.R_WI, s.p_WI, s.v_WI});
         covs.push_back({s.t_ns, 0.5 * (P + P.transpose())});
       }
     }
@@ -446,7 +541,12 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
                           ps.position.y(), ps.position.z(), v.x(), v.y(), v.z(), o.rtkFixed ? 1 : 0);
             ecefFile->out() << b;
             kml.push_back(ecefToGeodetic(ps.position));
-            antennaTrack.push_back({gnssStamp(t), ps.position});
+            const EcefTruthSample a{gnssStamp(t), ps.position, o.antennaVelocityEcef};
+            antennaTrack.push_back(a);
+            if (o.stage == "tight") {
+              if (firstTight < 0) firstTight = a.t_ns;
+              antennaTight.push_back(a);
+            }
           }
         }
         g.haveRover = g.rover->next(g.nextRover);
@@ -493,28 +593,68 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
   sum.gnssMsMean = sum.gnssEpochs ? gnssSum / static_cast<double>(sum.gnssEpochs) : 0.0;
   sum.datasetSeconds = firstT >= 0 ? static_cast<double>(lastT - firstT) * 1e-9 : 0.0;
   sum.wallSeconds = msSince(wall0) * 1e-3;
+  if (!estimatorMs.empty()) {
+    auto mid = estimatorMs.begin() + static_cast<std::ptrdiff_t>(estimatorMs.size() / 2);
+    std::nth_element(estimatorMs.begin(), mid, estimatorMs.end());
+    sum.estimatorMsMedian = *mid;
+  }
+  sum.gnssMsPerFrame = gnssSum / n;
+  {
+    rusage ru{};
+    if (getrusage(RUSAGE_SELF, &ru) == 0)
+      sum.cpuSeconds = static_cast<double>(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
+                       1e-6 * static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+  }
+  if (firstTight >= 0 && firstT >= 0) sum.frameInitSeconds = static_cast<double>(firstTight - firstT) * 1e-9;
+  if (gnss) sum.leverArm = gnss->leverArm();
+  sum.leverArmTruth = opt.leverArmTruth;
 
   if (opt.evaluate && ds.hasGroundTruth() && poses.size() >= 2) {
     vio::EvaluationOptions eo2;
     eo2.alignment = vio::AlignmentKind::Yaw4Dof;
     try {
-      const auto r = vio::evaluateTrajectory(vio::toTrajectorySamples(poses), vio::toTrajectorySamples(ds.groundTruth()), covs, eo2);
+      const auto r = vio::evaluateTrajectory(localTrack, vio::toTrajectorySamples(ds.groundTruth()), covs, eo2);
       std::ostringstream os;
       vio::printEvaluation(os, r);
       sum.evaluationTable = os.str();
+      sum.local = accuracyOf(r);
+      // Aligned on the poses of the first 10 % of the travelled path (estimated).
+      vio::EvaluationOptions eo4 = eo2;
+      double path = 0.0;
+      for (std::size_t i = 1; i < localTrack.size(); ++i) path += (localTrack[i].p - localTrack[i - 1].p).norm();
+      double walked = 0.0;
+      eo4.alignFirst = localTrack.size();
+      for (std::size_t i = 1; i < localTrack.size(); ++i) {
+        walked += (localTrack[i].p - localTrack[i - 1].p).norm();
+        if (walked >= 0.1 * path) {
+          eo4.alignFirst = std::max<std::size_t>(i + 1, 2);
+          break;
+        }
+      }
+      sum.local.startAlignedPositionRmse =
+          vio::evaluateTrajectory(localTrack, vio::toTrajectorySamples(ds.groundTruth()), covs, eo4).translation.rmse;
       for (const auto& f : vio::writeEvaluationPlots(r, (out / "eval_").string())) sum.files.push_back(f);
     } catch (const std::invalid_argument& e) {
       sum.evaluationTable = std::string("not evaluated: ") + e.what() + "\n";
     }
   }
   const fs::path ecefTruth = fs::path(dataset) / "truth" / "groundtruth_ecef.csv";
-  if (opt.evaluate && gnss && antennaTrack.size() >= 2 && fs::exists(ecefTruth)) {
+  // The solutions after the frame initialisation (all if the frame never converged).
+  const std::vector<EcefTruthSample>& evalTrack = antennaTight.size() >= 2 ? antennaTight : antennaTrack;
+  if (opt.evaluate && gnss && evalTrack.size() >= 2 && fs::exists(ecefTruth)) {
     const auto truth = readEcefTruthCsv(ecefTruth.string());
     if (!truth.empty()) {
       const Eigen::Vector3d origin = truth.front().antenna;
+      const Geodetic og = ecefToGeodetic(origin);
+      const Eigen::Matrix3d R_NE = ecefToEnuRotation(og.lat, og.lon);
+      auto enu = [&](const EcefTruthSample& x) {
+        std::optional<Eigen::Vector3d> v;
+        if (x.antennaVelocity) v = R_NE * *x.antennaVelocity;
+        return vio::TrajectorySample{x.t_ns, Eigen::Matrix3d::Identity(), ecefToEnu(x.antenna, origin), v};
+      };
       std::vector<vio::TrajectorySample> ref, track;
-      for (const auto& x : truth) ref.push_back({x.t_ns, Eigen::Matrix3d::Identity(), ecefToEnu(x.antenna, origin), std::nullopt});
-      for (const auto& x : antennaTrack) track.push_back({x.t_ns, Eigen::Matrix3d::Identity(), ecefToEnu(x.antenna, origin), std::nullopt});
+      for (const auto& x : truth) ref.push_back(enu(x));
+      for (const auto& x : evalTrack) track.push_back(enu(x));
       vio::EvaluationOptions eo3;
       eo3.alignment = vio::AlignmentKind::None;
       try {
@@ -528,15 +668,25 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
           v += e.z() * e.z();
         }
         const double m = static_cast<double>(std::max<std::size_t>(r.reference.size(), 1));
-        char b[160];
-        std::snprintf(b, sizeof b, "horizontal RMS %.4f m, vertical RMS %.4f m over %zu epochs\n", std::sqrt(h / m),
-                      std::sqrt(v / m), r.reference.size());
+        char b[200];
+        std::snprintf(b, sizeof b, "horizontal RMS %.4f m, vertical RMS %.4f m over %zu epochs%s\n", std::sqrt(h / m),
+                      std::sqrt(v / m), r.reference.size(),
+                      &evalTrack == &antennaTight ? " (after the frame initialisation)" : "");
         sum.globalEvaluationTable = os.str() + b;
+        sum.global = accuracyOf(r);
+        sum.global.horizontalRmse = std::sqrt(h / m);
+        sum.global.verticalRmse = std::sqrt(v / m);
         for (const auto& f : vio::writeEvaluationPlots(r, (out / "eval_global_").string())) sum.files.push_back(f);
       } catch (const std::invalid_argument& e) {
         sum.globalEvaluationTable = std::string("not evaluated: ") + e.what() + "\n";
       }
     }
+  }
+  {
+    OutFile mf(out / "metrics.csv");
+    sum.writeMetrics(mf.out());
+    mf.close();
+    sum.files.push_back(mf.path());
   }
   return sum;
 }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -202,6 +203,17 @@ TEST(Replay, V101ImagesThroughFrontendThreadAndOutputs) {
   EXPECT_NE(os.str().find("real-time factor"), std::string::npos);
 }
 
+/// metrics.csv of an output folder as key -> value.
+std::map<std::string, double> readMetrics(const fs::path& file) {
+  std::map<std::string, double> m;
+  for (const std::string& l : lines(file)) {
+    if (l.empty() || l[0] == '#') continue;
+    const auto c = l.find(',');
+    if (c != std::string::npos) m[l.substr(0, c)] = std::strtod(l.c_str() + c + 1, nullptr);
+  }
+  return m;
+}
+
 TEST(Replay, AccuracyTableWithGroundTruth) {
   // Ground truth = the stub's known trajectory at 200 Hz; the stub reports it with ±2 cm on z:
   // the accuracy table through the pipeline must show 0.0200 m position RMSE.
@@ -225,6 +237,14 @@ TEST(Replay, AccuracyTableWithGroundTruth) {
   ASSERT_FALSE(s.evaluationTable.empty());
   EXPECT_NE(s.evaluationTable.find("position [m]         0.0200"), std::string::npos) << s.evaluationTable;
   EXPECT_TRUE(fs::exists(out / "eval_trajectory_top.svg"));
+  // metrics.csv carries the same figures for scripts; no GNSS: global ones are NaN.
+  const auto m = readMetrics(out / "metrics.csv");
+  EXPECT_NEAR(m.at("local_position_rmse_m"), 0.02, 1e-4);
+  EXPECT_NEAR(m.at("local_vertical_rmse_m"), 0.02, 1e-4);
+  EXPECT_EQ(m.at("frames"), static_cast<double>(s.framesProcessed));
+  EXPECT_NEAR(m.at("estimator_ms_median"), s.estimatorMsMedian, 1e-5 * (1.0 + s.estimatorMsMedian));
+  EXPECT_TRUE(std::isnan(m.at("global_position_rmse_m")));
+  EXPECT_TRUE(std::isnan(m.at("lever_arm_error_m")));
   EXPECT_TRUE(fs::exists(out / "eval_position_error.svg"));
 }
 
@@ -310,11 +330,13 @@ TEST(Replay, GlobalAccuracyAgainstEcefTruth) {
   fs::create_directories(d / "truth");
   std::ostringstream tr;
   tr.precision(15);
-  tr << "#timestamp [ns],p_E_x,p_E_y,p_E_z,v_E_x,v_E_y,v_E_z,q_w,q_x,q_y,q_z,antenna_E_x,antenna_E_y,antenna_E_z\n";
+  tr << "#timestamp [ns],p_E_x,p_E_y,p_E_z,v_E_x,v_E_y,v_E_z,q_w,q_x,q_y,q_z,antenna_E_x,antenna_E_y,antenna_E_z,"
+        "antenna_v_E_x,antenna_v_E_y,antenna_v_E_z\n";
   const Eigen::Vector3d trueAntenna = gnss.antenna + Eigen::Vector3d(0.3, 0.0, -0.4);
+  // True antenna velocity 0.3 m/s (ECEF z) from the stub's (0.1, 0.2, 0.3).
   for (const auto& e : rover)
     tr << ns(e.time) - o.sensorToGpst_ns << ",0,0,0,0,0,0,1,0,0,0," << trueAntenna.x() << "," << trueAntenna.y() << ","
-       << trueAntenna.z() << "\n";
+       << trueAntenna.z() << ",0.1,0.2,0\n";
   writeText(d / "truth" / "groundtruth_ecef.csv", tr.str());
   const ReplaySummary s = runReplay(d.string(), est, &gnss, o);
   // Epochs handed over: those up to the last state time, counted from the file independently.
@@ -324,7 +346,16 @@ TEST(Replay, GlobalAccuracyAgainstEcefTruth) {
   EXPECT_GE(s.gnssEpochs, 20u);
   EXPECT_NE(s.globalEvaluationTable.find("position [m]         0.5000     0.5000"), std::string::npos)
       << s.globalEvaluationTable;
+  EXPECT_NE(s.globalEvaluationTable.find("velocity [m/s]       0.3000     0.3000"), std::string::npos)
+      << s.globalEvaluationTable;
   EXPECT_TRUE(fs::exists(fs::path(o.outDir) / "eval_global_trajectory_top.svg"));
+  const auto m = readMetrics(fs::path(o.outDir) / "metrics.csv");
+  EXPECT_NEAR(m.at("global_position_rmse_m"), 0.5, 1e-5);
+  EXPECT_NEAR(m.at("global_velocity_rmse_mps"), 0.3, 1e-5);
+  EXPECT_NEAR(std::hypot(m.at("global_horizontal_rmse_m"), m.at("global_vertical_rmse_m")), 0.5, 1e-5);
+  EXPECT_EQ(m.at("global_poses"), static_cast<double>(s.gnssEpochs));
+  // Every epoch of the stub is in the tight stage: the frame counts as initialised at the first.
+  EXPECT_GE(m.at("frame_init_s"), 0.0);
   // No base file given and none in the dataset: no base epochs.
   EXPECT_TRUE(gnss.base.empty());
 }
@@ -334,6 +365,10 @@ TEST(ReplayParsers, EcefTruth) {
   ASSERT_EQ(t.size(), 2u);
   EXPECT_EQ(t[0].antenna, Eigen::Vector3d(1.5, 2.5, 3.5));
   EXPECT_EQ(t[1].t_ns, 200);
+  EXPECT_FALSE(t[1].antennaVelocity);  // 16 fields: no velocity columns
+  const auto tv = parseEcefTruthCsv("100,0,0,0,0,0,0,1,0,0,0,1,2,3,0.5,-0.25,2\n", "g.csv");
+  ASSERT_TRUE(tv.at(0).antennaVelocity);
+  EXPECT_EQ(*tv[0].antennaVelocity, Eigen::Vector3d(0.5, -0.25, 2.0));
   auto err = [](const std::string& text) { return expectParseError([&] { parseEcefTruthCsv(text, "g.csv"); }); };
   ParseError e = err("100,0,0,0,0,0,0,1,0,0,0,1,2\n");
   EXPECT_EQ(e.field(), "antenna_E_z");
@@ -345,6 +380,10 @@ TEST(ReplayParsers, EcefTruth) {
   EXPECT_EQ(e.line(), 2);
   e = err("-5,0,0,0,0,0,0,1,0,0,0,1,2,3\n");
   EXPECT_EQ(e.field(), "timestamp");
+  e = err("100,0,0,0,0,0,0,1,0,0,0,1,2,3,0,v,0\n");
+  EXPECT_EQ(e.field(), "antenna_v_E_y");
+  e = err("100,0,0,0,0,0,0,1,0,0,0,1,2,3,0,0,nan\n");
+  EXPECT_EQ(e.field(), "antenna_v_E_z");
   EXPECT_THROW(readEcefTruthCsv("/nonexistent/groundtruth_ecef.csv"), ParseError);
 }
 

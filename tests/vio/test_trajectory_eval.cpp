@@ -141,6 +141,33 @@ TEST(TrajectoryMetrics, ExactTransformGivesZeroErrorAfterAlignment) {
   }
 }
 
+TEST(TrajectoryMetrics, EstimatedVelocityIsRotatedByTheAlignment) {
+  // An estimate in another frame (yaw 1 rad, shifted) that carries its own velocity: the
+  // velocity error uses it (rotated into the reference frame) instead of differencing
+  // positions, so it is exact where the differences are not; an error of 0.1 m/s added along
+  // the estimate's x axis appears as exactly 0.1 m/s after the rotation.
+  const auto ref = curve(60.0);
+  SimilarityTransform T;
+  T.R = rotZ(1.0);
+  T.t = {5, 6, 7};
+  auto est = transformed(ref, T, 10);
+  for (std::size_t i = 0; i < est.size(); ++i) est[i].v = T.R.transpose() * *ref[i * 10].v;
+  EvaluationOptions opt;
+  opt.alignment = AlignmentKind::Yaw4Dof;
+  const EvaluationResult r0 = evaluateTrajectory(est, ref, {}, opt);
+  EXPECT_EQ(r0.velocity.count, est.size());
+  EXPECT_LT(r0.velocity.max, 1e-9);
+  for (auto& s : est) *s.v += Eigen::Vector3d(0.1, 0.0, 0.0);
+  const EvaluationResult r1 = evaluateTrajectory(est, ref, {}, opt);
+  EXPECT_NEAR(r1.velocity.rmse, 0.1, 1e-9);
+  EXPECT_NEAR(r1.velocity.mean, 0.1, 1e-9);
+  // The body-frame velocity error needs no alignment: R_estᵀ (0.1 e_x) has length 0.1.
+  EXPECT_EQ(r0.bodyVelocity.count, est.size());
+  EXPECT_LT(r0.bodyVelocity.max, 1e-9);
+  EXPECT_NEAR(r1.bodyVelocity.rmse, 0.1, 1e-9);
+  EXPECT_NEAR(r1.bodyVelocity.max, 0.1, 1e-9);
+}
+
 TEST(TrajectoryMetrics, InterpolatedReferenceAtOffsetStamps) {
   // Straight line at constant velocity: linear interpolation of the 200 Hz reference is exact,
   // so an estimate equal to the analytic pose at shifted stamps has zero error.

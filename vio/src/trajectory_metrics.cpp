@@ -132,16 +132,37 @@ EvaluationResult evaluateTrajectory(const std::vector<TrajectorySample>& estimat
   r.translation = stats(terr);
   r.rotation = stats(rerr);
 
-  // Velocity by central differences over neighbouring matched poses (gaps up to 0.5 s).
+  // Velocity: the estimated velocity (rotated and scaled by the alignment) where the estimate
+  // carries one, else central differences over neighbouring matched poses (gaps up to 0.5 s).
   std::vector<double> verr;
-  for (std::size_t i = 1; i + 1 < n; ++i) {
-    const double dt = static_cast<double>(est[i + 1]->t_ns - est[i - 1]->t_ns) * 1e-9;
-    if (!(dt > 0.0) || dt > 1.0) continue;
-    const Eigen::Vector3d ve = (r.estimateAligned[i + 1] - r.estimateAligned[i - 1]) / dt;
-    const Eigen::Vector3d vr = ref[i].v ? *ref[i].v : Eigen::Vector3d((pr[i + 1] - pr[i - 1]) / dt);
+  for (std::size_t i = 0; i < n; ++i) {
+    Eigen::Vector3d ve, vr;
+    if (est[i]->v) {
+      ve = T.scale * (T.R * *est[i]->v);
+      if (ref[i].v) {
+        vr = *ref[i].v;
+      } else {
+        if (i == 0 || i + 1 >= n) continue;
+        const double dt = static_cast<double>(est[i + 1]->t_ns - est[i - 1]->t_ns) * 1e-9;
+        if (!(dt > 0.0) || dt > 1.0) continue;
+        vr = (pr[i + 1] - pr[i - 1]) / dt;
+      }
+    } else {
+      if (i == 0 || i + 1 >= n) continue;
+      const double dt = static_cast<double>(est[i + 1]->t_ns - est[i - 1]->t_ns) * 1e-9;
+      if (!(dt > 0.0) || dt > 1.0) continue;
+      ve = (r.estimateAligned[i + 1] - r.estimateAligned[i - 1]) / dt;
+      vr = ref[i].v ? *ref[i].v : Eigen::Vector3d((pr[i + 1] - pr[i - 1]) / dt);
+    }
     verr.push_back((ve - vr).norm());
   }
   r.velocity = stats(verr);
+  // Body-frame velocity (R^T v of each), where both carry a velocity: free of any alignment.
+  std::vector<double> berr;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (est[i]->v && ref[i].v) berr.push_back((est[i]->R.transpose() * *est[i]->v - ref[i].R.transpose() * *ref[i].v).norm());
+  }
+  r.bodyVelocity = stats(berr);
 
   // Relative errors over distance.
   std::vector<double> dist(n, 0.0);
@@ -225,6 +246,7 @@ void printEvaluation(std::ostream& os, const EvaluationResult& r) {
   row("position [m]", r.translation);
   row("rotation [deg]", r.rotation);
   row("velocity [m/s]", r.velocity);
+  if (r.bodyVelocity.count > 0) row("body vel. [m/s]", r.bodyVelocity);
   os << "segment [m]   count   mean [m]   rmse [m]   drift [%]   rot [deg/m]\n";
   for (const SegmentError& s : r.segments) {
     if (s.count == 0) {

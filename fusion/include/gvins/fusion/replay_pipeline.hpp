@@ -25,6 +25,7 @@
 #include <cstdint>
 #include <functional>
 #include <iosfwd>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -83,6 +84,8 @@ class ReplayGnss {
   virtual ~ReplayGnss() = default;
   virtual void setBasePosition(const Eigen::Vector3d& ecef) = 0;
   virtual ReplayGnssOutcome processEpoch(const ObsEpoch& rover, const ObsEpoch* base, const EphemerisStore& nav) = 0;
+  /// The current GNSS-IMU lever-arm estimate (^I p_r, m), when the client has one.
+  virtual std::optional<Eigen::Vector3d> leverArm() const { return std::nullopt; }
 };
 
 enum class ImuGapPolicy { Error, Warn };
@@ -109,6 +112,8 @@ struct ReplayOptions {
   /// stamps are GPST; set it to replay GNSS files against a recording stamped on another clock.
   std::int64_t sensorToGpst_ns = 0;
   std::string modeName = "vio";  ///< for the summary and output headers
+  /// The true GNSS lever arm (gvins-sim dataset.yaml), for the lever-arm error in metrics.csv.
+  std::optional<Eigen::Vector3d> leverArmTruth;
   bool progress = true;
   /// Evaluate against the dataset's ground truth at the end (table + SVG plots in outDir).
   bool evaluate = true;
@@ -126,21 +131,44 @@ struct ReplaySummary {
   double gnssMsMean = 0.0;  ///< per epoch
   std::size_t gnssEpochs = 0, gnssEpochsUpdated = 0, gnssEpochsFixed = 0, gnssEpochsSkipped = 0;
   double realTimeFactor() const { return wallSeconds > 0.0 ? datasetSeconds / wallSeconds : 0.0; }
+  double estimatorMsMedian = 0.0;
+  double gnssMsPerFrame = 0.0;   ///< GNSS time summed over the run / processed frames
+  double cpuSeconds = 0.0;       ///< process CPU time (user + system), all threads
   std::vector<std::string> files;
   std::string evaluationTable;  ///< printEvaluation output, empty without ground truth
+  /// Key figures of the evaluations for scripts (metrics.csv): NaN where not evaluated.
+  static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  struct Accuracy {
+    double positionRmse = kNaN, rotationRmseDeg = kNaN, velocityRmse = kNaN, bodyVelocityRmse = kNaN;
+    /// Local only: 4-DoF alignment on the poses of the first 10 % of the path (VIO as a navigator started
+    /// in a known frame: its drift is not aligned away).
+    double startAlignedPositionRmse = kNaN;
+    double horizontalRmse = kNaN, verticalRmse = kNaN;
+    double pathLength = kNaN, driftPercent = kNaN;  ///< drift: longest segment length evaluated
+    double positionNees = kNaN, orientationNees = kNaN;
+    std::size_t poses = 0;
+  };
+  Accuracy local;   ///< trajectory.tum vs ground truth, 4-DoF aligned
+  Accuracy global;  ///< GNSS antenna solutions after the frame initialisation, ENU, no alignment
+  double frameInitSeconds = kNaN;  ///< from the first processed frame to the first tight GNSS epoch
+  std::optional<Eigen::Vector3d> leverArm, leverArmTruth;  ///< final estimate; options' truth
   /// GNSS modes with DATASET/truth/groundtruth_ecef.csv: accuracy of the GNSS antenna solutions
   /// (global_ecef.csv) against the true antenna track, in ENU at the first truth point, no
   /// alignment (rotation rows are meaningless there: the antenna has no orientation).
   std::string globalEvaluationTable;
   void print(std::ostream& os) const;
+  /// `key,value` lines of the figures above (metrics.csv; NaN where not evaluated).
+  void writeMetrics(std::ostream& os) const;
 };
 
 /// Antenna track of a gvins-sim ECEF truth file (truth/groundtruth_ecef.csv: t [ns], IMU
-/// position/velocity/orientation, then antenna_E_x/y/z in columns 12-14, ...). Throws ParseError
+/// position/velocity/orientation, then antenna_E_x/y/z in columns 12-14 and, when present, the
+/// antenna velocity in columns 15-17). Throws ParseError
 /// (file, line, field) on malformed rows or stamps that do not increase.
 struct EcefTruthSample {
   std::int64_t t_ns = 0;
   Eigen::Vector3d antenna = Eigen::Vector3d::Zero();
+  std::optional<Eigen::Vector3d> antennaVelocity;  ///< columns 15-17 when present
 };
 std::vector<EcefTruthSample> readEcefTruthCsv(const std::string& path);
 std::vector<EcefTruthSample> parseEcefTruthCsv(std::string_view text, const std::string& name);

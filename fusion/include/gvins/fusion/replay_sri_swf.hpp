@@ -49,6 +49,7 @@ class GnssFusionReplayClient final : public ReplayGnss {
     o.antennaVelocityEcef = r.antennaVelocityEcef;
     return o;
   }
+  std::optional<Eigen::Vector3d> leverArm() const override { return fusion_.leverArm(est_); }
   GnssFusion<Scalar>& fusion() { return fusion_; }
 
  private:

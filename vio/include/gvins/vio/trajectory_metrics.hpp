@@ -5,8 +5,11 @@
 //     else it is counted as unmatched;
 //   - alignment (trajectory_alignment.hpp) of the matched positions;
 //   - absolute errors after alignment: position (m), orientation (angle of R_ref^T·R·R_est, deg),
-//     velocity (m/s; estimated velocity by central differences of the aligned positions of
-//     neighbouring matched poses, reference velocity from the file or likewise differenced);
+//     velocity (m/s; the estimate's own velocity, rotated and scaled by the alignment, where it
+//     has one, else central differences of the aligned positions of neighbouring matched
+//     poses; reference velocity from the file or likewise differenced);
+//   - body-frame velocity error |R_estᵀ v_est − R_refᵀ v_ref| where both carry velocities
+//     (independent of the alignment; the velocity RMSE of the SRI-GVINS paper's tables);
 //   - relative errors over travelled distance (KITTI odometry style, Geiger et al., CVPR 2012):
 //     for each segment length L and every start pose, the pose at which the reference path has
 //     grown by L; translation error |trans(ΔT_ref⁻¹ ΔT_est)| with ΔT = T_i⁻¹ T_j (independent of
@@ -72,6 +75,7 @@ struct EvaluationResult {
   ErrorStats translation;     ///< m
   ErrorStats rotation;        ///< deg
   ErrorStats velocity;        ///< m/s (count 0 if not computable)
+  ErrorStats bodyVelocity;    ///< m/s, |R_estᵀ v_est − R_refᵀ v_ref| where both have a velocity
   std::vector<SegmentError> segments;
   std::size_t neesCount = 0;  ///< matched poses with a covariance
   double positionNees = 0.0, orientationNees = 0.0;  ///< averages (expected 3 each)
