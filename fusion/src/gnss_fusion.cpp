@@ -7,6 +7,7 @@
 #include "gvins/base/constants.hpp"
 #include "gvins/base/local_frame.hpp"
 #include "gvins/fusion/gnss_clock_init.hpp"
+#include "gvins/gnss/ionosphere_free.hpp"
 #include "gvins/gnss/klobuchar.hpp"
 #include "gvins/gnss/sagnac.hpp"
 #include "gvins/gnss/troposphere.hpp"
@@ -77,6 +78,7 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
   const Geodetic g = ecefToGeodetic(x);
   const IonosphereParameters& iono = nav.ionosphere();
   const double fL1 = *carrierFrequency(System::Gps, '1');
+  const auto bandOrder = SppConfig{}.bands;  // preferred bands per system
   for (const SatObs& so : rover.sats) {
     if (!so.sat.valid() || !config_.useSystem(so.sat.system)) continue;
     const char band = primaryBand(so.sat.system);
@@ -112,6 +114,28 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     // Code: white noise and multipath growing with 1/sin(el), plus 30 % of the broadcast
     // ionosphere (Klobuchar corrects about half of the delay; IS-GPS-200N 20.3.3.5.2.5).
     m.codeVariance = std::pow(config_.codeSigma, 2) * (0.5 + 0.5 / (sinEl * sinEl)) + std::pow(0.3 * m.ionosphere, 2);
+    // Dual frequency: the ionosphere-free pair with the first other band tracked (the SPP band
+    // order), group delays combined alike; its noise is the single-band noise times
+    // sqrt(a1² + a2²) (about 3 for L1/L2) and it carries no ionospheric model error.
+    if (config_.ionosphere == GnssIonosphere::kDualFrequency) {
+      const std::string& order = bandOrder[static_cast<std::size_t>(systemIndex(so.sat.system))];
+      for (char b2 : order) {
+        if (b2 == band) continue;
+        const SignalObs* s2 = so.bestOnBand(b2, SignalObs::kCode);
+        const auto f2 = s2 ? carrierFrequency(so.sat.system, b2, channel) : std::nullopt;
+        if (!f2 || !(s2->pseudorange > 1e6 && s2->pseudorange < 1e8)) continue;
+        const IonosphereFreeCoefficients c = ionosphereFreeCoefficients(*f, *f2);
+        m.pseudorange = c.a1 * s->pseudorange + c.a2 * s2->pseudorange;
+        m.groupDelay = c.a1 * m.groupDelay + c.a2 * nav.groupDelay(so.sat, s2->code, tx->transmitTime);
+        m.ionosphere = 0.0;
+        m.ionosphereFree = true;
+        m.code2 = s2->code;
+        m.ifA1 = c.a1;
+        m.ifA2 = c.a2;
+        m.codeVariance = std::pow(config_.codeSigma * c.noiseFactor(), 2) * (0.5 + 0.5 / (sinEl * sinEl));
+        break;
+      }
+    }
     m.dopplerVariance = std::pow(config_.dopplerSigma, 2) * (0.5 + 0.5 / (sinEl * sinEl));
     const SignalObs* d = s->hasDoppler() ? s : nullptr;
     if (d && std::abs(d->doppler) < 1e5) {

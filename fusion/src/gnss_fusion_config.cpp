@@ -116,7 +116,7 @@ GnssFusionConfig parseGnssFusionConfig(std::string_view yaml, const std::string&
   if (!map.IsMap()) rd.fail(map, "gnss_fusion", "expected a mapping");
   static const std::set<std::string> kKeys = {
       "mode", "lever_arm", "calibrate_lever_arm", "lever_arm_sigma", "min_rotation_rate", "systems",
-      "elevation_mask_deg", "code_sigma", "doppler_sigma", "clock_bias_random_walk", "clock_drift_random_walk",
+      "elevation_mask_deg", "ionosphere", "code_sigma", "doppler_sigma", "clock_bias_random_walk", "clock_drift_random_walk",
       "row_gate", "epoch_gate", "frame_yaw_sigma_deg", "frame_min_speed", "outage_reset",
       "clock_ransac_threshold", "base_position", "max_base_age"};
   for (const auto& kv : map) {
@@ -136,6 +136,7 @@ GnssFusionConfig parseGnssFusionConfig(std::string_view yaml, const std::string&
       c.mode = *m;
     } else if (key == "lever_arm") {
       c.leverArm = rd.vec3(v, key);
+      c.leverArmGiven = true;
     } else if (key == "calibrate_lever_arm") {
       c.calibrateLeverArm = rd.boolean(v, key);
     } else if (key == "lever_arm_sigma") {
@@ -154,6 +155,11 @@ GnssFusionConfig parseGnssFusionConfig(std::string_view yaml, const std::string&
     } else if (key == "elevation_mask_deg") {
       c.elevationMaskDeg = rd.number(v, key);
       if (c.elevationMaskDeg < 0.0 || c.elevationMaskDeg >= 90.0) rd.fail(v, key, "must be in [0, 90)");
+    } else if (key == "ionosphere") {
+      const std::string s = rd.scalar(v, key);
+      if (s == "broadcast") c.ionosphere = GnssIonosphere::kBroadcast;
+      else if (s == "dual-frequency") c.ionosphere = GnssIonosphere::kDualFrequency;
+      else rd.fail(v, key, "expected broadcast or dual-frequency, got '" + s + "'");
     } else if (key == "code_sigma") {
       c.codeSigma = rd.positive(v, key);
     } else if (key == "doppler_sigma") {

@@ -16,8 +16,14 @@ TEST(GnssFusionConfig, ParsesAllKeys) {
       "  calibrate_lever_arm: true\n"
       "  systems: GE\n"
       "  code_sigma: 0.8\n"
+      "  ionosphere: broadcast\n"
       "  base_position: [1, 2, 3]\n"
       "  row_gate: 0.99\n");
+  EXPECT_EQ(c.ionosphere, GnssIonosphere::kBroadcast);
+  EXPECT_TRUE(c.leverArmGiven);
+  const GnssFusionConfig d = parseGnssFusionConfig("gnss_fusion:\n  mode: vio+dopp+psr\n");
+  EXPECT_EQ(d.ionosphere, GnssIonosphere::kDualFrequency);
+  EXPECT_FALSE(d.leverArmGiven);
   EXPECT_EQ(c.mode, GnssFusionMode::kDoppDdcp);
   EXPECT_EQ(c.leverArm, Eigen::Vector3d(0.1, -0.2, 0.3));
   EXPECT_TRUE(c.calibrateLeverArm);
@@ -70,6 +76,13 @@ TEST(GnssFusionConfig, ErrorsNameFileLineAndField) {
   } catch (const ParseError& e) {
     EXPECT_EQ(e.line(), 2);
     EXPECT_EQ(e.field(), "typo_key");
+  }
+  try {
+    parseGnssFusionConfig("gnss_fusion:\n  mode: vio+dopp\n  ionosphere: klobuchar\n", "i.yaml");
+    FAIL() << "no error";
+  } catch (const ParseError& e) {
+    EXPECT_EQ(e.line(), 3);
+    EXPECT_EQ(e.field(), "ionosphere");
   }
   EXPECT_THROW(parseGnssFusionConfig("gnss_fusion: [\n"), ParseError);
   EXPECT_THROW(loadGnssFusionConfig("/nonexistent/gnss.yaml"), ParseError);

@@ -202,12 +202,17 @@ TEST(GnssFusionSim, FrameInitialisationConvergesAndPseudorangeFusion) {
 }
 
 // Residuals at the simulated truth (state, frame, lever arm, true receiver clocks) equal the
-// simulated error terms that the models do not contain.
-TEST(GnssFusionSim, ResidualsAtTruthAreTheSimulatedErrors) {
+// simulated error terms that the models do not contain: on the primary band with the broadcast
+// ionosphere, and for the dual-frequency ionosphere-free pairs (whose ionospheric terms cancel).
+class GnssFusionSimResiduals : public ::testing::TestWithParam<GnssIonosphere> {};
+
+TEST_P(GnssFusionSimResiduals, AtTruthAreTheSimulatedErrors) {
   const Scenario& sc = scenario();
-  GnssFusion<double> fusion(mode(GnssFusionMode::kDoppPsr));
+  GnssFusionConfig cfg = mode(GnssFusionMode::kDoppPsr);
+  cfg.ionosphere = GetParam();
+  GnssFusion<double> fusion(cfg);
   double d2 = 0.0, r2 = 0.0, dd2 = 0.0;
-  int n = 0, nd = 0;
+  int n = 0, nd = 0, nif = 0;
   for (const sim::GnssSimEpoch& e : sc.epochs) {
     if (e.role != sim::GnssReceiverRole::Rover || n > 2000) continue;
     const double tf = sc.frame.flightTime(e.truth.time);
@@ -228,16 +233,27 @@ TEST(GnssFusionSim, ResidualsAtTruthAreTheSimulatedErrors) {
       while (i < e.obs.sats.size() && !(e.obs.sats[i].sat == m.sat)) ++i;
       ASSERT_LT(i, e.obs.sats.size());
       const sim::GnssSatelliteTruth& st = e.truth.sats[i];
-      std::size_t j = 0;
-      while (j < st.signals.size() && !(st.signals[j].code == m.code)) ++j;
-      ASSERT_LT(j, st.signals.size());
-      const sim::GnssSignalTruth& g = st.signals[j];
+      auto signal = [&](ObsCode c) -> const sim::GnssSignalTruth& {
+        std::size_t j = 0;
+        while (j < st.signals.size() && !(st.signals[j].code == c)) ++j;
+        EXPECT_LT(j, st.signals.size());
+        return st.signals[std::min(j, st.signals.size() - 1)];
+      };
+      // Unmodelled terms of one signal; an ionosphere-free pair combines them with a1, a2.
+      auto errors = [&](const sim::GnssSignalTruth& g) {
+        return g.ionosphere + g.multipathCode + g.codeNoise + g.interFrequencyBias;
+      };
+      double signalErrors = errors(signal(m.code));
+      if (m.ionosphereFree) {
+        ++nif;
+        EXPECT_NEAR(m.ifA1 + m.ifA2, 1.0, 1e-12);
+        signalErrors = m.ifA1 * signalErrors + m.ifA2 * errors(signal(m.code2));
+      }
       const double clock = constants::kSpeedOfLight * e.truth.systemClockBias[static_cast<std::size_t>(systemIndex(m.sat.system))];
       const double r = pseudorangeRow(m, k, clock).residual;
       const Vector3d u = (st.satPosition - e.truth.antennaPosition).normalized();
-      const double predicted = (st.troposphere - m.troposphere) + (g.ionosphere - m.ionosphere) + st.shapiro +
-                               g.multipathCode + st.nlosBias + g.codeNoise + g.interFrequencyBias +
-                               u.dot(st.orbitError) - constants::kSpeedOfLight * st.clockError;
+      const double predicted = (st.troposphere - m.troposphere) - m.ionosphere + signalErrors + st.shapiro +
+                               st.nlosBias + u.dot(st.orbitError) - constants::kSpeedOfLight * st.clockError;
       d2 += std::pow(r - predicted, 2);
       r2 += r * r;
       ++n;
@@ -250,12 +266,18 @@ TEST(GnssFusionSim, ResidualsAtTruthAreTheSimulatedErrors) {
   }
   ASSERT_GT(n, 500);
   const double modelRms = std::sqrt(d2 / n), rms = std::sqrt(r2 / n), doppRms = std::sqrt(dd2 / nd);
-  std::fprintf(stderr, "psr residual at truth: RMS %.3f m, minus the simulated error terms %.3f m; Doppler %.4f m/s\n",
-               rms, modelRms, doppRms);
+  std::fprintf(stderr, "psr residual at truth (%s): RMS %.3f m, minus the simulated error terms %.3f m; %d of %d "
+               "ionosphere-free; Doppler %.4f m/s\n",
+               GetParam() == GnssIonosphere::kBroadcast ? "broadcast" : "dual-frequency", rms, modelRms, nif, n, doppRms);
   EXPECT_LT(modelRms, 0.1);  // measured 0.019 m (our troposphere/satellite-state evaluation vs the simulator)
   EXPECT_LT(rms, 5.0);
   EXPECT_LT(doppRms, 0.2);
+  if (GetParam() == GnssIonosphere::kBroadcast) EXPECT_EQ(nif, 0);
+  else EXPECT_GT(nif, n * 9 / 10);  // the simulator gives every satellite two bands or more
 }
+
+INSTANTIATE_TEST_SUITE_P(Ionosphere, GnssFusionSimResiduals,
+                         ::testing::Values(GnssIonosphere::kBroadcast, GnssIonosphere::kDualFrequency));
 
 TEST(GnssFusionSim, ModesTable) {
   std::map<GnssFusionMode, RunResult> r;

@@ -9,6 +9,8 @@
 //     min_rotation_rate: 0.3              # rad/s: lever-arm Jacobian used by Doppler rows above it
 //     systems: GREJ                       # RINEX letters of the constellations used
 //     elevation_mask_deg: 10
+//     ionosphere: dual-frequency          # psr rows: ionosphere-free code where a second band
+//                                         # exists (else broadcast), or broadcast (Klobuchar)
 //     code_sigma: 0.6                     # m at zenith; variance (a² + a²/sin²(el)) style
 //     doppler_sigma: 0.1                  # m/s at zenith
 //     clock_bias_random_walk: 0.1         # m/√s per constellation bias
@@ -47,14 +49,22 @@ enum class GnssFusionMode : std::uint8_t {
 const char* toString(GnssFusionMode m);
 std::optional<GnssFusionMode> gnssFusionModeFromString(std::string_view s);
 
+/// Ionosphere of the undifferenced pseudorange rows.
+enum class GnssIonosphere : std::uint8_t {
+  kBroadcast,      ///< Klobuchar (GPS; BeiDou's own for BeiDou) on the primary band
+  kDualFrequency,  ///< ionosphere-free pair where a second band exists, else kBroadcast
+};
+
 struct GnssFusionConfig {
   GnssFusionMode mode = GnssFusionMode::kDoppPsr;
   Eigen::Vector3d leverArm = Eigen::Vector3d::Zero();
+  bool leverArmGiven = false;  ///< set by the parser when the file has `lever_arm`
   bool calibrateLeverArm = false;
   double leverArmSigma = 0.2;
   double minRotationRate = 0.3;
   std::array<bool, kNumSystems> systems{true, true, true, true, true, false, false};
   double elevationMaskDeg = 10.0;
+  GnssIonosphere ionosphere = GnssIonosphere::kDualFrequency;
   double codeSigma = 0.6;
   double dopplerSigma = 0.1;
   double clockBiasRandomWalk = 0.1;

@@ -97,7 +97,10 @@ struct SatelliteModel {
   double clockDrift = 0.0;  ///< s/s
   double groupDelay = 0.0;  ///< s, broadcast for this code
   double troposphere = 0.0; ///< m, modelled slant delay at the rover
-  double ionosphere = 0.0;  ///< m, modelled code delay (Klobuchar) on this frequency
+  double ionosphere = 0.0;  ///< m, modelled code delay (Klobuchar) on this frequency; 0 if ionosphere-free
+  bool ionosphereFree = false;  ///< pseudorange and group delay are a dual-frequency ionosphere-free pair:
+  ObsCode code2;                ///< its second signal, and the combination
+  double ifA1 = 1.0, ifA2 = 0.0;  ///< P = a1·P(code) + a2·P(code2)
   double wavelength = 0.0;  ///< m
   AzEl azel;
   double pseudorange = 0.0; ///< m
