@@ -234,6 +234,13 @@ void RinexObsWriter::write(const ObsEpoch& e, const std::vector<std::string>& ev
     for (const auto& r : eventRecords) {
       if (count >= 999) break;
       std::string l = fit(r, 80);
+      std::string_view lab = std::string_view(l).substr(60);
+      while (!lab.empty() && lab.back() == ' ') lab.remove_suffix(1);
+      if (lab == "SYS / # / OBS TYPES" || lab == "SYS / SCALE FACTOR" || lab == "# / TYPES OF OBSERV" ||
+          lab == "WAVELENGTH FACT L1/2" || lab == "RINEX VERSION / TYPE" || lab == "END OF HEADER") {
+        ++droppedRecords_;
+        continue;
+      }
       if (l[0] == '>') l[0] = ' ';  // would read as an epoch line
       while (!l.empty() && l.back() == ' ') l.pop_back();
       body += l;

@@ -580,6 +580,60 @@ TEST(RinexObs, WriterEventsClockOffsetAndTypesFromData) {
   EXPECT_FALSE(rd.next(b));
 }
 
+// A RINEX 2 in-file header record (flag 4) that changes the observation types must not be copied
+// into the RINEX 3 output: the writer writes every epoch in its own header's columns, and a copied
+// "# / TYPES OF OBSERV" or "SYS / # / OBS TYPES" line would make a reader parse the following
+// epochs with other columns (found by fuzz_rinex_obs: a copied SYS / # / OBS TYPES line without
+// its continuation line made the written file unreadable).
+TEST(RinexObs, WriterLeavesOutEventRecordsThatRedefineColumns) {
+  const std::string t =
+      "     2.11           OBSERVATION DATA    G (GPS)             RINEX VERSION / TYPE\n"
+      "     3    C1    L1    S1                                    # / TYPES OF OBSERV\n"
+      "  2020     1     1     0     0    0.0000000     GPS         TIME OF FIRST OBS\n"
+      "                                                            END OF HEADER\n"
+      " 20  1  1  0  0  0.0000000  0  1G01\n"
+      "  20000000.000   100000000.250          45.000\n"
+      "                            4  3\n"
+      "     2    C1    L1                                          # / TYPES OF OBSERV\n"
+      "G   14 C1C L1C S1C C1W S1W C2W L2W S2W C2L L2L S2L C5Q L5Q  SYS / # / OBS TYPES\n"
+      "in-file comment                                             COMMENT\n"
+      " 20  1  1  0  0  1.0000000  0  1G01\n"
+      "  20000001.000   100000001.250\n";
+  RinexObsReaderOptions opt;
+  opt.returnSpecialRecords = true;
+  RinexObsReader r(std::string_view(t), "types211.obs", opt);
+  RinexObsHeader h = r.header();
+  h.date = "20240101 000000 UTC";
+  std::ostringstream os;
+  std::vector<ObsEpoch> in;
+  {
+    RinexObsWriter w(os, h);
+    ObsEpoch e;
+    while (r.next(e)) {
+      w.write(e, r.eventRecords());
+      in.push_back(e);
+    }
+    w.finish();
+    EXPECT_EQ(w.droppedEventRecords(), 2);
+    EXPECT_EQ(w.droppedValues(), 0);
+  }
+  ASSERT_EQ(in.size(), 3u);
+  const std::string text = os.str();
+  RinexObsReader back(std::string_view(text), "written.obs", opt);
+  ObsEpoch b;
+  for (const ObsEpoch& a : in) {
+    ASSERT_TRUE(back.next(b));
+    expectSameEpoch(a, b);
+  }
+  EXPECT_FALSE(back.next(b));
+  EXPECT_EQ(back.header().comments.back(), "in-file comment");
+  // The epoch after the event has code and phase only, in the written header's three columns.
+  const SignalObs* s = in[2].sats[0].find(oc("1C"));
+  ASSERT_NE(s, nullptr);
+  EXPECT_DOUBLE_EQ(s->carrierPhase, 100000001.25);
+  EXPECT_FALSE(s->hasSnr());
+}
+
 // ---- malformed input --------------------------------------------------------------------------
 
 namespace {

@@ -39,6 +39,11 @@ class RinexObsWriter {
   /// Writes one epoch. Flags 0, 1 and 6 write the satellites; flags 2-5 write `eventRecords`
   /// (header-format lines, e.g. from RinexObsReader::eventRecords(); each padded/cut to 80
   /// characters) and no satellites. Satellites of systems without types in the header are skipped.
+  /// Every epoch is written in the columns of this writer's header, so event records that would
+  /// redefine the columns (SYS / # / OBS TYPES, SYS / SCALE FACTOR), RINEX 2 records (# / TYPES OF
+  /// OBSERV, WAVELENGTH FACT L1/2) and RINEX VERSION / TYPE or END OF HEADER lines are left out
+  /// (counted in droppedEventRecords()): copied, they would make a reader parse the following
+  /// epochs with other columns than those written.
   void write(const ObsEpoch& epoch, const std::vector<std::string>& eventRecords = {});
   /// Writes the header if no epoch was written yet (a file with a header only) and flushes.
   void finish();
@@ -46,6 +51,8 @@ class RinexObsWriter {
   std::int64_t epochsWritten() const { return epochs_; }
   /// Values not written: descriptor missing from the header, or too large for F14.3.
   std::int64_t droppedValues() const { return dropped_; }
+  /// Event records left out (see write()).
+  std::int64_t droppedEventRecords() const { return droppedRecords_; }
   const RinexObsHeader& header() const { return header_; }
 
  private:
@@ -56,6 +63,7 @@ class RinexObsWriter {
   bool headerWritten_ = false;
   std::int64_t epochs_ = 0;
   std::int64_t dropped_ = 0;
+  std::int64_t droppedRecords_ = 0;
   std::string buf_;
 };
 
