@@ -234,8 +234,9 @@ void RinexObsWriter::write(const ObsEpoch& e, const std::vector<std::string>& ev
     for (const auto& r : eventRecords) {
       if (count >= 999) break;
       std::string l = fit(r, 80);
-      std::string_view lab = std::string_view(l).substr(60);
+      std::string_view lab = std::string_view(l).substr(60);  // trimmed as RinexObsReader reads it
       while (!lab.empty() && lab.back() == ' ') lab.remove_suffix(1);
+      while (!lab.empty() && lab.front() == ' ') lab.remove_prefix(1);
       if (lab == "SYS / # / OBS TYPES" || lab == "SYS / SCALE FACTOR" || lab == "# / TYPES OF OBSERV" ||
           lab == "WAVELENGTH FACT L1/2" || lab == "RINEX VERSION / TYPE" || lab == "END OF HEADER") {
         ++droppedRecords_;

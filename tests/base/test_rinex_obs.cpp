@@ -593,9 +593,10 @@ TEST(RinexObs, WriterLeavesOutEventRecordsThatRedefineColumns) {
       "                                                            END OF HEADER\n"
       " 20  1  1  0  0  0.0000000  0  1G01\n"
       "  20000000.000   100000000.250          45.000\n"
-      "                            4  3\n"
+      "                            4  4\n"
       "     2    C1    L1                                          # / TYPES OF OBSERV\n"
       "G   14 C1C L1C S1C C1W S1W C2W L2W S2W C2L L2L S2L C5Q L5Q  SYS / # / OBS TYPES\n"
+      "G   14 C1C L1C S1C C01W S1W C2W L2W S2W C2L L2L S2L C5Q L5Q  SYS / # / OBS TYPES\n"  // label a column late
       "in-file comment                                             COMMENT\n"
       " 20  1  1  0  0  1.0000000  0  1G01\n"
       "  20000001.000   100000001.250\n";
@@ -614,7 +615,7 @@ TEST(RinexObs, WriterLeavesOutEventRecordsThatRedefineColumns) {
       in.push_back(e);
     }
     w.finish();
-    EXPECT_EQ(w.droppedEventRecords(), 2);
+    EXPECT_EQ(w.droppedEventRecords(), 3);
     EXPECT_EQ(w.droppedValues(), 0);
   }
   ASSERT_EQ(in.size(), 3u);
