@@ -27,6 +27,7 @@
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "gvins/fusion/replay_feature_tracks.hpp"
+#include "gvins/gnss/base_reader.hpp"
 #include "gvins/gnss/pos_writer.hpp"
 #include "gvins/vio/camera_model.hpp"
 #include "gvins/vio/euroc_dataset.hpp"
@@ -86,7 +87,9 @@ std::string findNavFile(const fs::path& dir) {
 }
 
 struct GnssInputs {
-  std::unique_ptr<RinexObsReader> rover, base;
+  std::unique_ptr<RinexObsReader> rover;
+  std::unique_ptr<BaseReader> base;  // RINEX or an RTCM 3 log
+  bool basePositionSet = false;
   EphemerisStore nav;
   ObsEpoch nextRover, nextBase, currentBase;
   bool haveRover = false, haveBase = false, haveCurrentBase = false;
@@ -327,19 +330,27 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
     RinexObsReaderOptions ro;
     ro.skipBadEpochs = true;
     g.rover = std::make_unique<RinexObsReader>(roverPath, ro);
+    g.haveRover = g.rover->next(g.nextRover);
     if (fs::exists(basePath)) {
-      g.base = std::make_unique<RinexObsReader>(basePath, ro);
-      const auto& hp = g.base->header().station.approxPosition;
+      // RINEX (header position + antenna delta) or RTCM 3 (1005/1006, possibly only after some
+      // epochs; its ephemerides join the store); RTCM times of week resolve against the rover.
+      const GpsTime ref = g.haveRover ? g.nextRover.time : GpsTime{};
+      g.base = BaseReader::open(basePath, ref, &g.nav, true);
       if (opt.basePosition) {
         gnss->setBasePosition(*opt.basePosition);
-      } else if (hp && hp->norm() > 1e6) {
-        gnss->setBasePosition(*hp);
-      } else {
-        throw ParseError(basePath, 0, "APPROX POSITION XYZ", "base position missing in the header (use --base-position)");
+        g.basePositionSet = true;
+      }
+      g.haveBase = g.base->next(g.nextBase);
+      if (!g.basePositionSet) {
+        const auto p = g.base->antennaPosition();
+        if (p && p->norm() > 1e6) {
+          gnss->setBasePosition(*p);
+          g.basePositionSet = true;
+        } else if (g.base->format() == BaseFormat::Rinex) {
+          throw ParseError(basePath, 0, "APPROX POSITION XYZ", "base position missing in the header (use --base-position)");
+        }
       }
     }
-    g.haveRover = g.rover->next(g.nextRover);
-    if (g.base) g.haveBase = g.base->next(g.nextBase);
   }
 
   // Outputs.
@@ -510,6 +521,13 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
             std::swap(g.currentBase, g.nextBase);
             g.haveCurrentBase = true;
             g.haveBase = g.base->next(g.nextBase);
+          }
+          if (!g.basePositionSet && g.base) {  // an RTCM station message arrived
+            const auto p = g.base->antennaPosition();
+            if (p && p->norm() > 1e6) {
+              gnss->setBasePosition(*p);
+              g.basePositionSet = true;
+            }
           }
           const auto t0 = Clock::now();
           const ReplayGnssOutcome o = gnss->processEpoch(g.nextRover, g.haveCurrentBase ? &g.currentBase : nullptr, g.nav);

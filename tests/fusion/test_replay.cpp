@@ -21,6 +21,7 @@
 #include "gvins/fusion/replay_config.hpp"
 #include "gvins/fusion/replay_feature_tracks.hpp"
 #include "gvins/fusion/replay_pipeline.hpp"
+#include "gvins/rtcm/encoder.hpp"
 #include "gvins/gnss/pos_reader.hpp"
 #include "gvins/vio/camera_model.hpp"
 #include "gvins/vio/euroc_csv.hpp"
@@ -358,6 +359,59 @@ TEST(Replay, GlobalAccuracyAgainstEcefTruth) {
   EXPECT_GE(m.at("frame_init_s"), 0.0);
   // No base file given and none in the dataset: no base epochs.
   EXPECT_TRUE(gnss.base.empty());
+}
+
+TEST(Replay, RtcmBaseStreamHandsOverTheSameBaseEpochs) {
+  // The GEONET 3040 base as an RTCM 3 log (MSM7 by the project's encoder, 1005 with a position
+  // 1 m away from the RINEX header's, so that its use shows): the pipeline detects the format,
+  // takes the station position from 1005 and hands over the same base epochs as from RINEX.
+  const fs::path g = kData / "gnss" / "geonet_0759_3040_2005";
+  const auto rover = readRinexObs((g / "07590920.05o.gz").string());
+  RinexObsHeader bh;
+  const auto base = readRinexObs((g / "30400920.05o.gz").string(), &bh);
+  ASSERT_TRUE(bh.station.approxPosition);
+  const Eigen::Vector3d arp = *bh.station.approxPosition + Eigen::Vector3d(1.0, 0.0, 0.0);
+  const fs::path rtcmFile = scratch("rtcm_base") / "base.rtcm3";
+  {
+    std::ofstream out(rtcmFile, std::ios::binary);
+    rtcm::Encoder enc(3040);
+    rtcm::StationPosition sp;
+    sp.stationId = 3040;
+    sp.gps = true;
+    sp.arp = arp;
+    const auto f = enc.stationPosition(sp);
+    out.write(reinterpret_cast<const char*>(f.data()), static_cast<std::streamsize>(f.size()));
+    for (const ObsEpoch& e : base) {
+      const auto m = enc.msm(e, 7);
+      out.write(reinterpret_cast<const char*>(m.data()), static_cast<std::streamsize>(m.size()));
+    }
+  }
+  const auto stamps = cameraStamps(kV101 / "mav0" / "cam0" / "data.csv");
+  const auto ns = [](const GpsTime& t) {
+    return t.wholeSeconds() * 1'000'000'000LL + static_cast<std::int64_t>(std::llround(t.fraction() * 1e9));
+  };
+  auto run = [&](const fs::path& baseFile, const std::string& name) {
+    StubEstimator est;
+    est.stateStride = 30'000'000'000LL;
+    StubGnss gnss;
+    ReplayOptions o = quietOptions(scratch(name) / "out");
+    o.sensorToGpst_ns = ns(rover[0].time) + 10'000'000 - stamps[2] - 2 * est.stateStride;
+    o.roverObs = (g / "07590920.05o.gz").string();
+    o.baseObs = baseFile.string();
+    o.navFile = (g / "07590920.05n.gz").string();
+    o.evaluate = false;
+    runReplay(copyV101(name + "_ds").string(), est, &gnss, o);
+    return gnss;
+  };
+  const StubGnss fromRinex = run(g / "30400920.05o.gz", "base_rinex");
+  const StubGnss fromRtcm = run(rtcmFile, "base_rtcm");
+  EXPECT_LT((fromRtcm.basePos - arp).norm(), 1e-3);  // 1005: 0.1 mm resolution
+  EXPECT_LT((fromRinex.basePos - *bh.station.approxPosition).norm(), 1e-6);
+  ASSERT_GE(fromRinex.base.size(), 20u);
+  EXPECT_EQ(fromRtcm.rover, fromRinex.rover);
+  // MSM epoch times have a resolution of 1 ms (RTCM 10403.3, DF004).
+  ASSERT_EQ(fromRtcm.base.size(), fromRinex.base.size());
+  for (std::size_t i = 0; i < fromRtcm.base.size(); ++i) EXPECT_LE(std::abs(fromRtcm.base[i] - fromRinex.base[i]), 0.0005) << i;
 }
 
 TEST(ReplayParsers, EcefTruth) {
