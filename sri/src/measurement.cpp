@@ -49,6 +49,41 @@ Eigen::Block<typename Measurement<Scalar>::Matrix> Measurement<Scalar>::jacobian
 }
 
 template <typename Scalar>
+void Measurement<Scalar>::addBlocks(std::span<const BlockId> ids, std::span<const int> dims) {
+  if (ids.size() != dims.size()) throw std::invalid_argument("sri::Measurement::addBlocks: ids and dims differ in size");
+  int add = 0;
+  std::vector<Entry> fresh;
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    if (!ids[k].valid() || dims[k] <= 0) {
+      throw std::invalid_argument("sri::Measurement::addBlocks: invalid block id or dimension");
+    }
+    bool found = false;
+    auto check = [&](const Entry& e) {
+      if (e.id != ids[k]) return;
+      if (e.dim != dims[k]) {
+        throw std::invalid_argument("sri::Measurement::addBlocks: block " + std::to_string(e.id.value) +
+                                    " has dimension " + std::to_string(e.dim) + ", not " + std::to_string(dims[k]));
+      }
+      found = true;
+    };
+    for (const Entry& e : blocks_) check(e);
+    for (const Entry& e : fresh) check(e);
+    if (found) continue;
+    fresh.push_back({ids[k], static_cast<int>(H_.cols()) + add, dims[k]});
+    add += dims[k];
+  }
+  if (add == 0) return;
+  const Eigen::Index c0 = H_.cols();
+  if (c0 == 0) {
+    H_.setZero(rows(), add);
+  } else {
+    H_.conservativeResize(Eigen::NoChange, c0 + add);
+    H_.rightCols(add).setZero();
+  }
+  blocks_.insert(blocks_.end(), fresh.begin(), fresh.end());
+}
+
+template <typename Scalar>
 Eigen::Block<typename Measurement<Scalar>::Matrix> Measurement<Scalar>::nuisance(int dim) {
   if (dim <= 0) throw std::invalid_argument("sri::Measurement::nuisance: dimension must be > 0");
   if (nuisance_.cols() != dim) {

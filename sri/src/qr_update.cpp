@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <vector>
@@ -66,33 +67,53 @@ inline Scalar makeGivens(Scalar a, Scalar b, Scalar& c, Scalar& s) {
 
 #if defined(__GNUC__) || defined(__clang__)
 #define GVINS_SRI_VECTOR_EXT 1
-#if defined(__AVX__)
-#define GVINS_SRI_SIMD_BYTES 32
+// 32-byte vectors only pass between always-inlined functions (never through a call), so the
+// ABI note GCC gives for them in non-AVX translation units does not apply.
+#pragma GCC diagnostic ignored "-Wpsabi"
+#define GVINS_SRI_INLINE inline __attribute__((always_inline))
+#define GVINS_SRI_LAMBDA_INLINE __attribute__((always_inline))
+/// SIMD vector of Scalar (GCC/Clang vector extension) of B bytes: 16 (SSE2, the x86-64
+/// baseline) or 32 (AVX2). The kernels below are templates on B and always inlined into the
+/// per-instruction-set entry points at the end of the file, so that AVX code only exists inside
+/// functions compiled with __attribute__((target("avx2"))) and is only run when the CPU has it
+/// (runtime dispatch; no shared inline function is ever compiled for AVX).
+template <typename Scalar, int B>
+struct Simd;
+#define GVINS_SRI_SIMD(BYTES)                                                          \
+  template <typename Scalar>                                                           \
+  struct Simd<Scalar, BYTES> {                                                         \
+    typedef Scalar type __attribute__((vector_size(BYTES)));                           \
+    static constexpr int kLanes = BYTES / static_cast<int>(sizeof(Scalar));            \
+    GVINS_SRI_INLINE static type load(const Scalar* p) {                               \
+      type v;                                                                          \
+      std::memcpy(&v, p, sizeof(v));                                                   \
+      return v;                                                                        \
+    }                                                                                  \
+    GVINS_SRI_INLINE static void store(Scalar* p, type v) { std::memcpy(p, &v, sizeof(v)); } \
+    GVINS_SRI_INLINE static type broadcast(Scalar s) { return type{} + s; }            \
+  };
+GVINS_SRI_SIMD(16)
+GVINS_SRI_SIMD(32)
+#undef GVINS_SRI_SIMD
 #else
-#define GVINS_SRI_SIMD_BYTES 16
+#define GVINS_SRI_INLINE inline
+#define GVINS_SRI_LAMBDA_INLINE
 #endif
-/// SIMD vector of Scalar (GCC/Clang vector extension): 16 bytes (SSE2, the x86-64 baseline) or
-/// 32 bytes when the target has AVX (-march=native, GVINS_SRI_NATIVE).
-template <typename Scalar>
-struct Simd {
-  typedef Scalar type __attribute__((vector_size(GVINS_SRI_SIMD_BYTES)));
-  static constexpr int kLanes = GVINS_SRI_SIMD_BYTES / static_cast<int>(sizeof(Scalar));
-  static type load(const Scalar* p) {
-    type v;
-    std::memcpy(&v, p, sizeof(v));
-    return v;
-  }
-  static void store(Scalar* p, type v) { std::memcpy(p, &v, sizeof(v)); }
-  static type broadcast(Scalar s) { return type{} + s; }
-};
-#endif
+
+/// Broadcast table: value k at b[k·L .. k·L + L) (L lanes of B bytes), loaded with one
+/// (unaligned) vector load; plain Scalar storage so that no vector type leaves the kernels.
+template <typename Scalar, int B>
+GVINS_SRI_INLINE void putBroadcast(Scalar* b, int k, Scalar v) {
+  constexpr int L = B / static_cast<int>(sizeof(Scalar));
+  for (int l = 0; l < L; ++l) b[k * L + l] = v;
+}
 
 /// Qᵀ = I − V Tᵀ Vᵀ of P reflectors (V = [I_P; V_W]) applied to the columns [t0, len) of the P
 /// pivot rows x[p] of R and of the a rows of W (row i at w0 + i·ws): Z = X + V_Wᵀ W,
 /// Z ← Tᵀ Z, X −= Z, W −= V_W Z. V_W(i, p) = v[p·a + i] (column-major); T is P×P upper
 /// triangular, column-major.
 template <typename Scalar, int P>
-void applyReflectorsScalar(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a, int t0, int len,
+GVINS_SRI_INLINE void applyReflectorsScalar(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a, int t0, int len,
                            const Scalar* v, const Scalar* T) {
   for (; t0 < len; ++t0) {
     Scalar zr[P];
@@ -117,10 +138,10 @@ void applyReflectorsScalar(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int 
 
 #ifdef GVINS_SRI_VECTOR_EXT
 /// One chunk of NV SIMD vectors (columns t0 .. t0 + NV·lanes) of applyReflectors.
-template <typename Scalar, int P, int NV>
-inline void applyReflectorsChunk(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a, int t0,
-                                 const typename Simd<Scalar>::type* vv, const Scalar* T) {
-  using V = Simd<Scalar>;
+template <typename Scalar, int B, int P, int NV>
+GVINS_SRI_INLINE void applyReflectorsChunk(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a,
+                                           int t0, const Scalar* vv, const Scalar* T) {
+  using V = Simd<Scalar, B>;
   using Vec = typename V::type;
   constexpr int L = V::kLanes;
   Vec z[P][NV];
@@ -132,7 +153,7 @@ inline void applyReflectorsChunk(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws
     Vec wr[NV];
     for (int u = 0; u < NV; ++u) wr[u] = V::load(wi + u * L);
     for (int p = 0; p < P; ++p) {
-      const Vec vp = vv[i * P + p];
+      const Vec vp = V::load(vv + (i * P + p) * L);
       for (int u = 0; u < NV; ++u) z[p][u] += vp * wr[u];
     }
   }
@@ -154,7 +175,7 @@ inline void applyReflectorsChunk(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws
     Vec wr[NV];
     for (int u = 0; u < NV; ++u) wr[u] = V::load(wi + u * L);
     for (int p = 0; p < P; ++p) {
-      const Vec vp = vv[i * P + p];
+      const Vec vp = V::load(vv + (i * P + p) * L);
       for (int u = 0; u < NV; ++u) wr[u] -= vp * z[p][u];
     }
     for (int u = 0; u < NV; ++u) V::store(wi + u * L, wr[u]);
@@ -165,16 +186,15 @@ inline void applyReflectorsChunk(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws
 /// As applyReflectorsScalar on [0, len), register-blocked: per chunk of 2 SIMD vectors the P
 /// rows of Z stay in registers while the rows of W stream through twice. vb holds V_W(i, p)
 /// broadcast to full vectors at vb[i·P + p] (SSE2 has no cheap broadcast from memory).
-template <typename Scalar, int P>
-void applyReflectors(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a, int len,
-                     const Scalar* v, [[maybe_unused]] const void* vb, const Scalar* T) {
+template <typename Scalar, int B, int P>
+GVINS_SRI_INLINE void applyReflectors(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a, int len,
+                                      const Scalar* v, [[maybe_unused]] const Scalar* vv,
+                                      const Scalar* T) {
   int t0 = 0;
 #ifdef GVINS_SRI_VECTOR_EXT
-  using V = Simd<Scalar>;
-  constexpr int L = V::kLanes;
-  const auto* vv = static_cast<const typename V::type*>(vb);
-  for (; t0 + 2 * L <= len; t0 += 2 * L) applyReflectorsChunk<Scalar, P, 2>(x, w0, ws, a, t0, vv, T);
-  for (; t0 + L <= len; t0 += L) applyReflectorsChunk<Scalar, P, 1>(x, w0, ws, a, t0, vv, T);
+  constexpr int L = Simd<Scalar, B>::kLanes;
+  for (; t0 + 2 * L <= len; t0 += 2 * L) applyReflectorsChunk<Scalar, B, P, 2>(x, w0, ws, a, t0, vv, T);
+  for (; t0 + L <= len; t0 += L) applyReflectorsChunk<Scalar, B, P, 1>(x, w0, ws, a, t0, vv, T);
 #endif
   applyReflectorsScalar<Scalar, P>(x, w0, ws, a, t0, len, v, T);
 }
@@ -186,22 +206,19 @@ constexpr int kFusedPanel = 4;
 
 }  // namespace
 
-template <typename Scalar>
-void householderRowUpdate(RowMatrixView<Scalar> R, VectorView<Scalar> r, RowMatrixView<Scalar> W,
-                          VectorView<Scalar> z, std::span<const int> lead) {
+template <typename Scalar, int B>
+GVINS_SRI_INLINE void householderImpl(RowMatrixView<Scalar> R, VectorView<Scalar> r, RowMatrixView<Scalar> W,
+                                      VectorView<Scalar> z, std::span<const int> lead) {
   const int k = static_cast<int>(R.rows());
   const int m = static_cast<int>(W.rows());
   if (m == 0 || k == 0 || lead.empty() || lead[0] >= k) return;
   const std::ptrdiff_t ws = W.outerStride();
   // Narrow panels: the panel's columns of W are copied to a contiguous column-major block,
   // its reflectors broadcast to SIMD vectors for the register-blocked kernel.
+  constexpr int L = B / static_cast<int>(sizeof(Scalar));
   std::vector<Scalar> vc(static_cast<std::size_t>(kFusedPanel * m));
-#ifdef GVINS_SRI_VECTOR_EXT
-  std::vector<typename Simd<Scalar>::type> vb(static_cast<std::size_t>(kFusedPanel * m));
-  void* vbp = vb.data();
-#else
-  void* vbp = nullptr;
-#endif
+  std::vector<Scalar> vb(static_cast<std::size_t>(kFusedPanel * m * L));
+  Scalar* vbp = vb.data();
   int a = 0;  // active rows: lead < end of the panel
   for (int j0 = lead[0]; j0 < k;) {
     {
@@ -246,9 +263,8 @@ void householderRowUpdate(RowMatrixView<Scalar> R, VectorView<Scalar> r, RowMatr
         }
       }
 #ifdef GVINS_SRI_VECTOR_EXT
-      auto* vbv = static_cast<typename Simd<Scalar>::type*>(vbp);
       for (int i = 0; i < a; ++i) {
-        for (int p = 0; p < jb; ++p) vbv[i * jb + p] = Simd<Scalar>::broadcast(V[p * a + i]);
+        for (int p = 0; p < jb; ++p) putBroadcast<Scalar, B>(vbp, i * jb + p, V[p * a + i]);
       }
 #endif
       const int c1 = j0 + jb;
@@ -262,19 +278,19 @@ void householderRowUpdate(RowMatrixView<Scalar> R, VectorView<Scalar> r, RowMatr
       Scalar* w0 = &W(0, 0) + c1;
       switch (jb) {
         case 4:
-          applyReflectors<Scalar, 4>(x, w0, ws, a, nt, V, vbp, Tc);
+          applyReflectors<Scalar, B, 4>(x, w0, ws, a, nt, V, vbp, Tc);
           applyReflectorsScalar<Scalar, 4>(xr, z.data(), 1, a, 0, 1, V, Tc);
           break;
         case 3:
-          applyReflectors<Scalar, 3>(x, w0, ws, a, nt, V, vbp, Tc);
+          applyReflectors<Scalar, B, 3>(x, w0, ws, a, nt, V, vbp, Tc);
           applyReflectorsScalar<Scalar, 3>(xr, z.data(), 1, a, 0, 1, V, Tc);
           break;
         case 2:
-          applyReflectors<Scalar, 2>(x, w0, ws, a, nt, V, vbp, Tc);
+          applyReflectors<Scalar, B, 2>(x, w0, ws, a, nt, V, vbp, Tc);
           applyReflectorsScalar<Scalar, 2>(xr, z.data(), 1, a, 0, 1, V, Tc);
           break;
         default:
-          applyReflectors<Scalar, 1>(x, w0, ws, a, nt, V, vbp, Tc);
+          applyReflectors<Scalar, B, 1>(x, w0, ws, a, nt, V, vbp, Tc);
           applyReflectorsScalar<Scalar, 1>(xr, z.data(), 1, a, 0, 1, V, Tc);
           break;
       }
@@ -286,7 +302,7 @@ void householderRowUpdate(RowMatrixView<Scalar> R, VectorView<Scalar> r, RowMatr
 namespace {
 
 template <typename Scalar, int P>
-void chainRotationsScalar(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a, int t0, int len,
+GVINS_SRI_INLINE void chainRotationsScalar(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a, int t0, int len,
                           const Scalar* C, const Scalar* S, int ld) {
   for (; t0 < len; ++t0) {
     Scalar xr[P];
@@ -308,11 +324,10 @@ void chainRotationsScalar(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a
 
 #ifdef GVINS_SRI_VECTOR_EXT
 /// One chunk of NV SIMD vectors of chainRotations.
-template <typename Scalar, int P, int NV>
-inline void chainRotationsChunk(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a, int t0,
-                                const typename Simd<Scalar>::type* cb,
-                                const typename Simd<Scalar>::type* sb) {
-  using V = Simd<Scalar>;
+template <typename Scalar, int B, int P, int NV>
+GVINS_SRI_INLINE void chainRotationsChunk(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a,
+                                          int t0, const Scalar* cb, const Scalar* sb) {
+  using V = Simd<Scalar, B>;
   using Vec = typename V::type;
   constexpr int L = V::kLanes;
   Vec xr[P][NV];
@@ -324,8 +339,8 @@ inline void chainRotationsChunk(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws,
     Vec wr[NV];
     for (int u = 0; u < NV; ++u) wr[u] = V::load(wi + u * L);
     for (int p = 0; p < P; ++p) {
-      const Vec c = cb[i * P + p];
-      const Vec sn = sb[i * P + p];
+      const Vec c = V::load(cb + (i * P + p) * L);
+      const Vec sn = V::load(sb + (i * P + p) * L);
       for (int u = 0; u < NV; ++u) {
         const Vec xv = xr[p][u];
         xr[p][u] = c * xv + sn * wr[u];
@@ -347,19 +362,15 @@ inline void chainRotationsChunk(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws,
 /// rotations that do not share a row commute. The pivot rows of a chunk of 2 SIMD vectors stay
 /// in registers while the rows of W stream through once (register blocking). cb, sb hold the
 /// same c, s broadcast to SIMD vectors at [i·P + p].
-template <typename Scalar, int P>
-void chainRotations(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a, int len,
-                    const Scalar* C, const Scalar* S, int ld, [[maybe_unused]] const void* cb,
-                    [[maybe_unused]] const void* sb) {
+template <typename Scalar, int B, int P>
+GVINS_SRI_INLINE void chainRotations(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a, int len,
+                                     const Scalar* C, const Scalar* S, int ld,
+                                     [[maybe_unused]] const Scalar* cb, [[maybe_unused]] const Scalar* sb) {
   int t0 = 0;
 #ifdef GVINS_SRI_VECTOR_EXT
-  using V = Simd<Scalar>;
-  using Vec = typename V::type;
-  constexpr int L = V::kLanes;
-  const auto* cv = static_cast<const Vec*>(cb);
-  const auto* sv = static_cast<const Vec*>(sb);
-  for (; t0 + 2 * L <= len; t0 += 2 * L) chainRotationsChunk<Scalar, P, 2>(x, w0, ws, a, t0, cv, sv);
-  for (; t0 + L <= len; t0 += L) chainRotationsChunk<Scalar, P, 1>(x, w0, ws, a, t0, cv, sv);
+  constexpr int L = Simd<Scalar, B>::kLanes;
+  for (; t0 + 2 * L <= len; t0 += 2 * L) chainRotationsChunk<Scalar, B, P, 2>(x, w0, ws, a, t0, cb, sb);
+  for (; t0 + L <= len; t0 += L) chainRotationsChunk<Scalar, B, P, 1>(x, w0, ws, a, t0, cb, sb);
 #endif
   chainRotationsScalar<Scalar, P>(x, w0, ws, a, t0, len, C, S, ld);
 }
@@ -369,10 +380,11 @@ constexpr int kGivensPanel = 4;
 
 }  // namespace
 
-template <typename Scalar>
-void givensRowUpdate(RowMatrixView<Scalar> R, VectorView<Scalar> r, RowMatrixView<Scalar> W,
-                     VectorView<Scalar> z, std::span<const int> lead) {
+template <typename Scalar, int B>
+GVINS_SRI_INLINE void givensImpl(RowMatrixView<Scalar> R, VectorView<Scalar> r, RowMatrixView<Scalar> W,
+                                 VectorView<Scalar> z, std::span<const int> lead) {
   constexpr int P = kGivensPanel;
+  constexpr int L = B / static_cast<int>(sizeof(Scalar));
   const int k = static_cast<int>(R.rows());
   const int m = static_cast<int>(W.rows());
   if (m == 0 || k == 0 || lead.empty() || lead[0] >= k) return;
@@ -381,11 +393,8 @@ void givensRowUpdate(RowMatrixView<Scalar> R, VectorView<Scalar> r, RowMatrixVie
   std::vector<Scalar> C(static_cast<std::size_t>(P * m));
   std::vector<Scalar> S(static_cast<std::size_t>(P * m));
   std::vector<Scalar> vc(static_cast<std::size_t>(P * m));
-#ifdef GVINS_SRI_VECTOR_EXT
-  using Vec = typename Simd<Scalar>::type;
-  std::vector<Vec> cbv(static_cast<std::size_t>(P * m));
-  std::vector<Vec> sbv(static_cast<std::size_t>(P * m));
-#endif
+  std::vector<Scalar> cbv(static_cast<std::size_t>(P * m * L));
+  std::vector<Scalar> sbv(static_cast<std::size_t>(P * m * L));
   const std::ptrdiff_t ws = W.outerStride();
   int a = 0;
   for (int j0 = lead[0]; j0 < k; j0 += P) {
@@ -435,21 +444,18 @@ void givensRowUpdate(RowMatrixView<Scalar> R, VectorView<Scalar> r, RowMatrixVie
 #ifdef GVINS_SRI_VECTOR_EXT
       for (int i = 0; i < a; ++i) {
         for (int q = 0; q < pw; ++q) {
-          cbv[static_cast<std::size_t>(i * pw + q)] = Simd<Scalar>::broadcast(C[q * m + i]);
-          sbv[static_cast<std::size_t>(i * pw + q)] = Simd<Scalar>::broadcast(S[q * m + i]);
+          putBroadcast<Scalar, B>(cbv.data(), i * pw + q, C[q * m + i]);
+          putBroadcast<Scalar, B>(sbv.data(), i * pw + q, S[q * m + i]);
         }
       }
-      const void* cb = cbv.data();
-      const void* sb = sbv.data();
-#else
-      const void* cb = nullptr;
-      const void* sb = nullptr;
 #endif
+      const Scalar* cb = cbv.data();
+      const Scalar* sb = sbv.data();
       switch (pw) {
-        case 4: chainRotations<Scalar, 4>(x, w0, ws, a, len, C.data(), S.data(), m, cb, sb); break;
-        case 3: chainRotations<Scalar, 3>(x, w0, ws, a, len, C.data(), S.data(), m, cb, sb); break;
-        case 2: chainRotations<Scalar, 2>(x, w0, ws, a, len, C.data(), S.data(), m, cb, sb); break;
-        default: chainRotations<Scalar, 1>(x, w0, ws, a, len, C.data(), S.data(), m, cb, sb); break;
+        case 4: chainRotations<Scalar, B, 4>(x, w0, ws, a, len, C.data(), S.data(), m, cb, sb); break;
+        case 3: chainRotations<Scalar, B, 3>(x, w0, ws, a, len, C.data(), S.data(), m, cb, sb); break;
+        case 2: chainRotations<Scalar, B, 2>(x, w0, ws, a, len, C.data(), S.data(), m, cb, sb); break;
+        default: chainRotations<Scalar, B, 1>(x, w0, ws, a, len, C.data(), S.data(), m, cb, sb); break;
       }
     }
     // Right-hand side.
@@ -467,16 +473,15 @@ void givensRowUpdate(RowMatrixView<Scalar> R, VectorView<Scalar> r, RowMatrixVie
   }
 }
 
-template <typename Scalar>
-void sweepColumnsToFront(RowMatrixView<Scalar> R, VectorView<Scalar> r, int c, int d, int t) {
+template <typename Scalar, int B>
+GVINS_SRI_INLINE void sweepImpl(RowMatrixView<Scalar> R, VectorView<Scalar> r, int c, int d, int t) {
   const int n = static_cast<int>(R.cols());
   if (d <= 0 || c <= t) return;
+  constexpr int LB = B / static_cast<int>(sizeof(Scalar));
   std::vector<Scalar> cs(static_cast<std::size_t>(d));
   std::vector<Scalar> sn(static_cast<std::size_t>(d));
-#ifdef GVINS_SRI_VECTOR_EXT
-  std::vector<typename Simd<Scalar>::type> cb(static_cast<std::size_t>(d));
-  std::vector<typename Simd<Scalar>::type> sb(static_cast<std::size_t>(d));
-#endif
+  std::vector<Scalar> cb(static_cast<std::size_t>(d * LB));
+  std::vector<Scalar> sb(static_cast<std::size_t>(d * LB));
   const int cend = c + d;
   for (int i = c - 1; i >= t; --i) {
     // Rotation k acts on rows (i+k, i+k+1) and zeroes R(i+k+1, c+k); computed sequentially on
@@ -496,20 +501,18 @@ void sweepColumnsToFront(RowMatrixView<Scalar> R, VectorView<Scalar> r, int c, i
       }
       cs[static_cast<std::size_t>(k)] = ck;
       sn[static_cast<std::size_t>(k)] = sk;
-#ifdef GVINS_SRI_VECTOR_EXT
-      cb[static_cast<std::size_t>(k)] = Simd<Scalar>::broadcast(ck);
-      sb[static_cast<std::size_t>(k)] = Simd<Scalar>::broadcast(sk);
-#endif
+      putBroadcast<Scalar, B>(cb.data(), k, ck);
+      putBroadcast<Scalar, B>(sb.data(), k, sk);
     }
     // The same chain on the other columns ≥ i and on r: one pass per row, the "bottom" result
     // of rotation k is carried into rotation k+1.
     // One pass per chunk of columns with the carried row in registers: each row of the window
     // is loaded and stored once.
-    auto chain = [&](int col0, int len) {
+    auto chain = [&](int col0, int len) GVINS_SRI_LAMBDA_INLINE {
       if (len <= 0) return;
       int q0 = 0;
 #ifdef GVINS_SRI_VECTOR_EXT
-      using V = Simd<Scalar>;
+      using V = Simd<Scalar, B>;
       using Vec = typename V::type;
       constexpr int L = V::kLanes;
       Scalar* base = &R(i, col0);
@@ -518,8 +521,8 @@ void sweepColumnsToFront(RowMatrixView<Scalar> R, VectorView<Scalar> r, int c, i
         Vec c0 = V::load(base + q0);
         Vec c1 = V::load(base + q0 + L);
         for (int k = 0; k < d; ++k) {
-          const Vec ck = cb[static_cast<std::size_t>(k)];
-          const Vec sk = sb[static_cast<std::size_t>(k)];
+          const Vec ck = V::load(cb.data() + k * L);
+          const Vec sk = V::load(sb.data() + k * L);
           Scalar* top = base + k * rs + q0;
           const Scalar* bot = top + rs;
           const Vec y0 = V::load(bot);
@@ -563,6 +566,85 @@ void sweepColumnsToFront(RowMatrixView<Scalar> R, VectorView<Scalar> r, int c, i
     }
     r(i + d) = x;
   }
+}
+
+// ---------------------------------------------------------------- instruction-set dispatch
+// The kernels are built twice: for the x86-64 baseline (SSE2, 16-byte vectors) and, in functions
+// with __attribute__((target("avx2"))), for AVX2 (32-byte vectors). The AVX2 path is taken when
+// the CPU (and OS) support it; GVINS_SRI_SIMD=sse2 in the environment forces the baseline (for
+// benchmarks). Same algorithm and operation order per lane: results agree to rounding.
+namespace {
+#if defined(GVINS_SRI_VECTOR_EXT) && (defined(__x86_64__) || defined(__i386__)) && !defined(__AVX2__)
+#define GVINS_SRI_DISPATCH 1
+bool useAvx2() {
+  static const bool yes = [] {
+    const char* e = std::getenv("GVINS_SRI_SIMD");
+    if (e && std::strcmp(e, "sse2") == 0) return false;
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") != 0;
+  }();
+  return yes;
+}
+#define GVINS_SRI_AVX2_ENTRY(NAME, IMPL, SCALAR, PARAMS, ARGS) \
+  __attribute__((target("avx2"))) void NAME PARAMS { IMPL<SCALAR, 32> ARGS; }
+#define GVINS_SRI_ENTRIES(S)                                                                    \
+  GVINS_SRI_AVX2_ENTRY(householderAvx2_##S, householderImpl, S,                                 \
+                       (RowMatrixView<S> R, VectorView<S> r, RowMatrixView<S> W, VectorView<S> z, \
+                        std::span<const int> lead),                                             \
+                       (R, r, W, z, lead))                                                      \
+  GVINS_SRI_AVX2_ENTRY(givensAvx2_##S, givensImpl, S,                                           \
+                       (RowMatrixView<S> R, VectorView<S> r, RowMatrixView<S> W, VectorView<S> z, \
+                        std::span<const int> lead),                                             \
+                       (R, r, W, z, lead))                                                      \
+  GVINS_SRI_AVX2_ENTRY(sweepAvx2_##S, sweepImpl, S,                                             \
+                       (RowMatrixView<S> R, VectorView<S> r, int c, int d, int t), (R, r, c, d, t))
+GVINS_SRI_ENTRIES(float)
+GVINS_SRI_ENTRIES(double)
+#undef GVINS_SRI_ENTRIES
+#undef GVINS_SRI_AVX2_ENTRY
+template <typename S> struct Avx2;
+template <> struct Avx2<float> {
+  static constexpr auto householder = &householderAvx2_float;
+  static constexpr auto givens = &givensAvx2_float;
+  static constexpr auto sweep = &sweepAvx2_float;
+};
+template <> struct Avx2<double> {
+  static constexpr auto householder = &householderAvx2_double;
+  static constexpr auto givens = &givensAvx2_double;
+  static constexpr auto sweep = &sweepAvx2_double;
+};
+#endif
+#if defined(__AVX2__)
+constexpr int kBaseBytes = 32;
+#else
+constexpr int kBaseBytes = 16;
+#endif
+}  // namespace
+
+template <typename Scalar>
+void householderRowUpdate(RowMatrixView<Scalar> R, VectorView<Scalar> r, RowMatrixView<Scalar> W,
+                          VectorView<Scalar> z, std::span<const int> lead) {
+#ifdef GVINS_SRI_DISPATCH
+  if (useAvx2()) return Avx2<Scalar>::householder(R, r, W, z, lead);
+#endif
+  householderImpl<Scalar, kBaseBytes>(R, r, W, z, lead);
+}
+
+template <typename Scalar>
+void givensRowUpdate(RowMatrixView<Scalar> R, VectorView<Scalar> r, RowMatrixView<Scalar> W,
+                     VectorView<Scalar> z, std::span<const int> lead) {
+#ifdef GVINS_SRI_DISPATCH
+  if (useAvx2()) return Avx2<Scalar>::givens(R, r, W, z, lead);
+#endif
+  givensImpl<Scalar, kBaseBytes>(R, r, W, z, lead);
+}
+
+template <typename Scalar>
+void sweepColumnsToFront(RowMatrixView<Scalar> R, VectorView<Scalar> r, int c, int d, int t) {
+#ifdef GVINS_SRI_DISPATCH
+  if (useAvx2()) return Avx2<Scalar>::sweep(R, r, c, d, t);
+#endif
+  sweepImpl<Scalar, kBaseBytes>(R, r, c, d, t);
 }
 
 #define GVINS_SRI_INSTANTIATE(S)                                                              \

@@ -256,6 +256,35 @@ TEST(Measurement, ErrorsAreReported) {
   EXPECT_EQ(f.dim(), 2);  // failed additions left nothing behind
 }
 
+// addBlocks declares columns at once: later jacobian() calls find them, existing blocks are kept,
+// and a dimension that differs is an error; the stacked Jacobian equals the one built block by block.
+TEST(Measurement, AddBlocksDeclaresColumnsOnce) {
+  const BlockId a{1}, b{2}, c{3};
+  Measurement<double> z(3);
+  z.jacobian(a, 2).setConstant(1.0);
+  const BlockId ids[] = {b, a, c};
+  const int dims[] = {3, 2, 1};
+  z.addBlocks(ids, dims);
+  ASSERT_EQ(z.numBlocks(), 3);
+  EXPECT_EQ(z.blockId(0), a);
+  EXPECT_EQ(z.blockId(1), b);
+  EXPECT_EQ(z.blockId(2), c);
+  EXPECT_EQ(z.stackedJacobian().cols(), 6);
+  EXPECT_EQ(z.jacobianAt(0).sum(), 6.0);  // kept
+  EXPECT_EQ(z.jacobianAt(1).norm(), 0.0);  // new columns are zero
+  z.jacobian(b, 3)(1, 2) = 5.0;
+  z.jacobian(c, 1)(2, 0) = 7.0;
+  Measurement<double> w(3);
+  w.jacobian(a, 2).setConstant(1.0);
+  w.jacobian(b, 3)(1, 2) = 5.0;
+  w.jacobian(c, 1)(2, 0) = 7.0;
+  EXPECT_EQ((z.stackedJacobian() - w.stackedJacobian()).norm(), 0.0);
+  const int bad[] = {3, 3, 1};  // a has 2 columns
+  EXPECT_THROW(z.addBlocks(ids, bad), std::invalid_argument);
+  const int shortDims[] = {3, 2};
+  EXPECT_THROW(z.addBlocks(ids, shortDims), std::invalid_argument);
+}
+
 // Uninformative priors: the update is then ordinary weighted least squares; unobserved
 // components are reported, not invented.
 TEST(Measurement, UninformativePriorGivesLeastSquares) {

@@ -10,6 +10,7 @@
 //   filter.update(m);
 #pragma once
 
+#include <span>
 #include <vector>
 
 #include <Eigen/Core>
@@ -34,6 +35,10 @@ class Measurement {
   /// convention, block.hpp). Zero on first access; later calls return the same columns and
   /// throw std::invalid_argument if `dim` differs.
   Eigen::Block<Matrix> jacobian(BlockId id, int dim);
+  /// Declares block columns at once (one allocation, zero-initialised), appended in this order;
+  /// blocks already present are kept (their dimension must match). Saves the reallocation that
+  /// every new block costs in jacobian() when many blocks are stacked.
+  void addBlocks(std::span<const BlockId> ids, std::span<const int> dims);
   /// Residual r = z − h(x̂) (rows() entries).
   Vector& residual() { return residual_; }
   const Vector& residual() const { return residual_; }
