@@ -154,6 +154,29 @@ TEST(SriSwfJacobians, PropagationTransitionMatchesFiniteDifferences) {
     Jn.col(k) = (boxMinus(a, s1) - boxMinus(b, s1)) / (2 * h);
   }
   EXPECT_LT((Phi - Jn).cwiseAbs().maxCoeff(), 1e-6);
+  // First-estimate transition: at the propagator's own linearisation point it reproduces Φ; at
+  // another first estimate (R₀, p₀, v₀) it maps the yaw direction of that estimate,
+  // [R₀ᵀe_z; e_z × p₀; e_z × v₀; 0; 0], onto the one of the propagated state in p and v
+  // (observability, Li & Mourikis 2013).
+  {
+    Matrix15d P2 = Phi;
+    applyFirstEstimates(P2, s0.R_WI, s0.p_WI, s0.v_WI, s1.p_WI, s1.v_WI, 0.05, m.g);
+    EXPECT_LT((P2 - Phi).cwiseAbs().maxCoeff(), 1e-9);
+    const Matrix3d R0 = s0.R_WI * so3::exp(Vector3d(0.02, -0.01, 0.03));
+    const Vector3d p0 = s0.p_WI + Vector3d(0.3, -0.2, 0.1), v0 = s0.v_WI + Vector3d(0.05, 0.02, -0.04);
+    applyFirstEstimates(P2, R0, p0, v0, s1.p_WI, s1.v_WI, 0.05, m.g);
+    const Vector3d ez = Vector3d::UnitZ();
+    Vector15d n0 = Vector15d::Zero();
+    n0.segment<3>(ImuErr::kTheta) = R0.transpose() * ez;
+    n0.segment<3>(ImuErr::kPos) = ez.cross(p0);
+    n0.segment<3>(ImuErr::kVel) = ez.cross(v0);
+    const Vector15d n1 = P2 * n0;
+    EXPECT_LT((n1.segment<3>(ImuErr::kPos) - ez.cross(s1.p_WI)).norm(), 1e-9);
+    EXPECT_LT((n1.segment<3>(ImuErr::kVel) - ez.cross(s1.v_WI)).norm(), 1e-9);
+    // Without first estimates the same direction is not preserved (the test can fail).
+    const Vector15d n1c = Phi * n0;
+    EXPECT_GT((n1c.segment<3>(ImuErr::kPos) - ez.cross(s1.p_WI)).norm(), 1e-4);
+  }
   // Q' is symmetric positive definite (the row needs Q'^(−½)).
   EXPECT_LT((Qd - Qd.transpose()).norm(), 1e-15);
   EXPECT_GT(Eigen::SelfAdjointEigenSolver<Matrix15d>(Qd).eigenvalues()(0), 0.0);

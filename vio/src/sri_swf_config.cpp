@@ -39,6 +39,7 @@ void SriSwfConfig::validate() const {
   req(max_msckf_per_frame >= 0, "max_msckf_per_frame must be >= 0");
   req(reanchor_sigma > 0, "reanchor_sigma must be positive");
   req(zero_velocity_sigma > 0, "zero_velocity_sigma must be positive");
+  req(first_estimate_delay >= 0, "first_estimate_delay must not be negative");
   req(init_window > 0.05 && init_window <= 30, "init.window must be in (0.05, 30] s");
   req(static_max_accel_std > 0 && static_max_gyro_std > 0 && static_max_parallax > 0,
       "init static thresholds must be positive");
@@ -150,6 +151,8 @@ SriSwfConfig parseRoot(const YAML::Node& root, const Ctx& c) {
       {"reanchor_sigma", d(cfg.reanchor_sigma, "reanchor_sigma")},
       {"zero_velocity_update", b(cfg.zero_velocity_update, "zero_velocity_update")},
       {"zero_velocity_sigma", d(cfg.zero_velocity_sigma, "zero_velocity_sigma")},
+      {"first_estimate_jacobians", b(cfg.first_estimate_jacobians, "first_estimate_jacobians")},
+      {"first_estimate_delay", d(cfg.first_estimate_delay, "first_estimate_delay")},
       {"calibrate_extrinsics", b(cfg.calibrate_extrinsics, "calibrate_extrinsics")},
       {"extrinsic_rotation_sigma", d(cfg.extrinsic_rotation_sigma, "extrinsic_rotation_sigma")},
       {"extrinsic_translation_sigma", d(cfg.extrinsic_translation_sigma, "extrinsic_translation_sigma")},

@@ -46,6 +46,14 @@ double median(std::vector<double> v) {
 
 }  // namespace
 
+void applyFirstEstimates(Eigen::Matrix<double, 15, 15>& Phi, const Eigen::Matrix3d& R0, const Eigen::Vector3d& p0,
+                         const Eigen::Vector3d& v0, const Eigen::Vector3d& p1, const Eigen::Vector3d& v1, double dt,
+                         double gravity) {
+  const Eigen::Vector3d g(0.0, 0.0, -gravity);
+  Phi.block<3, 3>(ImuErr::kVel, ImuErr::kTheta) = -so3::skew(v1 - v0 - g * dt) * R0;
+  Phi.block<3, 3>(ImuErr::kPos, ImuErr::kTheta) = -so3::skew(p1 - p0 - v0 * dt - 0.5 * dt * dt * g) * R0;
+}
+
 // ======================================================================================= Impl
 template <typename Scalar>
 struct SriSwfEstimator<Scalar>::Impl {
@@ -93,6 +101,11 @@ struct SriSwfEstimator<Scalar>::Impl {
   std::deque<FeatureFrame> init_frames;
   std::deque<FeatureFrame> recent;  // frames of the last init_window (zero-velocity detection)
   std::unordered_map<std::uint64_t, PoseEstimate> pose_cache;
+  // First estimates (first_estimate_jacobians): of every clone (its propagated pose) and of the
+  // newest velocity.
+  std::unordered_map<std::uint64_t, PoseEstimate> fe_pose;
+  Eigen::Vector3d fe_v = Eigen::Vector3d::Zero();
+  std::int64_t t_init = 0;
   mutable std::vector<double> chi2_thr;
 
   explicit Impl(const SriSwfConfig& c) : cfg(c), prop(c.imu, c.gravity) {
@@ -132,6 +145,13 @@ struct SriSwfEstimator<Scalar>::Impl {
     auto it = pose_cache.find(id.value);
     if (it == pose_cache.end()) it = pose_cache.emplace(id.value, poseOf(f.estimate(id))).first;
     return it->second;
+  }
+  /// Linearisation point of a clone for Jacobians: its first estimate, or the current estimate.
+  const PoseEstimate& poseJ(BlockId id) {
+    if (cfg.first_estimate_jacobians) {
+      if (auto it = fe_pose.find(id.value); it != fe_pose.end()) return it->second;
+    }
+    return pose(id);
   }
   ImuState newestState() const {
     ImuState s;
@@ -198,6 +218,9 @@ struct SriSwfEstimator<Scalar>::Impl {
     newest = {pid, eid};
     t_newest = s.t_ns;
     clones.push_back({pid, s.t_ns});
+    fe_pose[pid.value] = poseOf(f.estimate(pid));  // the gauge pose: its prior fixes it anyway
+    fe_v = s.v_WI;
+    t_init = s.t_ns;
     initialized = true;
   }
 
@@ -388,6 +411,12 @@ struct SriSwfEstimator<Scalar>::Impl {
     ImuState s = newestState();
     Matrix15d Phi, Qd;
     prop.propagate(s, imuSpan(), t, &Phi, &Qd);
+    if (cfg.first_estimate_jacobians) {
+      if (auto it = fe_pose.find(newest.pose.value); it != fe_pose.end()) {
+        applyFirstEstimates(Phi, it->second.R_WI, it->second.p_WI, fe_v, s.p_WI, s.v_WI,
+                            static_cast<double>(t - t_newest) * 1e-9, cfg.gravity);
+      }
+    }
     Qd.diagonal().array() += 1e-14;  // keeps Q' positive definite for back-to-back frames
     sri::Propagation<Scalar> step;
     step.addNewBlock(BlockSpec::pose("imu_pose"), poseEstimate<Scalar>(s.R_WI, s.p_WI), Placement::after(newest.pose));
@@ -403,6 +432,11 @@ struct SriSwfEstimator<Scalar>::Impl {
     newest = {ids[0], ids[1]};
     t_newest = t;
     clones.push_back({ids[0], t});
+    // Clones get first estimates once the initialisation transient is over (first_estimate_delay).
+    if (static_cast<double>(t - t_init) * 1e-9 >= cfg.first_estimate_delay) {
+      fe_pose[ids[0].value] = poseOf(f.estimate(ids[0]));
+    }
+    fe_v = s.v_WI;
     return true;
   }
 
@@ -475,22 +509,43 @@ struct SriSwfEstimator<Scalar>::Impl {
     return base >= cfg.min_baseline_ratio * depth0;
   }
 
+  /// Declares the block columns of a feature's rows at once (one allocation): the feature and
+  /// anchor blocks (if valid), the observing clones, the extrinsics.
+  std::vector<BlockId> decl_ids;
+  std::vector<int> decl_dims;
+  void declareBlocks(Meas& m, BlockId feature, BlockId anchor, const std::vector<Obs>& obs) {
+    decl_ids.clear();
+    decl_dims.clear();
+    auto add = [&](BlockId id, int d) {
+      if (std::find(decl_ids.begin(), decl_ids.end(), id) != decl_ids.end()) return;
+      decl_ids.push_back(id);
+      decl_dims.push_back(d);
+    };
+    if (feature.valid()) add(feature, 3);
+    if (anchor.valid()) add(anchor, 6);
+    for (const Obs& o : obs) add(o.clone, 6);
+    for (BlockId e : ext_ids) add(e, 6);
+    m.addBlocks(decl_ids, decl_dims);
+  }
+
   /// Rows of a feature at world point p_W (nuisance columns) for the listed observations.
   void featureRows(const std::vector<Obs>& obs, const Eigen::Vector3d& p_W, Meas& m) {
     m.reset(2 * static_cast<int>(obs.size()));
+    declareBlocks(m, BlockId{}, BlockId{}, obs);
     auto N = m.nuisance(3);
     for (std::size_t k = 0; k < obs.size(); ++k) {
       const Obs& o = obs[k];
       const int r = 2 * static_cast<int>(k);
       const CameraPoint cp = cameraPoint(pose(o.clone), ext(o.cam), p_W);
+      const CameraPoint cj = cfg.first_estimate_jacobians ? cameraPoint(poseJ(o.clone), ext(o.cam), p_W) : cp;
       const double is = 1.0 / sigma_n[static_cast<std::size_t>(o.cam)];
-      const Eigen::Matrix<double, 2, 3> Jp = is * projectionJacobian(cp.p_C);
-      m.jacobian(o.clone, 6).middleRows(r, 2) += (Jp * cp.J_pose).template cast<Scalar>();
+      const Eigen::Matrix<double, 2, 3> Jp = is * projectionJacobian(cj.p_C);
+      m.jacobian(o.clone, 6).middleRows(r, 2) += (Jp * cj.J_pose).template cast<Scalar>();
       if (!ext_ids.empty()) {
         m.jacobian(ext_ids[static_cast<std::size_t>(o.cam)], 6).middleRows(r, 2) +=
-            (Jp * cp.J_ext).template cast<Scalar>();
+            (Jp * cj.J_ext).template cast<Scalar>();
       }
-      N.middleRows(r, 2) = (Jp * cp.J_point).template cast<Scalar>();
+      N.middleRows(r, 2) = (Jp * cj.J_point).template cast<Scalar>();
       m.residual().segment(r, 2) = (is * (o.z - cp.p_C.head<2>() / cp.p_C.z())).template cast<Scalar>();
     }
     m.setWhitened();
@@ -499,35 +554,90 @@ struct SriSwfEstimator<Scalar>::Impl {
   /// Rows of a SLAM feature (state block) for observations from the listed clones.
   bool slamRows(const Slam& s, const std::vector<Obs>& obs, Meas& m) {
     m.reset(2 * static_cast<int>(obs.size()));
+    declareBlocks(m, s.block, s.anchor, obs);
     const Eigen::Vector3d fx = f.estimate(s.block).vector.template cast<double>();
     const AnchoredPoint ap = anchoredPoint(fx, pose(s.anchor), ext(0));
+    // Jacobians at the first estimates of anchor and clone (the residual at the current ones).
+    const bool fej = cfg.first_estimate_jacobians;
+    const AnchoredPoint apj = fej ? anchoredPoint(fx, poseJ(s.anchor), ext(0)) : ap;
     for (std::size_t k = 0; k < obs.size(); ++k) {
       const Obs& o = obs[k];
       const int r = 2 * static_cast<int>(k);
       const CameraPoint cp = cameraPoint(pose(o.clone), ext(o.cam), ap.p_W);
       if (!(cp.p_C.z() > cfg.min_depth)) return false;
+      const CameraPoint cj = fej ? cameraPoint(poseJ(o.clone), ext(o.cam), apj.p_W) : cp;
       const double is = 1.0 / sigma_n[static_cast<std::size_t>(o.cam)];
-      const Eigen::Matrix<double, 2, 3> Jp = is * projectionJacobian(cp.p_C);
-      const Eigen::Matrix<double, 2, 3> A = Jp * cp.J_point;
-      m.jacobian(s.block, 3).middleRows(r, 2) += (A * ap.J_feature).template cast<Scalar>();
-      m.jacobian(s.anchor, 6).middleRows(r, 2) += (A * ap.J_anchor).template cast<Scalar>();
-      m.jacobian(o.clone, 6).middleRows(r, 2) += (Jp * cp.J_pose).template cast<Scalar>();
+      const Eigen::Matrix<double, 2, 3> Jp = is * projectionJacobian(cj.p_C);
+      const Eigen::Matrix<double, 2, 3> A = Jp * cj.J_point;
+      m.jacobian(s.block, 3).middleRows(r, 2) += (A * apj.J_feature).template cast<Scalar>();
+      m.jacobian(s.anchor, 6).middleRows(r, 2) += (A * apj.J_anchor).template cast<Scalar>();
+      m.jacobian(o.clone, 6).middleRows(r, 2) += (Jp * cj.J_pose).template cast<Scalar>();
       if (!ext_ids.empty()) {
-        m.jacobian(ext_ids[0], 6).middleRows(r, 2) += (A * ap.J_ext).template cast<Scalar>();
+        m.jacobian(ext_ids[0], 6).middleRows(r, 2) += (A * apj.J_ext).template cast<Scalar>();
         m.jacobian(ext_ids[static_cast<std::size_t>(o.cam)], 6).middleRows(r, 2) +=
-            (Jp * cp.J_ext).template cast<Scalar>();
+            (Jp * cj.J_ext).template cast<Scalar>();
       }
       m.residual().segment(r, 2) = (is * (o.z - cp.p_C.head<2>() / cp.p_C.z())).template cast<Scalar>();
     }
     m.setWhitened();
+    triangularizeBlock(m, s.block, 3);
     return true;
+  }
+
+  /// Rotates the rows of m (Givens, orthogonal: same information and χ²) so that its columns of
+  /// block `id` are upper triangular: rows ≥ d then have exact zeros there and start at a later
+  /// column of R. For a stereo SLAM re-observation (4 rows, 3 feature columns) one of the four
+  /// rows no longer starts at the feature, i.e. it skips the columns of all SLAM features in
+  /// the update (docs/vio_estimator.md, speed).
+  static void triangularizeBlock(Meas& m, BlockId id, int d) {
+    const int rows = m.rows();
+    if (rows <= d) return;
+    int b = -1;
+    for (int i = 0; i < m.numBlocks(); ++i) {
+      if (m.blockId(i) == id) b = i;
+    }
+    if (b < 0) return;
+    const int nb = m.numBlocks();
+    for (int j = 0; j < d; ++j) {
+      for (int i = rows - 1; i > j; --i) {
+        auto F = m.jacobian(id, d);
+        const Scalar y = F(i, j);
+        if (y == Scalar(0)) continue;
+        const Scalar x = F(i - 1, j);
+        const Scalar rho = std::hypot(x, y);
+        const Scalar c = x / rho, sn = y / rho;
+        for (int q = 0; q < nb; ++q) {
+          auto J = m.jacobian(m.blockId(q), m.blockDim(q));
+          for (int col = 0; col < J.cols(); ++col) {
+            const Scalar a = J(i - 1, col), bb = J(i, col);
+            J(i - 1, col) = c * a + sn * bb;
+            J(i, col) = c * bb - sn * a;
+          }
+        }
+        auto& r = m.residual();
+        const Scalar a = r(i - 1), bb = r(i);
+        r(i - 1) = c * a + sn * bb;
+        r(i) = c * bb - sn * a;
+        F(i, j) = Scalar(0);
+      }
+    }
   }
 
   /// Stacks whitened measurements without nuisance columns into one (single allocation).
   static void stackAll(const std::vector<Meas>& ms, Meas& out) {
     int rows = 0;
-    for (const Meas& m : ms) rows += m.rows();
+    std::vector<BlockId> ids;
+    std::vector<int> dims;
+    for (const Meas& m : ms) {
+      rows += m.rows();
+      for (int i = 0; i < m.numBlocks(); ++i) {
+        if (std::find(ids.begin(), ids.end(), m.blockId(i)) != ids.end()) continue;
+        ids.push_back(m.blockId(i));
+        dims.push_back(m.blockDim(i));
+      }
+    }
     out.reset(rows);
+    out.addBlocks(ids, dims);  // one allocation
     int r0 = 0;
     for (const Meas& m : ms) {
       for (int i = 0; i < m.numBlocks(); ++i) {
@@ -626,6 +736,8 @@ struct SriSwfEstimator<Scalar>::Impl {
     std::sort(ids.begin(), ids.end());
     const PoseEstimate& Pa = pose(old_anchor);
     const PoseEstimate& Pb = pose(newest.pose);
+    const PoseEstimate& PaJ = poseJ(old_anchor);
+    const PoseEstimate& PbJ = poseJ(newest.pose);
     const CameraExtrinsic e0 = ext(0);
     struct Item {
       std::uint64_t id;
@@ -637,15 +749,19 @@ struct SriSwfEstimator<Scalar>::Impl {
     for (std::uint64_t id : ids) {
       Slam& s = slam[id];
       const Eigen::Vector3d fx = f.estimate(s.block).vector.template cast<double>();
-      const AnchoredPoint ap = anchoredPoint(fx, Pa, e0);
-      Eigen::Matrix3d D;
-      CameraPoint cp;
-      const Eigen::Vector3d fn = inverseDepthOf(ap.p_W, Pb, e0, &D, &cp);
-      if (!(cp.p_C.z() > cfg.min_depth)) {
+      const AnchoredPoint ap0 = anchoredPoint(fx, Pa, e0);
+      CameraPoint cp0;
+      const Eigen::Vector3d fn = inverseDepthOf(ap0.p_W, Pb, e0, nullptr, &cp0);
+      if (!(cp0.p_C.z() > cfg.min_depth)) {
         drop.push_back(s.block);
         slam.erase(id);
         continue;
       }
+      // Jacobians at the first estimates of both anchors (first_estimate_jacobians).
+      const AnchoredPoint ap = anchoredPoint(fx, PaJ, e0);
+      Eigen::Matrix3d D;
+      CameraPoint cp;
+      inverseDepthOf(ap.p_W, PbJ, e0, &D, &cp);
       Item it;
       it.id = id;
       it.fnew = fn;
@@ -891,6 +1007,7 @@ struct SriSwfEstimator<Scalar>::Impl {
       marg.insert(marg.end(), d.begin(), d.end());
       marg.push_back(oldest);
       clones.pop_front();
+      fe_pose.erase(oldest.value);
       for (auto& [id, tr] : tracks) {
         auto& o = tr.obs;
         const auto n0 = o.size();
