@@ -4,6 +4,9 @@
 #include <chrono>
 #include <cmath>
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
 #include "gvins/base/constants.hpp"
 #include "gvins/base/local_frame.hpp"
 #include "gvins/fusion/gnss_clock_init.hpp"
@@ -304,53 +307,129 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
                                                      std::vector<bool>& accepted, bool gate) {
   const vio::ImuBlocks ib = est.newestImuBlocks();
   const int nc = clockBlock_.valid() ? static_cast<int>(clockSystems_.size()) + 1 : 0;
-  auto fill = [&](sri::Measurement<Scalar>& m, const std::vector<int>& idx) {
-    m.reset(static_cast<int>(idx.size()));
-    bool lever = false, clock = false;
-    for (int i : idx) {
-      lever = lever || !rows[static_cast<std::size_t>(i)].H_lever.isZero();
-      clock = clock || rows[static_cast<std::size_t>(i)].clockBias >= 0 || rows[static_cast<std::size_t>(i)].H_drift != 0.0;
-    }
-    for (std::size_t j = 0; j < idx.size(); ++j) {
-      const GnssRow& r = rows[static_cast<std::size_t>(idx[j])];
-      const int jj = static_cast<int>(j);
-      m.jacobian(ib.pose, 6).row(jj) = r.H_imu.template head<6>().template cast<Scalar>();
-      m.jacobian(ib.extra, 9).row(jj) = r.H_imu.template tail<9>().template cast<Scalar>();
-      if (frameBlock_.valid()) m.jacobian(frameBlock_, 4).row(jj) = r.H_frame.template cast<Scalar>();
-      if (lever && leverBlock_.valid()) m.jacobian(leverBlock_, 3).row(jj) = r.H_lever.template cast<Scalar>();
-      if (clock && nc > 0) {
-        auto J = m.jacobian(clockBlock_, nc);
-        if (r.clockBias >= 0) J(jj, r.clockBias) = Scalar(1);
-        J(jj, nc - 1) = static_cast<Scalar>(r.H_drift);
-      }
-      m.residual()[jj] = static_cast<Scalar>(r.residual);
-    }
-    Eigen::MatrixXd S(idx.size(), idx.size());
-    Eigen::MatrixXd He(idx.size(), 9);
-    for (std::size_t a = 0; a < idx.size(); ++a) {
-      He.row(static_cast<Eigen::Index>(a)) = rows[static_cast<std::size_t>(idx[a])].H_earlier;
-      for (std::size_t b = 0; b < idx.size(); ++b) S(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) = noise(idx[a], idx[b]);
-    }
-    S += He * intCov * He.transpose();  // Σ = Σ_m + J Σ_g Jᵀ (paper Sec. III-C)
-    m.whitenCovariance(S.template cast<Scalar>());
-  };
   accepted.assign(rows.size(), false);
+  // The blocks GNSS rows touch: newest pose and extra, frame, lever arm, clocks (all at the back
+  // of the state); a row as a vector h over them, in this order.
+  std::vector<sri::BlockId> blocks{ib.pose, ib.extra};
+  std::vector<int> dims{6, 9};
+  int dim = 15;
+  auto addBlock = [&](sri::BlockId id, int size) {
+    blocks.push_back(id);
+    dims.push_back(size);
+    dim += size;
+  };
+  const int frameAt = frameBlock_.valid() ? dim : -1;
+  if (frameBlock_.valid()) addBlock(frameBlock_, 4);
+  const int leverAt = leverBlock_.valid() ? dim : -1;
+  if (leverBlock_.valid()) addBlock(leverBlock_, 3);
+  const int clockAt = nc > 0 ? dim : -1;
+  if (nc > 0) addBlock(clockBlock_, nc);
+  auto rowVector = [&](const GnssRow& r, auto&& h) {
+    h.setZero();
+    h.template head<15>() = r.H_imu;
+    if (frameAt >= 0) h.template segment<4>(frameAt) = r.H_frame;
+    if (leverAt >= 0) h.template segment<3>(leverAt) = r.H_lever;
+    if (clockAt >= 0) {
+      if (r.clockBias >= 0) h[clockAt + r.clockBias] = 1.0;
+      h[clockAt + nc - 1] = r.H_drift;
+    }
+  };
+
+  // Row gate: each row alone against the joint marginal covariance P of those blocks (cheap at
+  // the back of the state): χ² = r² / (σ² + J Σ_k Jᵀ + h P hᵀ), the innovation test of the row.
+  const bool rowGate = gate && config_.rowGate < 1.0;
+  Eigen::MatrixXd P;
+  bool haveP = false;
+  if (rowGate) {
+    try {
+      P = est.covariance(std::span<const sri::BlockId>(blocks)).template cast<double>();
+      haveP = true;
+    } catch (const std::exception&) {
+      // A block without information (e.g. a new frame block): rows pass the row gate.
+    }
+  }
+  const double q1 = rowGate ? sri::chiSquareQuantile(config_.rowGate, 1) : 0.0;
   std::vector<int> keep;
-  const double q1 = gate && config_.rowGate < 1.0 ? sri::chiSquareQuantile(config_.rowGate, 1) : 0.0;
+  Eigen::RowVectorXd h(dim);
   for (std::size_t i = 0; i < rows.size(); ++i) {
-    if (!std::isfinite(rows[i].residual)) continue;
-    if (gate && config_.rowGate < 1.0) {
-      sri::Measurement<Scalar> one;
-      fill(one, {static_cast<int>(i)});
-      const auto c = est.chiSquare(one);
-      if (c && static_cast<double>(c->value) > q1) continue;
+    const GnssRow& r = rows[i];
+    if (!std::isfinite(r.residual)) continue;
+    if (haveP) {
+      rowVector(r, h);
+      const double s2 = noise(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)) +
+                        (r.H_earlier * intCov * r.H_earlier.transpose())(0, 0) + h.dot(h * P);
+      if (!(s2 > 0.0) || r.residual * r.residual > q1 * s2) continue;
     }
     keep.push_back(static_cast<int>(i));
   }
   vio::BackendUpdate<Scalar> u;
   if (keep.empty()) return u;
-  sri::Measurement<Scalar> m;
-  fill(m, keep);
+
+  // Whitening with Σ = Σ_m + J Σ_k Jᵀ (paper Sec. III-C). Σ_m is block diagonal (independent
+  // rows; the gpsvel triple and the DD phases correlated among themselves): each block is
+  // whitened by its own Cholesky factor. The integration error e ~ N(0, Σ_k) of the state at the
+  // measurement time, common to all rows, enters as a 9-column nuisance J L_k (Σ_k = L_k L_kᵀ)
+  // with prior rows I and is projected out: exactly the rows that the full Σ would give, without
+  // the n³ Cholesky of Σ.
+  const auto nk = static_cast<Eigen::Index>(keep.size());
+  Eigen::MatrixXd A(nk, dim + 9 + 1);  // [h | J | r]
+  for (Eigen::Index j = 0; j < nk; ++j) {
+    const GnssRow& r = rows[static_cast<std::size_t>(keep[static_cast<std::size_t>(j)])];
+    rowVector(r, A.row(j).head(dim));
+    A.row(j).segment<9>(dim) = r.H_earlier;
+    A(j, dim + 9) = r.residual;
+  }
+  auto sigma = [&](Eigen::Index a, Eigen::Index b) { return noise(keep[static_cast<std::size_t>(a)], keep[static_cast<std::size_t>(b)]); };
+  std::vector<std::pair<Eigen::Index, Eigen::Index>> groups;  // [begin, end) of coupled rows
+  for (Eigen::Index a = 0; a < nk;) {
+    Eigen::Index b = a + 1;
+    for (bool coupled = true; coupled && b < nk;) {
+      coupled = false;
+      for (Eigen::Index c = a; c < b && !coupled; ++c) coupled = sigma(b, c) != 0.0;
+      if (coupled) ++b;
+    }
+    groups.emplace_back(a, b);
+    a = b;
+  }
+  bool blockDiagonal = true;
+  for (const auto& g : groups) {
+    for (Eigen::Index a = g.first; a < g.second && blockDiagonal; ++a)
+      for (Eigen::Index c = g.second; c < nk && blockDiagonal; ++c) blockDiagonal = sigma(a, c) == 0.0;
+  }
+  if (!blockDiagonal) groups.assign(1, {0, nk});  // not expected: whiten with the whole Σ_m
+  for (const auto& [a, b] : groups) {
+    if (b - a == 1) {
+      const double s2 = sigma(a, a);
+      if (!(s2 > 0.0)) return u;
+      A.row(a) /= std::sqrt(s2);
+      continue;
+    }
+    Eigen::MatrixXd S(b - a, b - a);
+    for (Eigen::Index i = a; i < b; ++i)
+      for (Eigen::Index k = a; k < b; ++k) S(i - a, k - a) = sigma(i, k);
+    const Eigen::LLT<Eigen::MatrixXd> llt(S);
+    if (llt.info() != Eigen::Success) return u;
+    llt.matrixL().solveInPlace(A.middleRows(a, b - a));
+  }
+  // L_k of the (positive semi-definite) integration covariance.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 9, 9>> eig(intCov);
+  const Eigen::Matrix<double, 9, 9> Lk =
+      eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+  const bool nuisance = Lk.norm() > 0.0;
+  sri::Measurement<Scalar> m(static_cast<int>(nk) + (nuisance ? 9 : 0));
+  for (std::size_t bi = 0, col = 0; bi < blocks.size(); col += static_cast<std::size_t>(dims[bi]), ++bi) {
+    const auto c = static_cast<Eigen::Index>(col);
+    if (bi >= 2 && A.middleCols(c, dims[bi]).isZero(0.0)) continue;  // e.g. the lever arm without excitation
+    m.jacobian(blocks[bi], dims[bi]).topRows(nk) = A.middleCols(c, dims[bi]).template cast<Scalar>();
+  }
+  m.residual().head(nk) = A.col(dim + 9).template cast<Scalar>();
+  if (nuisance) {
+    auto N = m.nuisance(9);
+    N.topRows(nk) = (A.middleCols(dim, 9) * Lk).template cast<Scalar>();
+    N.bottomRows(9).setIdentity();
+  }
+  m.setWhitened();
+  if (nuisance) m.projectNuisance();
   u = est.update(m, gate ? config_.epochGate : 1.0);
   if (u.applied) {
     for (int i : keep) accepted[static_cast<std::size_t>(i)] = true;
@@ -380,14 +459,21 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
     }
   }
   const SppSolution spp = spp_->solve(rover);
-  std::optional<RtkSolution> rtk;
+  // Dpsr needs only the single differences, formed in the tight stage about the antenna
+  // estimate (RtkSolver::differences: no float filter, no ambiguity resolution); Ddcp runs the
+  // whole RTK module for its fixed ambiguities.
+  const bool fullRtk = rtk_ && config_.mode == GnssFusionMode::kDoppDdcp;
+  std::optional<double> baseAge;
   if (rtk_) {
     if (base && (!lastBase_ || base->time > *lastBase_)) {
       rtk_->addBaseEpoch(*base);
       lastBase_ = base->time;
     }
-    rtk = rtk_->process(rover);
-    rep.rtkFixed = rtk->quality == SolutionQuality::Fix;
+    if (fullRtk) {
+      const RtkSolution rtk = rtk_->process(rover);
+      rep.rtkFixed = rtk.quality == SolutionQuality::Fix;
+      baseAge = rtk.age;
+    }
   }
   if (!est.initialized()) {
     stage_ = GnssFusionStage::kWaitingVio;
@@ -531,7 +617,8 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
     }
     const std::size_t nIndependent = rows.size();
     std::vector<DoubleDifference> phase;
-    if (rtk && config_.usesDifferences() && rtk->age <= config_.maxBaseAge) {
+    if (rtk_ && !fullRtk) baseAge = rtk_->differences(rover, k.x_E);
+    if (baseAge && config_.usesDifferences() && *baseAge <= config_.maxBaseAge) {
       const DdEpoch& e = rtk_->measurements();
       // Base clock per system: mean base code OMC (clock + errors common to the base).
       std::vector<double> sum(static_cast<std::size_t>(n), 0.0);

@@ -364,6 +364,19 @@ bool RtkSolver::rejectOutlier(RtkSolution& sol) {
   return true;
 }
 
+std::optional<double> RtkSolver::differences(const ObsEpoch& rover, const Eigen::Vector3d& x) {
+  GlonassChannels ch = roverChannels_;
+  ch.mergeMissing(nav_.glonassChannels());
+  roverSlips_.process(rover, ch);
+  if (base_.snapshot(rover.time, snapshot_) != BaseAvailability::Ok) {
+    dd_.clear();
+    dd_.time = rover.time;
+    return std::nullopt;
+  }
+  builder_.form(rover, roverSlips_, snapshot_, *base_.position(), x, dd_);
+  return snapshot_.age;
+}
+
 RtkSolution RtkSolver::process(const ObsEpoch& rover) {
   RtkSolution sol;
   sol.time = rover.time;

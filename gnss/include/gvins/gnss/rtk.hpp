@@ -133,6 +133,13 @@ class RtkSolver {
   /// The single and double differences of the last processed epoch, with the fixed ambiguities of
   /// the DD phases when the epoch was fixed (for the fusion and for diagnostics).
   const DdEpoch& measurements() const { return dd_; }
+  /// Steps 2 and 4 only (rover slips, base aligned to the rover time, single and double
+  /// differences about the rover position `x`), without SPP, the float filter and ambiguity
+  /// resolution: for users of the code differences alone (e.g. the fusion's SD pseudoranges).
+  /// The differences go to measurements(); returns the base data's age (s), or nullopt when
+  /// the base has no usable data for this epoch (measurements() is then empty). Do not mix
+  /// with process() on the same solver.
+  std::optional<double> differences(const ObsEpoch& rover, const Eigen::Vector3d& x);
   /// Forgets the float solution and all ambiguities (base buffer and slip history stay).
   void reset();
 
