@@ -15,6 +15,14 @@
 // Among usable records the nearest toe wins; equal distances go to the newest transmission, then
 // the larger issue of data. Records whose transmission time is after t are used only within
 // EphemerisSelection::futureTolerance of toe.
+//
+// Spans of a choice (chooseKepler/chooseGlonass): as t moves, the selection can only change where
+// a rule flips for some record: at toe -+ the search bound, toe -+ the validity window, the
+// transmission time, toe -+ the future tolerance, or half-way between the toe of the selected
+// record and that of another usable one (nearest toe). Between the nearest such edges before and
+// after t (less the margin) every rule evaluates as at t, so the selection is the same. Records
+// more than twice the search bound from t cannot be in the search range anywhere within one
+// bound of t, which also limits the span.
 #include <algorithm>
 #include <cmath>
 
@@ -52,6 +60,123 @@ bool transmittedInTime(const GpsTime& ttr, const GpsTime& toe, const GpsTime& t,
 const std::vector<KeplerEphemeris> kNoKepler;
 const std::vector<GlonassEphemeris> kNoGlonass;
 
+/// The nearest rule edges before and after t, within one search bound.
+class Edges {
+ public:
+  Edges(const GpsTime& t, double bound) : t_(t), before_(t - bound), after_(t + bound) {}
+  void add(const GpsTime& edge) {
+    if (t_ < edge) {
+      if (edge < after_) after_ = edge;
+    } else if (before_ < edge) {
+      before_ = edge;
+    }
+  }
+  /// The span between the edges less the margin; only t itself when t is within the margin of an
+  /// edge (the selection at an edge may differ on either side).
+  template <class Record>
+  EphemerisChoice<Record> choice(const Record* record) const {
+    EphemerisChoice<Record> c{record, before_ + kEphemerisSpanMargin, after_ - kEphemerisSpanMargin};
+    if (t_ < c.from || c.until < t_) c.from = c.until = t_;
+    return c;
+  }
+
+ private:
+  GpsTime t_, before_, after_;
+};
+
+/// Kepler record selection among one satellite's records (sorted by toe) for one message filter;
+/// with `edges`, also collects the rule edges of every record that may matter near t.
+const KeplerEphemeris* pickKepler(const std::vector<KeplerEphemeris>& list, const GpsTime& t, double bound,
+                                  const EphemerisSelection& policy, bool anyMessage, NavMessage wanted,
+                                  Edges* edges) {
+  const GpsTime lo = t - bound, hi = t + bound;
+  auto considered = [&](const KeplerEphemeris& e) {
+    return (anyMessage || e.message == wanted) && (policy.allowUnhealthy || isHealthy(e));
+  };
+  auto usable = [&](const KeplerEphemeris& e) {
+    if (e.toe < lo || hi < e.toe || !considered(e)) return false;
+    if (std::fabs(t - e.toe) > EphemerisStore::validityHalfWindow(e)) return false;
+    return transmittedInTime(e.ttr, e.toe, t, policy);
+  };
+  const KeplerEphemeris* best = nullptr;
+  double bestDt = 0.0;
+  auto it = std::lower_bound(list.begin(), list.end(), lo,
+                             [](const KeplerEphemeris& e, const GpsTime& x) { return e.toe < x; });
+  for (; it != list.end() && !(hi < it->toe); ++it) {
+    const KeplerEphemeris& e = *it;
+    if (!usable(e)) continue;
+    const double dt = std::fabs(t - e.toe);
+    if (best) {
+      if (dt > bestDt) continue;
+      if (dt == bestDt && (e.ttr < best->ttr || (e.ttr == best->ttr && e.iode <= best->iode))) continue;
+    }
+    best = &e;
+    bestDt = dt;
+  }
+  if (!edges) return best;
+  auto wide = std::lower_bound(list.begin(), list.end(), t - 2.0 * bound,
+                               [](const KeplerEphemeris& e, const GpsTime& x) { return e.toe < x; });
+  for (; wide != list.end() && !(t + 2.0 * bound < wide->toe); ++wide) {
+    const KeplerEphemeris& e = *wide;
+    if (!considered(e)) continue;
+    const double window = EphemerisStore::validityHalfWindow(e);
+    edges->add(e.toe - bound);
+    edges->add(e.toe + bound);
+    edges->add(e.toe - window);
+    edges->add(e.toe + window);
+    edges->add(e.ttr);
+    if (policy.futureTolerance >= 0.0) {
+      edges->add(e.toe - policy.futureTolerance);
+      edges->add(e.toe + policy.futureTolerance);
+    }
+    if (best && e.toe != best->toe && usable(e)) edges->add(best->toe + 0.5 * (e.toe - best->toe));
+  }
+  return best;
+}
+
+/// The same for GLONASS records (transmission time tof; ties to the latest tof).
+const GlonassEphemeris* pickGlonass(const std::vector<GlonassEphemeris>& list, const GpsTime& t, double bound,
+                                    const EphemerisSelection& policy, Edges* edges) {
+  const GpsTime lo = t - bound, hi = t + bound;
+  auto usable = [&](const GlonassEphemeris& e) {
+    if (e.toe < lo || hi < e.toe) return false;
+    if (!policy.allowUnhealthy && !isHealthy(e)) return false;
+    if (std::fabs(t - e.toe) > EphemerisStore::validityHalfWindow(e)) return false;
+    return transmittedInTime(e.tof, e.toe, t, policy);
+  };
+  const GlonassEphemeris* best = nullptr;
+  double bestDt = 0.0;
+  auto it = std::lower_bound(list.begin(), list.end(), lo,
+                             [](const GlonassEphemeris& e, const GpsTime& x) { return e.toe < x; });
+  for (; it != list.end() && !(hi < it->toe); ++it) {
+    const GlonassEphemeris& e = *it;
+    if (!usable(e)) continue;
+    const double dt = std::fabs(t - e.toe);
+    if (best && (dt > bestDt || (dt == bestDt && !(best->tof < e.tof)))) continue;
+    best = &e;
+    bestDt = dt;
+  }
+  if (!edges) return best;
+  auto wide = std::lower_bound(list.begin(), list.end(), t - 2.0 * bound,
+                               [](const GlonassEphemeris& e, const GpsTime& x) { return e.toe < x; });
+  for (; wide != list.end() && !(t + 2.0 * bound < wide->toe); ++wide) {
+    const GlonassEphemeris& e = *wide;
+    if (!policy.allowUnhealthy && !isHealthy(e)) continue;
+    const double window = EphemerisStore::validityHalfWindow(e);
+    edges->add(e.toe - bound);
+    edges->add(e.toe + bound);
+    edges->add(e.toe - window);
+    edges->add(e.toe + window);
+    edges->add(e.tof);
+    if (policy.futureTolerance >= 0.0) {
+      edges->add(e.toe - policy.futureTolerance);
+      edges->add(e.toe + policy.futureTolerance);
+    }
+    if (best && e.toe != best->toe && usable(e)) edges->add(best->toe + 0.5 * (e.toe - best->toe));
+  }
+  return best;
+}
+
 }  // namespace
 
 double EphemerisStore::validityHalfWindow(const KeplerEphemeris& eph) {
@@ -80,11 +205,15 @@ void EphemerisStore::add(const KeplerEphemeris& eph) {
   for (auto j = it; j != list.end() && j->toe == eph.toe; ++j) {
     if (sameKeplerRecord(*j, eph)) {
       // The same data set seen again: keep the copy that was available first.
-      if (eph.ttr < j->ttr) *j = eph;
+      if (eph.ttr < j->ttr) {
+        *j = eph;
+        ++revision_;
+      }
       return;
     }
   }
   list.insert(it, eph);
+  ++revision_;
 }
 
 void EphemerisStore::add(const GlonassEphemeris& eph) {
@@ -96,11 +225,15 @@ void EphemerisStore::add(const GlonassEphemeris& eph) {
                              [](const GlonassEphemeris& e, const GpsTime& t) { return e.toe < t; });
   for (auto j = it; j != list.end() && j->toe == eph.toe; ++j) {
     if (j->position == eph.position && j->velocity == eph.velocity) {
-      if (eph.tof < j->tof) *j = eph;
+      if (eph.tof < j->tof) {
+        *j = eph;
+        ++revision_;
+      }
       return;
     }
   }
   list.insert(it, eph);
+  ++revision_;
   if (eph.frequencyChannel >= -7 && eph.frequencyChannel <= 6) channels_.set(eph.sat.prn, eph.frequencyChannel);
 }
 
@@ -114,35 +247,10 @@ void EphemerisStore::add(const NavData& nav) {
   if (!leapSeconds_) leapSeconds_ = nav.leapSeconds;
 }
 
-const KeplerEphemeris* EphemerisStore::selectKepler(SatId sat, const GpsTime& t,
-                                                    const EphemerisSelection& policy) const {
-  if (!sat.valid() || sat.system == System::Glonass || kepler_.empty()) return nullptr;
-  const auto& list = kepler_[satIndex(sat)];
-  if (list.empty()) return nullptr;
-  const double bound = maxHalfWindow(sat.system);
+namespace {
 
-  auto pick = [&](bool anyMessage, NavMessage wanted) -> const KeplerEphemeris* {
-    const KeplerEphemeris* best = nullptr;
-    double bestDt = 0.0;
-    auto it = std::lower_bound(list.begin(), list.end(), t - bound,
-                               [](const KeplerEphemeris& e, const GpsTime& x) { return e.toe < x; });
-    for (; it != list.end() && !(t + bound < it->toe); ++it) {
-      const KeplerEphemeris& e = *it;
-      if (!anyMessage && e.message != wanted) continue;
-      if (!policy.allowUnhealthy && !isHealthy(e)) continue;
-      const double dt = std::fabs(t - e.toe);
-      if (dt > validityHalfWindow(e)) continue;
-      if (!transmittedInTime(e.ttr, e.toe, t, policy)) continue;
-      if (best) {
-        if (dt > bestDt) continue;
-        if (dt == bestDt && (e.ttr < best->ttr || (e.ttr == best->ttr && e.iode <= best->iode))) continue;
-      }
-      best = &e;
-      bestDt = dt;
-    }
-    return best;
-  };
-
+template <class Pick>
+auto chooseGalileoFirst(SatId sat, const EphemerisSelection& policy, Pick pick) {
   if (sat.system == System::Galileo) {
     const NavMessage first = policy.preferGalileoInav ? NavMessage::GalileoInav : NavMessage::GalileoFnav;
     const NavMessage second = policy.preferGalileoInav ? NavMessage::GalileoFnav : NavMessage::GalileoInav;
@@ -152,26 +260,44 @@ const KeplerEphemeris* EphemerisStore::selectKepler(SatId sat, const GpsTime& t,
   return pick(true, NavMessage::GpsLnav);
 }
 
+}  // namespace
+
+const KeplerEphemeris* EphemerisStore::selectKepler(SatId sat, const GpsTime& t,
+                                                    const EphemerisSelection& policy) const {
+  if (!sat.valid() || sat.system == System::Glonass || kepler_.empty()) return nullptr;
+  const auto& list = kepler_[satIndex(sat)];
+  if (list.empty()) return nullptr;
+  const double bound = maxHalfWindow(sat.system);
+  return chooseGalileoFirst(sat, policy, [&](bool anyMessage, NavMessage wanted) {
+    return pickKepler(list, t, bound, policy, anyMessage, wanted, nullptr);
+  });
+}
+
+EphemerisChoice<KeplerEphemeris> EphemerisStore::chooseKepler(SatId sat, const GpsTime& t,
+                                                             const EphemerisSelection& policy) const {
+  const double bound = sat.valid() ? maxHalfWindow(sat.system) : 0.0;
+  Edges edges(t, bound);
+  if (!sat.valid() || sat.system == System::Glonass || kepler_.empty()) return edges.choice<KeplerEphemeris>(nullptr);
+  const auto& list = kepler_[satIndex(sat)];
+  // A Galileo I/NAV pick holds in its own span; a fall-back to F/NAV also needs the I/NAV
+  // search to stay empty, so the edges of both add up.
+  return edges.choice(chooseGalileoFirst(sat, policy, [&](bool anyMessage, NavMessage wanted) {
+    return pickKepler(list, t, bound, policy, anyMessage, wanted, &edges);
+  }));
+}
+
 const GlonassEphemeris* EphemerisStore::selectGlonass(SatId sat, const GpsTime& t,
                                                       const EphemerisSelection& policy) const {
   if (!sat.valid() || sat.system != System::Glonass || glonass_.empty()) return nullptr;
-  const auto& list = glonass_[satIndex(sat)];
+  return pickGlonass(glonass_[satIndex(sat)], t, maxHalfWindow(System::Glonass), policy, nullptr);
+}
+
+EphemerisChoice<GlonassEphemeris> EphemerisStore::chooseGlonass(SatId sat, const GpsTime& t,
+                                                               const EphemerisSelection& policy) const {
   const double bound = maxHalfWindow(System::Glonass);
-  const GlonassEphemeris* best = nullptr;
-  double bestDt = 0.0;
-  auto it = std::lower_bound(list.begin(), list.end(), t - bound,
-                             [](const GlonassEphemeris& e, const GpsTime& x) { return e.toe < x; });
-  for (; it != list.end() && !(t + bound < it->toe); ++it) {
-    const GlonassEphemeris& e = *it;
-    if (!policy.allowUnhealthy && !isHealthy(e)) continue;
-    const double dt = std::fabs(t - e.toe);
-    if (dt > validityHalfWindow(e)) continue;
-    if (!transmittedInTime(e.tof, e.toe, t, policy)) continue;
-    if (best && (dt > bestDt || (dt == bestDt && !(best->tof < e.tof)))) continue;
-    best = &e;
-    bestDt = dt;
-  }
-  return best;
+  Edges edges(t, bound);
+  if (!sat.valid() || sat.system != System::Glonass || glonass_.empty()) return edges.choice<GlonassEphemeris>(nullptr);
+  return edges.choice(pickGlonass(glonass_[satIndex(sat)], t, bound, policy, &edges));
 }
 
 std::optional<SatelliteState> EphemerisStore::satelliteState(SatId sat, const GpsTime& t,

@@ -84,7 +84,8 @@ struct SppSolver::Measurement {
   double ionoMap = 0.0;    // partial of the delay w.r.t. a zenith L1 ionosphere correction
 };
 
-SppSolver::SppSolver(const EphemerisStore& nav, SppConfig config) : nav_(nav), config_(std::move(config)) {}
+SppSolver::SppSolver(const EphemerisStore& nav, SppConfig config)
+    : nav_(nav), config_(std::move(config)), ephemerides_(nav_, config_.ephemeris) {}
 
 void SppSolver::setGlonassChannels(const GlonassChannels& channels) { channels_ = channels; }
 void SppSolver::setInitialPosition(const Eigen::Vector3d& ecef) { initial_ = ecef; }
@@ -160,8 +161,8 @@ bool SppSolver::gatherMeasurements(const ObsEpoch& epoch, SppSolution& sol, std:
     // One record selection per satellite for the state and the group delays.
     const GlonassEphemeris* ge = nullptr;
     const KeplerEphemeris* ke = nullptr;
-    if (so.sat.system == System::Glonass) ge = nav_.selectGlonass(so.sat, ttx, cfg.ephemeris);
-    else ke = nav_.selectKepler(so.sat, ttx, cfg.ephemeris);
+    if (so.sat.system == System::Glonass) ge = ephemerides_.glonass(so.sat, ttx);
+    else ke = ephemerides_.kepler(so.sat, ttx);
     if (!ge && !ke) {
       out.use = SatelliteUse::NoEphemeris;
       continue;

@@ -2,6 +2,7 @@
 // one for a satellite and time.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <vector>
 
@@ -13,6 +14,19 @@
 #include "gvins/ephemeris/satellite_state.hpp"
 
 namespace gvins {
+
+/// A selected record (nullptr: none) with a span of times [from, until] around the time asked
+/// for in which the same satellite and policy select the same record again: no selection rule
+/// flips for any record inside it (validity window, transmission time, search range, nearest toe),
+/// with a margin of kEphemerisSpanMargin to the nearest flip. It allows caching the selection.
+template <class Record>
+struct EphemerisChoice {
+  const Record* record = nullptr;
+  GpsTime from, until;
+};
+/// Margin (s) kept between a choice's span and the times at which a selection rule flips: far above
+/// the rounding of the time differences (< 1e-9 s), far below the spacing of broadcast records.
+inline constexpr double kEphemerisSpanMargin = 1e-3;
 
 /// Selection policy knobs.
 struct EphemerisSelection {
@@ -42,6 +56,13 @@ class EphemerisStore {
                                       const EphemerisSelection& policy = {}) const;
   const GlonassEphemeris* selectGlonass(SatId sat, const GpsTime& t,
                                         const EphemerisSelection& policy = {}) const;
+  /// The same selections with the span in which they stay the same (see EphemerisChoice).
+  EphemerisChoice<KeplerEphemeris> chooseKepler(SatId sat, const GpsTime& t,
+                                                const EphemerisSelection& policy = {}) const;
+  EphemerisChoice<GlonassEphemeris> chooseGlonass(SatId sat, const GpsTime& t,
+                                                  const EphemerisSelection& policy = {}) const;
+  /// Changes whenever records are added: choices made before are then out of date.
+  std::uint64_t revision() const { return revision_; }
 
   /// Satellite state at transmit time t from the selected record; std::nullopt when there is no
   /// usable record.
@@ -76,6 +97,7 @@ class EphemerisStore {
   IonosphereParameters iono_;
   GlonassChannels channels_;
   std::optional<int> leapSeconds_;
+  std::uint64_t revision_ = 0;
 };
 
 }  // namespace gvins

@@ -11,6 +11,7 @@
 
 #include "gvins/base/local_frame.hpp"
 #include "gvins/base/observation.hpp"
+#include "gvins/ephemeris/ephemeris_cache.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/gnss/dop.hpp"
 #include "gvins/gnss/doppler_velocity.hpp"
@@ -107,6 +108,7 @@ class SppSolver {
 
   const EphemerisStore& nav_;
   SppConfig config_;
+  EphemerisCache ephemerides_;  // record selection per satellite, reused across epochs
   GlonassChannels channels_;
   std::optional<Eigen::Vector3d> initial_;
   std::optional<Eigen::Vector3d> last_;
