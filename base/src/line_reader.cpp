@@ -50,48 +50,96 @@ bool LineReader::fill() {
   return true;
 }
 
-bool LineReader::next(std::string& line) {
+void LineReader::tooLong() const {
+  throw ParseError(name_, line_ + 1, "", "line longer than " + std::to_string(maxLen_) + " characters");
+}
+
+std::string_view LineReader::lastLine() const {
+  switch (lastIn_) {
+    case Storage::Memory: return mem_.substr(lastPos_, lastLen_);
+    case Storage::Buffer: return std::string_view(buf_).substr(lastPos_, lastLen_);
+    case Storage::Spill: return std::string_view(spill_).substr(lastPos_, lastLen_);
+    case Storage::Saved: break;
+  }
+  return saved_;
+}
+
+void LineReader::saveLast(Storage overwritten) {
+  // Once per buffer refill at most: the line stays available to unread().
+  if (lastIn_ != overwritten) return;
+  saved_.assign(lastLine());
+  lastIn_ = Storage::Saved;
+}
+
+bool LineReader::next(std::string_view& line) {
   if (pushedBack_) {
     pushedBack_ = false;
-    line = last_;
+    line = lastLine();
     ++line_;
     return true;
   }
-  line.clear();
-  bool any = false;
   if (!gz_) {
     if (memPos_ >= mem_.size()) return false;
     const std::size_t nl = mem_.find('\n', memPos_);
     const std::size_t end = nl == std::string_view::npos ? mem_.size() : nl;
-    if (end - memPos_ > maxLen_) {
-      throw ParseError(name_, line_ + 1, "", "line longer than " + std::to_string(maxLen_) + " characters");
-    }
-    line.assign(mem_.substr(memPos_, end - memPos_));
+    if (end - memPos_ > maxLen_) tooLong();
+    lastIn_ = Storage::Memory;
+    lastPos_ = memPos_;
+    lastLen_ = end - memPos_;
     memPos_ = nl == std::string_view::npos ? mem_.size() : nl + 1;
-    any = true;
   } else {
-    for (;;) {
-      if (bufPos_ >= buf_.size() && !fill()) break;
-      any = true;
-      const char* start = buf_.data() + bufPos_;
-      const std::size_t avail = buf_.size() - bufPos_;
-      const void* nlp = std::memchr(start, '\n', avail);
-      const std::size_t take = nlp ? static_cast<std::size_t>(static_cast<const char*>(nlp) - start) : avail;
-      if (line.size() + take > maxLen_) {
-        throw ParseError(name_, line_ + 1, "", "line longer than " + std::to_string(maxLen_) + " characters");
-      }
-      line.append(start, take);
-      bufPos_ += take;
-      if (nlp) {
-        ++bufPos_;
-        break;
-      }
+    if (bufPos_ >= buf_.size()) {
+      saveLast(Storage::Buffer);
+      if (!fill()) return false;
     }
-    if (!any) return false;
+    const char* start = buf_.data() + bufPos_;
+    const std::size_t avail = buf_.size() - bufPos_;
+    const void* nlp = std::memchr(start, '\n', avail);
+    if (nlp) {
+      // The common case: the whole line is in the buffer.
+      const std::size_t take = static_cast<std::size_t>(static_cast<const char*>(nlp) - start);
+      if (take > maxLen_) tooLong();
+      lastIn_ = Storage::Buffer;
+      lastPos_ = bufPos_;
+      lastLen_ = take;
+      bufPos_ += take + 1;
+    } else {
+      // The line continues after a refill: collect it in spill_.
+      if (avail > maxLen_) tooLong();
+      saveLast(Storage::Spill);
+      saveLast(Storage::Buffer);
+      spill_.assign(start, avail);
+      bufPos_ = buf_.size();
+      while (fill()) {
+        const char* s = buf_.data();
+        const void* p = std::memchr(s, '\n', buf_.size());
+        const std::size_t take = p ? static_cast<std::size_t>(static_cast<const char*>(p) - s) : buf_.size();
+        if (spill_.size() + take > maxLen_) tooLong();
+        spill_.append(s, take);
+        bufPos_ = take;
+        if (p) {
+          ++bufPos_;
+          break;
+        }
+      }
+      lastIn_ = Storage::Spill;
+      lastPos_ = 0;
+      lastLen_ = spill_.size();
+    }
   }
-  if (!line.empty() && line.back() == '\r') line.pop_back();
+  if (lastLen_ > 0 && lastLine().back() == '\r') --lastLen_;
+  line = lastLine();
   ++line_;
-  last_ = line;
+  return true;
+}
+
+bool LineReader::next(std::string& line) {
+  std::string_view v;
+  if (!next(v)) {
+    line.clear();
+    return false;
+  }
+  line.assign(v);
   return true;
 }
 

@@ -17,12 +17,39 @@ namespace {
 constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,
                              1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18};
 
+bool isDigit(char c) { return c >= '0' && c <= '9'; }
+
+/// The layout RINEX writers use for F14.3: blanks, an optional sign and digits in columns 1-10,
+/// the point in column 11, three decimals. Same mantissa and scale as the general loop below
+/// (at most 13 digits), hence the same value.
+bool fixedF14_3(std::string_view s, double& out) {
+  if (s.size() != 14 || s[10] != '.' || !isDigit(s[11]) || !isDigit(s[12]) || !isDigit(s[13])) return false;
+  std::size_t i = 0;
+  while (i < 10 && s[i] == ' ') ++i;
+  bool neg = false;
+  if (i < 10 && (s[i] == '-' || s[i] == '+')) {
+    neg = s[i] == '-';
+    ++i;
+  }
+  std::uint64_t m = 0;
+  for (; i < 10; ++i) {
+    if (!isDigit(s[i])) return false;
+    m = m * 10 + static_cast<unsigned>(s[i] - '0');
+  }
+  m = m * 1000 + static_cast<unsigned>(s[11] - '0') * 100 + static_cast<unsigned>(s[12] - '0') * 10 +
+      static_cast<unsigned>(s[13] - '0');
+  const double v = static_cast<double>(m) / kPow10[3];
+  out = neg ? -v : v;
+  return true;
+}
+
 /// Plain fixed-point decimal ("  -1234.567") without exponent. The digits form an integer below
 /// 2^53, so mantissa / 10^k is the correctly rounded value (same result as strtod). Returns false
 /// for anything else, blank included; the caller then falls back to the general parser.
 enum class Fast { Blank, Value, Other };
 
 Fast fastDecimal(std::string_view s, double& out) {
+  if (fixedF14_3(s, out)) return Fast::Value;
   std::size_t i = 0;
   const std::size_t n = s.size();
   while (i < n && s[i] == ' ') ++i;
@@ -116,7 +143,7 @@ struct RinexObsReader::Impl {
 
   std::vector<std::string> events;
   RinexObsReaderStats stats;
-  std::string line;
+  std::string_view line;  // the line last read (valid until the next read)
   std::vector<std::string> satLines;  // RINEX 2 satellite list
   GpsTime lastTime;
   bool haveTime = false;
@@ -618,7 +645,7 @@ bool RinexObsReader::Impl::readEpoch(ObsEpoch& e) {
         in.unread();
         fail("special records", "fewer special records than the " + std::to_string(nsat) + " announced");
       }
-      events.push_back(line);
+      events.emplace_back(line);
     }
     typesChanged = false;
     for (const auto& h : events) headerLine(h, label(h), true);
@@ -658,10 +685,10 @@ bool RinexObsReader::Impl::readEpoch(ObsEpoch& e) {
   if (r2) {
     // Satellite list: 12 per line in columns 33-68, continuation lines for more.
     satLines.clear();
-    satLines.push_back(line);
+    satLines.emplace_back(line);
     for (long i = 12; i < nsat; i += 12) {
       if (!in.next(line)) fail("satellite list", "file ends inside the satellite list");
-      satLines.push_back(line);
+      satLines.emplace_back(line);
     }
     const std::size_t ntypes = hdr.rinex2Types.size();
     const std::size_t linesPerSat = ntypes == 0 ? 1 : (ntypes + 4) / 5;

@@ -1,6 +1,6 @@
 #include "gvins/base/text_fields.hpp"
 
-#include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 
@@ -44,12 +44,19 @@ std::optional<double> parseOptionalDouble(std::string_view text, const TextLocat
     buf[i] = c;
   }
   buf[text.size()] = '\0';
-  errno = 0;
-  char* end = nullptr;
-  const double v = std::strtod(buf, &end);
-  if (end != buf + text.size() || end == buf) {
+  const char* const last = buf + text.size();
+  // std::from_chars rounds correctly like strtod (same value) and is several times faster; it
+  // does not take the leading '+' strtod accepts, so that is skipped here (but not "+-1").
+  const char* first = buf;
+  if (*first == '+') ++first;
+  double v = 0.0;
+  const auto [ptr, ec] = std::from_chars(first, last, v);
+  if ((ec != std::errc() && ec != std::errc::result_out_of_range) || ptr != last ||
+      (first != buf && (*first == '-' || *first == '+'))) {
     throwParseError(where, field, "not a number: '" + std::string(text) + "'");
   }
+  // Overflow is an error below; strtod's treatment of underflow (0 or a subnormal) is kept.
+  if (ec == std::errc::result_out_of_range) v = std::strtod(buf, nullptr);
   if (!std::isfinite(v)) throwParseError(where, field, "number out of range: '" + std::string(text) + "'");
   return v;
 }

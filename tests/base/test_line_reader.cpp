@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <vector>
 
 #include "gvins/base/line_reader.hpp"
 
@@ -67,6 +69,79 @@ TEST(LineReader, PlainAndGzipFilesReadTheSame) {
     EXPECT_EQ(n, 20000);
   }
   EXPECT_THROW(LineReader("/nonexistent/file.obs"), ParseError);
+  std::remove(plain.c_str());
+  std::remove(gz.c_str());
+}
+
+TEST(LineReader, ViewsAcrossBufferRefillsWithUnreadEverywhere) {
+  // Lines of many lengths (0 to 3000 characters, about 70 of them across the 64 KiB refills), CRLF
+  // and LF, no final newline: the string_view interface returns the lines, and unread() after any
+  // line (one read across a refill, the last one at the end of the file) gives it back.
+  const auto dir = std::filesystem::temp_directory_path();
+  const std::string plain = (dir / "gvins_lr_views.txt").string();
+  const std::string gz = (dir / "gvins_lr_views.txt.gz").string();
+  std::vector<std::string> lines;
+  std::string content;
+  for (int i = 0; i < 3000; ++i) {
+    std::string l = std::to_string(i) + ":" + std::string(static_cast<std::size_t>((i * 7919) % 3000), 'a' + i % 26);
+    lines.push_back(l);
+    content += l + (i % 3 == 0 ? "\r\n" : "\n");
+  }
+  lines.push_back("tail");
+  content += "tail";
+  for (const std::string end : {"", "\n"}) {
+    const std::string all = content + end;
+    { std::ofstream(plain, std::ios::binary) << all; }
+    {
+      gzFile f = gzopen(gz.c_str(), "wb");
+      ASSERT_NE(f, nullptr);
+      gzwrite(f, all.data(), static_cast<unsigned>(all.size()));
+      gzclose(f);
+    }
+    for (const auto& p : {plain, gz}) {
+      for (int unreadEvery : {0, 1, 5}) {
+        LineReader r(p, 8192);
+        std::string_view v;
+        std::size_t n = 0;
+        while (r.next(v)) {
+          ASSERT_LT(n, lines.size());
+          ASSERT_EQ(v, lines[n]) << p << " line " << n;
+          if (unreadEvery && n % unreadEvery == 0) {
+            r.unread();
+            std::string again;
+            ASSERT_TRUE(r.next(again));
+            ASSERT_EQ(again, lines[n]);
+            EXPECT_EQ(r.lineNumber(), static_cast<std::int64_t>(n + 1));
+          }
+          ++n;
+        }
+        EXPECT_EQ(n, lines.size());
+        // At the end the last line can still be pushed back.
+        r.unread();
+        ASSERT_TRUE(r.next(v));
+        EXPECT_EQ(v, "tail");
+        EXPECT_FALSE(r.next(v));
+      }
+    }
+  }
+  // A line across a refill is checked against the limit as a whole.
+  {
+    std::string text;
+    for (int i = 0; i < 650; ++i) text += std::string(99, 'x') + "\n";  // 65000 bytes
+    text += std::string(9000, 'y') + "\n";
+    { std::ofstream(plain, std::ios::binary) << text; }
+    for (std::size_t limit : {9000u, 8999u}) {
+      LineReader r(plain, limit);
+      std::string_view v;
+      for (int i = 0; i < 650; ++i) ASSERT_TRUE(r.next(v));
+      if (limit == 9000u) {
+        ASSERT_TRUE(r.next(v));
+        EXPECT_EQ(v, std::string(9000, 'y'));
+      } else {
+        EXPECT_THROW(r.next(v), ParseError);
+      }
+    }
+  }
   std::remove(plain.c_str());
   std::remove(gz.c_str());
 }

@@ -27,6 +27,9 @@ class LineReader {
   /// Reads the next line without its terminator ('\n', "\r\n"). Returns false at end of input.
   /// Throws ParseError for a line longer than the limit, or for a read error/corrupt gzip stream.
   bool next(std::string& line);
+  /// The same without a copy: `line` views the reader's buffer and stays valid until the next
+  /// call of next(), or until the reader is moved or destroyed.
+  bool next(std::string_view& line);
   /// Pushes the last line back so that the next call to next() returns it again (one level).
   void unread();
 
@@ -43,12 +46,20 @@ class LineReader {
   std::string name_;
   std::size_t maxLen_;
   std::int64_t line_ = 0;
-  std::string last_;
+  // The last line returned, for unread(): offset and length in its storage.
+  enum class Storage { Memory, Buffer, Spill, Saved };
+  Storage lastIn_ = Storage::Memory;
+  std::size_t lastPos_ = 0, lastLen_ = 0;
   bool pushedBack_ = false;
   std::string buf_;
   std::size_t bufPos_ = 0;
+  std::string spill_;  // a line that continues across a buffer refill
+  std::string saved_;  // the last line, when its storage is about to be overwritten
   bool eof_ = false;
   bool fill();
+  std::string_view lastLine() const;
+  void saveLast(Storage overwritten);
+  [[noreturn]] void tooLong() const;
 };
 
 }  // namespace gvins
