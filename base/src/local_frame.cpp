@@ -33,7 +33,7 @@ Eigen::Vector3d enuToEcef(const Eigen::Vector3d& enu, const Eigen::Vector3d& ori
   return originEcef + ecefToEnuRotation(g.lat, g.lon).transpose() * enu;
 }
 
-AzEl azimuthElevation(const Geodetic& rcv, const Eigen::Vector3d& rcvEcef,
+AzEl azimuthElevation(const Eigen::Matrix3d& ecefToEnu, const Eigen::Vector3d& rcvEcef,
                       const Eigen::Vector3d& satEcef) {
   AzEl out;
   if (rcvEcef.norm() < 1000.0) {
@@ -41,11 +41,16 @@ AzEl azimuthElevation(const Geodetic& rcv, const Eigen::Vector3d& rcvEcef,
     return out;
   }
   const Eigen::Vector3d los = (satEcef - rcvEcef).normalized();
-  const Eigen::Vector3d enu = ecefToEnuRotation(rcv.lat, rcv.lon) * los;
+  const Eigen::Vector3d enu = ecefToEnu * los;
   out.azimuth = std::atan2(enu.x(), enu.y());
   if (out.azimuth < 0.0) out.azimuth += 2.0 * M_PI;
   out.elevation = std::asin(std::clamp(enu.z(), -1.0, 1.0));
   return out;
+}
+
+AzEl azimuthElevation(const Geodetic& rcv, const Eigen::Vector3d& rcvEcef,
+                      const Eigen::Vector3d& satEcef) {
+  return azimuthElevation(ecefToEnuRotation(rcv.lat, rcv.lon), rcvEcef, satEcef);
 }
 
 AzEl azimuthElevation(const Eigen::Vector3d& rcvEcef, const Eigen::Vector3d& satEcef) {

@@ -10,9 +10,13 @@ Dop computeDop(const std::vector<Eigen::Vector3d>& los, const std::vector<int>& 
   Dop d;
   const int m = 3 + numClocks;
   const int n = static_cast<int>(los.size());
-  if (numClocks < 1 || n < m || static_cast<int>(clockIndex.size()) != n) return d;
-  Eigen::MatrixXd ata = Eigen::MatrixXd::Zero(m, m);
-  Eigen::VectorXd row(m);
+  if (numClocks < 1 || numClocks > kNumSystems || n < m || static_cast<int>(clockIndex.size()) != n) return d;
+  // Sizes bounded by one clock per constellation: no heap allocation.
+  constexpr int kMax = 3 + kNumSystems;
+  using Mat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMax, kMax>;
+  using Vec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMax, 1>;
+  Mat ata = Mat::Zero(m, m);
+  Vec row(m);
   for (int i = 0; i < n; ++i) {
     row.setZero();
     row.head<3>() = -los[i];
@@ -20,9 +24,9 @@ Dop computeDop(const std::vector<Eigen::Vector3d>& los, const std::vector<int>& 
     row[3 + clockIndex[i]] = 1.0;
     ata.noalias() += row * row.transpose();
   }
-  Eigen::LDLT<Eigen::MatrixXd> ldlt(ata);
+  Eigen::LDLT<Mat> ldlt(ata);
   if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().array() > 1e-12).all()) return d;
-  const Eigen::MatrixXd q = ldlt.solve(Eigen::MatrixXd::Identity(m, m));
+  const Mat q = ldlt.solve(Mat::Identity(m, m));
   if (!q.allFinite() || (q.diagonal().array() < 0.0).any()) return d;
   d.gdop = std::sqrt(q.trace());
   d.pdop = std::sqrt(q(0, 0) + q(1, 1) + q(2, 2));

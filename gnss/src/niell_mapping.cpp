@@ -41,25 +41,33 @@ double mariniContinuedFraction(double s, double a, double b, double c) {
   return top / bottom;
 }
 
-MappingFactors niellMapping(const Geodetic& station, double elevation, double dayOfYear) {
-  const double el = std::max(elevation, 1.0 * constants::kDegToRad);
-  const double s = std::sin(el);
+NiellCoefficients niellCoefficients(const Geodetic& station, double dayOfYear) {
   const double absLat = std::abs(station.lat) * constants::kRadToDeg;
   // Annual term referred to DOY 28; the southern hemisphere is half a year out of phase.
   double doy = dayOfYear - 28.0;
   if (station.lat < 0.0) doy += 365.25 / 2.0;
   const double season = std::cos(2.0 * 3.14159265358979323846 * doy / 365.25);
-  double hc[3], wc[3];
+  NiellCoefficients c;
   for (int k = 0; k < 3; ++k) {
-    hc[k] = interpolate(kHydAvg[k], absLat) - interpolate(kHydAmp[k], absLat) * season;
-    wc[k] = interpolate(kWet[k], absLat);
+    c.hydrostatic[k] = interpolate(kHydAvg[k], absLat) - interpolate(kHydAmp[k], absLat) * season;
+    c.wet[k] = interpolate(kWet[k], absLat);
   }
+  c.heightKm = station.height / 1000.0;
+  return c;
+}
+
+MappingFactors niellMapping(const NiellCoefficients& c, double elevation) {
+  const double el = std::max(elevation, 1.0 * constants::kDegToRad);
+  const double s = std::sin(el);
   MappingFactors m;
-  const double heightKm = station.height / 1000.0;
-  const double dm = (1.0 / s - mariniContinuedFraction(s, kAht, kBht, kCht)) * heightKm;
-  m.hydrostatic = mariniContinuedFraction(s, hc[0], hc[1], hc[2]) + dm;
-  m.wet = mariniContinuedFraction(s, wc[0], wc[1], wc[2]);
+  const double dm = (1.0 / s - mariniContinuedFraction(s, kAht, kBht, kCht)) * c.heightKm;
+  m.hydrostatic = mariniContinuedFraction(s, c.hydrostatic[0], c.hydrostatic[1], c.hydrostatic[2]) + dm;
+  m.wet = mariniContinuedFraction(s, c.wet[0], c.wet[1], c.wet[2]);
   return m;
+}
+
+MappingFactors niellMapping(const Geodetic& station, double elevation, double dayOfYear) {
+  return niellMapping(niellCoefficients(station, dayOfYear), elevation);
 }
 
 }  // namespace gvins

@@ -1,6 +1,7 @@
 #include "gvins/gnss/pos_writer.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <ostream>
@@ -12,6 +13,47 @@
 namespace gvins {
 
 double signedSqrt(double c) { return c < 0.0 ? -std::sqrt(-c) : std::sqrt(c); }
+
+namespace {
+
+// printf-style fields appended to a row. std::to_chars with a precision produces exactly the
+// characters of printf's %.*f (C++17 [charconv.to.chars]: "as if by printf in the C locale"),
+// without printf's format parsing and multi-precision arithmetic; the padding is added here.
+
+/// Right-aligned in `width` characters; with `zeros`, padded with '0' after the sign (printf's
+/// '0' flag) instead of blanks.
+void appendPadded(std::string& out, const char* first, const char* last, int width, bool zeros) {
+  const int len = static_cast<int>(last - first);
+  const int pad = std::max(width - len, 0);
+  if (zeros && pad > 0 && first < last && *first == '-') {
+    out += '-';
+    ++first;
+  }
+  out.append(static_cast<std::size_t>(pad), zeros ? '0' : ' ');
+  out.append(first, last);
+}
+
+/// %<width>.<precision>f (%0<width>.<precision>f with `zeros`).
+void appendFixed(std::string& out, double v, int width, int precision, bool zeros = false) {
+  char buf[400];  // any double in %.9f: at most 309 integer digits, sign, point, 9 decimals
+  if (!std::isfinite(v)) {
+    // inf/nan are spelled by the C library itself.
+    const int n = std::snprintf(buf, sizeof buf, "%*.*f", width, precision, v);
+    out.append(buf, static_cast<std::size_t>(std::max(n, 0)));
+    return;
+  }
+  const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::fixed, precision);
+  appendPadded(out, buf, r.ptr, width, zeros);
+}
+
+/// %<width>d (%0<width>d with `zeros`).
+void appendInt(std::string& out, int v, int width, bool zeros = false) {
+  char buf[16];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  appendPadded(out, buf, r.ptr, width, zeros);
+}
+
+}  // namespace
 
 PosWriter::PosWriter(std::ostream& out, PosWriterOptions options) : out_(out), opt_(std::move(options)) {
   opt_.timeDecimals = std::clamp(opt_.timeDecimals, 0, 9);
@@ -60,21 +102,31 @@ void PosWriter::writeHeader() {
 
 void PosWriter::write(const PositionSolution& s) {
   if (!headerDone_) writeHeader();
-  char buf[512];
   // Time rounded to the printed resolution first, so that seconds never read 60.
   const double scale = std::pow(10.0, opt_.timeDecimals);
   const double frac = std::round(s.time.fraction() * scale) / scale;
   const CalendarTime c = GpsTime::fromSeconds(s.time.wholeSeconds(), frac).toCalendar();
   const double sec = std::floor(c.second * scale + 0.5) / scale;
-  std::snprintf(buf, sizeof buf, "%04d/%02d/%02d %02d:%02d:%0*.*f", c.year, c.month, c.day, c.hour, c.minute,
-                opt_.timeDecimals > 0 ? opt_.timeDecimals + 3 : 2, opt_.timeDecimals, sec);
-  buf_ = buf;
+  // "%04d/%02d/%02d %02d:%02d:%0*.*f"
+  buf_.clear();
+  appendInt(buf_, c.year, 4, true);
+  buf_ += '/';
+  appendInt(buf_, c.month, 2, true);
+  buf_ += '/';
+  appendInt(buf_, c.day, 2, true);
+  buf_ += ' ';
+  appendInt(buf_, c.hour, 2, true);
+  buf_ += ':';
+  appendInt(buf_, c.minute, 2, true);
+  buf_ += ':';
+  appendFixed(buf_, sec, opt_.timeDecimals > 0 ? opt_.timeDecimals + 3 : 2, opt_.timeDecimals, true);
   const bool xyz = opt_.coordinates == PosCoordinates::Xyz;
   Eigen::Matrix3d P = s.positionCovariance;
   Eigen::Matrix3d V = s.velocityCovariance;
   Eigen::Vector3d vel = s.velocity.value_or(Eigen::Vector3d::Zero());
   if (xyz) {
-    std::snprintf(buf, sizeof buf, "%15.4f%15.4f%15.4f", s.position.x(), s.position.y(), s.position.z());
+    // "%15.4f%15.4f%15.4f"
+    for (int i = 0; i < 3; ++i) appendFixed(buf_, s.position[i], 15, 4);
   } else {
     const Geodetic g = ecefToGeodetic(s.position);
     const Eigen::Matrix3d r = ecefToEnuRotation(g.lat, g.lon);
@@ -85,21 +137,29 @@ void PosWriter::write(const PositionSolution& s) {
     P = rn * P * rn.transpose();
     V = rn * V * rn.transpose();
     vel = rn * vel;
-    std::snprintf(buf, sizeof buf, "%15.9f%15.9f%11.4f", g.lat * constants::kRadToDeg, g.lon * constants::kRadToDeg,
-                  g.height);
+    // "%15.9f%15.9f%11.4f"
+    appendFixed(buf_, g.lat * constants::kRadToDeg, 15, 9);
+    appendFixed(buf_, g.lon * constants::kRadToDeg, 15, 9);
+    appendFixed(buf_, g.height, 11, 4);
   }
-  buf_ += buf;
-  std::snprintf(buf, sizeof buf, "%4d%4d%9.4f%9.4f%9.4f%9.4f%9.4f%9.4f%7.2f%7.1f", static_cast<int>(s.quality),
-                s.numSatellites, std::sqrt(std::max(P(0, 0), 0.0)), std::sqrt(std::max(P(1, 1), 0.0)),
-                std::sqrt(std::max(P(2, 2), 0.0)), signedSqrt(P(0, 1)), signedSqrt(P(1, 2)), signedSqrt(P(2, 0)),
-                s.age, s.ratio);
-  buf_ += buf;
+  // "%4d%4d%9.4f%9.4f%9.4f%9.4f%9.4f%9.4f%7.2f%7.1f"
+  appendInt(buf_, static_cast<int>(s.quality), 4);
+  appendInt(buf_, s.numSatellites, 4);
+  for (int i = 0; i < 3; ++i) appendFixed(buf_, std::sqrt(std::max(P(i, i), 0.0)), 9, 4);
+  appendFixed(buf_, signedSqrt(P(0, 1)), 9, 4);
+  appendFixed(buf_, signedSqrt(P(1, 2)), 9, 4);
+  appendFixed(buf_, signedSqrt(P(2, 0)), 9, 4);
+  appendFixed(buf_, s.age, 7, 2);
+  appendFixed(buf_, s.ratio, 7, 1);
   if (opt_.velocity) {
     if (!s.velocity) V.setZero();
-    std::snprintf(buf, sizeof buf, "%11.5f%11.5f%11.5f %9.5f%9.5f%9.5f%9.5f%9.5f%9.5f", vel.x(), vel.y(), vel.z(),
-                  std::sqrt(std::max(V(0, 0), 0.0)), std::sqrt(std::max(V(1, 1), 0.0)),
-                  std::sqrt(std::max(V(2, 2), 0.0)), signedSqrt(V(0, 1)), signedSqrt(V(1, 2)), signedSqrt(V(2, 0)));
-    buf_ += buf;
+    // "%11.5f%11.5f%11.5f %9.5f%9.5f%9.5f%9.5f%9.5f%9.5f"
+    for (int i = 0; i < 3; ++i) appendFixed(buf_, vel[i], 11, 5);
+    buf_ += ' ';
+    for (int i = 0; i < 3; ++i) appendFixed(buf_, std::sqrt(std::max(V(i, i), 0.0)), 9, 5);
+    appendFixed(buf_, signedSqrt(V(0, 1)), 9, 5);
+    appendFixed(buf_, signedSqrt(V(1, 2)), 9, 5);
+    appendFixed(buf_, signedSqrt(V(2, 0)), 9, 5);
   }
   buf_ += '\n';
   out_ << buf_;

@@ -220,7 +220,7 @@ struct EpochModel {
 struct LsqResult {
   bool ok = false;
   VecN x;     // state increment or state
-  MatN cov;   // (H^T W H)^-1
+  MatN cov;   // (H^T W H)^-1, computed with the statistics (wantResiduals) only
   double chi2 = 0.0;
   int nObs = 0;
   int nUnknowns = 0;
@@ -254,6 +254,9 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
   const bool estIono = cfg.ionosphereEstimation.enabled && cfg.ionosphere != IonosphereOption::Off && ionoPar.gps.has_value();
   double ionoPriorVar = 1.0;
 
+  const double fL1 = *carrierFrequency(System::Gps, '1');
+  const double fB1 = *carrierFrequency(System::BeiDou, '2');
+
   // Updates az/el, atmospheric delays, variances and the mask flag of every measurement at x.
   // Model values change by < 1 mm when the position moves by less than a metre (elevations by
   // < 2e-7 rad), so they are refreshed only after larger moves.
@@ -265,13 +268,18 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
     Geodetic g;
     SurfaceMeteo meteo;
     double zhd = 0.0, zwd = 0.0;
+    // Station-dependent parts of the models, computed once for all satellites.
+    Eigen::Matrix3d enu = Eigen::Matrix3d::Identity();
+    NiellCoefficients niell;
     if (surface) {
       g = ecefToGeodetic(x);
+      enu = ecefToEnuRotation(g.lat, g.lon);
       if (cfg.troposphere == TroposphereOption::Saastamoinen && g.height > -500.0 && g.height < 20000.0) {
         meteo = cfg.climatologicalMeteo ? climatologicalMeteo(g.lat, g.height, doy)
                                         : standardAtmosphere(g.height, cfg.relativeHumidity);
         zhd = saastamoinenZenithHydrostatic(meteo.pressure, g.lat, g.height);
         zwd = saastamoinenZenithWet(meteo.temperature, meteo.waterVapour);
+        niell = niellCoefficients(g, doy);
       }
     }
     if (surface && estIono && ionoPar.gps) {
@@ -284,20 +292,19 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
       double ionoVar = 0.0, tropoVar = 0.0;
       m.ionoMap = 0.0;
       if (surface) {
-        m.azel = azimuthElevation(g, x, m.state.position);
+        m.azel = azimuthElevation(enu, x, m.state.position);
         m.active = m.azel.elevation >= cfg.elevationMask;
         if (zhd > 0.0) {
-          const MappingFactors mf = niellMapping(g, m.azel.elevation, doy);
+          const MappingFactors mf = niellMapping(niell, m.azel.elevation);
           m.tropo = zhd * mf.hydrostatic + zwd * mf.wet;
           const double e = cfg.troposphereZenithError * mf.hydrostatic;
           tropoVar = e * e;
         }
         if (!m.ionosphereFree && cfg.ionosphere != IonosphereOption::Off) {
           const System s = m.sat.system;
-          const double fL1 = *carrierFrequency(System::Gps, '1');
           if (s == System::BeiDou && ionoPar.beidou) {
             m.iono = beidouKlobucharDelayB1I(*ionoPar.beidou, g, m.azel, epoch.time) *
-                     ionosphereFrequencyScale(*carrierFrequency(System::BeiDou, '2'), m.frequency);
+                     ionosphereFrequencyScale(fB1, m.frequency);
           } else if (s == System::Qzss && ionoPar.qzss) {
             m.iono = klobucharDelayL1(*ionoPar.qzss, g, m.azel, epoch.time) * ionosphereFrequencyScale(fL1, m.frequency);
           } else if (ionoPar.gps) {
@@ -353,6 +360,8 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
   // Returns the increment and the statistics of the linearisation point.
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, Eigen::Dynamic, kMaxUnknowns> Hw;
   Eigen::VectorXd vw;
+  std::vector<std::pair<Eigen::Matrix<double, kMaxUnknowns, 1>, double>> rows;  // for residual normalisation
+  std::vector<double> resid;
   auto lsqStep = [&](const Eigen::Vector3d& x, const VecN& clk, double ion, const std::vector<char>& use,
                      bool wantResiduals) {
     LsqResult r;
@@ -371,8 +380,8 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
       ++row;
     };
     Eigen::Matrix<double, kMaxUnknowns, 1> h;
-    std::vector<std::pair<Eigen::Matrix<double, kMaxUnknowns, 1>, double>> rows;  // for residual normalisation
-    std::vector<double> resid(wantResiduals ? n : 0, 0.0);
+    rows.clear();
+    resid.assign(wantResiduals ? n : 0, 0.0);
     double chi2 = 0.0;
     int nobs = 0;
     for (int i = 0; i < n; ++i) {
@@ -440,8 +449,12 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
     Eigen::LDLT<MatN> ldlt(N);
     if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().array() > 1e-12 * N.diagonal().maxCoeff()).all()) return r;
     r.x = ldlt.solve(b);
-    r.cov = ldlt.solve(MatN::Identity(m, m));
-    if (!r.x.allFinite() || !r.cov.allFinite()) return r;
+    if (!r.x.allFinite()) return r;
+    if (wantResiduals) {
+      // The covariance only with the statistics: the iterations use the increment alone.
+      r.cov = ldlt.solve(MatN::Identity(m, m));
+      if (!r.cov.allFinite()) return r;
+    }
     r.ok = true;
     if (wantResiduals) {
       // Normalised post-fit residuals of the linearised problem: v_post = v - H dx,
@@ -579,9 +592,9 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
       return sol;
     }
   } else {
-    // `use` already holds the active set; recompute the final statistics at x.
+    // `last` holds the statistics at x for the active set `use` (nothing changed since: the
+    // exclusion fits froze the models); only the clock columns are restored.
     assignColumns(use);
-    last = lsqStep(x, clk, ion, use, true);
   }
   sol.chi2 = last.chi2;
   sol.dof = last.nObs - last.nUnknowns;

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <random>
 #include <sstream>
 
@@ -65,6 +67,64 @@ TEST(PosIo, RoundTripInBothLayouts) {
         EXPECT_LT((*b.velocity - *a.velocity).norm(), 2e-5);
       }
     }
+  }
+}
+
+TEST(PosIo, RowsAreCharacterForCharacterPrintf) {
+  // The writer formats numbers itself; every row must equal the printf layout
+  // "%15.4f%15.4f%15.4f%4d%4d%9.4f..." (xyz) including rounding ties, negative zero, values that
+  // round to zero, wide values, and zero-padded seconds.
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const double ties[] = {0.03125, -0.03125, 0.00005, -0.00005, 0.0, -0.0, -0.00004, 1e9 + 0.5, 2.5e-5};
+  for (int decimals : {0, 1, 3, 6}) {
+    PosWriterOptions o;
+    o.coordinates = PosCoordinates::Xyz;
+    o.timeDecimals = decimals;
+    o.header = false;
+    std::ostringstream os;
+    PosWriter w(os, o);
+    std::string expected;
+    for (int i = 0; i < 400; ++i) {
+      PositionSolution s;
+      s.time = GpsTime::fromCalendar({2024, 6, 24, 8, 20, 0.0}) + i * 0.731 + u(rng) * 1e-3;
+      s.quality = SolutionQuality::Single;
+      const double pick = i < 9 ? ties[i] : u(rng) * std::pow(10.0, static_cast<int>(rng() % 12) - 4);
+      s.position = Eigen::Vector3d(pick, -3.9e6 + u(rng), 1e7 * u(rng));
+      Eigen::Matrix3d c;
+      c << pick * pick, u(rng), -pick * std::abs(pick), u(rng), 2.0, u(rng), u(rng), -0.0, 1e-12;
+      s.positionCovariance = c;
+      s.numSatellites = i % 60;
+      s.age = u(rng) * 30.0;
+      s.ratio = i % 3 == 0 ? pick : 999.95;
+      if (i % 2 == 0) {
+        s.velocity = Eigen::Vector3d(pick, u(rng) * 1e3, -1e-7);
+        s.velocityCovariance = c * 1e-4;
+      }
+      w.write(s);
+      // Expected row: the writer's time rounding, then printf.
+      const double scale = std::pow(10.0, decimals);
+      const CalendarTime t =
+          GpsTime::fromSeconds(s.time.wholeSeconds(), std::round(s.time.fraction() * scale) / scale).toCalendar();
+      char buf[600];
+      std::snprintf(buf, sizeof buf, "%04d/%02d/%02d %02d:%02d:%0*.*f", t.year, t.month, t.day, t.hour, t.minute,
+                    decimals > 0 ? decimals + 3 : 2, decimals, std::floor(t.second * scale + 0.5) / scale);
+      expected += buf;
+      const Eigen::Matrix3d& P = s.positionCovariance;
+      std::snprintf(buf, sizeof buf, "%15.4f%15.4f%15.4f%4d%4d%9.4f%9.4f%9.4f%9.4f%9.4f%9.4f%7.2f%7.1f", s.position.x(),
+                    s.position.y(), s.position.z(), 5, s.numSatellites, std::sqrt(std::max(P(0, 0), 0.0)),
+                    std::sqrt(std::max(P(1, 1), 0.0)), std::sqrt(std::max(P(2, 2), 0.0)), signedSqrt(P(0, 1)),
+                    signedSqrt(P(1, 2)), signedSqrt(P(2, 0)), s.age, s.ratio);
+      expected += buf;
+      const Eigen::Vector3d v = s.velocity.value_or(Eigen::Vector3d::Zero());
+      const Eigen::Matrix3d V = s.velocity ? s.velocityCovariance : Eigen::Matrix3d::Zero();
+      std::snprintf(buf, sizeof buf, "%11.5f%11.5f%11.5f %9.5f%9.5f%9.5f%9.5f%9.5f%9.5f\n", v.x(), v.y(), v.z(),
+                    std::sqrt(std::max(V(0, 0), 0.0)), std::sqrt(std::max(V(1, 1), 0.0)),
+                    std::sqrt(std::max(V(2, 2), 0.0)), signedSqrt(V(0, 1)), signedSqrt(V(1, 2)), signedSqrt(V(2, 0)));
+      expected += buf;
+    }
+    w.finish();
+    EXPECT_EQ(os.str(), expected) << "time decimals " << decimals;
   }
 }
 

@@ -29,5 +29,9 @@ AzEl azimuthElevation(const Eigen::Vector3d& receiverEcef, const Eigen::Vector3d
 /// Same with the receiver's geodetic coordinates already known.
 AzEl azimuthElevation(const Geodetic& receiver, const Eigen::Vector3d& receiverEcef,
                       const Eigen::Vector3d& satelliteEcef);
+/// Same with the receiver's ECEF-to-ENU rotation (ecefToEnuRotation of its latitude and
+/// longitude) already known, for many satellites seen from one place.
+AzEl azimuthElevation(const Eigen::Matrix3d& ecefToEnu, const Eigen::Vector3d& receiverEcef,
+                      const Eigen::Vector3d& satelliteEcef);
 
 }  // namespace gvins

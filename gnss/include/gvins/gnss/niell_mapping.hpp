@@ -18,6 +18,18 @@ struct MappingFactors {
 /// `dayOfYear` may be fractional.
 MappingFactors niellMapping(const Geodetic& station, double elevation, double dayOfYear);
 
+/// The elevation-independent part of niellMapping for one station and day: the continued-fraction
+/// coefficients interpolated in latitude (with the annual term) and the height in km. Computed
+/// once, it serves every satellite seen from that station (same results as niellMapping).
+struct NiellCoefficients {
+  double hydrostatic[3] = {0.0, 0.0, 0.0};  ///< a, b, c of the hydrostatic function
+  double wet[3] = {0.0, 0.0, 0.0};          ///< a, b, c of the wet function
+  double heightKm = 0.0;
+};
+NiellCoefficients niellCoefficients(const Geodetic& station, double dayOfYear);
+/// niellMapping from precomputed coefficients.
+MappingFactors niellMapping(const NiellCoefficients& coefficients, double elevation);
+
 /// The Marini (1972) continued fraction normalised to 1 at zenith, as used by Niell.
 double mariniContinuedFraction(double sinElevation, double a, double b, double c);
 
