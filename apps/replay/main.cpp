@@ -16,6 +16,7 @@
 #include "gvins/fusion/replay_config.hpp"
 #include "gvins/fusion/replay_pipeline.hpp"
 #include "gvins/fusion/replay_sri_swf.hpp"
+#include "gvins/fusion/sim_dataset_info.hpp"
 #include "gvins/vio/sensor_yaml.hpp"
 #include "gvins/vio/sri_swf_estimator.hpp"
 
@@ -73,25 +74,6 @@ double toNumber(const std::string& s, const std::string& opt) {
   } catch (const std::exception&) {
   }
   usageError("bad number '" + s + "' for " + opt);
-}
-
-/// lever_arm_m: [x, y, z] of a gvins-sim dataset.yaml (nullopt if absent).
-std::optional<Eigen::Vector3d> datasetLeverArm(const fs::path& yaml) {
-  std::ifstream f(yaml);
-  std::string line;
-  while (std::getline(f, line)) {
-    if (line.rfind("lever_arm_m:", 0) != 0) continue;
-    const auto a = line.find('['), b = line.find(']');
-    if (a == std::string::npos || b == std::string::npos || b < a) return std::nullopt;
-    Eigen::Vector3d v;
-    std::string s = line.substr(a + 1, b - a - 1);
-    for (char& c : s)
-      if (c == ',') c = ' ';
-    std::istringstream is(s);
-    if (is >> v.x() >> v.y() >> v.z()) return v;
-    return std::nullopt;
-  }
-  return std::nullopt;
 }
 
 template <typename Scalar>
@@ -196,6 +178,8 @@ int main(int argc, char** argv) {
     opt.basePosition = basePos;
     opt.sensorToGpst_ns = sensorToGpst;
 
+    // A gvins-sim dataset: its lever arm and the gravity its IMU was simulated with.
+    const std::optional<SimDatasetInfo> info = readSimDatasetInfo(dataset);
     // Estimator configuration: the file named by the config, else the dataset's calibration.
     vio::SriSwfConfig ec;
     if (!rc.estimatorConfig.empty()) {
@@ -207,11 +191,14 @@ int main(int argc, char** argv) {
       ec.cameras.push_back(vio::readCameraSensorYaml((mav0 / "cam0" / "sensor.yaml").string()));
       if (opt.frontend.useStereo && fs::exists(mav0 / "cam1" / "sensor.yaml"))
         ec.cameras.push_back(vio::readCameraSensorYaml((mav0 / "cam1" / "sensor.yaml").string()));
+      if (info && info->gravity) ec.gravity = *info->gravity;
+      if (info && info->gravityModel == "rotating")
+        std::fprintf(stderr, "gvins-replay: note: the dataset's IMU includes the Earth rotation, which the estimator does not model\n");
     }
     if (useFloat) ec.use_float = true;
 
     std::optional<GnssFusionConfig> gc;
-    const auto trueLever = datasetLeverArm(fs::path(dataset) / "dataset.yaml");
+    const std::optional<Eigen::Vector3d> trueLever = info ? info->leverArm : std::nullopt;
     if (*gnssMode != GnssFusionMode::kVio) {
       gc = rc.hasGnssFusion ? parseGnssFusionConfig(rc.text, rc.file) : GnssFusionConfig{};
       gc->mode = *gnssMode;

@@ -21,6 +21,7 @@
 #include "gvins/fusion/replay_config.hpp"
 #include "gvins/fusion/replay_feature_tracks.hpp"
 #include "gvins/fusion/replay_pipeline.hpp"
+#include "gvins/fusion/sim_dataset_info.hpp"
 #include "gvins/rtcm/encoder.hpp"
 #include "gvins/gnss/pos_reader.hpp"
 #include "gvins/vio/camera_model.hpp"
@@ -412,6 +413,38 @@ TEST(Replay, RtcmBaseStreamHandsOverTheSameBaseEpochs) {
   // MSM epoch times have a resolution of 1 ms (RTCM 10403.3, DF004).
   ASSERT_EQ(fromRtcm.base.size(), fromRinex.base.size());
   for (std::size_t i = 0; i < fromRtcm.base.size(); ++i) EXPECT_LE(std::abs(fromRtcm.base[i] - fromRinex.base[i]), 0.0005) << i;
+}
+
+TEST(ReplayParsers, SimDatasetInfo) {
+  const SimDatasetInfo i = parseSimDatasetInfo(
+      "format: gvins-sim-dataset\ngravity:\n  model: flat  # c\n  magnitude_mps2: 9.797126914213944\n"
+      "lever_arm_m: [0.08, 0, 0.18]  # antenna\nother: {a: 1}\n",
+      "dataset.yaml");
+  ASSERT_TRUE(i.leverArm);
+  EXPECT_EQ(*i.leverArm, Eigen::Vector3d(0.08, 0.0, 0.18));
+  ASSERT_TRUE(i.gravity);
+  EXPECT_DOUBLE_EQ(*i.gravity, 9.797126914213944);
+  EXPECT_EQ(i.gravityModel, "flat");
+  EXPECT_FALSE(parseSimDatasetInfo("format: x\n", "d.yaml").leverArm);
+  auto err = [](const std::string& text) { return expectParseError([&] { parseSimDatasetInfo(text, "d.yaml"); }); };
+  ParseError e = err("a: 1\nlever_arm_m: [0.1, 0.2]\n");
+  EXPECT_EQ(e.field(), "lever_arm_m");
+  EXPECT_EQ(e.line(), 2);
+  e = err("gravity:\n  magnitude_mps2: 98.1\n");
+  EXPECT_EQ(e.field(), "gravity.magnitude_mps2");
+  e = err("gravity:\n  model: round\n");
+  EXPECT_EQ(e.field(), "gravity.model");
+  e = err("gravity: 9.8\n");
+  EXPECT_EQ(e.field(), "gravity");
+  e = err("lever_arm_m: [1, 2\n");
+  EXPECT_EQ(e.file(), "d.yaml");
+  // From a dataset folder; none there: nullopt (a EuRoC recording).
+  const fs::path d = scratch("siminfo");
+  writeText(d / "dataset.yaml", "lever_arm_m: [0.1, -0.2, 0.3]\n");
+  const auto r = readSimDatasetInfo(d.string());
+  ASSERT_TRUE(r && r->leverArm);
+  EXPECT_EQ(*r->leverArm, Eigen::Vector3d(0.1, -0.2, 0.3));
+  EXPECT_FALSE(readSimDatasetInfo((d / "none").string()));
 }
 
 TEST(ReplayParsers, EcefTruth) {

@@ -18,6 +18,7 @@
 #include "gvins/base/local_frame.hpp"
 #include "gvins/fusion/replay_pipeline.hpp"
 #include "gvins/fusion/replay_sri_swf.hpp"
+#include "gvins/fusion/sim_dataset_info.hpp"
 #include "gvins/sim/dataset_generator.hpp"
 #include "gvins/sim/scenario.hpp"
 #include "gvins/vio/sensor_yaml.hpp"
@@ -94,6 +95,7 @@ template <typename Scalar>
 ReplayRun replay(const std::string& name, GnssFusionConfig gc) {
   const fs::path d = dataset();
   vio::SriSwfConfig ec;
+  ec.gravity = *readSimDatasetInfo(d.string())->gravity;  // as gvins-replay does
   ec.imu = vio::readImuSensorYaml((d / "mav0" / "imu0" / "sensor.yaml").string()).noise;
   ec.cameras.push_back(vio::readCameraSensorYaml((d / "mav0" / "cam0" / "sensor.yaml").string()));
   ec.cameras.push_back(vio::readCameraSensorYaml((d / "mav0" / "cam1" / "sensor.yaml").string()));
@@ -146,6 +148,15 @@ std::vector<EpochError> antennaErrors(const ReplayRun& r) {
     out.push_back({static_cast<double>(t - truth.front().t_ns) * 1e-9, (Eigen::Vector3d(x, y, z) - a).norm(), fixed != 0});
   }
   return out;
+}
+
+TEST(ReplaySim, DatasetYamlGivesTheLeverArmAndGravity) {
+  const auto info = readSimDatasetInfo(dataset().string());
+  ASSERT_TRUE(info && info->leverArm && info->gravity);
+  EXPECT_LT((*info->leverArm - kLever).norm(), 1e-12);
+  EXPECT_EQ(info->gravityModel, "flat");
+  // WGS 84 normal gravity at 35.13° N, 105 m + 30 m flight height: 9.7972 m/s² (Somigliana).
+  EXPECT_NEAR(*info->gravity, 9.7972, 5e-4);
 }
 
 TEST(ReplaySim, CarrierPhaseFusionSurvivesASixtySecondOutage) {

@@ -1,0 +1,47 @@
+#include "gvins/fusion/sim_dataset_info.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <yaml-cpp/yaml.h>
+
+#include "gvins/base/parse_error.hpp"
+#include "gvins/base/yaml_reader.hpp"
+
+namespace gvins::fusion {
+
+SimDatasetInfo parseSimDatasetInfo(std::string_view yaml, const std::string& file) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(std::string(yaml));
+  } catch (const YAML::Exception& e) {
+    throw ParseError(file, e.mark.is_null() ? 0 : e.mark.line + 1, "YAML", e.msg);
+  }
+  const YamlReader r(file);
+  SimDatasetInfo info;
+  if (root.IsNull()) return info;
+  if (!root.IsMap()) r.fail(root, "", "dataset.yaml must be a map");
+  if (const YAML::Node l = root["lever_arm_m"]) {
+    const auto v = r.numbers(l, "lever_arm_m", 3, -100.0, 100.0);
+    info.leverArm = Eigen::Vector3d(v[0], v[1], v[2]);
+  }
+  if (const YAML::Node g = root["gravity"]) {
+    if (!g.IsMap()) r.fail(g, "gravity", "'gravity' must be a map");
+    if (const YAML::Node m = g["model"]) info.gravityModel = r.choice(m, "gravity.model", {"flat", "rotating"});
+    if (const YAML::Node m = g["magnitude_mps2"]) info.gravity = r.number(m, "gravity.magnitude_mps2", 9.7, 9.9);
+  }
+  return info;
+}
+
+std::optional<SimDatasetInfo> readSimDatasetInfo(const std::string& datasetFolder) {
+  const std::filesystem::path p = std::filesystem::path(datasetFolder) / "dataset.yaml";
+  if (!std::filesystem::exists(p)) return std::nullopt;
+  std::ifstream in(p);
+  if (!in) throw ParseError(p.string(), 0, "", "cannot open file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parseSimDatasetInfo(ss.str(), p.string());
+}
+
+}  // namespace gvins::fusion
