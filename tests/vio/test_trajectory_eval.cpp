@@ -168,6 +168,32 @@ TEST(TrajectoryMetrics, EstimatedVelocityIsRotatedByTheAlignment) {
   EXPECT_NEAR(r1.bodyVelocity.max, 0.1, 1e-9);
 }
 
+TEST(TrajectoryMetrics, FirstPoseAlignmentKeepsTheDrift) {
+  // An estimate in another frame (yaw 1 rad, shifted, tilted start) that drifts by 0.01 m per s
+  // along its own x axis: the first-pose alignment recovers the frame from the first pose alone
+  // and leaves the drift in the errors (a whole-trajectory 4-DoF fit would spread it).
+  const auto ref = curve(60.0);
+  SimilarityTransform T;
+  T.R = rotZ(1.0);
+  T.t = {5, 6, 7};
+  auto est = transformed(ref, T, 10);
+  for (auto& s : est) s.p += Eigen::Vector3d(0.01 * static_cast<double>(s.t_ns - est.front().t_ns) * 1e-9, 0.0, 0.0);
+  EvaluationOptions opt;
+  opt.alignment = AlignmentKind::FirstPose4Dof;
+  const EvaluationResult r = evaluateTrajectory(est, ref, {}, opt);
+  EXPECT_LT((r.alignment.R - T.R).norm(), 1e-12);
+  EXPECT_LT((r.alignment.t - T.t).norm(), 1e-9);
+  ASSERT_EQ(r.translationError.size(), est.size());
+  for (std::size_t i = 0; i < est.size(); ++i) EXPECT_NEAR(r.translationError[i], 0.01 * r.time[i], 1e-9) << i;
+  EXPECT_LT(r.rotation.max, 1e-6);
+  opt.alignment = AlignmentKind::Yaw4Dof;
+  EXPECT_LT(evaluateTrajectory(est, ref, {}, opt).translation.max, r.translation.max);
+  EXPECT_EQ(parseAlignmentKind("first"), AlignmentKind::FirstPose4Dof);
+  EXPECT_EQ(toString(AlignmentKind::FirstPose4Dof), "first");
+  const std::vector<Eigen::Vector3d> pts{Eigen::Vector3d::Zero()};
+  EXPECT_THROW(alignTrajectory(AlignmentKind::FirstPose4Dof, pts, pts), std::invalid_argument);
+}
+
 TEST(TrajectoryMetrics, InterpolatedReferenceAtOffsetStamps) {
   // Straight line at constant velocity: linear interpolation of the 200 Hz reference is exact,
   // so an estimate equal to the analytic pose at shifted stamps has zero error.

@@ -13,6 +13,7 @@ std::optional<AlignmentKind> parseAlignmentKind(std::string_view name) {
   if (name == "4dof" || name == "yaw" || name == "posyaw") return AlignmentKind::Yaw4Dof;
   if (name == "se3") return AlignmentKind::SE3;
   if (name == "sim3") return AlignmentKind::Sim3;
+  if (name == "first" || name == "first-pose") return AlignmentKind::FirstPose4Dof;
   return std::nullopt;
 }
 
@@ -22,6 +23,7 @@ std::string toString(AlignmentKind kind) {
     case AlignmentKind::Yaw4Dof: return "4dof";
     case AlignmentKind::SE3: return "se3";
     case AlignmentKind::Sim3: return "sim3";
+    case AlignmentKind::FirstPose4Dof: return "first";
   }
   return "?";
 }
@@ -91,6 +93,8 @@ SimilarityTransform alignTrajectory(AlignmentKind kind, std::span<const Eigen::V
     case AlignmentKind::Yaw4Dof: return yawAlign(est, ref);
     case AlignmentKind::SE3: return umeyama(est, ref, false);
     case AlignmentKind::Sim3: return umeyama(est, ref, true);
+    case AlignmentKind::FirstPose4Dof:
+      throw std::invalid_argument("alignTrajectory: the first-pose alignment needs orientations (evaluateTrajectory)");
     case AlignmentKind::None: break;
   }
   return {};

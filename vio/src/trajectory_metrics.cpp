@@ -108,7 +108,15 @@ EvaluationResult evaluateTrajectory(const std::vector<TrajectorySample>& estimat
   std::vector<Eigen::Vector3d> pe(n), pr(n);
   for (std::size_t i = 0; i < n; ++i) pe[i] = est[i]->p, pr[i] = ref[i].p;
   const std::size_t na = options.alignFirst > 0 ? std::min(options.alignFirst, n) : n;
-  r.alignment = alignTrajectory(options.alignment, std::span(pe.data(), na), std::span(pr.data(), na));
+  if (options.alignment == AlignmentKind::FirstPose4Dof) {
+    // Yaw of R_ref0 R_est0ᵀ (rotation about z only) and the translation that maps p_est0 to p_ref0.
+    const Eigen::Matrix3d D = ref[0].R * est[0]->R.transpose();
+    const double yaw = std::atan2(D(1, 0) - D(0, 1), D(0, 0) + D(1, 1));
+    r.alignment.R = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    r.alignment.t = pr[0] - r.alignment.R * pe[0];
+  } else {
+    r.alignment = alignTrajectory(options.alignment, std::span(pe.data(), na), std::span(pr.data(), na));
+  }
   const SimilarityTransform& T = r.alignment;
 
   // Absolute errors.

@@ -146,6 +146,10 @@ struct ReplaySummary {
     double horizontalRmse = kNaN, verticalRmse = kNaN;
     double pathLength = kNaN, driftPercent = kNaN;  ///< drift: longest segment length evaluated
     double positionNees = kNaN, orientationNees = kNaN;
+    /// Local only: NEES under the first-pose alignment (the estimator's gauge, under which its
+    /// covariances describe its errors; the whole-flight fit moves the first poses, whose
+    /// covariance is the tight initial prior).
+    double positionNeesFirstPose = kNaN, orientationNeesFirstPose = kNaN;
     std::size_t poses = 0;
   };
   Accuracy local;   ///< trajectory.tum vs ground truth, 4-DoF aligned
