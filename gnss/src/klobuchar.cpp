@@ -11,7 +11,17 @@ namespace {
 constexpr double kPiIcd = constants::kPi;  // semicircle conversion as prescribed by the ICDs
 }
 
+double klobucharObliquity(double elevation) {
+  const double e = elevation / kPiIcd;
+  return 1.0 + 16.0 * std::pow(0.53 - e, 3.0);
+}
+
 double klobucharDelayL1(const KlobucharParameters& p, const Geodetic& rx, const AzEl& azel, const GpsTime& t) {
+  return klobucharDelayL1(p, rx, azel, t, klobucharObliquity(azel.elevation));
+}
+
+double klobucharDelayL1(const KlobucharParameters& p, const Geodetic& rx, const AzEl& azel, const GpsTime& t,
+                        double obliquity) {
   // IS-GPS-200N figure 20-4; angles in semicircles.
   const double e = azel.elevation / kPiIcd;
   const double phiU = rx.lat / kPiIcd;
@@ -24,7 +34,7 @@ double klobucharDelayL1(const KlobucharParameters& p, const Geodetic& rx, const 
   double tLocal = 4.32e4 * lamI + t.tow();
   tLocal = std::fmod(tLocal, 86400.0);
   if (tLocal < 0.0) tLocal += 86400.0;
-  const double f = 1.0 + 16.0 * std::pow(0.53 - e, 3.0);  // obliquity factor
+  const double f = obliquity;
   double amp = 0.0, per = 0.0, pm = 1.0;
   for (int n = 0; n < 4; ++n) {
     amp += p.alpha[n] * pm;

@@ -302,22 +302,27 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
         }
         if (!m.ionosphereFree && cfg.ionosphere != IonosphereOption::Off) {
           const System s = m.sat.system;
+          // Obliquity of the broadcast model (IS-GPS-200N 20.3.3.5.2.5), shared by the delay and
+          // its partial below.
+          const double obliquity = klobucharObliquity(m.azel.elevation);
           if (s == System::BeiDou && ionoPar.beidou) {
             m.iono = beidouKlobucharDelayB1I(*ionoPar.beidou, g, m.azel, epoch.time) *
                      ionosphereFrequencyScale(fB1, m.frequency);
           } else if (s == System::Qzss && ionoPar.qzss) {
-            m.iono = klobucharDelayL1(*ionoPar.qzss, g, m.azel, epoch.time) * ionosphereFrequencyScale(fL1, m.frequency);
+            m.iono = klobucharDelayL1(*ionoPar.qzss, g, m.azel, epoch.time, obliquity) *
+                     ionosphereFrequencyScale(fL1, m.frequency);
           } else if (ionoPar.gps) {
-            m.iono = klobucharDelayL1(*ionoPar.gps, g, m.azel, epoch.time) * ionosphereFrequencyScale(fL1, m.frequency);
+            m.iono = klobucharDelayL1(*ionoPar.gps, g, m.azel, epoch.time, obliquity) *
+                     ionosphereFrequencyScale(fL1, m.frequency);
           } else if (ionoPar.qzss) {
-            m.iono = klobucharDelayL1(*ionoPar.qzss, g, m.azel, epoch.time) * ionosphereFrequencyScale(fL1, m.frequency);
+            m.iono = klobucharDelayL1(*ionoPar.qzss, g, m.azel, epoch.time, obliquity) *
+                     ionosphereFrequencyScale(fL1, m.frequency);
           }
           const double e = cfg.ionosphereModelError * m.iono;
           ionoVar = e * e;
           if (m.iono == 0.0) ionoVar = 25.0;  // no model available: ~5 m slant delay unaccounted
-          // Obliquity of the broadcast model (IS-GPS-200N 20.3.3.5.2.5) scaled to the frequency.
-          const double el = m.azel.elevation / constants::kPi;
-          m.ionoMap = (1.0 + 16.0 * std::pow(0.53 - el, 3.0)) * ionosphereFrequencyScale(fL1, m.frequency);
+          // The obliquity scaled to the frequency.
+          m.ionoMap = obliquity * ionosphereFrequencyScale(fL1, m.frequency);
         }
       } else {
         m.azel = AzEl{0.0, 0.5 * constants::kPi};
@@ -511,10 +516,13 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
       }
     }
     sol.iterations += it;
-    if (!res.ok) return res;
+    // Without convergence the fit is not used; its size (nObs, nUnknowns) is that of the last step.
+    if (!res.ok || !converged) {
+      res.ok = false;
+      return res;
+    }
     // Statistics at the converged point.
     res = lsqStep(xs, clks, ion, active, true);
-    res.ok = res.ok && converged;
     use = active;
     return res;
   };

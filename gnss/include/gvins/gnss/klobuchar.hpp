@@ -13,6 +13,13 @@ namespace gvins {
 /// L1 in metres for a receiver (geodetic), satellite azimuth/elevation and GPS time.
 double klobucharDelayL1(const KlobucharParameters& p, const Geodetic& receiver, const AzEl& azel,
                         const GpsTime& t);
+/// The same with its obliquity factor klobucharObliquity(azel.elevation) given, for callers that
+/// use the factor themselves (the result is the same).
+double klobucharDelayL1(const KlobucharParameters& p, const Geodetic& receiver, const AzEl& azel,
+                        const GpsTime& t, double obliquity);
+/// Obliquity factor of the broadcast model, F = 1 + 16 (0.53 - E)^3 with E the elevation in
+/// semicircles (IS-GPS-200N figure 20-4).
+double klobucharObliquity(double elevation);
 
 /// BeiDou Klobuchar variant (BDS-SIS-ICD-B1I 3.0, 5.2.4.7): single-layer model at 375 km with
 /// geographic ionospheric pierce point, BDT local time, the 72000..172800 s period clamp; slant
