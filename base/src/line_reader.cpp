@@ -1,24 +1,43 @@
 #include "gvins/base/line_reader.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
 #include <zlib.h>
 
+#include <cerrno>
 #include <cstring>
 
 namespace gvins {
 
+namespace {
+constexpr std::size_t kBufferSize = 1 << 16;
+}
+
+// A gzip stream read through zlib, or (f == nullptr) an uncompressed file read with read(2)
+// straight into the line buffer: zlib's transparent mode would copy through its own input and
+// output buffers (192 kB of fresh pages per file, one more copy of every byte).
 struct LineReader::GzFile {
   gzFile f = nullptr;
+  int fd = -1;
   ~GzFile() {
-    if (f) gzclose(f);
+    if (f) gzclose(f);  // closes fd
+    else if (fd >= 0) ::close(fd);
   }
 };
 
 LineReader::LineReader(const std::string& path, std::size_t maxLineLength)
     : gz_(std::make_unique<GzFile>()), name_(path), maxLen_(maxLineLength) {
-  // gzopen reads uncompressed files transparently.
-  gz_->f = gzopen(path.c_str(), "rb");
-  if (!gz_->f) throw ParseError(path, 0, "", std::string("cannot open file: ") + std::strerror(errno));
-  gzbuffer(gz_->f, 1 << 16);
+  gz_->fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (gz_->fd < 0) throw ParseError(path, 0, "", std::string("cannot open file: ") + std::strerror(errno));
+  // Compression is detected from the content (the gzip magic bytes), as zlib does. A file that
+  // cannot be peeked at (a pipe) is left to zlib, which reads either kind sequentially.
+  unsigned char magic[2] = {0, 0};
+  const ssize_t m = ::pread(gz_->fd, magic, 2, 0);
+  if (m < 0 || (m == 2 && magic[0] == 0x1f && magic[1] == 0x8b)) {
+    gz_->f = gzdopen(gz_->fd, "rb");
+    if (!gz_->f) throw ParseError(path, 0, "", "cannot open file: out of memory");
+    gzbuffer(gz_->f, 1 << 16);
+  }
 }
 
 LineReader::LineReader(std::string_view text, std::string name, std::size_t maxLineLength)
@@ -34,14 +53,31 @@ bool LineReader::fill() {
     eof_ = true;
     return false;
   }
-  buf_.resize(1 << 16);
-  const int n = gzread(gz_->f, buf_.data(), static_cast<unsigned>(buf_.size()));
-  if (n < 0) {
-    int err = 0;
-    const char* msg = gzerror(gz_->f, &err);
-    throw ParseError(name_, line_ + 1, "", std::string("read error: ") + (msg ? msg : "unknown"));
+  if (buf_.size() != kBufferSize) buf_.resize(kBufferSize);  // once: later fills reuse it
+  long n = 0;
+  if (gz_->f) {
+    n = gzread(gz_->f, buf_.data(), static_cast<unsigned>(buf_.size()));
+    if (n < 0) {
+      int err = 0;
+      const char* msg = gzerror(gz_->f, &err);
+      throw ParseError(name_, line_ + 1, "", std::string("read error: ") + (msg ? msg : "unknown"));
+    }
+  } else {
+    // Fill the buffer as gzread does (short reads are continued) so that refills fall at the
+    // same places.
+    std::size_t got = 0;
+    while (got < buf_.size()) {
+      const ssize_t r = ::read(gz_->fd, buf_.data() + got, buf_.size() - got);
+      if (r < 0) {
+        if (errno == EINTR) continue;
+        throw ParseError(name_, line_ + 1, "", std::string("read error: ") + std::strerror(errno));
+      }
+      if (r == 0) break;
+      got += static_cast<std::size_t>(r);
+    }
+    n = static_cast<long>(got);
   }
-  buf_.resize(static_cast<std::size_t>(n));
+  bufLen_ = static_cast<std::size_t>(n);
   bufPos_ = 0;
   if (n == 0) {
     eof_ = true;
@@ -88,12 +124,12 @@ bool LineReader::next(std::string_view& line) {
     lastLen_ = end - memPos_;
     memPos_ = nl == std::string_view::npos ? mem_.size() : nl + 1;
   } else {
-    if (bufPos_ >= buf_.size()) {
+    if (bufPos_ >= bufLen_) {
       saveLast(Storage::Buffer);
       if (!fill()) return false;
     }
     const char* start = buf_.data() + bufPos_;
-    const std::size_t avail = buf_.size() - bufPos_;
+    const std::size_t avail = bufLen_ - bufPos_;
     const void* nlp = std::memchr(start, '\n', avail);
     if (nlp) {
       // The common case: the whole line is in the buffer.
@@ -109,11 +145,11 @@ bool LineReader::next(std::string_view& line) {
       saveLast(Storage::Spill);
       saveLast(Storage::Buffer);
       spill_.assign(start, avail);
-      bufPos_ = buf_.size();
+      bufPos_ = bufLen_;
       while (fill()) {
         const char* s = buf_.data();
-        const void* p = std::memchr(s, '\n', buf_.size());
-        const std::size_t take = p ? static_cast<std::size_t>(static_cast<const char*>(p) - s) : buf_.size();
+        const void* p = std::memchr(s, '\n', bufLen_);
+        const std::size_t take = p ? static_cast<std::size_t>(static_cast<const char*>(p) - s) : bufLen_;
         if (spill_.size() + take > maxLen_) tooLong();
         spill_.append(s, take);
         bufPos_ = take;

@@ -51,7 +51,8 @@ class LineReader {
   Storage lastIn_ = Storage::Memory;
   std::size_t lastPos_ = 0, lastLen_ = 0;
   bool pushedBack_ = false;
-  std::string buf_;
+  std::string buf_;         // the file's bytes; the first bufLen_ of them are valid
+  std::size_t bufLen_ = 0;
   std::size_t bufPos_ = 0;
   std::string spill_;  // a line that continues across a buffer refill
   std::string saved_;  // the last line, when its storage is about to be overwritten
