@@ -1,6 +1,7 @@
 #include "gvins/base/text_fields.hpp"
 
 #include <charconv>
+#include <cstdint>
 #include <cmath>
 #include <cstdlib>
 
@@ -28,10 +29,66 @@ void throwParseError(const TextLocation& where, std::string_view field, const st
   throw ParseError(std::string(where.file), where.line, std::string(field), what);
 }
 
+bool parseShortDecimal(std::string_view text, double& v) {
+  // Exact powers of ten (10^22 is the largest one a double holds exactly).
+  static constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                      1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+                                      1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+  const char* p = text.data();
+  const char* const end = p + text.size();
+  bool neg = false;
+  if (p != end && (*p == '-' || *p == '+')) {
+    neg = *p == '-';
+    ++p;
+  }
+  // Digits accumulate into m (it wraps past 19 digits, which are declined below).
+  auto isDigit = [](char c) { return static_cast<unsigned>(c - '0') < 10u; };
+  std::uint64_t m = 0;
+  const char* const int0 = p;
+  for (; p != end && isDigit(*p); ++p) m = m * 10 + static_cast<std::uint64_t>(*p - '0');
+  const long intDigits = p - int0;
+  long fraction = 0;  // digits after the point
+  if (p != end && *p == '.') {
+    const char* const frac0 = ++p;
+    for (; p != end && isDigit(*p); ++p) m = m * 10 + static_cast<std::uint64_t>(*p - '0');
+    fraction = p - frac0;
+  }
+  if (intDigits + fraction == 0 || intDigits + fraction > 19) return false;
+  long exp10 = 0;
+  if (p != end) {
+    if (*p != 'E' && *p != 'e' && *p != 'D' && *p != 'd') return false;
+    ++p;
+    bool eneg = false;
+    if (p != end && (*p == '-' || *p == '+')) {
+      eneg = *p == '-';
+      ++p;
+    }
+    const char* const exp0 = p;
+    for (; p != end && isDigit(*p) && p - exp0 < 3; ++p) exp10 = exp10 * 10 + (*p - '0');
+    if (p == exp0 || p != end) return false;  // no digits, more than 3, or more text
+    if (eneg) exp10 = -exp10;
+  }
+  if (m > (std::uint64_t{1} << 53)) return false;
+  const long k = exp10 - fraction;
+  double r;
+  if (m == 0) {
+    r = 0.0;
+  } else if (k >= 0 && k <= 22) {
+    r = static_cast<double>(m) * kPow10[k];
+  } else if (k < 0 && k >= -22) {
+    r = static_cast<double>(m) / kPow10[-k];
+  } else {
+    return false;
+  }
+  v = neg ? -r : r;
+  return true;
+}
+
 std::optional<double> parseOptionalDouble(std::string_view text, const TextLocation& where,
                                           std::string_view field) {
   text = trim(text);
   if (text.empty()) return std::nullopt;
+  if (double v; text.size() < 64 && parseShortDecimal(text, v)) return v;
   char buf[64];
   if (text.size() >= sizeof buf) throwParseError(where, field, "number too long: '" + std::string(text) + "'");
   for (std::size_t i = 0; i < text.size(); ++i) {

@@ -32,6 +32,8 @@ double navNumber(std::string_view text, const TextLocation& where, std::string_v
   text = trim(text);
   if (text.empty()) return 0.0;
   if (text.size() > 40) throwParseError(where, field, "number too long: '" + std::string(text) + "'");
+  // The usual D19.12 / E19.12 layout, with an exponent letter: the value parseDouble gives.
+  if (double v; parseShortDecimal(text, v)) return v;
   char buf[48];
   std::size_t n = 0;
   bool exponent = false;
@@ -60,6 +62,25 @@ int toInt(double v, const TextLocation& where, std::string_view field) {
 struct RecordLines {
   std::vector<std::string> text;
   std::vector<std::int64_t> number;
+  // Strings of earlier records, kept for their storage: one record after the other reuses them
+  // instead of allocating every line anew.
+  std::vector<std::string> spare;
+
+  void reset() {
+    for (auto& t : text) spare.push_back(std::move(t));
+    text.clear();
+    number.clear();
+  }
+  void add(const std::string& line, std::int64_t lineNumber) {
+    if (spare.empty()) {
+      text.push_back(line);
+    } else {
+      text.push_back(std::move(spare.back()));
+      spare.pop_back();
+      text.back().assign(line);
+    }
+    number.push_back(lineNumber);
+  }
 };
 
 class NavReader {
@@ -76,6 +97,8 @@ class NavReader {
   bool rinex2_ = false;
   bool rinex4_ = false;
   std::string line_;
+  std::string continuation_;  // readContinuation's line
+  RecordLines record_;        // the record being read (storage reused)
   // RINEX 4 ION records: keep the newest per source.
   std::array<GpsTime, 4> ionEpoch_{};
 
@@ -179,7 +202,7 @@ std::optional<SatId> NavReader::recordSatellite(const std::string& line, const T
 
 void NavReader::readContinuation(RecordLines& r, int minLines, int maxLines, std::string_view what,
                                  bool untilMarker) {
-  std::string line;
+  std::string& line = continuation_;
   int got = 0;
   while (untilMarker || got < maxLines) {
     if (!in_.next(line)) break;
@@ -187,8 +210,7 @@ void NavReader::readContinuation(RecordLines& r, int minLines, int maxLines, std
       in_.unread();
       break;
     }
-    r.text.push_back(line);
-    r.number.push_back(in_.lineNumber());
+    r.add(line, in_.lineNumber());
     ++got;
   }
   if (got < minLines) {
@@ -492,9 +514,9 @@ void NavReader::readBody() {
     if (isBlank(line)) continue;
     const TextLocation w = here();
     if (isContinuation(line)) throwParseError(w, "SV / EPOCH / SV CLK", "orbit line without a record start");
-    RecordLines r;
-    r.text.push_back(line);
-    r.number.push_back(in_.lineNumber());
+    RecordLines& r = record_;
+    r.reset();
+    r.add(line, in_.lineNumber());
     const auto sat = recordSatellite(line, w);
     // System of the record: from the satellite, or from the letter when the number is unknown.
     System sys;
@@ -555,13 +577,13 @@ void NavReader::readRinex4Body() {
       throwParseError(w, "satellite system", "unknown satellite system in '" + line + "'");
     }
     const System sys = *systemFromLetter(satText[0]);
-    RecordLines r;
+    RecordLines& r = record_;
+    r.reset();
     if (!in_.next(line) || (!line.empty() && line[0] == '>')) {
       throwParseError({in_.name(), w.line + 1}, type == "EPH" ? "SV / EPOCH / SV CLK" : "epoch",
                       type + " record without data lines");
     }
-    r.text.push_back(line);
-    r.number.push_back(in_.lineNumber());
+    r.add(line, in_.lineNumber());
 
     if (type == "EPH") {
       std::optional<NavMessage> message;

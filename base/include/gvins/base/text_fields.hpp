@@ -27,6 +27,13 @@ std::string_view trim(std::string_view s);
 /// std::nullopt; anything that is not a number throws ParseError naming `field`.
 std::optional<double> parseOptionalDouble(std::string_view text, const TextLocation& where,
                                           std::string_view field);
+/// The common short form of a decimal number without a conversion call: [sign] digits [. digits]
+/// [E|e|D|d [sign] 1-3 digits] (at least one mantissa digit, no blanks) with at most 19
+/// mantissa digits forming an integer M <= 2^53 and a decimal exponent k of M 10^k within
+/// -22..22. M and 10^|k| are exact doubles, so the one multiplication or division is correctly
+/// rounded: the value is the one strtod / std::from_chars give. Returns false (v unchanged) for
+/// anything else, which the caller parses the general way.
+bool parseShortDecimal(std::string_view text, double& v);
 /// As parseOptionalDouble but a blank field is an error too.
 double parseDouble(std::string_view text, const TextLocation& where, std::string_view field);
 /// Blank means `blankValue`.
