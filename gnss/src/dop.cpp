@@ -14,15 +14,20 @@ Dop computeDop(const std::vector<Eigen::Vector3d>& los, const std::vector<int>& 
   // Sizes bounded by one clock per constellation: no heap allocation.
   constexpr int kMax = 3 + kNumSystems;
   using Mat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMax, kMax>;
-  using Vec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMax, 1>;
   Mat ata = Mat::Zero(m, m);
-  Vec row(m);
+  double row[kMax];
   for (int i = 0; i < n; ++i) {
-    row.setZero();
-    row.head<3>() = -los[i];
     if (clockIndex[i] < 0 || clockIndex[i] >= numClocks) return d;
+    for (int k = 0; k < m; ++k) row[k] = 0.0;
+    row[0] = -los[i][0];
+    row[1] = -los[i][1];
+    row[2] = -los[i][2];
     row[3 + clockIndex[i]] = 1.0;
-    ata.noalias() += row * row.transpose();
+    // The rank-1 update ata += row row^T element by element: the same product and sum per
+    // element as Eigen's outer product (no heap, no expression set-up per row).
+    for (int c = 0; c < m; ++c) {
+      for (int r = 0; r < m; ++r) ata(r, c) += row[c] * row[r];
+    }
   }
   Eigen::LDLT<Mat> ldlt(ata);
   if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().array() > 1e-12).all()) return d;
