@@ -3,11 +3,15 @@
 // gvins::ParseError naming file, line and field.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "gvins/base/parse_error.hpp"
 #include "gvins/vio/euroc_csv.hpp"
@@ -339,6 +343,240 @@ TEST(ImageIo, RealPngAndBadFiles) {
   writeFile(dir / "huge.png", huge);
   expectParseError([&] { readGrayImage((dir / "huge.png").string()); }, 0, "image", "implausible");
   fs::remove_all(dir);
+}
+
+namespace {
+// A PNG written by hand from the specification (PNG 2nd edition: chunks with CRC-32, a zlib
+// stream of stored deflate blocks with Adler-32, row filter `filterOf(y)` computed from the
+// definitions), independent of libpng and zlib.
+std::uint32_t crc32Of(const std::string& bytes) {
+  std::uint32_t c = 0xffffffffu;
+  for (const unsigned char ch : bytes) {
+    c ^= ch;
+    for (int k = 0; k < 8; ++k) c = (c >> 1) ^ (0xedb88320u & (0u - (c & 1u)));
+  }
+  return c ^ 0xffffffffu;
+}
+std::string be32(std::uint32_t v) {
+  return {static_cast<char>(v >> 24), static_cast<char>(v >> 16), static_cast<char>(v >> 8), static_cast<char>(v)};
+}
+std::string chunk(const std::string& type, const std::string& data) {
+  return be32(static_cast<std::uint32_t>(data.size())) + type + data + be32(crc32Of(type + data));
+}
+int paethPredictor(int a, int b, int c) {
+  const int p = a + b - c, pa = std::abs(p - a), pb = std::abs(p - b), pc = std::abs(p - c);
+  return pa <= pb && pa <= pc ? a : (pb <= pc ? b : c);
+}
+// A zlib stream (RFC 1950) of stored deflate blocks (RFC 1951, section 3.2.4) holding `raw`.
+std::string zlibStored(const std::string& raw) {
+  std::string z = "\x78\x01";  // zlib header: deflate, 32 KiB window, no dictionary
+  for (std::size_t o = 0; o < raw.size();) {
+    const std::size_t n = std::min<std::size_t>(65535, raw.size() - o);
+    const bool last = o + n == raw.size();
+    z.push_back(last ? 1 : 0);  // stored block
+    z.push_back(static_cast<char>(n & 0xff));
+    z.push_back(static_cast<char>(n >> 8));
+    z.push_back(static_cast<char>(~n & 0xff));
+    z.push_back(static_cast<char>((~n >> 8) & 0xff));
+    z += raw.substr(o, n);
+    o += n;
+  }
+  std::uint32_t s1 = 1, s2 = 0;
+  for (const unsigned char ch : raw) {
+    s1 = (s1 + ch) % 65521;
+    s2 = (s2 + s1) % 65521;
+  }
+  z += be32((s2 << 16) | s1);
+  return z;
+}
+std::string handWrittenPng(const cv::Mat& img, const std::function<int(int)>& filterOf, std::size_t idatChunk) {
+  std::string raw;
+  for (int y = 0; y < img.rows; ++y) {
+    const int f = filterOf(y);
+    raw.push_back(static_cast<char>(f));
+    for (int x = 0; x < img.cols; ++x) {
+      const int v = img.at<std::uint8_t>(y, x);
+      const int a = x > 0 ? img.at<std::uint8_t>(y, x - 1) : 0;
+      const int b = y > 0 ? img.at<std::uint8_t>(y - 1, x) : 0;
+      const int c = x > 0 && y > 0 ? img.at<std::uint8_t>(y - 1, x - 1) : 0;
+      const int pred = f == 0 ? 0 : f == 1 ? a : f == 2 ? b : f == 3 ? (a + b) / 2 : paethPredictor(a, b, c);
+      raw.push_back(static_cast<char>((v - pred) & 0xff));
+    }
+  }
+  const std::string z = zlibStored(raw);
+  std::string png = "\x89PNG\r\n\x1a\n";
+  png += chunk("IHDR", be32(static_cast<std::uint32_t>(img.cols)) + be32(static_cast<std::uint32_t>(img.rows)) +
+                           std::string("\x08\x00\x00\x00\x00", 5));
+  for (std::size_t o = 0; o < z.size(); o += idatChunk) png += chunk("IDAT", z.substr(o, idatChunk));
+  png += chunk("tEXt", std::string("Comment\0hand-written", 20));
+  png += chunk("IEND", "");
+  return png;
+}
+cv::Mat decode(const std::string& png, const std::string& name = "hand.png") {
+  return decodeGrayImage(std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(png.data()), png.size()), name);
+}
+}  // namespace
+
+TEST(ImageIo, GrayPngRowFiltersDecodeExactly) {
+  // Real and random pixels, every row filter (one per row in turn, or all rows the same), the
+  // image data split over several IDAT chunks: decoded exactly (and as cv::imdecode does).
+  cv::Mat noise(97, 131, CV_8UC1);
+  cv::RNG(5).fill(noise, cv::RNG::UNIFORM, 0, 256);
+  const cv::Mat real = readGrayImage(kV101 + "/mav0/cam0/data/1403715274312143104.png", 752, 480);
+  for (const cv::Mat& img : {noise, real}) {
+    for (int mode = -1; mode < 5; ++mode) {
+      const std::string png = handWrittenPng(img, [&](int y) { return mode < 0 ? y % 5 : mode; }, 8192);
+      const cv::Mat ours = decode(png);
+      ASSERT_EQ(ours.size(), img.size());
+      EXPECT_EQ(cv::norm(ours, img, cv::NORM_INF), 0.0) << "filter mode " << mode;
+      const cv::Mat ref = cv::imdecode(std::vector<std::uint8_t>(png.begin(), png.end()), cv::IMREAD_UNCHANGED);
+      EXPECT_EQ(cv::norm(ref, img, cv::NORM_INF), 0.0) << "the hand-written PNG is not what libpng reads";
+    }
+  }
+  // Compressed files: the bundled EuRoC PNGs (zlib level 9, adaptive filters) and OpenCV's own
+  // encodings decode as libpng decodes them.
+  const EurocDataset ds(kV101);
+  for (int cam = 0; cam < 2; ++cam) {
+    for (std::size_t i = 0; i < ds.cameraEntries(cam).size(); ++i) {
+      const std::string bytes = readFile(ds.imagePath(cam, i));
+      const cv::Mat ref = cv::imdecode(std::vector<std::uint8_t>(bytes.begin(), bytes.end()), cv::IMREAD_UNCHANGED);
+      EXPECT_EQ(cv::norm(decode(bytes), ref, cv::NORM_INF), 0.0) << ds.imagePath(cam, i);
+    }
+  }
+  for (const std::vector<int>& params : {std::vector<int>{}, std::vector<int>{cv::IMWRITE_PNG_COMPRESSION, 1}}) {
+    std::vector<std::uint8_t> buf;
+    cv::imencode(".png", real, buf, params);
+    EXPECT_EQ(cv::norm(decode(std::string(buf.begin(), buf.end())), real, cv::NORM_INF), 0.0);
+  }
+  // Other PNG kinds still go through OpenCV: 16-bit grey scaled to 8 bits, colour to grey.
+  cv::Mat wide;
+  real.convertTo(wide, CV_16U, 257.0);
+  std::vector<std::uint8_t> buf;
+  cv::imencode(".png", wide, buf);
+  EXPECT_EQ(cv::norm(decode(std::string(buf.begin(), buf.end())), real, cv::NORM_INF), 0.0);
+  cv::Mat colour;
+  cv::cvtColor(real, colour, cv::COLOR_GRAY2BGR);
+  cv::imencode(".png", colour, buf);
+  EXPECT_LE(cv::norm(decode(std::string(buf.begin(), buf.end())), real, cv::NORM_INF), 1.0);
+}
+
+TEST(ImageIo, DamagedGrayPngIsAParseError) {
+  cv::Mat img(40, 60, CV_8UC1);
+  cv::RNG(9).fill(img, cv::RNG::UNIFORM, 0, 256);
+  const std::string good = handWrittenPng(img, [](int y) { return y % 5; }, 1000);
+  ASSERT_EQ(cv::norm(decode(good), img, cv::NORM_INF), 0.0);
+  const std::size_t idat = good.find("IDAT");
+  ASSERT_NE(idat, std::string::npos);
+  // A flipped bit in the image data: the chunk CRC.
+  std::string bad = good;
+  bad[idat + 100] = static_cast<char>(bad[idat + 100] ^ 0x10);
+  expectParseError([&] { decode(bad, "flip.png"); }, 0, "image", "CRC");
+  // Cut after the image data (no IEND), or inside a chunk.
+  expectParseError([&] { decode(good.substr(0, good.find("tEXt") - 4), "cut.png"); }, 0, "image", "unreadable");
+  expectParseError([&] { decode(good.substr(0, idat + 500), "cut.png"); }, 0, "image", "past the end");
+  // A row filter type that does not exist (valid CRC and checksums).
+  expectParseError([&] { decode(handWrittenPng(img, [](int y) { return y == 7 ? 5 : 0; }, 1000)); }, 0, "image",
+                   "row filter");
+  // Fewer rows of data than the header says: the stream does not inflate to the size.
+  std::string shortData = handWrittenPng(img.rowRange(0, 30), [](int) { return 1; }, 1000);
+  const std::string ihdr = be32(60) + be32(40) + std::string("\x08\x00\x00\x00\x00", 5);
+  shortData.replace(8, 25, chunk("IHDR", ihdr));
+  expectParseError([&] { decode(shortData); }, 0, "image", "inflate");
+}
+
+TEST(ImageIo, MalformedGrayPngsAreParseErrors) {
+  // Every kind of damage the own decoder can meet is a ParseError naming the problem; none
+  // crashes, hangs or allocates what the header promises before the data back it up.
+  const std::string sig = "\x89PNG\r\n\x1a\n";
+  const auto ihdr = [](std::uint32_t w, std::uint32_t h) {
+    return chunk("IHDR", be32(w) + be32(h) + std::string("\x08\x00\x00\x00\x00", 5));
+  };
+  const auto rows = [](int w, int h) {  // filter byte 0 and mid-grey pixels
+    std::string raw;
+    for (int y = 0; y < h; ++y) raw += '\0' + std::string(static_cast<std::size_t>(w), '\x80');
+    return raw;
+  };
+  const std::string iend = chunk("IEND", "");
+  const std::string good = sig + ihdr(6, 4) + chunk("IDAT", zlibStored(rows(6, 4))) + iend;
+  const cv::Mat ok = decode(good);
+  ASSERT_EQ(ok.size(), cv::Size(6, 4));
+  EXPECT_EQ(cv::norm(ok, cv::Mat(4, 6, CV_8UC1, cv::Scalar(128)), cv::NORM_INF), 0.0);
+  // Zero-length IDAT chunks are legal (the stream is the concatenation of all IDAT data).
+  EXPECT_EQ(decode(sig + ihdr(6, 4) + chunk("IDAT", "") + chunk("IDAT", zlibStored(rows(6, 4))) + iend).size(),
+            cv::Size(6, 4));
+
+  expectParseError([&] { decode(""); }, 0, "image", "empty");
+  expectParseError([&] { decode(sig); }, 0, "image", "truncated PNG header");
+  expectParseError([&] { decode(good.substr(0, 32)); }, 0, "image", "truncated PNG header");
+  // Zero or huge dimensions, before anything is allocated.
+  expectParseError([&] { decode(sig + ihdr(0, 4) + chunk("IDAT", zlibStored(rows(0, 4))) + iend); }, 0, "image",
+                   "implausible image size 0x4");
+  expectParseError([&] { decode(sig + ihdr(0xffffffffu, 0xffffffffu) + iend); }, 0, "image", "implausible");
+  expectParseError([&] { decode(sig + ihdr(0x80000000u, 1) + iend); }, 0, "image", "implausible");
+  // 10000 x 10000 is a plausible size, but 20 bytes of data cannot inflate to 100 MB.
+  expectParseError([&] { decode(sig + ihdr(10000, 10000) + chunk("IDAT", zlibStored(rows(6, 1))) + iend); }, 0,
+                   "image", "shorter than the header");
+  // No image data at all, or only empty IDAT chunks.
+  expectParseError([&] { decode(sig + ihdr(6, 4) + iend); }, 0, "image", "shorter than the header");
+  expectParseError([&] { decode(sig + ihdr(6, 4) + chunk("IDAT", "") + iend); }, 0, "image", "shorter than the header");
+  // IHDR CRC wrong.
+  std::string badIhdr = good;
+  badIhdr[32] = static_cast<char>(badIhdr[32] ^ 1);
+  expectParseError([&] { decode(badIhdr); }, 0, "image", "IHDR CRC");
+  // A chunk length that runs past the end of the file (0xffffffff and one byte too many).
+  expectParseError([&] { decode(sig + ihdr(6, 4) + be32(0xffffffffu) + "IDAT" + std::string(40, 'x')); }, 0, "image",
+                   "past the end");
+  const std::string idat = chunk("IDAT", zlibStored(rows(6, 4)));
+  std::string longer = sig + ihdr(6, 4) + be32(static_cast<std::uint32_t>(idat.size() - 11)) + idat.substr(4) + iend;
+  expectParseError([&] { decode(longer.substr(0, longer.size() - iend.size())); }, 0, "image", "past the end");
+  // More data than the header's rows, or fewer; a damaged Adler-32; a cut zlib stream; all with
+  // valid chunk CRCs.
+  expectParseError([&] { decode(sig + ihdr(6, 4) + chunk("IDAT", zlibStored(rows(6, 5))) + iend); }, 0, "image",
+                   "inflate");
+  expectParseError([&] { decode(sig + ihdr(6, 4) + chunk("IDAT", zlibStored(rows(6, 3))) + iend); }, 0, "image",
+                   "inflate");
+  std::string z = zlibStored(rows(6, 4));
+  z.back() = static_cast<char>(z.back() ^ 1);
+  expectParseError([&] { decode(sig + ihdr(6, 4) + chunk("IDAT", z) + iend); }, 0, "image", "inflate");
+  z = zlibStored(rows(6, 4));
+  expectParseError([&] { decode(sig + ihdr(6, 4) + chunk("IDAT", z.substr(0, z.size() - 9)) + iend); }, 0, "image",
+                   "inflate");
+  expectParseError([&] { decode(sig + ihdr(6, 4) + chunk("IDAT", "\x78\x01garbage") + iend); }, 0, "image", "inflate");
+  // Filter byte 255 on the first row.
+  std::string raw = rows(6, 4);
+  raw[0] = '\xff';
+  expectParseError([&] { decode(sig + ihdr(6, 4) + chunk("IDAT", zlibStored(raw)) + iend); }, 0, "image", "row filter");
+  // A critical chunk a grey image must not have (PLTE), or an unknown one.
+  expectParseError([&] { decode(sig + ihdr(6, 4) + chunk("PLTE", "abc") + idat + iend); }, 0, "image",
+                   "unexpected critical chunk");
+  expectParseError([&] { decode(sig + ihdr(6, 4) + idat + chunk("ABCD", "") + iend); }, 0, "image",
+                   "unexpected critical chunk");
+
+  // Every prefix and every single-bit flip of the good file: a 6x4 8-bit image or a ParseError.
+  int decoded = 0, errors = 0;
+  auto tryDecode = [&](const std::string& bytes) {
+    try {
+      const cv::Mat m = decode(bytes);
+      EXPECT_EQ(m.type(), CV_8UC1);
+      EXPECT_EQ(m.size(), cv::Size(6, 4));
+      ++decoded;
+    } catch (const ParseError&) {
+      ++errors;
+    }
+  };
+  for (std::size_t n = 0; n < good.size(); ++n) tryDecode(good.substr(0, n));
+  EXPECT_EQ(decoded, 0);  // no prefix is a whole PNG (IEND missing)
+  for (std::size_t i = 0; i < good.size(); ++i) {
+    for (int bit = 0; bit < 8; ++bit) {
+      std::string b = good;
+      b[i] = static_cast<char>(b[i] ^ (1 << bit));
+      tryDecode(b);
+    }
+  }
+  std::printf("%zu prefixes and %zu bit flips of a %zu-byte PNG: %d decoded, %d ParseErrors\n", good.size(),
+              good.size() * 8, good.size(), decoded, errors);
+  EXPECT_EQ(decoded, 0);  // every flip hits a CRC, a length, a chunk type or the signature
+  EXPECT_EQ(errors, static_cast<int>(good.size() * 9));
 }
 
 // ------------------------------------------------------------------------------------ dataset
