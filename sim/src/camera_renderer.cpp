@@ -9,6 +9,10 @@
 
 #include <opencv2/imgproc.hpp>
 
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#include <immintrin.h>
+#endif
+
 #include "gvins/sim/random.hpp"
 
 namespace gvins::sim {
@@ -84,6 +88,146 @@ inline float sampleView(const LevelView& v, float gx, float gy, Fallback&& fallb
   const float wx = fx - static_cast<float>(i), wy = fy - static_cast<float>(j);
   return (1.0f - wy) * ((1.0f - wx) * p[0] + wx * p[1]) + wy * ((1.0f - wx) * p[kStride] + wx * p[kStride + 1]);
 }
+
+/// What the AVX2 row kernel needs of one row and of the frame's level views.
+struct RowKernel {
+  float r00, r01, r02, r10, r11, r12, r20, r21, r22;
+  float cx, cy, cz, maxRange, l2s0, maxL, weight;
+  int maxLevel;
+  const float* base;  // texel index origin of the views' int32 tile offsets
+  const float* inv;   // per level
+  const float* offX;
+  const float* offY;
+  const int* nx;
+  const int* ny;
+  const std::int32_t* const* tileOff;  // per level: tile start in texels from `base`, or null
+};
+
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#define GVINS_SIM_HAVE_AVX2_KERNEL 1
+bool cpuHasAvx2() {
+  static const bool has = __builtin_cpu_supports("avx2");
+  return has;
+}
+
+/// Bilinear samples of 8 lanes of one level view; false if a lane is outside it.
+__attribute__((target("avx2"))) inline bool sampleView8(const RowKernel& k, int l, __m256 gx, __m256 gy, __m256& val) {
+  const std::int32_t* off = k.tileOff[l];
+  if (!off) return false;
+  const __m256 fx = _mm256_add_ps(_mm256_mul_ps(gx, _mm256_set1_ps(k.inv[l])), _mm256_set1_ps(k.offX[l]));
+  const __m256 fy = _mm256_add_ps(_mm256_mul_ps(gy, _mm256_set1_ps(k.inv[l])), _mm256_set1_ps(k.offY[l]));
+  const __m256 zero = _mm256_setzero_ps();
+  const __m256 nonneg = _mm256_and_ps(_mm256_cmp_ps(fx, zero, _CMP_GE_OQ), _mm256_cmp_ps(fy, zero, _CMP_GE_OQ));
+  if (_mm256_movemask_ps(nonneg) != 0xFF) return false;
+  const __m256i i = _mm256_cvttps_epi32(fx), j = _mm256_cvttps_epi32(fy);
+  const __m256i tx = _mm256_srai_epi32(i, kTileShift), ty = _mm256_srai_epi32(j, kTileShift);
+  // 0 <= tx < nx and 0 <= ty < ny (a conversion overflow gives INT_MIN, caught by >= 0).
+  const __m256i minus1 = _mm256_set1_epi32(-1);
+  const __m256i in = _mm256_and_si256(
+      _mm256_and_si256(_mm256_cmpgt_epi32(tx, minus1), _mm256_cmpgt_epi32(_mm256_set1_epi32(k.nx[l]), tx)),
+      _mm256_and_si256(_mm256_cmpgt_epi32(ty, minus1), _mm256_cmpgt_epi32(_mm256_set1_epi32(k.ny[l]), ty)));
+  if (_mm256_movemask_ps(_mm256_castsi256_ps(in)) != 0xFF) return false;
+  const __m256i tile = _mm256_add_epi32(_mm256_mullo_epi32(ty, _mm256_set1_epi32(k.nx[l])), tx);
+  const __m256i mask = _mm256_set1_epi32(kTile - 1);
+  const __m256i idx = _mm256_add_epi32(
+      _mm256_i32gather_epi32(off, tile, 4),
+      _mm256_add_epi32(_mm256_mullo_epi32(_mm256_and_si256(j, mask), _mm256_set1_epi32(static_cast<int>(kStride))),
+                       _mm256_and_si256(i, mask)));
+  const __m256 p0 = _mm256_i32gather_ps(k.base, idx, 4);
+  const __m256 p1 = _mm256_i32gather_ps(k.base, _mm256_add_epi32(idx, _mm256_set1_epi32(1)), 4);
+  const __m256 p2 = _mm256_i32gather_ps(k.base, _mm256_add_epi32(idx, _mm256_set1_epi32(static_cast<int>(kStride))), 4);
+  const __m256 p3 = _mm256_i32gather_ps(k.base, _mm256_add_epi32(idx, _mm256_set1_epi32(static_cast<int>(kStride) + 1)), 4);
+  const __m256 wx = _mm256_sub_ps(fx, _mm256_cvtepi32_ps(i)), wy = _mm256_sub_ps(fy, _mm256_cvtepi32_ps(j));
+  const __m256 one = _mm256_set1_ps(1.0f);
+  const __m256 ax = _mm256_sub_ps(one, wx), ay = _mm256_sub_ps(one, wy);
+  // Same operations in the same order as sampleView (no FMA: the results are bit-identical).
+  const __m256 top = _mm256_add_ps(_mm256_mul_ps(ax, p0), _mm256_mul_ps(wx, p1));
+  const __m256 bot = _mm256_add_ps(_mm256_mul_ps(ax, p2), _mm256_mul_ps(wx, p3));
+  val = _mm256_add_ps(_mm256_mul_ps(ay, top), _mm256_mul_ps(wy, bot));
+  return true;
+}
+
+/// The per-pixel loop of CameraRenderer::accumulate for pixels [0, 8 floor(w / 8)) of a row,
+/// 8 at a time, with the scalar loop's operations in its order (so bit-identical pixels).
+/// Blocks it cannot do (a ray off the ground or beyond the range, lanes at different mip
+/// levels, a lane outside a level view) are listed in `failed` (first pixel) for the scalar
+/// loop; returns their number.
+__attribute__((target("avx2"))) int accumulateRowAvx2(const RowKernel& k, const float* rx, const float* ry,
+                                                      const float* rnorm, const float* pangle, float* out, int w,
+                                                      int* failed) {
+  int nFailed = 0;
+  const __m256 r00 = _mm256_set1_ps(k.r00), r01 = _mm256_set1_ps(k.r01), r02 = _mm256_set1_ps(k.r02);
+  const __m256 r10 = _mm256_set1_ps(k.r10), r11 = _mm256_set1_ps(k.r11), r12 = _mm256_set1_ps(k.r12);
+  const __m256 r20 = _mm256_set1_ps(k.r20), r21 = _mm256_set1_ps(k.r21), r22 = _mm256_set1_ps(k.r22);
+  const __m256 cx = _mm256_set1_ps(k.cx), cy = _mm256_set1_ps(k.cy), negCz = _mm256_set1_ps(-k.cz);
+  const __m256 maxRange = _mm256_set1_ps(k.maxRange), l2s0 = _mm256_set1_ps(k.l2s0);
+  const __m256 maxL = _mm256_set1_ps(k.maxL), weight = _mm256_set1_ps(k.weight);
+  const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
+  const __m256 signMask = _mm256_set1_ps(-0.0f);
+  for (int u = 0; u + 8 <= w; u += 8) {
+    if (!(k.cz > 0.0f)) {
+      failed[nFailed++] = u;
+      continue;
+    }
+    const __m256 x = _mm256_loadu_ps(rx + u), y = _mm256_loadu_ps(ry + u);
+    const __m256 dz = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(r20, x), _mm256_mul_ps(r21, y)), r22);
+    const __m256 lam = _mm256_div_ps(negCz, dz);
+    const __m256 rn = _mm256_loadu_ps(rnorm + u);
+    const __m256 dist = _mm256_mul_ps(lam, rn);
+    const __m256 ok = _mm256_and_ps(_mm256_cmp_ps(dz, _mm256_set1_ps(-1e-6f), _CMP_LT_OQ),
+                                    _mm256_cmp_ps(dist, maxRange, _CMP_LE_OQ));
+    if (_mm256_movemask_ps(ok) != 0xFF) {
+      failed[nFailed++] = u;
+      continue;
+    }
+    const __m256 gx = _mm256_add_ps(
+        cx, _mm256_mul_ps(lam, _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(r00, x), _mm256_mul_ps(r01, y)), r02)));
+    const __m256 gy = _mm256_add_ps(
+        cy, _mm256_mul_ps(lam, _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(r10, x), _mm256_mul_ps(r11, y)), r12)));
+    const __m256 cosInc = _mm256_div_ps(_mm256_xor_ps(dz, signMask), rn);
+    const __m256 arg = _mm256_div_ps(_mm256_mul_ps(dist, _mm256_loadu_ps(pangle + u)), _mm256_sqrt_ps(cosInc));
+    // fastLog2
+    const __m256i b = _mm256_castps_si256(arg);
+    const __m256 e = _mm256_cvtepi32_ps(
+        _mm256_sub_epi32(_mm256_and_si256(_mm256_srli_epi32(b, 23), _mm256_set1_epi32(255)), _mm256_set1_epi32(127)));
+    const __m256 m = _mm256_castsi256_ps(_mm256_or_si256(_mm256_and_si256(b, _mm256_set1_epi32(0x007FFFFF)),
+                                                         _mm256_set1_epi32(0x3F800000)));
+    __m256 poly = _mm256_sub_ps(_mm256_mul_ps(_mm256_set1_ps(0.15824871f), m), _mm256_set1_ps(1.05187502f));
+    poly = _mm256_add_ps(_mm256_mul_ps(poly, m), _mm256_set1_ps(3.04788415f));
+    poly = _mm256_mul_ps(poly, m);
+    __m256 level = _mm256_sub_ps(_mm256_sub_ps(_mm256_add_ps(e, poly), _mm256_set1_ps(2.15541759f)), l2s0);
+    // std::clamp(level, 0, maxL): level < 0 -> 0, maxL < level -> maxL (level is never NaN here).
+    level = _mm256_blendv_ps(level, zero, _mm256_cmp_ps(level, zero, _CMP_LT_OQ));
+    level = _mm256_blendv_ps(level, maxL, _mm256_cmp_ps(maxL, level, _CMP_LT_OQ));
+    const __m256i l0v = _mm256_cvttps_epi32(level);
+    const int l0 = _mm256_cvtsi256_si32(l0v);
+    if (_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(l0v, _mm256_set1_epi32(l0)))) != 0xFF) {
+      failed[nFailed++] = u;
+      continue;
+    }
+    const __m256 f = _mm256_sub_ps(level, _mm256_cvtepi32_ps(l0v));
+    __m256 val;
+    if (!sampleView8(k, l0, gx, gy, val)) {
+      failed[nFailed++] = u;
+      continue;
+    }
+    if (l0 < k.maxLevel) {
+      const __m256 second = _mm256_cmp_ps(f, _mm256_set1_ps(1e-3f), _CMP_GT_OQ);
+      if (_mm256_movemask_ps(second) != 0) {
+        __m256 val1;
+        if (!sampleView8(k, l0 + 1, gx, gy, val1)) {
+          failed[nFailed++] = u;
+          continue;
+        }
+        const __m256 mixed = _mm256_add_ps(_mm256_mul_ps(_mm256_sub_ps(one, f), val), _mm256_mul_ps(f, val1));
+        val = _mm256_blendv_ps(val, mixed, second);
+      }
+    }
+    _mm256_storeu_ps(out + u, _mm256_add_ps(_mm256_loadu_ps(out + u), _mm256_mul_ps(weight, val)));
+  }
+  return nFailed;
+}
+#endif
 
 }  // namespace
 
@@ -219,6 +363,56 @@ void CameraRenderer::accumulate(const std::vector<RowPose>& rows, float weight, 
   const auto maxRange = static_cast<float>(img_.maxRange);
   const auto l2s0 = static_cast<float>(log2s0);
   const auto maxL = static_cast<float>(maxLevel);
+
+#ifdef GVINS_SIM_HAVE_AVX2_KERNEL
+  // The AVX2 kernel addresses the texels of all views by 32-bit offsets from one base texel
+  // pointer (views whose tiles lie further apart in memory are left to the scalar loop).
+  const bool simd = vectorized_ && cpuHasAvx2();
+  RowKernel kern{};
+  std::vector<float> kInv(views.size()), kOffX(views.size()), kOffY(views.size());
+  std::vector<int> kNx(views.size()), kNy(views.size());
+  std::vector<std::vector<std::int32_t>> kOff(views.size());
+  std::vector<const std::int32_t*> kOffPtr(views.size(), nullptr);
+  std::vector<int> failed(static_cast<std::size_t>(w_ / 8 + 1));
+  if (simd) {
+    const float* base = nullptr;
+    for (const LevelView& view : views)
+      if (!view.data.empty()) {
+        base = view.data.front();
+        break;
+      }
+    for (std::size_t l = 0; l < views.size(); ++l) {
+      const LevelView& view = views[l];
+      kInv[l] = view.inv;
+      kOffX[l] = view.offX;
+      kOffY[l] = view.offY;
+      kNx[l] = view.nx;
+      kNy[l] = view.ny;
+      if (view.data.empty() || !base) continue;
+      std::vector<std::int32_t>& off = kOff[l];
+      for (const float* d : view.data) {
+        const std::intptr_t bytes = reinterpret_cast<std::intptr_t>(d) - reinterpret_cast<std::intptr_t>(base);
+        constexpr std::intptr_t kLimit = (std::intptr_t{1} << 31) - 2 * static_cast<std::intptr_t>(kStride * kStride);
+        if (bytes % static_cast<std::intptr_t>(sizeof(float)) != 0 || bytes / 4 > kLimit || bytes / 4 < -kLimit) break;
+        off.push_back(static_cast<std::int32_t>(bytes / 4));
+      }
+      if (off.size() == view.data.size()) kOffPtr[l] = off.data();
+    }
+    kern.base = base;
+    kern.inv = kInv.data();
+    kern.offX = kOffX.data();
+    kern.offY = kOffY.data();
+    kern.nx = kNx.data();
+    kern.ny = kNy.data();
+    kern.tileOff = kOffPtr.data();
+    kern.maxRange = maxRange;
+    kern.l2s0 = l2s0;
+    kern.maxL = maxL;
+    kern.weight = weight;
+    kern.maxLevel = maxLevel;
+  }
+#endif
+
   for (int v = 0; v < h_; ++v) {
     const RowPose& P = poseOf(v);
     const auto r00 = static_cast<float>(P.R(0, 0)), r01 = static_cast<float>(P.R(0, 1)), r02 = static_cast<float>(P.R(0, 2));
@@ -227,7 +421,7 @@ void CameraRenderer::accumulate(const std::vector<RowPose>& rows, float weight, 
     const auto cx = static_cast<float>(P.p.x() - ox), cy = static_cast<float>(P.p.y() - oy);
     const auto cz = static_cast<float>(P.p.z());
     const std::size_t base = static_cast<std::size_t>(v) * w_;
-    for (int u = 0; u < w_; ++u) {
+    auto pixel = [&](int u) {
       const std::size_t i = base + u;
       const float x = rayX_[i], y = rayY_[i];
       const float dz = r20 * x + r21 * y + r22;
@@ -251,7 +445,22 @@ void CameraRenderer::accumulate(const std::vector<RowPose>& rows, float weight, 
         }
       }
       out[i] += weight * val;
+    };
+    int u0 = 0;
+#ifdef GVINS_SIM_HAVE_AVX2_KERNEL
+    if (simd && kern.base) {
+      kern.r00 = r00, kern.r01 = r01, kern.r02 = r02;
+      kern.r10 = r10, kern.r11 = r11, kern.r12 = r12;
+      kern.r20 = r20, kern.r21 = r21, kern.r22 = r22;
+      kern.cx = cx, kern.cy = cy, kern.cz = cz;
+      const int nFailed = accumulateRowAvx2(kern, rayX_.data() + base, rayY_.data() + base, rayNorm_.data() + base,
+                                            pixelAngle_.data() + base, out + base, w_, failed.data());
+      for (int b = 0; b < nFailed; ++b)
+        for (int u = failed[static_cast<std::size_t>(b)]; u < failed[static_cast<std::size_t>(b)] + 8; ++u) pixel(u);
+      u0 = w_ / 8 * 8;
     }
+#endif
+    for (int u = u0; u < w_; ++u) pixel(u);
   }
 }
 

@@ -59,6 +59,10 @@ class CameraRenderer {
   /// Camera pose at a trajectory state.
   void cameraPose(const TrajectoryState& s, Eigen::Matrix3d& R_WC, Eigen::Vector3d& p_WC) const;
 
+  /// Use the AVX2 kernel of the per-pixel loop where the CPU has it (default). Off: the scalar
+  /// loop only. The pixels are the same bit for bit either way (tests/sim/test_dataset.cpp).
+  void setVectorized(bool on) { vectorized_ = on; }
+
   const vio::CameraModel& model() const { return model_; }
   const vio::CameraCalibration& calibration() const { return calib_; }
 
@@ -79,6 +83,7 @@ class CameraRenderer {
   std::vector<float> vignette_;       // brightness factor
   Eigen::Matrix3d R_BC_;
   Eigen::Vector3d p_BC_;
+  bool vectorized_ = true;
 };
 
 /// Per-frame gains exp(x_k) with x an AR(1) process of stationary 1-sigma gainSigma.
