@@ -8,12 +8,25 @@
 //    frame-to-frame step against the projection of the ground point under its previous pixel,
 //    ray through cv::undistortPoints, cv::projectPoints).
 // 2. The error of whole tracks against the ground point seen at detection grows with the track
-//    age: KLT's own drift (translation-only windows on a camera turning 36 deg/s). The strict
-//    criterion "sub-pixel over the whole track" fails (kept below as a DISABLED_ test with its
-//    measured numbers); test 3 shows the images themselves agree with the truth to ~0.1 px.
+//    age, about linearly (median below 0.05 px per image of age; measured 0.011-0.027): KLT's own
+//    drift, not the images'. Measured (2026-12-01) on images rendered in memory (test 4 checks
+//    the first two): hovering, tracks stay at 0.05 px RMS after 199 images; turning in place at
+//    36 deg/s (the circle's yaw rate) they drift 0.76 px after 10 images, 2.7-2.9 px after 40, 11.6 px
+//    after 199, while the same features matched from their detection image against the later
+//    image warped back by the truth ground homography stay at 0.03-0.08 px RMS (up to 290 deg):
+//    a translation-only 21x21 window on a patch that turns 1.8 deg per image settles off its
+//    centre by a fraction of a pixel each step, always the same way. Flying straight at 6 m/s
+//    without rotation, tracks drift 0.09 px after 10 images and 0.22 px after 40 with the default
+//    vignetting (a brightness gradient KLT does not model) and 0.015 / 0.024 px without it.
+//    The strict criterion "sub-pixel over the whole track" therefore holds only for young tracks
+//    (the 1-19 image bin) and is not asserted for old ones.
 // 3. Images far apart (up to 19 m and 174 deg) are the same ground: image a, undistorted and
 //    warped into image b by the ground-plane homography of the truth poses, matches image b
 //    patch by patch (phase correlation) to a tenth of a pixel; a 0.1 m pose error is detected.
+// 4. The drift is the tracker's: a hover turning in place at 36 deg/s, rendered in memory with an
+//    undistorted camera: chained KLT drifts by pixels, KLT from the detection image against each
+//    later image warped back by the truth homography stays below 0.15 px at every age; hovering
+//    without rotation, chained tracks do not drift.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -35,6 +48,7 @@
 
 #include <Eigen/Geometry>
 
+#include "gvins/sim/camera_renderer.hpp"
 #include "gvins/sim/dataset_generator.hpp"
 #include "gvins/sim/scenario.hpp"
 #include "gvins/vio/euroc_csv.hpp"
@@ -127,6 +141,8 @@ class RenderedFlight : public ::testing::Test {
     fs::remove_all(*dir_, ec);
     delete dir_;
     dir_ = nullptr;
+    delete klt_;
+    klt_ = nullptr;
   }
   void SetUp() override {
     ASSERT_GT(frames_, 200u);
@@ -171,9 +187,15 @@ class RenderedFlight : public ::testing::Test {
   }
 
   KltResult runKlt() const;
+  /// runKlt() once for the test suite.
+  const KltResult& klt() const {
+    if (!klt_) klt_ = new KltResult(runKlt());
+    return *klt_;
+  }
 
   static fs::path* dir_;
   static std::size_t frames_;
+  static KltResult* klt_;
   fs::path cam_;
   vio::CameraCalibration cal_;
   std::vector<vio::CameraCsvEntry> frames;
@@ -184,6 +206,7 @@ class RenderedFlight : public ::testing::Test {
 
 fs::path* RenderedFlight::dir_ = nullptr;
 std::size_t RenderedFlight::frames_ = 0;
+KltResult* RenderedFlight::klt_ = nullptr;
 
 KltResult RenderedFlight::runKlt() const {
   KltResult res;
@@ -287,7 +310,7 @@ KltResult RenderedFlight::runKlt() const {
 }
 
 TEST_F(RenderedFlight, KltKeepsOverAHundredFeaturesWithSubPixelFrameToFrameError) {
-  const KltResult r = runKlt();
+  const KltResult& r = klt();
   ASSERT_GT(r.stepErrors.size(), 10000u);
   const Percentiles s = percentiles(r.stepErrors);
   EXPECT_GE(r.minTracked, 100u);
@@ -297,20 +320,28 @@ TEST_F(RenderedFlight, KltKeepsOverAHundredFeaturesWithSubPixelFrameToFrameError
   EXPECT_GT(s.subPixelShare, 0.999);
 }
 
-// The strict reading of the issue (every track sub-pixel against its detection-time ground point
-// over the whole flight). Measured on this flight (2026-12-01): at least 32 features per image
-// below 1 px, RMS 6.7 px, 95 % 12.8 px, 48 % below 1 px: tracks of up to 390 images drift
-// (median 0.06 px after one image, 0.5 px after 20-40, ~9 px after 300), although the images agree
-// with the truth to ~0.1 px (ImagesAgreeWithTheTruthPosesThroughTheGroundHomography). Disabled
-// until the tracker (e.g. refinement against the first appearance) or the criterion changes.
-TEST_F(RenderedFlight, DISABLED_KltTracksStaySubPixelSinceDetection) {
-  const KltResult r = runKlt();
+// Whole tracks against their detection-time ground point. Measured on this flight (2026-12-01):
+// RMS 6.7 px, 48 % below 1 px overall; by age bin (images) the median is 0.20 px (1-19, 95 %
+// 1.0 px), 0.56 (20-39), 0.46 (40-59), 0.52 (60-79), 1.0 (80-99), 1.8 (100-119), 2.7 (120-139),
+// 3.5 (140-159), 4.3 (160-179), 5.1 (180-199), 7.6 (200 and more): 0.011-0.027 px per image of
+// age, KLT's drift under the 36 deg/s yaw (header, item 2, and test 4). Asserted: young tracks
+// are sub-pixel, and no age bin drifts faster than 0.05 px per image.
+TEST_F(RenderedFlight, KltWholeTrackDriftIsSubPixelWhenYoungAndGrowsAtMostLinearly) {
+  const KltResult& r = klt();
   ASSERT_GT(r.trackErrors.size(), 10000u);
-  const Percentiles t = percentiles(r.trackErrors);
-  EXPECT_GE(r.minSubPixelTrack, 100u);
-  EXPECT_LT(t.rms, 0.5);
-  EXPECT_LT(t.p95, 0.8);
-  EXPECT_GT(t.subPixelShare, 0.97);
+  ASSERT_GE(r.trackErrorsByAge.size(), 10u);
+  for (const auto& [age, e] : r.trackErrorsByAge) {
+    const Percentiles a = percentiles(e);
+    if (age == 0) {
+      EXPECT_LT(a.median, 0.3) << "ages 1-19";
+      EXPECT_LT(a.p95, 1.5) << "ages 1-19";
+      EXPECT_GT(a.subPixelShare, 0.9) << "ages 1-19";
+      continue;
+    }
+    // The bin's middle age (the last bin: its first age).
+    const double mid = age == 200 ? 200.0 : age + 9.5;
+    EXPECT_LT(a.median / mid, 0.05) << "ages " << age << "+: median " << a.median << " px";
+  }
 }
 
 TEST_F(RenderedFlight, ImagesAgreeWithTheTruthPosesThroughTheGroundHomography) {
@@ -401,6 +432,164 @@ TEST_F(RenderedFlight, ImagesAgreeWithTheTruthPosesThroughTheGroundHomography) {
   const Shifts wrong = compare(A, Pa, undistorted(100), shifted);
   std::printf("with the position of image 100 moved by 0.1 m: median |shift| %.3f px\n", wrong.median);
   EXPECT_GT(wrong.median, 1.0);
+}
+
+/// Hovering at 30 m, turning about the vertical at a constant rate.
+class TurnInPlace : public Trajectory {
+ public:
+  explicit TurnInPlace(double yawRate) : yawRate_(yawRate) {}
+  double duration() const override { return 30.0; }
+  TrajectoryState evaluate(double t) const override {
+    TrajectoryState s;
+    s.t = t;
+    s.p_WB = Eigen::Vector3d(3.0, 1.0, 30.0);
+    s.R_WB = Eigen::AngleAxisd(0.4 + yawRate_ * t, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    s.omega_B = Eigen::Vector3d(0.0, 0.0, yawRate_);
+    return s;
+  }
+
+ private:
+  double yawRate_;
+};
+
+struct DriftByAge {
+  std::map<int, std::vector<double>> chained, warped;  ///< errors (px) by track age
+};
+
+/// KLT as in RenderedFlight::runKlt on `frames` images rendered in memory (default imaging, an
+/// undistorted copy of the default camera). Chained: the track against the projection of its
+/// detection-time ground point. Warped: KLT from the detection image to the image warped back
+/// into it by the truth ground homography (every 20th image), against the detection pixel.
+DriftByAge trackInMemory(const Trajectory& traj, int frames) {
+  const Scenario sc = defaultScenario();
+  vio::CameraCalibration cal = sc.cameras[0];
+  cal.intrinsics.model = vio::DistortionModel::None;
+  cal.intrinsics.distortion = {0.0, 0.0, 0.0, 0.0};
+  GroundTextureConfig tc = sc.texture;
+  const GroundTexture texture(tc);
+  const CameraRenderer r(cal, sc.imaging, texture);
+  const auto& k = cal.intrinsics;
+  Eigen::Matrix3d Ke;
+  Ke << k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1;
+  auto planeH = [&](const Pose& P) {
+    const Eigen::Matrix3d Rcw = P.R_WC.transpose();
+    Eigen::Matrix3d M;
+    M << Rcw.col(0), Rcw.col(1), -Rcw * P.p_WC;
+    return Eigen::Matrix3d(Ke * M);
+  };
+  auto project = [&](const Pose& P, const Eigen::Vector3d& X) {
+    const Eigen::Vector3d q = Ke * (P.R_WC.transpose() * (X - P.p_WC));
+    return cv::Point2f(static_cast<float>(q.x() / q.z()), static_cast<float>(q.y() / q.z()));
+  };
+  auto ground = [&](const Pose& P, const cv::Point2f& px, Eigen::Vector3d& X) {
+    const Eigen::Vector3d d = P.R_WC * Eigen::Vector3d((px.x - k.cx) / k.fx, (px.y - k.cy) / k.fy, 1.0);
+    if (d.z() > -1e-6) return false;
+    X = P.p_WC + (-P.p_WC.z() / d.z()) * d;
+    return true;
+  };
+  struct T {
+    cv::Point2f px, px0;
+    Eigen::Vector3d p_W;
+    int age = 0, det = 0;
+  };
+  DriftByAge out;
+  std::vector<T> tracks;
+  std::vector<cv::Mat> images;
+  std::vector<Pose> poses;
+  const cv::TermCriteria crit(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
+  for (int f = 0; f < frames; ++f) {
+    const double t = 0.5 + 0.05 * f;
+    Pose P;
+    r.cameraPose(traj.evaluate(t), P.R_WC, P.p_WC);
+    images.push_back(r.render(traj, t, 1.0, 1000 + static_cast<std::uint64_t>(f)));
+    poses.push_back(P);
+    const cv::Mat& img = images.back();
+    if (f > 0 && !tracks.empty()) {
+      std::vector<cv::Point2f> p0, p1, back;
+      for (const T& tr : tracks) p0.push_back(tr.px);
+      std::vector<unsigned char> st, stBack;
+      std::vector<float> err;
+      cv::calcOpticalFlowPyrLK(images[static_cast<std::size_t>(f - 1)], img, p0, p1, st, err, cv::Size(21, 21), 3, crit);
+      cv::calcOpticalFlowPyrLK(img, images[static_cast<std::size_t>(f - 1)], p1, back, stBack, err, cv::Size(21, 21), 3, crit);
+      std::vector<T> kept;
+      for (std::size_t i = 0; i < tracks.size(); ++i) {
+        const bool inside = p1[i].x >= 10 && p1[i].y >= 10 && p1[i].x < k.width - 10 && p1[i].y < k.height - 10;
+        if (!st[i] || !stBack[i] || !inside || cv::norm(back[i] - p0[i]) > 0.3) continue;
+        T tr = tracks[i];
+        tr.px = p1[i];
+        ++tr.age;
+        const cv::Point2f truth = project(P, tr.p_W);
+        out.chained[tr.age].push_back(std::hypot(tr.px.x - truth.x, tr.px.y - truth.y));
+        kept.push_back(tr);
+      }
+      tracks = std::move(kept);
+      if (f % 20 == 0) {
+        std::map<int, std::vector<std::size_t>> byDetection;
+        for (std::size_t i = 0; i < tracks.size(); ++i) byDetection[tracks[i].det].push_back(i);
+        for (const auto& [d, idx] : byDetection) {
+          const Eigen::Matrix3d H = planeH(P) * planeH(poses[static_cast<std::size_t>(d)]).inverse();
+          cv::Mat Hc(3, 3, CV_64F);
+          for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < 3; ++b) Hc.at<double>(a, b) = H(a, b);
+          cv::Mat W;
+          cv::warpPerspective(img, W, Hc, img.size(), cv::INTER_CUBIC | cv::WARP_INVERSE_MAP);
+          std::vector<cv::Point2f> a, g;
+          for (std::size_t i : idx) a.push_back(tracks[i].px0);
+          g = a;
+          std::vector<unsigned char> st2;
+          std::vector<float> e2;
+          cv::calcOpticalFlowPyrLK(images[static_cast<std::size_t>(d)], W, a, g, st2, e2, cv::Size(21, 21), 0, crit,
+                                   cv::OPTFLOW_USE_INITIAL_FLOW);
+          for (std::size_t q = 0; q < idx.size(); ++q)
+            if (st2[q]) out.warped[f - d].push_back(std::hypot(g[q].x - a[q].x, g[q].y - a[q].y));
+        }
+      }
+    }
+    if (tracks.size() < 200) {
+      cv::Mat mask(img.size(), CV_8UC1, cv::Scalar(255));
+      for (const T& tr : tracks) cv::circle(mask, tr.px, 12, cv::Scalar(0), -1);
+      std::vector<cv::Point2f> corners;
+      cv::goodFeaturesToTrack(img, corners, static_cast<int>(250 - tracks.size()), 0.01, 12, mask, 5);
+      for (const auto& c : corners) {
+        if (c.x < 20 || c.y < 20 || c.x > k.width - 20 || c.y > k.height - 20) continue;
+        T tr;
+        tr.px = tr.px0 = c;
+        tr.det = f;
+        if (ground(P, c, tr.p_W)) tracks.push_back(tr);
+      }
+    }
+  }
+  return out;
+}
+
+double rmsOf(const std::vector<double>& e) {
+  double s2 = 0.0;
+  for (double x : e) s2 += x * x;
+  return e.empty() ? 0.0 : std::sqrt(s2 / static_cast<double>(e.size()));
+}
+
+TEST(RenderedDrift, TurningDriftIsKltsWhileTheImagesMatchTheTruthHomography) {
+  // 36 deg/s, 1.8 deg per image; 80 images turn 144 deg.
+  const TurnInPlace turn(36.0 * M_PI / 180.0);
+  const DriftByAge d = trackInMemory(turn, 81);
+  for (int age : {10, 40, 80}) {
+    ASSERT_GT(d.chained.count(age), 0u);
+    std::printf("turning: chained age %d: %zu tracks, RMS %.3f px\n", age, d.chained.at(age).size(), rmsOf(d.chained.at(age)));
+  }
+  EXPECT_GT(rmsOf(d.chained.at(40)), 1.5);  // measured 2.9 px
+  ASSERT_GE(d.warped.size(), 4u);
+  for (const auto& [age, e] : d.warped) {
+    std::printf("turning: warped age %d: %zu tracks, RMS %.3f px\n", age, e.size(), rmsOf(e));
+    if (e.size() < 20) continue;
+    EXPECT_LT(rmsOf(e), 0.15) << "age " << age;  // measured 0.03-0.08 px
+  }
+  EXPECT_GT(d.warped.rbegin()->first, 60);
+  // Hovering without rotation: no drift (measured 0.05 px RMS after 199 images).
+  const TurnInPlace hover(0.0);
+  const DriftByAge h = trackInMemory(hover, 41);
+  ASSERT_GT(h.chained.count(40), 0u);
+  std::printf("hovering: chained age 40: %zu tracks, RMS %.3f px\n", h.chained.at(40).size(), rmsOf(h.chained.at(40)));
+  EXPECT_LT(rmsOf(h.chained.at(40)), 0.1);
 }
 
 }  // namespace
