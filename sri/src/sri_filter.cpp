@@ -7,6 +7,7 @@
 #include <numeric>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 #include "gvins/sri/square_root.hpp"
 
@@ -190,6 +191,9 @@ BlockId SriFilter<Scalar>::addBlock(const BlockSpec& spec, const BlockEstimate<S
   rview(c, d).setZero();
   const BlockId id = layout_.insert(spec, pos);
   estimates_.insert(estimates_.begin() + pos, estimate);
+  if constexpr (!std::is_same_v<Scalar, double>) {
+    nominal_.insert(nominal_.begin() + pos, castEstimate<double>(estimate));
+  }
   return id;
 }
 
@@ -218,6 +222,9 @@ void SriFilter<Scalar>::marginalize(std::span<const BlockId> ids) {
     for (int idx = first; idx <= last; ++idx) run.push_back(layout_.at(idx).id);
     layout_.erase(std::span<const BlockId>(run));
     estimates_.erase(estimates_.begin() + first, estimates_.begin() + last + 1);
+    if constexpr (!std::is_same_v<Scalar, double>) {
+      nominal_.erase(nominal_.begin() + first, nominal_.begin() + last + 1);
+    }
     todo.erase(std::remove_if(todo.begin(), todo.end(),
                               [&](BlockId id) { return !layout_.contains(id); }),
                todo.end());
@@ -239,6 +246,11 @@ void SriFilter<Scalar>::reorder(std::span<const BlockId> order) {
   std::vector<BlockEstimate<Scalar>> est;
   est.reserve(estimates_.size());
   for (BlockId id : order) est.push_back(estimates_[static_cast<std::size_t>(layout_.index(id))]);
+  std::vector<BlockEstimate<double>> nom;
+  if constexpr (!std::is_same_v<Scalar, double>) {
+    nom.reserve(nominal_.size());
+    for (BlockId id : order) nom.push_back(nominal_[static_cast<std::size_t>(layout_.index(id))]);
+  }
   if (p < n_) {
     const int k = n_ - p;
     // Rows above p keep their position; their columns ≥ p are permuted.
@@ -281,11 +293,41 @@ void SriFilter<Scalar>::reorder(std::span<const BlockId> order) {
   }
   layout_ = std::move(next);
   estimates_ = std::move(est);
+  if constexpr (!std::is_same_v<Scalar, double>) nominal_ = std::move(nom);
 }
 
 template <typename Scalar>
 const BlockEstimate<Scalar>& SriFilter<Scalar>::estimate(BlockId id) const {
   return estimates_[static_cast<std::size_t>(position(id))];
+}
+
+template <typename Scalar>
+const BlockEstimate<double>& SriFilter<Scalar>::nominal(BlockId id) const {
+  if constexpr (std::is_same_v<Scalar, double>) {
+    return estimates_[static_cast<std::size_t>(position(id))];
+  } else {
+    return nominal_[static_cast<std::size_t>(position(id))];
+  }
+}
+
+template <typename Scalar>
+void SriFilter<Scalar>::setNominal(BlockId id, const BlockEstimate<double>& value, double tolerance) {
+  const int pos = position(id);
+  const BlockInfo& b = layout_.at(pos);
+  if (!hasShape(value, b.kind, b.dim)) {
+    throw std::invalid_argument("sri::SriFilter::setNominal: value does not fit block '" + b.name + "'");
+  }
+  const auto d = boxminus<double>(b, value, nominal(id));
+  if (!(d.cwiseAbs().maxCoeff() <= tolerance)) {
+    throw std::invalid_argument("sri::SriFilter::setNominal: value of block '" + b.name +
+                                "' is not the current estimate up to rounding");
+  }
+  if constexpr (std::is_same_v<Scalar, double>) {
+    estimates_[static_cast<std::size_t>(pos)] = value;
+  } else {
+    nominal_[static_cast<std::size_t>(pos)] = value;
+    estimates_[static_cast<std::size_t>(pos)] = castEstimate<Scalar>(value);
+  }
 }
 
 template <typename Scalar>
@@ -296,12 +338,21 @@ void SriFilter<Scalar>::setEstimate(BlockId id, const BlockEstimate<Scalar>& val
     throw std::invalid_argument("sri::SriFilter::setEstimate: value does not fit block '" + b.name +
                                 "'");
   }
-  const Vector delta = boxminus<Scalar>(b, value, estimates_[static_cast<std::size_t>(pos)]);
+  Vector delta;
+  if constexpr (std::is_same_v<Scalar, double>) {
+    delta = boxminus<Scalar>(b, value, estimates_[static_cast<std::size_t>(pos)]);
+  } else {
+    delta = boxminus<double>(b, castEstimate<double>(value), nominal_[static_cast<std::size_t>(pos)])
+                .template cast<Scalar>();
+  }
   // Prior mean x̂_old ⊞ R⁻¹r stays put: R(δ' + δ) − r = R δ' − (r − R δ).
   if (b.offset > 0) rview(0, b.offset).noalias() -= cview(0, b.offset, b.offset, b.dim) * delta;
   rview(b.offset, b.dim).noalias() -=
       cview(b.offset, b.offset, b.dim, b.dim).template triangularView<Eigen::Upper>() * delta;
   estimates_[static_cast<std::size_t>(pos)] = value;
+  if constexpr (!std::is_same_v<Scalar, double>) {
+    nominal_[static_cast<std::size_t>(pos)] = castEstimate<double>(value);
+  }
 }
 
 template <typename Scalar>
@@ -560,9 +611,20 @@ template <typename Scalar>
 void SriFilter<Scalar>::correct() {
   if (n_ == 0) return;
   const Vector dx = solve();
-  for (int i = 0; i < layout_.size(); ++i) {
-    const BlockInfo& b = layout_.at(i);
-    boxplus<Scalar>(b, estimates_[static_cast<std::size_t>(i)], dx.segment(b.offset, b.dim));
+  if constexpr (std::is_same_v<Scalar, double>) {
+    for (int i = 0; i < layout_.size(); ++i) {
+      const BlockInfo& b = layout_.at(i);
+      boxplus<Scalar>(b, estimates_[static_cast<std::size_t>(i)], dx.segment(b.offset, b.dim));
+    }
+  } else {
+    // Mixed precision: the correction is applied to the double value (sri_filter.hpp).
+    const Eigen::VectorXd dxd = dx.template cast<double>();
+    for (int i = 0; i < layout_.size(); ++i) {
+      const BlockInfo& b = layout_.at(i);
+      auto& nom = nominal_[static_cast<std::size_t>(i)];
+      boxplus<double>(b, nom, dxd.segment(b.offset, b.dim));
+      estimates_[static_cast<std::size_t>(i)] = castEstimate<Scalar>(nom);
+    }
   }
   if (!hasZeroPivot(0)) {
     rview(0, n_).setZero();

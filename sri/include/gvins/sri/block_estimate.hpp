@@ -29,6 +29,12 @@ struct BlockEstimate {
   static BlockEstimate zero(BlockKind kind, int dim);
 };
 
+/// The same value in another scalar type (rounded when narrowing).
+template <typename To, typename From>
+BlockEstimate<To> castEstimate(const BlockEstimate<From>& e) {
+  return {e.rotation.template cast<To>(), e.vector.template cast<To>()};
+}
+
 /// True if `value` has the shape required by a block of this kind and dimension.
 template <typename Scalar>
 bool hasShape(const BlockEstimate<Scalar>& value, BlockKind kind, int dim);

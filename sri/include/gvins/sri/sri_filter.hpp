@@ -40,7 +40,14 @@
 // measurement rows by a Measurement (measurement.hpp), which also does null-space projection
 // of nuisance columns and QR compression. docs/sri_core.md has the derivations.
 //
-// Scalar is float or double (both compiled into gvins_sri).
+// Scalar is float or double (both compiled into gvins_sri). Mixed precision: R, r, the rows and
+// the solve are in Scalar, the nominal values (estimates) are always kept in double — a float
+// filter stores a double copy, applies every correction to it in double and hands out its
+// rounded value through estimate(). Nominal values can be far from zero (positions kilometres
+// from the origin, clock biases) where float's resolution (1e-4 m at 1.5 km) would add a
+// rounding error to every correction; the error state is small and float suffices for it.
+// nominal() gives the double value, setNominal() sets it without moving r (measurements in
+// docs/vio_estimator.md, "Float").
 #pragma once
 
 #include <optional>
@@ -119,7 +126,17 @@ class SriFilter {
   void reorder(std::span<const BlockId> order);
 
   // ---------------------------------------------------------------- estimates
+  /// The estimate in Scalar (for a float filter: the nominal() value rounded to float).
   const BlockEstimate<Scalar>& estimate(BlockId id) const;
+  /// The estimate in double (the value the filter corrects; equal to estimate() for double).
+  const BlockEstimate<double>& nominal(BlockId id) const;
+  /// Replaces the double value of a block by one that rounds to the same Scalar value up to
+  /// rounding (the exact value of an estimate that was passed in Scalar to addBlock or in a
+  /// Propagation): R and r are not changed, i.e. the difference is not treated as a move of the
+  /// linearization point. Throws std::invalid_argument for a wrong shape, or if `value` differs
+  /// from the current value by more than `tolerance` (absolute per entry: vector entries, rotation
+  /// angle in rad).
+  void setNominal(BlockId id, const BlockEstimate<double>& value, double tolerance = 1e-2);
   /// Moves the linearization point of a block, keeping the estimated distribution: r is adjusted
   /// by −R δ with δ = value ⊟ old (first order for rotations).
   void setEstimate(BlockId id, const BlockEstimate<Scalar>& value);
@@ -193,6 +210,7 @@ class SriFilter {
   SriOptions options_;
   StateLayout layout_;
   std::vector<BlockEstimate<Scalar>> estimates_;  // parallel to layout_.blocks()
+  std::vector<BlockEstimate<double>> nominal_;    // float filters only: double values, parallel
   RowMatrix<Scalar> buf_;                         // cap_ × cap_, R at (off_, off_)
   Vector rbuf_;                                   // cap_, r at off_
   int cap_ = 0;
