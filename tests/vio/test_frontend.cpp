@@ -229,6 +229,54 @@ TEST(Frontend, KltRecoversAKnownSubPixelShift) {
   EXPECT_LT(quantile(err, 0.95), 0.2);
 }
 
+TEST(Frontend, ConstantMotionPredictionAndItsFallback) {
+  // The image moves by (3.1, -2.2) px per frame, then turns back (the constant-motion prediction
+  // is then 7.6 px off, beyond predictedMaxCorrection): tracked with the prediction (one pyramid
+  // level) the tracks follow the shift as precisely as the single pass through the whole pyramid
+  // (predictedLevels = -1), and the turn costs no tracks (they fall back to the full pyramid).
+  const EurocDataset ds(kV101);
+  const cv::Mat a = ds.loadImage(0, 0);
+  const std::vector<cv::Point2d> offsets = {{0, 0}, {3.1, -2.2}, {6.2, -4.4}, {9.3, -6.6}, {12.4, -8.8}, {8.9, -6.2}};
+  std::vector<std::vector<double>> errs(2);
+  std::vector<std::size_t> kept(2, 0), started(2, 0);
+  for (int mode = 0; mode < 2; ++mode) {
+    FeatureTrackerConfig cfg = trackerConfig();
+    if (mode == 1) cfg.predictedLevels = -1;
+    FeatureTracker tr(CameraModel(ds.cameraCalibration(0).intrinsics), cfg);
+    std::vector<std::uint64_t> ids0;
+    std::vector<cv::Point2f> pts0;
+    for (std::size_t k = 0; k < offsets.size(); ++k) {
+      const cv::Matx23d shift(1, 0, offsets[k].x, 0, 1, offsets[k].y);
+      cv::Mat b;
+      cv::warpAffine(a, b, shift, a.size(), cv::INTER_CUBIC, cv::BORDER_REFLECT);
+      tr.process(ImagePyramid(b, tr.config().klt));
+      if (k == 0) {
+        ids0 = tr.ids();
+        pts0 = tr.points();
+        continue;
+      }
+      kept[mode] = 0;
+      for (std::size_t i = 0; i < tr.ids().size(); ++i) {
+        const auto it = std::find(ids0.begin(), ids0.end(), tr.ids()[i]);
+        if (it == ids0.end()) continue;
+        ++kept[mode];
+        const cv::Point2f p0 = pts0[static_cast<std::size_t>(it - ids0.begin())];
+        errs[mode].push_back(std::hypot(tr.points()[i].x - (p0.x + offsets[k].x), tr.points()[i].y - (p0.y + offsets[k].y)));
+      }
+    }
+    started[mode] = ids0.size();
+  }
+  std::fprintf(stderr,
+               "constant motion then a turn: predicted %zu of %zu kept, error median %.3f px, 95%% %.3f px; "
+               "single pass %zu of %zu, median %.3f px, 95%% %.3f px\n",
+               kept[0], started[0], quantile(errs[0], 0.5), quantile(errs[0], 0.95), kept[1], started[1],
+               quantile(errs[1], 0.5), quantile(errs[1], 0.95));
+  EXPECT_GE(kept[0] + 2, kept[1]);
+  EXPECT_GT(kept[0], 0.95 * static_cast<double>(started[0]));
+  EXPECT_LT(quantile(errs[0], 0.5), 0.06);
+  EXPECT_LT(quantile(errs[0], 0.95), quantile(errs[1], 0.95) + 0.05);
+}
+
 TEST(Frontend, GyroRotationPredictionTracksALargeRotation) {
   // Render what cam0 sees after rotating by R (exact for any scene depth since the camera only
   // rotates; the area outside the original field of view is mirrored in), then track with and

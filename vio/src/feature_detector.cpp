@@ -49,6 +49,7 @@ struct Cell {
   std::vector<cv::Point2f> candidates;  // strongest first
   std::size_t next = 0;
   int added = 0;
+  bool searched = false;
 };
 
 }  // namespace
@@ -89,12 +90,13 @@ int GridDetector::detect(const cv::Mat& image, std::vector<cv::Point2f>& points)
     if (Cell* cell = cellOf(p)) ++cell->existing;
   }
 
-  // Candidates per cell that still has room.
+  // Candidates of a cell that still has room, computed when the round-robin first reaches it.
   const cv::Rect imageRect(0, 0, W, H);
   std::vector<cv::KeyPoint> kps;
-  for (Cell& cell : cells) {
+  auto findCandidates = [&](Cell& cell) {
+    cell.searched = true;
     const int need = quota - cell.existing;
-    if (need <= 0) continue;
+    if (need <= 0) return;
     // FAST needs a 3-pixel ring: search a slightly larger window, keep corners inside the cell.
     const cv::Rect roi = (cell.rect + cv::Size(6, 6) - cv::Point(3, 3)) & imageRect;
     const cv::Mat sub = image(roi);
@@ -123,10 +125,12 @@ int GridDetector::detect(const cv::Mat& image, std::vector<cv::Point2f>& points)
         }
       }
     }
-  }
+  };
 
-  // Round-robin over the cells, strongest remaining candidate first: first up to each cell's
-  // share, then (if the cap is not reached because some cells are textureless) beyond it.
+  // Round-robin over the cells in image order, strongest remaining candidate first: first up to
+  // each cell's share, then (if the cap is not reached because some cells are textureless)
+  // beyond it. A cell is searched when the round-robin first reaches it: when only a few
+  // features are missing, only the first cells with room are.
   int added = 0;
   const int room = cfg_.maxFeatures - total;
   auto roundRobin = [&](int cellCap) {
@@ -135,6 +139,7 @@ int GridDetector::detect(const cv::Mat& image, std::vector<cv::Point2f>& points)
       for (Cell& cell : cells) {
         if (added >= room) break;
         if (cell.existing + cell.added >= cellCap) continue;
+        if (!cell.searched) findCandidates(cell);
         while (cell.next < cell.candidates.size()) {
           const cv::Point2f p = cell.candidates[cell.next++];
           if (occ.free(p)) {

@@ -1,5 +1,6 @@
 #include "gvins/vio/feature_tracker.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -25,8 +26,16 @@ void compact(std::vector<T>& v, const std::vector<unsigned char>& keep) {
 }
 }  // namespace
 
-ImagePyramid::ImagePyramid(const cv::Mat& gray, const KltParams& p) : image_(gray) {
+ImagePyramid::ImagePyramid(const cv::Mat& gray, const KltParams& p) { build(gray, p); }
+
+void ImagePyramid::build(const cv::Mat& gray, const KltParams& p) {
   if (gray.empty() || gray.type() != CV_8UC1) throw std::invalid_argument("ImagePyramid: 8-bit gray image expected");
+  // cv::Mat::create (inside buildOpticalFlowPyramid) keeps a buffer of the right size even if it
+  // is shared: drop the ones another ImagePyramid still uses, keep the rest.
+  for (cv::Mat& m : levels_) {
+    if (m.u && m.u->refcount > 1) m.release();
+  }
+  image_ = gray;
   cv::buildOpticalFlowPyramid(gray, levels_, cv::Size(p.window, p.window), p.levels, true);
 }
 
@@ -43,28 +52,38 @@ void trackKlt(const ImagePyramid& from, const ImagePyramid& to, const std::vecto
   const cv::Size win(p.window, p.window);
   const cv::TermCriteria term(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, p.iterations, p.epsilon);
   std::vector<unsigned char> st;
-  std::vector<float> err;
-  cv::calcOpticalFlowPyrLK(from.levels(), to.levels(), pts, out, st, err, win, p.levels, term,
+  // No error output: OpenCV then skips the extra pass over each window at the image level.
+  cv::calcOpticalFlowPyrLK(from.levels(), to.levels(), pts, out, st, cv::noArray(), win, p.levels, term,
                            cv::OPTFLOW_USE_INITIAL_FLOW);
-  // Backward from the tracked positions. The backward pass starts where the inverse of the
-  // prediction puts it (start + (tracked - predicted)), so it has to undo exactly what the
-  // forward pass added to the prediction: starting it at the start point instead would let a
-  // track in a flat or saturated area pass without moving.
-  std::vector<cv::Point2f> back(pts.size());
-  for (std::size_t i = 0; i < pts.size(); ++i) back[i] = pts[i] + (out[i] - predicted[i]);
-  std::vector<unsigned char> stBack;
-  cv::calcOpticalFlowPyrLK(to.levels(), from.levels(), out, back, stBack, err, win, p.levels, term,
-                           cv::OPTFLOW_USE_INITIAL_FLOW);
-  const float maxFb2 = static_cast<float>(p.maxForwardBackward * p.maxForwardBackward);
+  // Backward from the tracked positions, only for points that tracked forward into the border.
+  // The backward pass starts where the inverse of the prediction puts it (start + (tracked -
+  // predicted)), so it has to undo exactly what the forward pass added to the prediction:
+  // starting it at the start point instead would let a track in a flat or saturated area pass
+  // without moving.
   const float b = static_cast<float>(p.border);
   const float xMax = static_cast<float>(to.image().cols - 1) - b, yMax = static_cast<float>(to.image().rows - 1) - b;
+  std::vector<std::size_t> idx;
+  std::vector<cv::Point2f> fwd, back;
+  idx.reserve(pts.size());
+  fwd.reserve(pts.size());
+  back.reserve(pts.size());
   for (std::size_t i = 0; i < pts.size(); ++i) {
-    if (!st[i] || !stBack[i]) continue;
-    const cv::Point2f d = back[i] - pts[i];
-    if (d.x * d.x + d.y * d.y > maxFb2) continue;
     const cv::Point2f& q = out[i];
-    if (!(q.x >= b && q.y >= b && q.x <= xMax && q.y <= yMax)) continue;
-    status[i] = 1;
+    if (!st[i] || !(q.x >= b && q.y >= b && q.x <= xMax && q.y <= yMax)) continue;
+    idx.push_back(i);
+    fwd.push_back(q);
+    back.push_back(pts[i] + (q - predicted[i]));
+  }
+  if (idx.empty()) return;
+  std::vector<unsigned char> stBack;
+  cv::calcOpticalFlowPyrLK(to.levels(), from.levels(), fwd, back, stBack, cv::noArray(), win, p.levels, term,
+                           cv::OPTFLOW_USE_INITIAL_FLOW);
+  const float maxFb2 = static_cast<float>(p.maxForwardBackward * p.maxForwardBackward);
+  for (std::size_t k = 0; k < idx.size(); ++k) {
+    if (!stBack[k]) continue;
+    const cv::Point2f d = back[k] - pts[idx[k]];
+    if (d.x * d.x + d.y * d.y > maxFb2) continue;
+    status[idx[k]] = 1;
   }
 }
 
@@ -76,18 +95,95 @@ void FeatureTracker::process(const ImagePyramid& image, const Eigen::Matrix3d* R
   FrontendTiming& tm = timing ? *timing : local;
   if (!prev_.empty() && !pts_.empty()) {
     auto t0 = Clock::now();
-    std::vector<cv::Point2f> cur(pts_.size());
-    bool guess = false;
+    const std::size_t n = pts_.size();
+    // Unpredicted start: the rotation-predicted pixel with a gyro rotation, else the previous
+    // position (trackKlt's default).
+    std::vector<cv::Point2f> start = pts_;
     if (R_cur_prev) {
-      guess = true;
-      for (std::size_t i = 0; i < pts_.size(); ++i) {
+      for (std::size_t i = 0; i < n; ++i) {
         const Eigen::Vector3d b = *R_cur_prev * cam_.bearing({pts_[i].x, pts_[i].y});
         const auto px = cam_.project(b);
-        cur[i] = px ? cv::Point2f(static_cast<float>(px->x()), static_cast<float>(px->y())) : pts_[i];
+        if (px) start[i] = cv::Point2f(static_cast<float>(px->x()), static_cast<float>(px->y()));
       }
     }
-    std::vector<unsigned char> status;
-    trackKlt(prev_, image, pts_, cur, status, cfg_.klt, guess);
+    std::vector<cv::Point2f> cur = start;
+    std::vector<unsigned char> status(n, 0);
+    // First pass: the tracks with a prediction through the shallow pyramid.
+    std::vector<std::size_t> idx;
+    std::vector<cv::Point2f> from, to, predicted;
+    if (cfg_.predictedLevels >= 0 && cfg_.predictedLevels < cfg_.klt.levels) {
+      // With a rotation every track has its prediction. Without, tracks continue their last
+      // image step (constant image motion); new ones take the median step of those when there
+      // are enough of them, else they have no prediction.
+      cv::Point2f median(0.f, 0.f);
+      bool haveMedian = R_cur_prev != nullptr;
+      if (!R_cur_prev) {
+        std::vector<float> dx, dy;
+        dx.reserve(n);
+        dy.reserve(n);
+        for (std::size_t i = 0; i < n; ++i) {
+          if (lengths_[i] < 2) continue;
+          dx.push_back(pts_[i].x - prevPts_[i].x);
+          dy.push_back(pts_[i].y - prevPts_[i].y);
+        }
+        constexpr std::size_t kMinForMedian = 8;
+        if (dx.size() >= kMinForMedian) {
+          const auto mid = static_cast<std::ptrdiff_t>(dx.size() / 2);
+          std::nth_element(dx.begin(), dx.begin() + mid, dx.end());
+          std::nth_element(dy.begin(), dy.begin() + mid, dy.end());
+          median = {dx[static_cast<std::size_t>(mid)], dy[static_cast<std::size_t>(mid)]};
+          haveMedian = true;
+        }
+      }
+      for (std::size_t i = 0; i < n; ++i) {
+        if (R_cur_prev) {
+          to.push_back(start[i]);
+        } else if (lengths_[i] >= 2) {
+          to.push_back(pts_[i] + (pts_[i] - prevPts_[i]));
+        } else if (haveMedian) {
+          to.push_back(pts_[i] + median);
+        } else {
+          continue;
+        }
+        idx.push_back(i);
+        from.push_back(pts_[i]);
+      }
+      if (!idx.empty()) {
+        predicted = to;
+        KltParams p = cfg_.klt;
+        p.levels = cfg_.predictedLevels;
+        std::vector<unsigned char> st;
+        trackKlt(prev_, image, from, to, st, p, true);
+        // A shallow pyramid can settle on a wrong but forward-backward consistent match far from
+        // its start: only small corrections of the prediction are accepted.
+        const float maxCorr2 = static_cast<float>(cfg_.predictedMaxCorrection * cfg_.predictedMaxCorrection);
+        for (std::size_t k = 0; k < idx.size(); ++k) {
+          const cv::Point2f d = to[k] - predicted[k];
+          if (!st[k] || d.x * d.x + d.y * d.y > maxCorr2) continue;
+          cur[idx[k]] = to[k];
+          status[idx[k]] = 1;
+        }
+      }
+    }
+    // The others (no prediction, or failed above) from the unpredicted start through the whole
+    // pyramid.
+    idx.clear();
+    from.clear();
+    to.clear();
+    for (std::size_t i = 0; i < n; ++i) {
+      if (status[i]) continue;
+      idx.push_back(i);
+      from.push_back(pts_[i]);
+      to.push_back(start[i]);
+    }
+    if (!idx.empty()) {
+      std::vector<unsigned char> st;
+      trackKlt(prev_, image, from, to, st, cfg_.klt, R_cur_prev != nullptr);
+      for (std::size_t k = 0; k < idx.size(); ++k) {
+        cur[idx[k]] = to[k];
+        status[idx[k]] = st[k];
+      }
+    }
     tm.tracking += msSince(t0);
 
     t0 = Clock::now();

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <stdexcept>
-#include <unordered_map>
 
 #include <Eigen/LU>
 #include <opencv2/imgproc.hpp>
@@ -15,6 +15,11 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+double threadCpuMs() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
 }
 Eigen::Matrix4d inverse(const Eigen::Matrix4d& T) {
   Eigen::Matrix4d I = Eigen::Matrix4d::Identity();
@@ -43,9 +48,18 @@ struct StereoFrontend::Impl {
   std::optional<StereoMatcher> matcher;
   cv::Ptr<cv::CLAHE> clahe;
   std::uint64_t frames = 0;
-  // Last cam1 pixel of each stereo-matched feature, for the next prediction.
-  std::unordered_map<std::uint64_t, cv::Point2f> lastStereo;
+  // Last cam1 pixel of each stereo-matched feature, for the next prediction, by increasing id
+  // (the tracker keeps its ids sorted: survivors in order, new ones appended).
+  std::vector<std::pair<std::uint64_t, cv::Point2f>> lastStereo, nextStereo;
   double medianDepth;
+  // Buffers reused frame after frame (no fresh pages per frame). Two cam0 slots: the tracker
+  // still holds the previous frame's pyramid while this frame's is built.
+  cv::Mat equalized[2], equalizedRight;
+  ImagePyramid leftPyr[2], rightPyr;
+  std::vector<std::size_t> idx;
+  std::vector<cv::Point2f> leftPts, rightPts;
+  std::vector<unsigned char> status;
+  std::vector<double> depths;
 
   Impl(const FrontendConfig& c, const CameraCalibration& c0, const CameraCalibration* c1)
       : cfg(shared(c)), tracker(CameraModel(c0.intrinsics), cfg.tracker), medianDepth(c.stereo.defaultDepth) {
@@ -76,6 +90,7 @@ FeatureFrame StereoFrontend::process(std::int64_t t_ns, const cv::Mat& leftIn, c
                                      const Eigen::Matrix3d* R_cur_prev) {
   Impl& s = *impl_;
   const auto tStart = Clock::now();
+  const double cpuStart = threadCpuMs();
   FeatureFrame out;
   out.t_ns = t_ns;
   out.index = s.frames++;
@@ -85,17 +100,26 @@ FeatureFrame StereoFrontend::process(std::int64_t t_ns, const cv::Mat& leftIn, c
   if (doStereo) checkImage(rightIn, *s.cam1, "cam1");
 
   auto t0 = Clock::now();
+  const std::size_t slot = out.index % 2;
   cv::Mat left = leftIn, right = rightIn;
   if (s.cfg.equalize == Equalization::Clahe) {
-    s.clahe->apply(leftIn, left);
-    if (doStereo) s.clahe->apply(rightIn, right);
+    s.clahe->apply(leftIn, s.equalized[slot]);
+    left = s.equalized[slot];
+    if (doStereo) {
+      s.clahe->apply(rightIn, s.equalizedRight);
+      right = s.equalizedRight;
+    }
   } else if (s.cfg.equalize == Equalization::Histogram) {
-    cv::equalizeHist(leftIn, left);
-    if (doStereo) cv::equalizeHist(rightIn, right);
+    cv::equalizeHist(leftIn, s.equalized[slot]);
+    left = s.equalized[slot];
+    if (doStereo) {
+      cv::equalizeHist(rightIn, s.equalizedRight);
+      right = s.equalizedRight;
+    }
   }
-  const ImagePyramid leftPyr(left, s.cfg.tracker.klt);
-  ImagePyramid rightPyr;
-  if (doStereo) rightPyr = ImagePyramid(right, s.cfg.tracker.klt);
+  ImagePyramid& leftPyr = s.leftPyr[slot];
+  leftPyr.build(left, s.cfg.tracker.klt);
+  if (doStereo) s.rightPyr.build(right, s.cfg.tracker.klt);
   out.timing.pyramid = msSince(t0);
 
   s.tracker.process(leftPyr, R_cur_prev, &out.timing);
@@ -120,37 +144,41 @@ FeatureFrame StereoFrontend::process(std::int64_t t_ns, const cv::Mat& leftIn, c
     // view) are retried only every kRetry-th frame: failing matches cost the most (every pyramid
     // level runs to the iteration limit).
     constexpr std::uint64_t kRetry = 3;
-    std::vector<std::size_t> idx;
-    std::vector<cv::Point2f> leftPts, rightPts;
+    s.idx.clear();
+    s.leftPts.clear();
+    s.rightPts.clear();
+    std::size_t j = 0;  // merge walk: ids and lastStereo both increase
     for (std::size_t i = 0; i < pts.size(); ++i) {
-      const auto it = s.lastStereo.find(ids[i]);
-      const bool prior = it != s.lastStereo.end() && lengths[i] > 1;
+      while (j < s.lastStereo.size() && s.lastStereo[j].first < ids[i]) ++j;
+      const bool prior = j < s.lastStereo.size() && s.lastStereo[j].first == ids[i] && lengths[i] > 1;
       if (!prior && lengths[i] > 1 && (out.index + ids[i]) % kRetry != 0) continue;
-      idx.push_back(i);
-      leftPts.push_back(pts[i]);
-      rightPts.push_back(prior ? it->second + (pts[i] - prevPts[i]) : cv::Point2f(std::nanf(""), 0.f));
+      s.idx.push_back(i);
+      s.leftPts.push_back(pts[i]);
+      s.rightPts.push_back(prior ? s.lastStereo[j].second + (pts[i] - prevPts[i]) : cv::Point2f(std::nanf(""), 0.f));
     }
-    std::vector<unsigned char> status;
-    s.matcher->match(leftPyr, rightPyr, leftPts, rightPts, status, s.medianDepth);
-    s.lastStereo.clear();
-    std::vector<double> depths;
-    for (std::size_t k = 0; k < idx.size(); ++k) {
-      if (!status[k]) continue;
-      const std::size_t i = idx[k];
+    s.matcher->match(leftPyr, s.rightPyr, s.leftPts, s.rightPts, s.status, s.medianDepth);
+    s.nextStereo.clear();
+    s.depths.clear();
+    for (std::size_t k = 0; k < s.idx.size(); ++k) {
+      if (!s.status[k]) continue;
+      const std::size_t i = s.idx[k];
       FeatureObservation& f = out.features[i];
       f.stereo = true;
-      f.pixel1 = {rightPts[k].x, rightPts[k].y};
+      f.pixel1 = {s.rightPts[k].x, s.rightPts[k].y};
       f.normalized1 = s.cam1->undistort(f.pixel1);
-      s.lastStereo.emplace(ids[i], rightPts[k]);
-      if (const auto z = s.matcher->depth(f.normalized0, f.normalized1)) depths.push_back(*z);
+      s.nextStereo.emplace_back(ids[i], s.rightPts[k]);
+      if (const auto z = s.matcher->depth(f.normalized0, f.normalized1)) s.depths.push_back(*z);
     }
-    if (!depths.empty()) {
-      std::nth_element(depths.begin(), depths.begin() + static_cast<long>(depths.size() / 2), depths.end());
-      s.medianDepth = depths[depths.size() / 2];
+    std::swap(s.lastStereo, s.nextStereo);
+    if (!s.depths.empty()) {
+      auto& d = s.depths;
+      std::nth_element(d.begin(), d.begin() + static_cast<long>(d.size() / 2), d.end());
+      s.medianDepth = d[d.size() / 2];
     }
     out.timing.stereo = msSince(t0);
   }
   out.timing.total = msSince(tStart);
+  out.timing.cpu = threadCpuMs() - cpuStart;
   return out;
 }
 

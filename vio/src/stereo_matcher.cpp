@@ -45,9 +45,9 @@ void StereoMatcher::match(const ImagePyramid& leftImage, const ImagePyramid& rig
                           std::vector<unsigned char>& status, double predictionDepth) const {
   right.resize(left.size(), cv::Point2f(std::nanf(""), 0.f));
   status.assign(left.size(), 0);
-  // Features with a prior (last frame's match moved by the left motion) are off by a pixel or
-  // two: one pyramid level above the image suffices. The others start from the depth prediction
-  // and use the whole pyramid.
+  // Features with a prior (last frame's match moved by the left motion) are off by a fraction
+  // of a pixel: cfg_.priorLevels (default: the image only). The others start from the depth
+  // prediction and use the whole pyramid.
   std::vector<std::size_t> idx[2];
   std::vector<cv::Point2f> from[2], to[2];
   for (std::size_t i = 0; i < left.size(); ++i) {
@@ -64,7 +64,7 @@ void StereoMatcher::match(const ImagePyramid& leftImage, const ImagePyramid& rig
   for (int prior = 0; prior < 2; ++prior) {
     if (idx[prior].empty()) continue;
     KltParams p = cfg_.klt;
-    if (prior) p.levels = std::min(p.levels, 1);
+    if (prior) p.levels = std::clamp(cfg_.priorLevels, 0, p.levels);
     std::vector<unsigned char> st;
     trackKlt(leftImage, rightImage, from[prior], to[prior], st, p, true);
     for (std::size_t k = 0; k < idx[prior].size(); ++k) {

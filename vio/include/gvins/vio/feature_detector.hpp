@@ -1,8 +1,10 @@
 // Corner detection on a grid: the image is split into cells, each cell gets at most its share
 // of the feature cap, and a new corner keeps a minimum distance from every existing and new
 // feature. Cells are filled round-robin (strongest corner first) so that the cap spreads the
-// features over the image. FAST (Rosten & Drummond 2006) with a per-cell threshold that is
-// lowered in weakly textured cells, or Shi-Tomasi minimum-eigenvalue corners (Shi & Tomasi 1994).
+// features over the image; a cell is searched only when the round-robin reaches it (a frame that
+// misses a few features searches a few cells). FAST (Rosten & Drummond 2006) with a per-cell
+// threshold that is lowered in weakly textured cells, or Shi-Tomasi minimum-eigenvalue corners
+// (Shi & Tomasi 1994).
 #pragma once
 
 #include <vector>

@@ -21,7 +21,8 @@ struct FeatureObservation {
   Eigen::Vector2d normalized1 = Eigen::Vector2d::Zero();
 };
 
-/// Wall-clock milliseconds spent in each stage for this frame.
+/// Wall-clock milliseconds spent in each stage for this frame, and the CPU time of the whole
+/// frame (on a shared machine the wall times include waiting for a core).
 struct FrontendTiming {
   double pyramid = 0.0;    ///< image pyramids (both cameras)
   double tracking = 0.0;   ///< temporal KLT with forward-backward check
@@ -29,6 +30,7 @@ struct FrontendTiming {
   double detection = 0.0;  ///< new corners in empty grid cells
   double stereo = 0.0;     ///< left-right KLT and epipolar check
   double total = 0.0;
+  double cpu = 0.0;        ///< CPU time of the processing thread for the whole frame, ms
 };
 
 struct FeatureFrame {

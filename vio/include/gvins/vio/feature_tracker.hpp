@@ -27,12 +27,16 @@ struct KltParams {
   int border = 5;                     ///< tracked points closer to the edge are dropped
 };
 
-/// An image with its Lucas-Kanade pyramid (levels with precomputed derivatives). Build a new
-/// object for every image: the front end keeps the previous one alive.
+/// An image with its Lucas-Kanade pyramid (levels with precomputed derivatives). The object
+/// shares `gray` (no copy) and keeps its own level buffers.
 class ImagePyramid {
  public:
   ImagePyramid() = default;
   ImagePyramid(const cv::Mat& gray, const KltParams& params);
+  /// Rebuilds the pyramid for a new image of the same size in place: level buffers that no copy
+  /// of this object shares any more are reused instead of allocated (a 752x480 pyramid with
+  /// derivatives is ~3 MB; fresh pages cost page faults every frame).
+  void build(const cv::Mat& gray, const KltParams& params);
   const cv::Mat& image() const { return image_; }
   const std::vector<cv::Mat>& levels() const { return levels_; }
   bool empty() const { return image_.empty(); }
@@ -52,6 +56,15 @@ void trackKlt(const ImagePyramid& from, const ImagePyramid& to, const std::vecto
 struct FeatureTrackerConfig {
   GridDetectorConfig grid;
   KltParams klt;
+  /// Tracks that have a prediction (the gyro rotation if given; else the feature's own image
+  /// step in the last frame, and for new features the median step of the others) are first
+  /// tracked with `predictedLevels` pyramid levels above the image, and kept if they moved at
+  /// most `predictedMaxCorrection` px from the prediction. All other tracks, and those that fail
+  /// there, are tracked from the unpredicted start (previous position, or the rotation
+  /// prediction) with all `klt.levels`: a wrong prediction costs time, not tracks. Negative
+  /// `predictedLevels`: one pass with all levels for every track.
+  int predictedLevels = 1;
+  double predictedMaxCorrection = 4.0;  ///< px
   bool ransac = true;
   double ransacThreshold = 1.0;    ///< pixels at the camera's focal length, on undistorted points
   double ransacConfidence = 0.99;

@@ -20,6 +20,10 @@ struct StereoConfig {
   double maxEpipolarError = 1.5;  ///< pixels (at cam1's focal length) from the epipolar line
   double minDepth = 0.1;          ///< m; also rejects matches with the wrong disparity sign
   double defaultDepth = 5.0;      ///< m, for predicting right pixels before any match exists
+  /// Pyramid levels above the image for features whose cam1 pixel is predicted from their last
+  /// match (moved by the cam0 motion): off by a fraction of a pixel, so the full image suffices.
+  /// The others start from the depth prediction and use all `klt.levels`.
+  int priorLevels = 0;
 };
 
 class StereoMatcher {
