@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
+#include <type_traits>
 #include <unordered_set>
 
 #include <Eigen/Cholesky>
@@ -134,16 +135,21 @@ struct SriSwfEstimator<Scalar>::Impl {
   }
 
   // ------------------------------------------------------------------ state access
+  /// Mixed precision (sri_filter.hpp): blocks are created with values rounded to Scalar; a float
+  /// filter then gets the double value it was computed as (R and r do not change).
+  void setExact(BlockId id, const BlockEstimate<double>& v) {
+    if constexpr (!std::is_same_v<Scalar, double>) f.setNominal(id, v);
+  }
   CameraExtrinsic ext(int cam) const {
     if (!ext_ids.empty()) {
-      const PoseEstimate p = poseOf(f.estimate(ext_ids[static_cast<std::size_t>(cam)]));
+      const PoseEstimate p = poseOf(f.nominal(ext_ids[static_cast<std::size_t>(cam)]));
       return {p.R_WI, p.p_WI};
     }
     return ext_fixed[static_cast<std::size_t>(cam)];
   }
   const PoseEstimate& pose(BlockId id) {
     auto it = pose_cache.find(id.value);
-    if (it == pose_cache.end()) it = pose_cache.emplace(id.value, poseOf(f.estimate(id))).first;
+    if (it == pose_cache.end()) it = pose_cache.emplace(id.value, poseOf(f.nominal(id))).first;
     return it->second;
   }
   /// Linearisation point of a clone for Jacobians: its first estimate, or the current estimate.
@@ -157,10 +163,10 @@ struct SriSwfEstimator<Scalar>::Impl {
     ImuState s;
     if (!initialized) return s;
     s.t_ns = t_newest;
-    const PoseEstimate p = poseOf(f.estimate(newest.pose));
+    const PoseEstimate p = poseOf(f.nominal(newest.pose));
     s.R_WI = p.R_WI;
     s.p_WI = p.p_WI;
-    const Eigen::VectorXd x = f.estimate(newest.extra).vector.template cast<double>();
+    const Eigen::VectorXd x = f.nominal(newest.extra).vector.template cast<double>();
     s.v_WI = x.segment<3>(0);
     s.bg = x.segment<3>(3);
     s.ba = x.segment<3>(6);
@@ -197,6 +203,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     P.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() * cfg.init_position_sigma * cfg.init_position_sigma;
     const BlockId pid = f.addBlock(BlockSpec::pose("imu_pose"), poseEstimate<Scalar>(s.R_WI, s.p_WI),
                                    sri::Prior<Scalar>::covariance(P.cast<Scalar>()));
+    setExact(pid, poseEstimate<double>(s.R_WI, s.p_WI));
     if (cfg.calibrate_extrinsics) {
       for (std::size_t c = 0; c < ext_fixed.size(); ++c) {
         Eigen::Matrix<Scalar, 6, 1> sd;
@@ -205,6 +212,7 @@ struct SriSwfEstimator<Scalar>::Impl {
         ext_ids.push_back(f.addBlock(BlockSpec::pose("T_IC" + std::to_string(c)),
                                      poseEstimate<Scalar>(ext_fixed[c].R_IC, ext_fixed[c].p_IC),
                                      sri::Prior<Scalar>::stdDevs(sd)));
+        setExact(ext_ids.back(), poseEstimate<double>(ext_fixed[c].R_IC, ext_fixed[c].p_IC));
       }
     }
     Eigen::Matrix<double, 9, 1> x;
@@ -215,10 +223,11 @@ struct SriSwfEstimator<Scalar>::Impl {
     const BlockId eid = f.addBlock(BlockSpec::vector("imu_extra", 9),
                                    BlockEstimate<Scalar>::fromVector(x.cast<Scalar>()),
                                    sri::Prior<Scalar>::stdDevs(sd.cast<Scalar>()));
+    setExact(eid, BlockEstimate<double>::fromVector(x));
     newest = {pid, eid};
     t_newest = s.t_ns;
     clones.push_back({pid, s.t_ns});
-    fe_pose[pid.value] = poseOf(f.estimate(pid));  // the gauge pose: its prior fixes it anyway
+    fe_pose[pid.value] = poseOf(f.nominal(pid));  // the gauge pose: its prior fixes it anyway
     fe_v = s.v_WI;
     t_init = s.t_ns;
     initialized = true;
@@ -429,12 +438,14 @@ struct SriSwfEstimator<Scalar>::Impl {
     step.setNoiseCovariance(Qd.cast<Scalar>());
     step.marginalizeAfter(newest.extra);
     const std::vector<BlockId> ids = f.propagate(step);
+    setExact(ids[0], poseEstimate<double>(s.R_WI, s.p_WI));
+    setExact(ids[1], BlockEstimate<double>::fromVector(x));
     newest = {ids[0], ids[1]};
     t_newest = t;
     clones.push_back({ids[0], t});
     // Clones get first estimates once the initialisation transient is over (first_estimate_delay).
     if (static_cast<double>(t - t_init) * 1e-9 >= cfg.first_estimate_delay) {
-      fe_pose[ids[0].value] = poseOf(f.estimate(ids[0]));
+      fe_pose[ids[0].value] = poseOf(f.nominal(ids[0]));
     }
     fe_v = s.v_WI;
     return true;
@@ -555,7 +566,7 @@ struct SriSwfEstimator<Scalar>::Impl {
   bool slamRows(const Slam& s, const std::vector<Obs>& obs, Meas& m) {
     m.reset(2 * static_cast<int>(obs.size()));
     declareBlocks(m, s.block, s.anchor, obs);
-    const Eigen::Vector3d fx = f.estimate(s.block).vector.template cast<double>();
+    const Eigen::Vector3d fx = f.nominal(s.block).vector.template cast<double>();
     const AnchoredPoint ap = anchoredPoint(fx, pose(s.anchor), ext(0));
     // Jacobians at the first estimates of anchor and clone (the residual at the current ones).
     const bool fej = cfg.first_estimate_jacobians;
@@ -748,7 +759,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     std::vector<Item> items;
     for (std::uint64_t id : ids) {
       Slam& s = slam[id];
-      const Eigen::Vector3d fx = f.estimate(s.block).vector.template cast<double>();
+      const Eigen::Vector3d fx = f.nominal(s.block).vector.template cast<double>();
       const AnchoredPoint ap0 = anchoredPoint(fx, Pa, e0);
       CameraPoint cp0;
       const Eigen::Vector3d fn = inverseDepthOf(ap0.p_W, Pb, e0, nullptr, &cp0);
@@ -800,6 +811,7 @@ struct SriSwfEstimator<Scalar>::Impl {
       Slam& s = slam[items[static_cast<std::size_t>(k)].id];
       s.block = nids[static_cast<std::size_t>(k)];
       s.anchor = newest.pose;
+      setExact(s.block, BlockEstimate<double>::fromVector(items[static_cast<std::size_t>(k)].fnew));
     }
     return drop;
   }
@@ -831,7 +843,7 @@ struct SriSwfEstimator<Scalar>::Impl {
       int n = 0;
       if (staticCheck(frame, recent, ma, mg, n)) {
         const ImuState s = newestState();
-        const PoseEstimate prev = poseOf(f.estimate(previous_pose));
+        const PoseEstimate prev = poseOf(f.nominal(previous_pose));
         Meas z(6);
         const double sv = cfg.zero_velocity_sigma;
         const double sp = sv * static_cast<double>(frame.t_ns - recent[recent.size() - 2].t_ns) * 1e-9;
@@ -983,6 +995,7 @@ struct SriSwfEstimator<Scalar>::Impl {
       Slam s;
       s.block = f.addBlock(BlockSpec::vector("slam", 3), BlockEstimate<Scalar>::fromVector(f0.cast<Scalar>()),
                            sri::Prior<Scalar>::uninformative(), Placement::before(clones.front().id));
+      setExact(s.block, BlockEstimate<double>::fromVector(f0));
       s.anchor = newest.pose;
       s.seen = true;
       if (!slamRows(s, tr.obs, m)) {
