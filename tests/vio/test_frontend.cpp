@@ -231,7 +231,7 @@ TEST(Frontend, KltRecoversAKnownSubPixelShift) {
 
 TEST(Frontend, ConstantMotionPredictionAndItsFallback) {
   // The image moves by (3.1, -2.2) px per frame, then turns back (the constant-motion prediction
-  // is then 7.6 px off, beyond predictedMaxCorrection): tracked with the prediction (one pyramid
+  // is then 8.2 px off, beyond predictedMaxCorrection): tracked with the prediction (one pyramid
   // level) the tracks follow the shift as precisely as the single pass through the whole pyramid
   // (predictedLevels = -1), and the turn costs no tracks (they fall back to the full pyramid).
   const EurocDataset ds(kV101);
