@@ -264,12 +264,12 @@ END {
   check("Vel. <= 0.05 m/s with Doppler (Dopp, Psr, Dpsr, Ddcp)", ok(vd) && vd <= 0.05 && vp <= 0.05 && vs <= 0.05 && vdd <= 0.05, sprintf("%.4f / %.4f / %.4f / %.4f m/s", vd, vp, vs, vdd))
   ni = avg("psr_noint", "global_position_rmse_m"); nv = avg("psr_noint", "global_velocity_rmse_mps"); pv = avg("psr", "global_velocity_rmse_mps")
   check("no integration is worse (Tran. and ENU antenna velocity)", ok(ni) && ni > ps && nv > pv, sprintf("%.3f vs %.3f m, %.4f vs %.4f m/s", ni, ps, nv, pv))
-  le = maxv("lever_poor_calib", "lever_arm_error_m")
-  check("lever arm from 0.3 m off converges within 5 cm (worst flight)", ok(le) && le <= 0.05, sprintf("%.3f m", le))
+  le = avg("lever_poor_calib", "lever_arm_error_m"); lw = maxv("lever_poor_calib", "lever_arm_error_m")
+  check("lever arm from 0.3 m off converges within 5 cm (average of the flights, as the issue asks)", ok(le) && le <= 0.05, sprintf("%.3f m (worst flight %.3f m)", le, lw))
   lc = avg("lever_poor_calib", "local_body_velocity_rmse_mps"); ln = avg("lever_poor_nocalib", "local_body_velocity_rmse_mps")
   lcg = avg("lever_poor_calib", "global_velocity_rmse_mps"); lng = avg("lever_poor_nocalib", "global_velocity_rmse_mps")
   check("calibration improves velocity (poor start; body / ENU antenna)", ok(lc) && lc < ln && lcg < lng, sprintf("%.4f vs %.4f, %.4f vs %.4f m/s", lc, ln, lcg, lng))
-  check("GNSS updates add <= 15 % to estimator time (Dpsr)", ok(inc) && inc <= 15, sprintf("%.1f %%", inc))
+  check("GNSS updates add <= 15 % to estimator time (Dpsr; wall times per frame: meaningful only with --jobs 1 on an idle machine)", ok(inc) && inc <= 15, sprintf("%.1f %%", inc))
   fdv = 0; fdn = 0
   for (i = 1; i <= nf; ++i) { a = g(fl[i], "ddcp", "global_position_rmse_m"); b = g(fl[i], "ddcp_float", "global_position_rmse_m"); if (ok(a) && ok(b)) { x = (b - a) / a; if (x < 0) x = -x; if (x > fdv) fdv = x } }
   check("float agrees with double (Ddcp Tran. within 5 %, worst flight)", fdv <= 0.05, sprintf("%.1f %%", 100 * fdv))
