@@ -84,6 +84,33 @@ class Edges {
   GpsTime t_, before_, after_;
 };
 
+/// Collects into `edges` the rule edges of every considered record within two search bounds of
+/// t (sorted by toe): the search bound and validity window around its toe, its transmission time
+/// (`transmitted`: ttr or tof), the future tolerance, and the midpoint towards the chosen `best`
+/// where another usable record would take over.
+template <class Record, class Considered, class Usable>
+void addRuleEdges(const std::vector<Record>& list, const GpsTime& t, double bound, const EphemerisSelection& policy,
+                  const Record* best, const Considered& considered, const Usable& usable,
+                  GpsTime Record::*transmitted, Edges& edges) {
+  auto wide = std::lower_bound(list.begin(), list.end(), t - 2.0 * bound,
+                               [](const Record& e, const GpsTime& x) { return e.toe < x; });
+  for (; wide != list.end() && !(t + 2.0 * bound < wide->toe); ++wide) {
+    const Record& e = *wide;
+    if (!considered(e)) continue;
+    const double window = EphemerisStore::validityHalfWindow(e);
+    edges.add(e.toe - bound);
+    edges.add(e.toe + bound);
+    edges.add(e.toe - window);
+    edges.add(e.toe + window);
+    edges.add(e.*transmitted);
+    if (policy.futureTolerance >= 0.0) {
+      edges.add(e.toe - policy.futureTolerance);
+      edges.add(e.toe + policy.futureTolerance);
+    }
+    if (best && e.toe != best->toe && usable(e)) edges.add(best->toe + 0.5 * (e.toe - best->toe));
+  }
+}
+
 /// Kepler record selection among one satellite's records (sorted by toe) for one message filter;
 /// with `edges`, also collects the rule edges of every record that may matter near t.
 const KeplerEphemeris* pickKepler(const std::vector<KeplerEphemeris>& list, const GpsTime& t, double bound,
@@ -113,24 +140,7 @@ const KeplerEphemeris* pickKepler(const std::vector<KeplerEphemeris>& list, cons
     best = &e;
     bestDt = dt;
   }
-  if (!edges) return best;
-  auto wide = std::lower_bound(list.begin(), list.end(), t - 2.0 * bound,
-                               [](const KeplerEphemeris& e, const GpsTime& x) { return e.toe < x; });
-  for (; wide != list.end() && !(t + 2.0 * bound < wide->toe); ++wide) {
-    const KeplerEphemeris& e = *wide;
-    if (!considered(e)) continue;
-    const double window = EphemerisStore::validityHalfWindow(e);
-    edges->add(e.toe - bound);
-    edges->add(e.toe + bound);
-    edges->add(e.toe - window);
-    edges->add(e.toe + window);
-    edges->add(e.ttr);
-    if (policy.futureTolerance >= 0.0) {
-      edges->add(e.toe - policy.futureTolerance);
-      edges->add(e.toe + policy.futureTolerance);
-    }
-    if (best && e.toe != best->toe && usable(e)) edges->add(best->toe + 0.5 * (e.toe - best->toe));
-  }
+  if (edges) addRuleEdges(list, t, bound, policy, best, considered, usable, &KeplerEphemeris::ttr, *edges);
   return best;
 }
 
@@ -156,23 +166,9 @@ const GlonassEphemeris* pickGlonass(const std::vector<GlonassEphemeris>& list, c
     best = &e;
     bestDt = dt;
   }
-  if (!edges) return best;
-  auto wide = std::lower_bound(list.begin(), list.end(), t - 2.0 * bound,
-                               [](const GlonassEphemeris& e, const GpsTime& x) { return e.toe < x; });
-  for (; wide != list.end() && !(t + 2.0 * bound < wide->toe); ++wide) {
-    const GlonassEphemeris& e = *wide;
-    if (!policy.allowUnhealthy && !isHealthy(e)) continue;
-    const double window = EphemerisStore::validityHalfWindow(e);
-    edges->add(e.toe - bound);
-    edges->add(e.toe + bound);
-    edges->add(e.toe - window);
-    edges->add(e.toe + window);
-    edges->add(e.tof);
-    if (policy.futureTolerance >= 0.0) {
-      edges->add(e.toe - policy.futureTolerance);
-      edges->add(e.toe + policy.futureTolerance);
-    }
-    if (best && e.toe != best->toe && usable(e)) edges->add(best->toe + 0.5 * (e.toe - best->toe));
+  if (edges) {
+    auto considered = [&](const GlonassEphemeris& e) { return policy.allowUnhealthy || isHealthy(e); };
+    addRuleEdges(list, t, bound, policy, best, considered, usable, &GlonassEphemeris::tof, *edges);
   }
   return best;
 }
