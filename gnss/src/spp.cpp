@@ -9,8 +9,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Cholesky>
-
 #include "gvins/base/constants.hpp"
 #include "gvins/base/geodetic.hpp"
 #include "gvins/gnss/ionosphere_free.hpp"
@@ -19,6 +17,7 @@
 #include "gvins/gnss/niell_mapping.hpp"
 #include "gvins/gnss/saastamoinen.hpp"
 #include "gvins/gnss/sagnac.hpp"
+#include "normal_equations.hpp"
 
 namespace gvins {
 
@@ -363,9 +362,9 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
 
   // One Gauss-Newton step at state (x, clocks) using the frozen model values.
   // Returns the increment and the statistics of the linearisation point.
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, Eigen::Dynamic, kMaxUnknowns> Hw;
-  Eigen::VectorXd vw;
-  std::vector<std::pair<Eigen::Matrix<double, kMaxUnknowns, 1>, double>> rows;  // for residual normalisation
+  detail::NormalEquations<kMaxUnknowns> ne;
+  using SparseRow = detail::NormalEquations<kMaxUnknowns>::SparseRow;
+  std::vector<std::pair<SparseRow, double>> rows;  // for residual normalisation
   std::vector<double> resid;
   auto lsqStep = [&](const Eigen::Vector3d& x, const VecN& clk, double ion, const std::vector<char>& use,
                      bool wantResiduals) {
@@ -373,18 +372,10 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
     const int nc = static_cast<int>(colSystems.size());
     const int m = 3 + nc + (estIono ? 1 : 0);
     r.nUnknowns = m;
-    // Rows of the whitened design matrix sqrt(w) h and observations sqrt(w) v; the normal
-    // equations are formed once from them (one matrix product instead of rank-1 updates).
-    Hw.resize(n + kNumSystems + 1, m);
-    vw.resize(n + kNumSystems + 1);
-    int row = 0;
-    auto addRow = [&](const Eigen::Matrix<double, kMaxUnknowns, 1>& hh, double v, double w) {
-      const double sw = std::sqrt(w);
-      Hw.row(row) = sw * hh.head(m).transpose();
-      vw[row] = sw * v;
-      ++row;
-    };
-    Eigen::Matrix<double, kMaxUnknowns, 1> h;
+    // Normal equations accumulated row by row (rows have 4-5 non-zero entries).
+    ne.reset(m);
+    auto addRow = [&](const SparseRow& hh, double v, double w) { ne.addRow(hh, v, w); };
+    SparseRow h;
     rows.clear();
     resid.assign(wantResiduals ? n : 0, 0.0);
     double chi2 = 0.0;
@@ -400,10 +391,12 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
                           mm.ionoMap * ion + mm.tropo;
       const double v = mm.pseudorange - pred;
       const double w = 1.0 / mm.variance;
-      h.setZero();
-      h.head<3>() = -e;
-      h[3 + c] = 1.0;
-      if (estIono) h[3 + nc] = mm.ionoMap;
+      h.nnz = 0;
+      h.push(0, -e.x());
+      h.push(1, -e.y());
+      h.push(2, -e.z());
+      h.push(3 + c, 1.0);
+      if (estIono) h.push(3 + nc, mm.ionoMap);
       addRow(h, v, w);
       chi2 += w * v * v;
       ++nobs;
@@ -428,9 +421,9 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
         var = std::max(var, cfg.isbPriorSigma * cfg.isbPriorSigma);
         const double v = target - (clk[col[s]] - clk[col[ref]]);
         const double w = 1.0 / var;
-        h.setZero();
-        h[3 + col[s]] = 1.0;
-        h[3 + col[ref]] = -1.0;
+        h.nnz = 0;
+        h.push(3 + col[s], 1.0);
+        h.push(3 + col[ref], -1.0);
         addRow(h, v, w);
         chi2 += w * v * v;
         ++nobs;
@@ -439,8 +432,8 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
     if (estIono) {
       const double v = -ion;
       const double w = 1.0 / ionoPriorVar;
-      h.setZero();
-      h[3 + nc] = 1.0;
+      h.nnz = 0;
+      h.push(3 + nc, 1.0);
       addRow(h, v, w);
       chi2 += w * v * v;
       ++nobs;
@@ -448,16 +441,14 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
     r.nObs = nobs;
     r.chi2 = chi2;
     if (nobs < m) return r;
-    MatN N(m, m);
-    N.noalias() = Hw.topRows(row).transpose() * Hw.topRows(row);
-    const VecN b = Hw.topRows(row).transpose() * vw.head(row);
-    Eigen::LDLT<MatN> ldlt(N);
-    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().array() > 1e-12 * N.diagonal().maxCoeff()).all()) return r;
-    r.x = ldlt.solve(b);
+    if (!ne.factor(1e-12)) return r;
+    r.x.resize(m);
+    ne.solve(r.x.data());
     if (!r.x.allFinite()) return r;
     if (wantResiduals) {
       // The covariance only with the statistics: the iterations use the increment alone.
-      r.cov = ldlt.solve(MatN::Identity(m, m));
+      r.cov.resize(m, m);
+      ne.inverse(r.cov.data(), m);
       if (!r.cov.allFinite()) return r;
     }
     r.ok = true;
@@ -469,8 +460,8 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
       for (int i = 0; i < n; ++i) {
         if (!use[i]) continue;
         const auto& [hr, var] = rows[k++];
-        const double post = resid[i] - hr.head(m).dot(r.x);
-        const double q = var - hr.head(m).dot(r.cov * hr.head(m));
+        const double post = resid[i] - hr.dot(r.x.data());
+        const double q = var - detail::NormalEquations<kMaxUnknowns>::quadraticForm(hr, r.cov.data(), m);
         r.normResidual[i] = std::abs(post) / std::sqrt(std::max(q, 1e-6 * var));
       }
     }
