@@ -59,13 +59,24 @@ SatelliteState keplerSatelliteState(const KeplerEphemeris& eph, const GpsTime& t
   // once |d| < 1e-9, so that is where it stops (two or three steps for GNSS orbits).
   const double n = k.sqrtGm / (a * eph.sqrtA) + eph.deltaN;
   const double m = eph.m0 + n * tk;
+  // Once a step is below 1e-4 rad, sin/cos of E - d follow from the angle-difference formulas
+  // with the series sin d = d - d^3/6, cos d = 1 - d^2/2 + d^4/24 (truncation < d^5/120 < 1e-22):
+  // the same values to rounding, one sincos call fewer per iteration.
   double ecc = m + e * std::sin(m);
   double sinE = std::sin(ecc), cosE = std::cos(ecc);
   for (int it = 0; it < 30; ++it) {
     const double d = (ecc - e * sinE - m) / (1.0 - e * cosE);
     ecc -= d;
-    sinE = std::sin(ecc);
-    cosE = std::cos(ecc);
+    if (std::fabs(d) < 1e-4) {
+      const double d2 = d * d;
+      const double sd = d * (1.0 - d2 * (1.0 / 6.0)), cd = 1.0 - d2 * (0.5 - d2 * (1.0 / 24.0));
+      const double s = sinE * cd - cosE * sd;
+      cosE = cosE * cd + sinE * sd;
+      sinE = s;
+    } else {
+      sinE = std::sin(ecc);
+      cosE = std::cos(ecc);
+    }
     if (std::fabs(d) < 1e-9) break;
   }
   const double oneMinusECosE = 1.0 - e * cosE;
@@ -90,7 +101,16 @@ SatelliteState keplerSatelliteState(const KeplerEphemeris& eph, const GpsTime& t
 
   // Position and velocity in the orbital plane.
   // u = phi + du (du ~ 1e-5 rad).
-  const double sinDu = std::sin(du), cosDu = std::cos(du);
+  // |du| < 1e-4 rad for every GNSS orbit (C_us, C_uc ~ 1e-5): the same series as above.
+  double sinDu, cosDu;
+  if (std::fabs(du) < 1e-4) {
+    const double d2 = du * du;
+    sinDu = du * (1.0 - d2 * (1.0 / 6.0));
+    cosDu = 1.0 - d2 * (0.5 - d2 * (1.0 / 24.0));
+  } else {
+    sinDu = std::sin(du);
+    cosDu = std::cos(du);
+  }
   const double su = sinPhi * cosDu + cosPhi * sinDu, cu = cosPhi * cosDu - sinPhi * sinDu;
   const double xp = r * cu, yp = r * su;
   const double xpDot = rDot * cu - r * uDot * su;

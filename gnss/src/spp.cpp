@@ -422,8 +422,13 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
         const double v = target - (clk[col[s]] - clk[col[ref]]);
         const double w = 1.0 / var;
         h.nnz = 0;
-        h.push(3 + col[s], 1.0);
-        h.push(3 + col[ref], -1.0);
+        if (col[s] < col[ref]) {  // columns ascending
+          h.push(3 + col[s], 1.0);
+          h.push(3 + col[ref], -1.0);
+        } else {
+          h.push(3 + col[ref], -1.0);
+          h.push(3 + col[s], 1.0);
+        }
         addRow(h, v, w);
         chi2 += w * v * v;
         ++nobs;
