@@ -13,7 +13,8 @@ constexpr double kPiIcd = constants::kPi;  // semicircle conversion as prescribe
 
 double klobucharObliquity(double elevation) {
   const double e = elevation / kPiIcd;
-  return 1.0 + 16.0 * std::pow(0.53 - e, 3.0);
+  const double d = 0.53 - e;
+  return 1.0 + 16.0 * d * d * d;  // (0.53 - E)^3, IS-GPS-200N 20.3.3.5.2.5
 }
 
 double klobucharDelayL1(const KlobucharParameters& p, const Geodetic& rx, const AzEl& azel, const GpsTime& t) {
