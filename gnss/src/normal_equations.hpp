@@ -88,11 +88,11 @@ class NormalEquations {
   double rhs(int i) const { return b_[i]; }
 
   /// Factorises N = L D L^T in place of the upper triangle (L^T stored above the diagonal).
-  /// Returns false when N is singular to relTol.
-  bool factor(double relTol) {
+  /// Returns false when a pivot is not above max(relTol * max diag N, absTol).
+  bool factor(double relTol, double absTol = 0.0) {
     double maxDiag = 0.0;
     for (int i = 0; i < n_; ++i) maxDiag = std::max(maxDiag, a_[i][i]);
-    const double tol = relTol * maxDiag;
+    const double tol = std::max(relTol * maxDiag, absTol);
     // Column-wise LDL^T: for j, d_j = a_jj - sum_k<j l_jk^2 d_k, l_ij = (a_ji - sum l_ik l_jk d_k)/d_j.
     for (int j = 0; j < n_; ++j) {
       double d = a_[j][j];
