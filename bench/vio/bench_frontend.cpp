@@ -86,11 +86,11 @@ const Clip& rendered() {
     const std::size_t skip = std::getenv("GVINS_BENCH_SKIP") ? std::stoul(std::getenv("GVINS_BENCH_SKIP")) : 60;
     if (const char* dir = std::getenv("GVINS_BENCH_RENDERED")) return loadClip("rendered", dir, frames, skip);
     // The demo flight's cameras and imaging model over 5 s of a smaller figure-eight, after the
-    // shortest hover the scenario allows (2 s, left out).
+    // shortest hovers the scenario allows (2 s before, left out, and 2 s after).
     const gvins::sim::Scenario sc = gvins::sim::parseScenario(
         "name: bench_frontend\n"
         "trajectory: {pattern: figure_eight, height_m: 30, length_m: 30, speed_mps: 6, laps: 1, heading_deg: 30,\n"
-        "             takeoff_landing: false, hover_start_s: 2, hover_end_s: 0, wobble_deg: 0.3}\n"
+        "             takeoff_landing: false, hover_start_s: 2, hover_end_s: 2, wobble_deg: 0.3}\n"
         "cameras:\n"
         "  rate_hz: 20\n"
         "  list:\n"
