@@ -23,4 +23,11 @@ Eigen::Vector3d rotateEarth(const Eigen::Vector3d& v, double dt) {
   return {c * v.x() + s * v.y(), -s * v.x() + c * v.y(), v.z()};
 }
 
+double shapiroDelay(const Eigen::Vector3d& sat, const Eigen::Vector3d& rx) {
+  constexpr double kGm = 3.986004418e14;  // m³/s², IERS Conventions 2010 table 1.1
+  const double rs = sat.norm(), rr = rx.norm(), rho = (sat - rx).norm();
+  const double c = constants::kSpeedOfLight;
+  return 2.0 * kGm / (c * c) * std::log((rs + rr + rho) / (rs + rr - rho));
+}
+
 }  // namespace gvins

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <random>
 
+#include <Eigen/Geometry>
+
 #include "gvins/base/constants.hpp"
 #include "gvins/base/geodetic.hpp"
 #include "gvins/base/signal.hpp"
@@ -168,6 +170,23 @@ TEST(Geometry, SagnacTermMatchesExactEarthRotationDuringTravel) {
   const double h = 1e-3;
   const double fd = (sagnacRangeCorrection(s + h * vs, rx + h * vr) - sagnacRangeCorrection(s - h * vs, rx - h * vr)) / (2 * h);
   EXPECT_NEAR(sagnacRangeRateCorrection(s, vs, rx, vr), fd, 1e-9);
+}
+
+TEST(Geometry, ShapiroDelayOfMeoSatellitesIsOneToTwoCentimetres) {
+  // IERS Conventions 2010 eq. 11.17 (Earth term): 2GM/c² = 8.870 mm times the logarithm.
+  const Eigen::Vector3d rx = geodeticToEcef(geodeticFromDegrees(35.0, 137.0, 100.0));
+  const Eigen::Vector3d up = rx.normalized();
+  const double rs = 26560e3, rr = rx.norm();
+  const Eigen::Vector3d zenith = up * rs;
+  const double rho = rs - rr;
+  EXPECT_NEAR(shapiroDelay(zenith, rx), 8.870056e-3 * std::log((rs + rr + rho) / (rs + rr - rho)), 1e-8);
+  EXPECT_NEAR(shapiroDelay(zenith, rx), 0.0127, 3e-4);
+  // Near the horizon: a satellite at 26560 km seen tangentially from the receiver.
+  const Eigen::Vector3d east = Eigen::Vector3d::UnitZ().cross(up).normalized();
+  const double d = std::sqrt(rs * rs - rr * rr);
+  const double horizon = shapiroDelay(rx + d * east, rx);
+  EXPECT_GT(horizon, 0.018);
+  EXPECT_LT(horizon, 0.020);
 }
 
 TEST(Statistics, DopOfASymmetricGeometryIsAnalytic) {

@@ -1,4 +1,5 @@
-// Earth rotation during signal travel (Sagnac effect) for ranges and range rates in ECEF.
+// Range corrections of signal travel in ECEF: Earth rotation (Sagnac effect) for ranges and range
+// rates, and the relativistic (Shapiro) delay in the Earth's gravity field.
 #pragma once
 
 #include <Eigen/Core>
@@ -18,5 +19,10 @@ double sagnacRangeRateCorrection(const Eigen::Vector3d& sat, const Eigen::Vector
 /// Rotates an ECEF vector given at time t into the ECEF frame of time t + dt (Earth rotation by
 /// omega_e dt about z).
 Eigen::Vector3d rotateEarth(const Eigen::Vector3d& v, double dt);
+
+/// Relativistic signal delay (m) of the Earth's gravity field (Shapiro effect):
+/// 2 GM/c² ln((r_s + r_r + ρ) / (r_s + r_r − ρ)) with ρ = |r_s − r_r| (IERS Conventions 2010,
+/// eq. 11.17, Earth term only): 1.3 cm at zenith to 1.9 cm at the horizon for MEO satellites.
+double shapiroDelay(const Eigen::Vector3d& sat, const Eigen::Vector3d& rx);
 
 }  // namespace gvins
