@@ -81,7 +81,6 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
   const Geodetic g = ecefToGeodetic(x);
   const IonosphereParameters& iono = nav.ionosphere();
   const double fL1 = *carrierFrequency(System::Gps, '1');
-  const auto bandOrder = SppConfig{}.bands;  // preferred bands per system
   for (const SatObs& so : rover.sats) {
     if (!so.sat.valid() || !config_.useSystem(so.sat.system)) continue;
     const char band = primaryBand(so.sat.system);
@@ -106,6 +105,7 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     m.azel = azimuthElevation(g, x, m.position);
     if (m.azel.elevation < config_.elevationMaskDeg * constants::kDegToRad) continue;
     m.troposphere = slantTroposphereDelay(g, m.azel.elevation, rover.time).slant;
+    m.shapiro = shapiroDelay(m.position, x);
     if (so.sat.system == System::BeiDou && iono.beidou) {
       m.ionosphere = beidouKlobucharDelayB1I(*iono.beidou, g, m.azel, rover.time) *
                      ionosphereFrequencyScale(*carrierFrequency(System::BeiDou, '2'), *f);
@@ -116,12 +116,18 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     const double sinEl = std::max(std::sin(m.azel.elevation), 0.1);
     // Code: white noise and multipath growing with 1/sin(el), plus 30 % of the broadcast
     // ionosphere (Klobuchar corrects about half of the delay; IS-GPS-200N 20.3.3.5.2.5).
-    m.codeVariance = std::pow(config_.codeSigma, 2) * (0.5 + 0.5 / (sinEl * sinEl)) + std::pow(0.3 * m.ionosphere, 2);
-    // Dual frequency: the ionosphere-free pair with the first other band tracked (the SPP band
-    // order), group delays combined alike; its noise is the single-band noise times
-    // sqrt(a1² + a2²) (about 3 for L1/L2) and it carries no ionospheric model error.
+    // Broadcast orbit/clock error (SISRE) of the system: a bias per satellite, in the variance so
+    // that systems with poorer broadcast products weigh less.
+    const double ephemerisVariance =
+        std::pow(config_.ephemerisError[static_cast<std::size_t>(systemIndex(so.sat.system))], 2);
+    m.codeVariance = std::pow(config_.codeSigma, 2) * (0.5 + 0.5 / (sinEl * sinEl)) + std::pow(0.3 * m.ionosphere, 2) +
+                     ephemerisVariance;
+    // Dual frequency: the ionosphere-free pair with the first other band tracked (`bands`: the
+    // SPP band order, GPS/QZSS L5 before L2), group delays combined alike; its noise is the
+    // single-band noise times sqrt(a1² + a2²) (2.98 for L1/L2, 2.59 for L1/L5) and it carries no
+    // ionospheric model error.
     if (config_.ionosphere == GnssIonosphere::kDualFrequency) {
-      const std::string& order = bandOrder[static_cast<std::size_t>(systemIndex(so.sat.system))];
+      const std::string& order = config_.bands[static_cast<std::size_t>(systemIndex(so.sat.system))];
       for (char b2 : order) {
         if (b2 == band) continue;
         const SignalObs* s2 = so.bestOnBand(b2, SignalObs::kCode);
@@ -135,7 +141,8 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
         m.code2 = s2->code;
         m.ifA1 = c.a1;
         m.ifA2 = c.a2;
-        m.codeVariance = std::pow(config_.codeSigma * c.noiseFactor(), 2) * (0.5 + 0.5 / (sinEl * sinEl));
+        m.codeVariance =
+            std::pow(config_.codeSigma * c.noiseFactor(), 2) * (0.5 + 0.5 / (sinEl * sinEl)) + ephemerisVariance;
         break;
       }
     }
@@ -246,8 +253,9 @@ bool GnssFusion<Scalar>::initClocks(vio::EstimatorBackend<Scalar>& est, const st
   for (const SatelliteModel& m : models) {
     const int c = clockIndex(m.sat);
     const double rho = geometricRange(m.position, k.x_E);
-    rows.push_back({c, m.pseudorange - (rho - kC * (m.clockBias - m.groupDelay) + m.troposphere + m.ionosphere),
-                    config_.clockRansacThreshold});
+    rows.push_back(
+        {c, m.pseudorange - (rho - kC * (m.clockBias - m.groupDelay) + m.troposphere + m.ionosphere + m.shapiro),
+         config_.clockRansacThreshold});
     if (m.hasDoppler) {
       const Eigen::Vector3d e = (m.position - k.x_E).normalized();
       const double h = e.dot(m.velocity - k.u_E) + sagnacRangeRateCorrection(m.position, m.velocity, k.x_E, k.u_E) -

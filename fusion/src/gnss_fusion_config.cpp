@@ -10,6 +10,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "gvins/base/parse_error.hpp"
+#include "gvins/base/signal.hpp"
 
 namespace gvins::fusion {
 namespace {
@@ -116,7 +117,7 @@ GnssFusionConfig parseGnssFusionConfig(std::string_view yaml, const std::string&
   if (!map.IsMap()) rd.fail(map, "gnss_fusion", "expected a mapping");
   static const std::set<std::string> kKeys = {
       "mode", "lever_arm", "calibrate_lever_arm", "lever_arm_sigma", "min_rotation_rate", "systems",
-      "elevation_mask_deg", "ionosphere", "code_sigma", "doppler_sigma", "clock_bias_random_walk", "clock_drift_random_walk",
+      "elevation_mask_deg", "ionosphere", "bands", "ephemeris_error_m", "code_sigma", "doppler_sigma", "clock_bias_random_walk", "clock_drift_random_walk",
       "row_gate", "epoch_gate", "frame_yaw_sigma_deg", "frame_min_speed", "outage_reset",
       "clock_ransac_threshold", "base_position", "max_base_age"};
   for (const auto& kv : map) {
@@ -160,6 +161,27 @@ GnssFusionConfig parseGnssFusionConfig(std::string_view yaml, const std::string&
       if (s == "broadcast") c.ionosphere = GnssIonosphere::kBroadcast;
       else if (s == "dual-frequency") c.ionosphere = GnssIonosphere::kDualFrequency;
       else rd.fail(v, key, "expected broadcast or dual-frequency, got '" + s + "'");
+    } else if (key == "bands" || key == "ephemeris_error_m") {
+      if (!v.IsMap()) rd.fail(v, key, "expected a mapping of system letters, e.g. {G: ..., E: ...}");
+      for (const auto& e : v) {
+        const std::string letter = rd.scalar(e.first, key);
+        const auto sys = letter.size() == 1 ? systemFromLetter(letter[0]) : std::nullopt;
+        const std::string field = key + "." + letter;
+        if (!sys) rd.fail(e.first, field, "unknown system letter '" + letter + "'");
+        const auto i = static_cast<std::size_t>(systemIndex(*sys));
+        if (key == "ephemeris_error_m") {
+          c.ephemerisError[i] = rd.number(e.second, field);
+          if (!(c.ephemerisError[i] >= 0.0)) rd.fail(e.second, field, "must be >= 0");
+          continue;
+        }
+        const std::string b = rd.scalar(e.second, field);
+        if (b.empty()) rd.fail(e.second, field, "empty band list");
+        for (char ch : b) {
+          if (!isKnownBand(*sys, ch) && !(*sys == System::Glonass && (ch == '1' || ch == '2')))
+            rd.fail(e.second, field, std::string("band '") + ch + "' does not exist for " + std::string(systemName(*sys)));
+        }
+        c.bands[i] = b;
+      }
     } else if (key == "code_sigma") {
       c.codeSigma = rd.positive(v, key);
     } else if (key == "doppler_sigma") {

@@ -95,7 +95,8 @@ constexpr double kOmegaE = constants::kWgs84OmegaE;
 GnssRow pseudorangeRow(const SatelliteModel& m, const AntennaKinematics& k, double clockBiasMeters) {
   Vector3d g;
   const double rho = geometricRange(m.position, k.x_E, &g);
-  const double h = rho + clockBiasMeters - kC * (m.clockBias - m.groupDelay) + m.troposphere + m.ionosphere;
+  const double h =
+      rho + clockBiasMeters - kC * (m.clockBias - m.groupDelay) + m.troposphere + m.ionosphere + m.shapiro;
   GnssRow r = chainRow(k, g.transpose() * k.R_EN, RowVector3d::Zero());
   r.residual = m.pseudorange - h;
   r.variance = m.codeVariance;

@@ -18,8 +18,18 @@ TEST(GnssFusionConfig, ParsesAllKeys) {
       "  code_sigma: 0.8\n"
       "  ionosphere: broadcast\n"
       "  base_position: [1, 2, 3]\n"
-      "  row_gate: 0.99\n");
+      "  row_gate: 0.99\n"
+      "  bands: {G: \"152\", J: \"15\"}\n"
+      "  ephemeris_error_m: {R: 5, E: 0.25}\n");
   EXPECT_EQ(c.ionosphere, GnssIonosphere::kBroadcast);
+  EXPECT_EQ(c.bands[static_cast<std::size_t>(systemIndex(System::Gps))], "152");
+  EXPECT_EQ(c.bands[static_cast<std::size_t>(systemIndex(System::Qzss))], "15");
+  EXPECT_EQ(c.bands[static_cast<std::size_t>(systemIndex(System::Galileo))], SppConfig{}.bands[2]);
+  EXPECT_DOUBLE_EQ(c.ephemerisError[static_cast<std::size_t>(systemIndex(System::Glonass))], 5.0);
+  EXPECT_DOUBLE_EQ(c.ephemerisError[static_cast<std::size_t>(systemIndex(System::Galileo))], 0.25);
+  EXPECT_DOUBLE_EQ(c.ephemerisError[static_cast<std::size_t>(systemIndex(System::Gps))], SppConfig{}.ephemerisError[0]);
+  EXPECT_EQ(GnssFusionConfig{}.bands[static_cast<std::size_t>(systemIndex(System::Gps))], "152");  // L5 before L2
+  EXPECT_EQ(GnssFusionConfig{}.bands[static_cast<std::size_t>(systemIndex(System::BeiDou))], SppConfig{}.bands[3]);
   EXPECT_TRUE(c.leverArmGiven);
   const GnssFusionConfig d = parseGnssFusionConfig("gnss_fusion:\n  mode: vio+dopp+psr\n");
   EXPECT_EQ(d.ionosphere, GnssIonosphere::kDualFrequency);
@@ -83,6 +93,16 @@ TEST(GnssFusionConfig, ErrorsNameFileLineAndField) {
   } catch (const ParseError& e) {
     EXPECT_EQ(e.line(), 3);
     EXPECT_EQ(e.field(), "ionosphere");
+  }
+  for (const char* bad : {"  bands: {G: \"19\"}\n", "  bands: {X: \"12\"}\n", "  bands: \"12\"\n",
+                          "  ephemeris_error_m: {G: -1}\n"}) {
+    try {
+      parseGnssFusionConfig(std::string("gnss_fusion:\n  mode: vio+dopp+psr\n") + bad, "b.yaml");
+      FAIL() << "no error for " << bad;
+    } catch (const ParseError& e) {
+      EXPECT_EQ(e.line(), 3) << bad;
+      EXPECT_NE(e.field().find(std::string(bad).substr(2, 5)), std::string::npos) << e.field();
+    }
   }
   EXPECT_THROW(parseGnssFusionConfig("gnss_fusion: [\n"), ParseError);
   EXPECT_THROW(loadGnssFusionConfig("/nonexistent/gnss.yaml"), ParseError);

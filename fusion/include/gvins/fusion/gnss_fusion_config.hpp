@@ -11,6 +11,11 @@
 //     elevation_mask_deg: 10
 //     ionosphere: dual-frequency          # psr rows: ionosphere-free code where a second band
 //                                         # exists (else broadcast), or broadcast (Klobuchar)
+//     bands: {G: "152"}                   # per system: bands tried in order for the second signal of
+//                                         # the ionosphere-free pair (the primary band is skipped;
+//                                         # default: the SPP's order with GPS/QZSS L5 before L2)
+//     ephemeris_error_m: {G: 0.6, R: 5}   # per system: broadcast orbit/clock error (SISRE) added to
+//                                         # the psr variance (default: the SPP's ephemeris_error_m)
 //     code_sigma: 0.6                     # m at zenith; variance (a² + a²/sin²(el)) style
 //     doppler_sigma: 0.1                  # m/s at zenith
 //     clock_bias_random_walk: 0.1         # m/√s per constellation bias
@@ -34,6 +39,7 @@
 #include <Eigen/Core>
 
 #include "gvins/base/satellite.hpp"
+#include "gvins/gnss/spp_config.hpp"
 
 namespace gvins::fusion {
 
@@ -65,6 +71,22 @@ struct GnssFusionConfig {
   std::array<bool, kNumSystems> systems{true, true, true, true, true, false, false};
   double elevationMaskDeg = 10.0;
   GnssIonosphere ionosphere = GnssIonosphere::kDualFrequency;
+  /// Band order per system (index systemIndex): the ionosphere-free pair takes the first tracked
+  /// band of this list other than the primary band. Default: the SPP's, except GPS/QZSS L5 before
+  /// L2 (L1/L5 amplifies noise by 2.59 instead of 2.98 and L5 is a wideband signal, where L2 P(Y)
+  /// is tracked semi-codelessly; satellites without L5 fall back to L2).
+  std::array<std::string, kNumSystems> bands = defaultBands();
+  /// Broadcast orbit/clock error per system, m, added in quadrature to the psr sigma. Default:
+  /// the SPP's error budget (SppConfig::ephemerisError: GPS 0.6, GLONASS 5 with its FDMA code
+  /// biases, Galileo 0.3, BeiDou 1.0, QZSS 0.6 m).
+  std::array<double, kNumSystems> ephemerisError = SppConfig{}.ephemerisError;
+
+  static std::array<std::string, kNumSystems> defaultBands() {
+    std::array<std::string, kNumSystems> b = SppConfig{}.bands;
+    b[static_cast<std::size_t>(systemIndex(System::Gps))] = "152";
+    b[static_cast<std::size_t>(systemIndex(System::Qzss))] = "152";
+    return b;
+  }
   double codeSigma = 0.6;
   double dopplerSigma = 0.1;
   double clockBiasRandomWalk = 0.1;

@@ -97,6 +97,7 @@ struct SatelliteModel {
   double clockDrift = 0.0;  ///< s/s
   double groupDelay = 0.0;  ///< s, broadcast for this code
   double troposphere = 0.0; ///< m, modelled slant delay at the rover
+  double shapiro = 0.0;     ///< m, relativistic (Shapiro) delay, gnss::shapiroDelay
   double ionosphere = 0.0;  ///< m, modelled code delay (Klobuchar) on this frequency; 0 if ionosphere-free
   bool ionosphereFree = false;  ///< pseudorange and group delay are a dual-frequency ionosphere-free pair:
   ObsCode code2;                ///< its second signal, and the combination
@@ -110,7 +111,7 @@ struct SatelliteModel {
   double dopplerVariance = 0.0;  ///< (m/s)²
 };
 
-/// Pseudorange (paper eq. zp): h = ρ(x_E) + Sagnac + c·dt_r,sys − c(dt_s − gd) + T + I.
+/// Pseudorange (paper eq. zp): h = ρ(x_E) + Sagnac + c·dt_r,sys − c(dt_s − gd) + T + I + Shapiro.
 GnssRow pseudorangeRow(const SatelliteModel& m, const AntennaKinematics& k, double clockBiasMeters);
 /// Doppler as a range rate (paper eq. zd, times −λ): h = e·(v_s − u_E) + Sagnac rate + c·ḋt_r − c·ḋt_s.
 GnssRow dopplerRow(const SatelliteModel& m, const AntennaKinematics& k, double clockDriftMps);
