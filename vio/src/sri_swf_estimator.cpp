@@ -108,6 +108,10 @@ struct SriSwfEstimator<Scalar>::Impl {
   Eigen::Vector3d fe_v = Eigen::Vector3d::Zero();
   std::int64_t t_init = 0;
   mutable std::vector<double> chi2_thr;
+  std::function<void(const char*)> observer;  // setStepObserver (diagnostics)
+  void notify(const char* step) {
+    if (observer) observer(step);
+  }
 
   explicit Impl(const SriSwfConfig& c) : cfg(c), prop(c.imu, c.gravity) {
     for (const CameraCalibration& cam : c.cameras) {
@@ -816,6 +820,36 @@ struct SriSwfEstimator<Scalar>::Impl {
     return drop;
   }
 
+  /// The four unobservable directions of VIO (global yaw about the z axis through the origin,
+  /// global x, y, z translation) in the current error state, at the linearisation points the
+  /// Jacobians use (first estimates where the clones have them): clones δθ = R̂ᵀe_z, δp = e_z × p̂
+  /// (yaw) and δp = e_k (translation); IMU extra δv = e_z × v̂; SLAM features (anchored inverse
+  /// depth), extrinsics and client blocks 0.
+  Eigen::MatrixXd unobservableDirections() const {
+    Eigen::MatrixXd N = Eigen::MatrixXd::Zero(f.dim(), 4);
+    if (!initialized) return N;
+    const Eigen::Vector3d ez = Eigen::Vector3d::UnitZ();
+    const bool fej = cfg.first_estimate_jacobians;
+    for (const sri::BlockInfo& b : f.layout().blocks()) {
+      if (b.id == newest.extra) {
+        const bool use_fe = fej && fe_pose.count(newest.pose.value) != 0;
+        const Eigen::Vector3d v = use_fe ? fe_v : Eigen::Vector3d(f.nominal(b.id).vector.head(3));
+        N.block<3, 1>(b.offset, 0) = ez.cross(v);
+        continue;
+      }
+      const bool is_clone =
+          std::any_of(clones.begin(), clones.end(), [&](const Clone& c) { return c.id == b.id; });
+      if (!is_clone) continue;
+      PoseEstimate P;
+      auto it = fe_pose.find(b.id.value);
+      P = (fej && it != fe_pose.end()) ? it->second : poseOf(f.nominal(b.id));
+      N.block<3, 1>(b.offset, 0) = P.R_WI.transpose() * ez;
+      N.block<3, 1>(b.offset + 3, 0) = ez.cross(P.p_WI);
+      N.block<3, 3>(b.offset + 3, 1).setIdentity();
+    }
+    return N;
+  }
+
   FrameResult process(const FeatureFrame& frame) {
     FrameResult res;
     pose_cache.clear();
@@ -831,6 +865,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     }
     const BlockId previous_pose = newest.pose;
     propagateTo(frame.t_ns);
+    notify("propagate");
     // Zero-velocity update at a detected standstill (as at the static initialisation): v = 0 and
     // no displacement since the previous clone. Without it a mono rig at rest has no
     // triangulable features and drifts with the IMU.
@@ -859,6 +894,7 @@ struct SriSwfEstimator<Scalar>::Impl {
           f.update(z);
           res.updated = true;
           res.zero_velocity = true;
+          notify("zupt");
         }
       }
     }
@@ -915,6 +951,7 @@ struct SriSwfEstimator<Scalar>::Impl {
             res.updated = true;
           }
         }
+        notify("slam_update");
       }
       std::vector<std::uint64_t> sids;
       for (auto& [id, s] : slam) sids.push_back(id);
@@ -929,6 +966,7 @@ struct SriSwfEstimator<Scalar>::Impl {
 
     if (res.updated) {
       f.correct();
+      notify("correct");
     }
     pose_cache.clear();
     windowCovariance();
@@ -981,6 +1019,7 @@ struct SriSwfEstimator<Scalar>::Impl {
       total.compress();
       f.update(total);
       res.updated = true;
+      notify("msckf_update");
     }
     // 2c. New SLAM features: triangulate, gate the projected rows, add the block with no prior
     // and apply the full rows (the block gets its information from them).
@@ -1006,17 +1045,20 @@ struct SriSwfEstimator<Scalar>::Impl {
       slam.emplace(id, s);
       res.updated = true;
     }
+    if (!slam_new.empty()) notify("slam_init");
     for (const Cand& c : cands) tracks.erase(c.id);  // used (or unusable): restart alive ones
     for (auto it = tracks.begin(); it != tracks.end();) {
       it = observed.count(it->first) ? std::next(it) : tracks.erase(it);
     }
     f.correct();
+    notify("correct");
     pose_cache.clear();
 
     // 3. Marginalization: lost SLAM features, oldest clone (after re-anchoring).
     std::vector<BlockId> marg = lost_slam;
     if (dropping) {
       const std::vector<BlockId> d = reanchor(oldest);
+      notify("reanchor");
       marg.insert(marg.end(), d.begin(), d.end());
       marg.push_back(oldest);
       clones.pop_front();
@@ -1028,7 +1070,10 @@ struct SriSwfEstimator<Scalar>::Impl {
         if (o.size() != n0) --tr.frames;
       }
     }
-    if (!marg.empty()) f.marginalize(marg);
+    if (!marg.empty()) {
+      f.marginalize(marg);
+      notify("marginalize");
+    }
     pose_cache.clear();
     trimImu();
     res.slam_features = static_cast<int>(slam.size());
@@ -1098,6 +1143,16 @@ Eigen::Matrix4d SriSwfEstimator<Scalar>::cameraExtrinsic(int cam) const {
 template <typename Scalar>
 const sri::SriFilter<Scalar>& SriSwfEstimator<Scalar>::filter() const {
   return impl_->f;
+}
+
+template <typename Scalar>
+Eigen::MatrixXd SriSwfEstimator<Scalar>::unobservableDirections() const {
+  return impl_->unobservableDirections();
+}
+
+template <typename Scalar>
+void SriSwfEstimator<Scalar>::setStepObserver(std::function<void(const char* step)> observer) {
+  impl_->observer = std::move(observer);
 }
 
 template <typename Scalar>

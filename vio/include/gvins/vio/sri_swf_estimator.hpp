@@ -21,6 +21,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -175,6 +176,16 @@ class SriSwfEstimator final : public EstimatorBackend<Scalar> {
   Eigen::Matrix4d cameraExtrinsic(int cam) const;
   /// The underlying filter (tests, diagnostics).
   const sri::SriFilter<Scalar>& filter() const;
+  /// The four unobservable directions (columns: global yaw about the z axis through the origin,
+  /// x, y, z translation) in the filter's error state (filter().dim() rows), built from the
+  /// linearisation points of the Jacobians (first estimates). With exact arithmetic and
+  /// first-estimate Jacobians no step adds information along them: updates keep the Gram
+  /// (R N)ᵀ(R N), propagation and marginalization only reduce it (tests/vio/test_sri_swf_nullspace.cpp).
+  Eigen::MatrixXd unobservableDirections() const;
+  /// Diagnostics: called after each filter operation of processFrame with its name
+  /// ("propagate", "zupt", "slam_update", "correct", "msckf_update", "slam_init", "reanchor",
+  /// "marginalize"). Empty function: none.
+  void setStepObserver(std::function<void(const char* step)> observer);
 
   // ------------------------------------------------------------------ EstimatorBackend
   bool initialized() const override;

@@ -1,0 +1,162 @@
+// SRI-SWF float vs double: information along the four unobservable directions of VIO (global
+// yaw about the z axis and global translation, SriSwfEstimator::unobservableDirections(), built
+// from the first estimates). With exact arithmetic and first-estimate Jacobians:
+//   - an update with rows H (H N = 0) keeps the Gram matrix G = (R N)ᵀ(R N) (4×4): the rotation
+//     Q of [R; H] gives Q [R N; 0] = [R' N; 0];
+//   - a propagation appends rows with zero product with N (FEJ transition) and marginalizes the
+//     old IMU extra, a re-anchoring likewise; a marginalization is a Schur complement: these
+//     only reduce G.
+// The observer measures, per step kind, Σ log det(G_after / G_before) (signed: > 0 is
+// information gained) and the largest relative gain of one step, in double and in float.
+// Measured (25 s circle below; docs/vio_estimator.md "Float"): double updates change log det G
+// by ~1e-11 in total; float updates add +1.57 (SLAM re-observations +0.75, new SLAM features
+// +0.59, MSCKF +0.23; one SLAM update up to +0.95 % along one direction) and float
+// marginalizations remove 1.6 more than double's (-10.3 vs -8.7). The rows themselves are fine
+// (‖H N‖² of the float rows: 1e-8 of G); it is the float rounding of R in the QR steps: the
+// stiff IMU-chain rows (|R_ij| up to 1.5e5 on the clone columns, their products with N cancel)
+// perturb R·N by ~1e-7·|R|·|N| at every step. Not fixed yet; DISABLED_FloatUpdatesKeepTheNullspace
+// is the target.
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <string>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <gtest/gtest.h>
+
+#include "gvins/vio/sri_swf_estimator.hpp"
+#include "vio_sim_scene.hpp"
+
+namespace gvins::vio {
+namespace {
+
+struct StepStats {
+  double logdet = 0;    // Σ log det(G_after) − log det(G_before)
+  double max_gain = 0;  // largest λ_max(G_before⁻¹ G_after) − 1 of one step
+  int steps = 0;
+};
+
+struct NullspaceRun {
+  std::map<std::string, StepStats> step;
+  Eigen::Matrix4d G = Eigen::Matrix4d::Zero();  // at the end
+  double yaw_sigma = 0;                          // newest pose, rad
+  double max_R = 0;                              // largest |R_ij| in the clone/IMU columns at the end
+
+  double updates() const {
+    double s = 0;
+    for (const char* k : {"slam_update", "msckf_update", "slam_init"}) {
+      if (auto it = step.find(k); it != step.end()) s += it->second.logdet;
+    }
+    return s;
+  }
+};
+
+double logdet(const Eigen::Matrix4d& G) { return 2.0 * Eigen::LLT<Eigen::Matrix4d>(G).matrixL().toDenseMatrix().diagonal().array().log().sum(); }
+
+template <typename Scalar>
+NullspaceRun runNullspace(const test::SimScene& sc, const SriSwfConfig& cfg, double t_start) {
+  SriSwfEstimator<Scalar> est(cfg);
+  NullspaceRun run;
+  Eigen::Matrix4d Gprev = Eigen::Matrix4d::Zero();
+  bool have = false;
+  double t_now = 0;
+  Eigen::MatrixXd N;
+  Eigen::Vector3d ref = Eigen::Vector3d::Zero();
+  bool have_ref = false;
+  est.setStepObserver([&](const char* step) {
+    N = est.unobservableDirections();
+    // Yaw about a fixed point near the flight (same span; a better conditioned 4×4 Gram).
+    if (!have_ref) ref = est.newestImuState().p_WI;
+    have_ref = true;
+    N.col(0) -= N.middleCols(1, 3) * Eigen::Vector3d::UnitZ().cross(ref);
+    const Eigen::MatrixXd R = est.filter().squareRootInformation().template cast<double>();
+    const Eigen::MatrixXd RN = R.template triangularView<Eigen::Upper>() * N;
+    const Eigen::Matrix4d G = RN.transpose() * RN;
+    if (have && t_now >= t_start && Gprev.determinant() != 0) {
+      StepStats& s = run.step[step];
+      s.logdet += logdet(G) - logdet(Gprev);
+      const Eigen::LLT<Eigen::Matrix4d> L(Gprev);
+      Eigen::Matrix4d M = L.matrixL().solve(G);
+      M = L.matrixL().solve(M.transpose()).transpose();
+      const double l = Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d>(0.5 * (M + M.transpose())).eigenvalues()(3);
+      s.max_gain = std::max(s.max_gain, l - 1.0);
+      ++s.steps;
+    }
+    Gprev = G;
+    have = true;
+  });
+  std::size_t k = 0;
+  for (const FeatureFrame& fr : sc.frames) {
+    while (k < sc.imu.size() && sc.imu[k].t_ns <= fr.t_ns + 20'000'000) est.addImu(sc.imu[k++]);
+    t_now = static_cast<double>(fr.t_ns - sc.frames.front().t_ns) * 1e-9;
+    est.processFrame(fr);
+  }
+  run.G = Gprev;
+  const Eigen::Matrix3d Rw = est.newestImuState().R_WI;
+  const Eigen::Matrix3d Pt = est.poseCovariance().template topLeftCorner<3, 3>();
+  run.yaw_sigma = std::sqrt(Eigen::Vector3d::UnitZ().dot(Rw * Pt * Rw.transpose() * Eigen::Vector3d::UnitZ()));
+  const Eigen::MatrixXd R = est.filter().squareRootInformation().template cast<double>();
+  for (int j = 0; j < R.cols(); ++j) {
+    if (N.row(j).squaredNorm() > 0) run.max_R = std::max(run.max_R, R.col(j).cwiseAbs().maxCoeff());
+  }
+  std::fprintf(stderr, "  %s: |R n| yaw %.4g x %.4g y %.4g z %.4g, yaw sigma %.3f mrad, max |R| on N columns %.3g\n",
+               sizeof(Scalar) == 4 ? "float " : "double", std::sqrt(run.G(0, 0)), std::sqrt(run.G(1, 1)),
+               std::sqrt(run.G(2, 2)), std::sqrt(run.G(3, 3)), 1e3 * run.yaw_sigma, run.max_R);
+  std::fprintf(stderr, "    Σ Δ log det G (largest one-step relative gain) per step:");
+  for (const auto& [name, s] : run.step) {
+    std::fprintf(stderr, " %s %+.3g (%.2g)/%d", name.c_str(), s.logdet, s.max_gain, s.steps);
+  }
+  std::fprintf(stderr, "\n");
+  return run;
+}
+
+struct Scene {
+  test::SimScene sc;
+  Scene() {
+    sc.duration = 25.0;
+    sc.seed = 1;
+    sc.build();
+  }
+};
+const Scene& scene() {
+  static const Scene s;
+  return s;
+}
+
+// Double: the first-estimate-Jacobian nullspace is kept; updates leave G unchanged to rounding,
+// no step increases it beyond rounding.
+TEST(SriSwfNullspace, DoubleKeepsTheUnobservableDirections) {
+  const test::SimScene& sc = scene().sc;
+  const NullspaceRun d = runNullspace<double>(sc, sc.config(), 3.0);
+  EXPECT_LT(std::abs(d.updates()), 1e-6);
+  for (const char* k : {"slam_update", "msckf_update", "slam_init"}) {
+    ASSERT_TRUE(d.step.count(k)) << k;
+    EXPECT_GT(d.step.at(k).steps, 100) << k;
+    EXPECT_LT(d.step.at(k).max_gain, 1e-8) << k;
+  }
+  for (const char* k : {"propagate", "marginalize", "reanchor"}) {
+    ASSERT_TRUE(d.step.count(k)) << k;
+    EXPECT_LT(d.step.at(k).logdet, 0.0) << k;
+  }
+}
+
+// Float, as it is (issue 8, not fixed): the updates gain information along N. The bounds are
+// the measured values with a margin, so that the test catches a change either way; the target
+// is FloatUpdatesKeepTheNullspace.
+TEST(SriSwfNullspace, FloatUpdatesGainInformationAlongTheUnobservableDirections) {
+  const test::SimScene& sc = scene().sc;
+  const NullspaceRun f = runNullspace<float>(sc, sc.config(), 3.0);
+  EXPECT_GT(f.updates(), 0.1) << "float updates no longer gain information along N: issue 8 fixed? Update the docs";
+  EXPECT_LT(f.updates(), 10.0);
+}
+
+// Target: float updates keep G within 100× double's rounding level (not reached).
+TEST(SriSwfNullspace, DISABLED_FloatUpdatesKeepTheNullspace) {
+  const test::SimScene& sc = scene().sc;
+  const NullspaceRun f = runNullspace<float>(sc, sc.config(), 3.0);
+  EXPECT_LT(std::abs(f.updates()), 1e-4);
+}
+
+}  // namespace
+}  // namespace gvins::vio
