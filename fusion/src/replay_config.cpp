@@ -90,6 +90,17 @@ ReplayConfig parseReplayConfig(std::string_view text, const std::string& file, c
             o.evaluate = boolean(x, file, name);
           } else if (k == "stereo") {
             o.frontend.useStereo = boolean(x, file, name);
+          } else if (k == "max_track_length") {
+            const double n = number(x, file, name);
+            if (!(n >= 0.0 && n <= 1e6) || n != static_cast<double>(static_cast<int>(n))) {
+              throw ParseError(file, lineOf(x), name, "expected a whole number of images >= 0 (0: unlimited)");
+            }
+            o.frontend.tracker.maxTrackLength = static_cast<int>(n);
+          } else if (k == "max_track_travel_px") {
+            o.frontend.tracker.maxTrackTravel = number(x, file, name);
+            if (!(o.frontend.tracker.maxTrackTravel >= 0.0)) {
+              throw ParseError(file, lineOf(x), name, "must not be negative (0: unlimited)");
+            }
           } else {
             throw ParseError(file, lineOf(r.first), name, "unknown key");
           }

@@ -687,6 +687,14 @@ TEST(ReplayParsers, Config) {
   EXPECT_EQ(e.field(), "replay.max_imu_gap_s");
   e = err("replay:\n  evaluate: maybe\n");
   EXPECT_EQ(e.field(), "replay.evaluate");
+  const ReplayConfig t = parseReplayConfig("replay:\n  max_track_length: 30\n  max_track_travel_px: 80\n", "r.yaml");
+  EXPECT_EQ(t.options.frontend.tracker.maxTrackLength, 30);
+  EXPECT_EQ(t.options.frontend.tracker.maxTrackTravel, 80.0);
+  e = err("replay:\n  max_track_length: 2.5\n");
+  EXPECT_EQ(e.field(), "replay.max_track_length");
+  e = err("replay:\n  start_s: 0\n  max_track_travel_px: -1\n");
+  EXPECT_EQ(e.field(), "replay.max_track_travel_px");
+  EXPECT_EQ(e.line(), 3);
   e = err("other: 1\n");
   EXPECT_EQ(e.field(), "other");
   e = err("[1, 2\n");

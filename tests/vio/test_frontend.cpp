@@ -277,6 +277,52 @@ TEST(Frontend, ConstantMotionPredictionAndItsFallback) {
   EXPECT_LT(quantile(errs[0], 0.95), quantile(errs[1], 0.95) + 0.05);
 }
 
+TEST(Frontend, TracksEndAfterTheirImageTravelAndTheGridRefills) {
+  // The image moves by 4 px per frame: with maxTrackTravel 15 px every track ends at its fourth
+  // step (16 px), the detector refills the cells, and the survivors' recorded travel is the sum
+  // of their steps; without the cap the first frame's tracks survive all ten frames.
+  const EurocDataset ds(kV101);
+  const cv::Mat a = ds.loadImage(0, 0);
+  for (const double cap : {15.0, 0.0}) {
+    FeatureTrackerConfig cfg = trackerConfig();
+    cfg.maxTrackTravel = cap;
+    cfg.travelMinTrackLength = 0;
+    cfg.maxTrackLength = 0;
+    FeatureTracker tr(CameraModel(ds.cameraCalibration(0).intrinsics), cfg);
+    std::vector<std::uint64_t> ids0;
+    std::size_t minCount = 1000;
+    std::vector<double> stepErr;
+    for (int k = 0; k < 10; ++k) {
+      const cv::Matx23d shift(1, 0, 4.0 * k, 0, 1, 0);
+      cv::Mat b;
+      cv::warpAffine(a, b, shift, a.size(), cv::INTER_CUBIC, cv::BORDER_REFLECT);
+      tr.process(ImagePyramid(b, tr.config().klt));
+      if (k == 0) ids0 = tr.ids();
+      minCount = std::min(minCount, tr.ids().size());
+      ASSERT_EQ(tr.trackTravel().size(), tr.ids().size());
+      for (std::size_t i = 0; i < tr.ids().size(); ++i) {
+        const int steps = tr.trackLengths()[i] - 1;
+        if (steps > 0) stepErr.push_back(std::abs(tr.trackTravel()[i] - 4.0 * steps) / steps);
+        if (cap > 0.0) EXPECT_LE(tr.trackTravel()[i], cap);
+      }
+    }
+    // The recorded travel is the sum of the 4 px steps (a few tracks near the reflected border
+    // move less exactly).
+    EXPECT_LT(quantile(stepErr, 0.5), 0.01);
+    EXPECT_LT(quantile(stepErr, 0.95), 0.05);
+    std::size_t survivors = 0;
+    for (std::uint64_t id : tr.ids()) survivors += std::count(ids0.begin(), ids0.end(), id);
+    std::fprintf(stderr, "travel cap %.0f px: %zu of the first frame's %zu tracks after 36 px, min %zu features/frame\n",
+                 cap, survivors, ids0.size(), minCount);
+    if (cap > 0.0) {
+      EXPECT_EQ(survivors, 0u);
+      EXPECT_GE(minCount, 0.8 * static_cast<double>(ids0.size()));
+    } else {
+      EXPECT_GT(survivors, 0.9 * static_cast<double>(ids0.size()));
+    }
+  }
+}
+
 TEST(Frontend, GyroRotationPredictionTracksALargeRotation) {
   // Render what cam0 sees after rotating by R (exact for any scene depth since the camera only
   // rotates; the area outside the original field of view is mirrored in), then track with and

@@ -192,6 +192,7 @@ void FeatureTracker::process(const ImagePyramid& image, const Eigen::Matrix3d* R
     compact(cur, status);
     compact(ids_, status);
     compact(lengths_, status);
+    compact(travel_, status);
     if (cfg_.ransac && cur.size() >= 8) {
       // Undistorted points on a virtual pinhole with the camera's focal length, so that the
       // threshold is in pixels.
@@ -211,9 +212,31 @@ void FeatureTracker::process(const ImagePyramid& image, const Eigen::Matrix3d* R
         compact(cur, inlier);
         compact(ids_, inlier);
         compact(lengths_, inlier);
+        compact(travel_, inlier);
       }
     }
     for (int& l : lengths_) ++l;
+    for (std::size_t i = 0; i < cur.size(); ++i) {
+      const float dx = cur[i].x - before[i].x, dy = cur[i].y - before[i].y;
+      travel_[i] += std::sqrt(dx * dx + dy * dy);
+    }
+    if (cfg_.maxTrackLength > 0 || cfg_.maxTrackTravel > 0.0) {
+      std::vector<unsigned char> keep(lengths_.size());
+      bool any = false;
+      for (std::size_t i = 0; i < keep.size(); ++i) {
+        keep[i] = (cfg_.maxTrackLength <= 0 || lengths_[i] <= cfg_.maxTrackLength) &&
+                  (cfg_.maxTrackTravel <= 0.0 || lengths_[i] < cfg_.travelMinTrackLength ||
+                   travel_[i] <= cfg_.maxTrackTravel);
+        any |= !keep[i];
+      }
+      if (any) {
+        compact(before, keep);
+        compact(cur, keep);
+        compact(ids_, keep);
+        compact(lengths_, keep);
+        compact(travel_, keep);
+      }
+    }
     pts_ = std::move(cur);
     prevPts_ = std::move(before);
     tm.ransac += msSince(t0);
@@ -227,6 +250,7 @@ void FeatureTracker::process(const ImagePyramid& image, const Eigen::Matrix3d* R
   for (std::size_t i = before; i < pts_.size(); ++i) {
     ids_.push_back(nextId_++);
     lengths_.push_back(1);
+    travel_.push_back(0.0f);
     prevPts_.push_back(pts_[i]);
   }
   tm.detection += msSince(t0);

@@ -11,6 +11,9 @@
 //     feature_tracks: true       # use camN/features.csv when the dataset has it
 //     evaluate: true             # accuracy table and plots when the dataset has ground truth
 //     stereo: true               # match into cam1 when present (image front end)
+//     max_track_travel_px: 50    # image front end: end tracks (10 images or older) once they
+//                                # have moved 50 px since detection (0: never)
+//     max_track_length: 0        # ... or after this many images (0: never)
 //   estimator: sri_swf.yaml      # SRI-SWF configuration file (sri_swf_estimator.hpp), relative
 //                                # to this file; default: noise and cameras from the dataset
 //   gnss_fusion: { ... }         # GnssFusion options (gnss_fusion_config.hpp), read by its parser

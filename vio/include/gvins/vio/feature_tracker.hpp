@@ -67,6 +67,20 @@ struct FeatureTrackerConfig {
   double predictedMaxCorrection = 4.0;  ///< px
   bool ransac = true;
   double ransacThreshold = 1.0;    ///< pixels at the camera's focal length, on undistorted points
+  /// Tracks are ended once their image path since detection (the sum of the frame-to-frame
+  /// steps) exceeds maxTrackTravel px, or after maxTrackLength images (0: no limit); the
+  /// detector then fills the cell again. Frame-to-frame KLT is sub-pixel, but a translation-only
+  /// window chained over a patch that rotates and changes scale as the camera moves drifts by
+  /// ~0.01-0.03 px per image (docs/vio_frontend.md), while on a still camera it does not: old,
+  /// far-travelled tracks stop following one scene point, and the estimator, which takes every
+  /// observation of a feature as the same point with white noise, turns that into a biased,
+  /// overconfident state. Measured on the rendered demo flight in docs/vio_frontend.md.
+  double maxTrackTravel = 50.0;  ///< px (0: no limit)
+  /// Tracks younger than this many images are not ended by their travel (a fast rotation can
+  /// move every feature by > maxTrackTravel in one step; such tracks keep the observations the
+  /// estimator needs before they are cut).
+  int travelMinTrackLength = 10;
+  int maxTrackLength = 0;       ///< images (0: no limit)
   double ransacConfidence = 0.99;
 };
 
@@ -86,6 +100,8 @@ class FeatureTracker {
   const std::vector<cv::Point2f>& previousPoints() const { return prevPts_; }
   const std::vector<std::uint64_t>& ids() const { return ids_; }
   const std::vector<int>& trackLengths() const { return lengths_; }
+  /// Image path of each track since detection, px.
+  const std::vector<float>& trackTravel() const { return travel_; }
   const CameraModel& camera() const { return cam_; }
   const FeatureTrackerConfig& config() const { return cfg_; }
 
@@ -97,6 +113,7 @@ class FeatureTracker {
   std::vector<cv::Point2f> pts_, prevPts_;
   std::vector<std::uint64_t> ids_;
   std::vector<int> lengths_;
+  std::vector<float> travel_;
   std::uint64_t nextId_ = 0;
 };
 
