@@ -169,6 +169,7 @@ void BaseStation::model(Epoch& e) {
   }
   e.signals = std::move(out);
   e.modelled = true;
+  e.ratesValid = false;
 }
 
 BaseAvailability BaseStation::snapshot(const GpsTime& t, BaseSnapshot& out) {
@@ -235,7 +236,7 @@ BaseAvailability BaseStation::snapshot(const GpsTime& t, BaseSnapshot& out) {
 }
 
 void BaseStation::extrapolate(int b, const GpsTime& t, BaseSnapshot& out) {
-  const Epoch& eb = epochs_[static_cast<std::size_t>(b)];
+  Epoch& eb = epochs_[static_cast<std::size_t>(b)];
   // Rate window: the buffered epochs at most maxInterpolationGap before the held one; the rate of
   // each phase is the least-squares slope of its OMC over the epochs of the same arc, provided
   // they span at least kMinRateSpan seconds (shorter spans make the rate noise, multiplied by the
@@ -243,42 +244,52 @@ void BaseStation::extrapolate(int b, const GpsTime& t, BaseSnapshot& out) {
   int first = b;
   while (first > 0 && eb.time - epochs_[static_cast<std::size_t>(first - 1)].time <= config_.maxInterpolationGap) --first;
   if (eb.time - epochs_[static_cast<std::size_t>(first)].time < kMinRateSpan) return;
-  for (int k = first; k < b; ++k) model(epochs_[static_cast<std::size_t>(k)]);
-  std::vector<double> rate(out.signals.size(), std::numeric_limits<double>::quiet_NaN());
-  std::vector<double> all;
-  std::vector<std::size_t> cursor(static_cast<std::size_t>(b - first), 0);
-  for (std::size_t i = 0; i < out.signals.size(); ++i) {
-    const BaseSignal& s1 = out.signals[i];
-    if (!s1.hasPhase) continue;
-    // Sums for the slope over (t - t_b, omc - omc_b), the held epoch included.
-    double n = 1.0, st = 0.0, sy = 0.0, stt = 0.0, sty = 0.0, tmin = 0.0;
-    for (int k = first; k < b; ++k) {
-      const Epoch& e = epochs_[static_cast<std::size_t>(k)];
-      std::size_t& j = cursor[static_cast<std::size_t>(k - first)];
-      while (j < e.signals.size() && signalLess(e.signals[j], s1)) ++j;
-      if (j == e.signals.size()) continue;
-      const BaseSignal& s0 = e.signals[j];
-      if (!(s0.sat == s1.sat) || !(s0.code == s1.code) || !s0.hasPhase || !(s0.arcStart == s1.arcStart)) continue;
-      const double x = e.time - eb.time, y = s0.phaseOmc - s1.phaseOmc;
-      n += 1.0;
-      st += x;
-      sy += y;
-      stt += x * x;
-      sty += x * y;
-      tmin = std::min(tmin, x);
+  const GpsTime firstTime = epochs_[static_cast<std::size_t>(first)].time;
+  if (!eb.ratesValid || !(eb.ratesFirst == firstTime) || eb.ratesCount != b - first) {
+    for (int k = first; k < b; ++k) model(epochs_[static_cast<std::size_t>(k)]);
+    eb.rates.assign(eb.signals.size(), std::numeric_limits<double>::quiet_NaN());
+    std::vector<double> all;
+    std::vector<std::size_t> cursor(static_cast<std::size_t>(b - first), 0);
+    for (std::size_t i = 0; i < eb.signals.size(); ++i) {
+      const BaseSignal& s1 = eb.signals[i];
+      if (!s1.hasPhase) continue;
+      // Sums for the slope over (t - t_b, omc - omc_b), the held epoch included.
+      double n = 1.0, st = 0.0, sy = 0.0, stt = 0.0, sty = 0.0, tmin = 0.0;
+      for (int k = first; k < b; ++k) {
+        const Epoch& e = epochs_[static_cast<std::size_t>(k)];
+        std::size_t& j = cursor[static_cast<std::size_t>(k - first)];
+        while (j < e.signals.size() && signalLess(e.signals[j], s1)) ++j;
+        if (j == e.signals.size()) continue;
+        const BaseSignal& s0 = e.signals[j];
+        if (!(s0.sat == s1.sat) || !(s0.code == s1.code) || !s0.hasPhase || !(s0.arcStart == s1.arcStart)) continue;
+        const double x = e.time - eb.time, y = s0.phaseOmc - s1.phaseOmc;
+        n += 1.0;
+        st += x;
+        sy += y;
+        stt += x * x;
+        sty += x * y;
+        tmin = std::min(tmin, x);
+      }
+      const double den = n * stt - st * st;
+      if (n < 2.0 || -tmin < kMinRateSpan || !(den > 0.0)) continue;
+      eb.rates[i] = (n * sty - st * sy) / den;
+      all.push_back(eb.rates[i]);
     }
-    const double den = n * stt - st * st;
-    if (n < 2.0 || -tmin < kMinRateSpan || !(den > 0.0)) continue;
-    rate[i] = (n * sty - st * sy) / den;
-    all.push_back(rate[i]);
+    eb.ratesUsable = all.size() >= 3;
+    if (eb.ratesUsable) {
+      const std::size_t mid = all.size() / 2;
+      std::nth_element(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(mid), all.end());
+      const double common = all[mid];
+      for (double& r : eb.rates) r -= common;  // NaN stays NaN
+    }
+    eb.ratesValid = true;
+    eb.ratesFirst = firstTime;
+    eb.ratesCount = b - first;
   }
-  if (all.size() < 3) return;
-  const std::size_t mid = all.size() / 2;
-  std::nth_element(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(mid), all.end());
-  const double common = all[mid];
+  if (!eb.ratesUsable || eb.rates.size() != out.signals.size()) return;
   const double age = t - eb.time;
   for (std::size_t i = 0; i < out.signals.size(); ++i) {
-    if (std::isfinite(rate[i])) out.signals[i].phaseOmc += (rate[i] - common) * age;
+    if (std::isfinite(eb.rates[i])) out.signals[i].phaseOmc += eb.rates[i] * age;
   }
   out.extrapolated = true;
 }

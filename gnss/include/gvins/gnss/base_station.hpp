@@ -122,6 +122,14 @@ class BaseStation {
     ObsEpoch raw;
     bool modelled = false;
     std::vector<BaseSignal> signals;
+    // Phase rates for extrapolating this epoch (aligned with `signals`, NaN where none), minus
+    // their median, computed once per rate window (first epoch time and count) and reused for
+    // every rover epoch that holds this one; cleared when `signals` are modelled again.
+    bool ratesValid = false;
+    bool ratesUsable = false;
+    GpsTime ratesFirst;
+    int ratesCount = 0;
+    std::vector<double> rates;
   };
   void model(Epoch& e);
   /// Moves the phases of a held epoch `b` to `t` with their satellite-specific rates.
