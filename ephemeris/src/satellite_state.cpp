@@ -22,6 +22,14 @@ struct KeplerConstants {
   double f;  // relativistic clock constant -2 sqrt(GM)/c^2
 };
 
+// sin and cos of a small angle |d| < 1e-4 rad by their series, sin d = d - d^3/6 and
+// cos d = 1 - d^2/2 + d^4/24 (truncation < d^5/120 < 1e-22: the libm values to rounding).
+void smallAngleSinCos(double d, double& s, double& c) {
+  const double d2 = d * d;
+  s = d * (1.0 - d2 * (1.0 / 6.0));
+  c = 1.0 - d2 * (0.5 - d2 * (1.0 / 24.0));
+}
+
 KeplerConstants keplerConstants(System s) {
   switch (s) {
     case System::Galileo:
@@ -60,16 +68,15 @@ SatelliteState keplerSatelliteState(const KeplerEphemeris& eph, const GpsTime& t
   const double n = k.sqrtGm / (a * eph.sqrtA) + eph.deltaN;
   const double m = eph.m0 + n * tk;
   // Once a step is below 1e-4 rad, sin/cos of E - d follow from the angle-difference formulas
-  // with the series sin d = d - d^3/6, cos d = 1 - d^2/2 + d^4/24 (truncation < d^5/120 < 1e-22):
-  // the same values to rounding, one sincos call fewer per iteration.
+  // with the small-angle series: the same values to rounding, one sincos call fewer per iteration.
   double ecc = m + e * std::sin(m);
   double sinE = std::sin(ecc), cosE = std::cos(ecc);
   for (int it = 0; it < 30; ++it) {
     const double d = (ecc - e * sinE - m) / (1.0 - e * cosE);
     ecc -= d;
     if (std::fabs(d) < 1e-4) {
-      const double d2 = d * d;
-      const double sd = d * (1.0 - d2 * (1.0 / 6.0)), cd = 1.0 - d2 * (0.5 - d2 * (1.0 / 24.0));
+      double sd, cd;
+      smallAngleSinCos(d, sd, cd);
       const double s = sinE * cd - cosE * sd;
       cosE = cosE * cd + sinE * sd;
       sinE = s;
@@ -104,9 +111,7 @@ SatelliteState keplerSatelliteState(const KeplerEphemeris& eph, const GpsTime& t
   // |du| < 1e-4 rad for every GNSS orbit (C_us, C_uc ~ 1e-5): the same series as above.
   double sinDu, cosDu;
   if (std::fabs(du) < 1e-4) {
-    const double d2 = du * du;
-    sinDu = du * (1.0 - d2 * (1.0 / 6.0));
-    cosDu = 1.0 - d2 * (0.5 - d2 * (1.0 / 24.0));
+    smallAngleSinCos(du, sinDu, cosDu);
   } else {
     sinDu = std::sin(du);
     cosDu = std::cos(du);

@@ -10,7 +10,6 @@
 #include <yaml-cpp/yaml.h>
 
 #include "gvins/base/parse_error.hpp"
-#include "gvins/base/signal.hpp"
 
 namespace gvins::fusion {
 namespace {
@@ -175,11 +174,7 @@ GnssFusionConfig parseGnssFusionConfig(std::string_view yaml, const std::string&
           continue;
         }
         const std::string b = rd.scalar(e.second, field);
-        if (b.empty()) rd.fail(e.second, field, "empty band list");
-        for (char ch : b) {
-          if (!isKnownBand(*sys, ch) && !(*sys == System::Glonass && (ch == '1' || ch == '2')))
-            rd.fail(e.second, field, std::string("band '") + ch + "' does not exist for " + std::string(systemName(*sys)));
-        }
+        if (const std::string err = bandListError(*sys, b); !err.empty()) rd.fail(e.second, field, err);
         c.bands[i] = b;
       }
     } else if (key == "code_sigma") {

@@ -10,8 +10,8 @@
 // instructions (callgrind), the whole run from 335 M to 308 M.
 //
 // N is symmetric positive (semi-)definite; the factorisation declares it singular when a pivot
-// falls below `relTol` times the largest diagonal entry of N (the test the solver used with
-// Eigen's pivoted LDLT before).
+// is not above max(relTol x the largest diagonal entry of N, absTol) (the tests the SPP and the
+// DOPs used with Eigen's pivoted LDLT before).
 #pragma once
 
 #include <algorithm>
@@ -33,19 +33,6 @@ class NormalEquations {
     }
   }
 
-  int size() const { return n_; }
-
-  /// Adds the row h (length size()) with observation v and weight w: N += w h h^T, b += w h v.
-  /// Zero entries of h are skipped.
-  void addRow(const double* h, double v, double w) {
-    for (int i = 0; i < n_; ++i) {
-      if (h[i] == 0.0) continue;
-      const double whi = w * h[i];
-      b_[i] += whi * v;
-      for (int j = i; j < n_; ++j) a_[i][j] += whi * h[j];
-    }
-  }
-
   /// A design row with at most 5 non-zero entries, column indices strictly ascending.
   struct SparseRow {
     std::array<int, 5> col{};
@@ -63,7 +50,8 @@ class NormalEquations {
     }
   };
 
-  /// The same as addRow for a sparse row: N += w h h^T, b += w h v over its non-zeros only.
+  /// Adds the row h with observation v and weight w: N += w h h^T, b += w h v, over the
+  /// non-zeros of h only.
   void addRow(const SparseRow& h, double v, double w) {
     for (int k = 0; k < h.nnz; ++k) {
       const double whk = w * h.val[k];
@@ -83,9 +71,6 @@ class NormalEquations {
     }
     return diag + 2.0 * off;
   }
-
-  double normal(int i, int j) const { return i <= j ? a_[i][j] : a_[j][i]; }
-  double rhs(int i) const { return b_[i]; }
 
   /// Factorises N = L D L^T in place of the upper triangle (L^T stored above the diagonal).
   /// Returns false when a pivot is not above max(relTol * max diag N, absTol).

@@ -374,7 +374,6 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
     r.nUnknowns = m;
     // Normal equations accumulated row by row (rows have 4-5 non-zero entries).
     ne.reset(m);
-    auto addRow = [&](const SparseRow& hh, double v, double w) { ne.addRow(hh, v, w); };
     SparseRow h;
     rows.clear();
     resid.assign(wantResiduals ? n : 0, 0.0);
@@ -397,7 +396,7 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
       h.push(2, -e.z());
       h.push(3 + c, 1.0);
       if (estIono) h.push(3 + nc, mm.ionoMap);
-      addRow(h, v, w);
+      ne.addRow(h, v, w);
       chi2 += w * v * v;
       ++nobs;
       if (wantResiduals) {
@@ -429,7 +428,7 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
           h.push(3 + col[ref], -1.0);
           h.push(3 + col[s], 1.0);
         }
-        addRow(h, v, w);
+        ne.addRow(h, v, w);
         chi2 += w * v * v;
         ++nobs;
       }
@@ -439,7 +438,7 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
       const double w = 1.0 / ionoPriorVar;
       h.nnz = 0;
       h.push(3 + nc, 1.0);
-      addRow(h, v, w);
+      ne.addRow(h, v, w);
       chi2 += w * v * v;
       ++nobs;
     }

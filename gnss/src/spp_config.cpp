@@ -12,6 +12,16 @@
 
 namespace gvins {
 
+std::string bandListError(System s, std::string_view bands) {
+  if (bands.empty()) return "empty band list";
+  for (char ch : bands) {
+    if (!isKnownBand(s, ch) && !(s == System::Glonass && (ch == '1' || ch == '2'))) {
+      return std::string("band '") + ch + "' does not exist for " + std::string(systemName(s));
+    }
+  }
+  return {};
+}
+
 namespace {
 
 using Reader = YamlReader;
@@ -34,12 +44,7 @@ void apply(const Reader& r, const YAML::Node& spp, SppConfig& c) {
     } else if (k == "bands") {
       r.perSystem(v, full, [&](System s, const std::string& f2, const YAML::Node& b) {
         const std::string bands = r.text(b, f2);
-        if (bands.empty()) r.fail(b, f2, "empty band list");
-        for (char ch : bands) {
-          if (!isKnownBand(s, ch) && !(s == System::Glonass && (ch == '1' || ch == '2'))) {
-            r.fail(b, f2, std::string("band '") + ch + "' does not exist for " + std::string(systemName(s)));
-          }
-        }
+        if (const std::string e = bandListError(s, bands); !e.empty()) r.fail(b, f2, e);
         c.bands[systemIndex(s)] = bands;
       });
     } else if (k == "ionosphere") {

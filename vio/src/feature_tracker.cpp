@@ -188,11 +188,15 @@ void FeatureTracker::process(const ImagePyramid& image, const Eigen::Matrix3d* R
 
     t0 = Clock::now();
     std::vector<cv::Point2f> before = pts_;
-    compact(before, status);
-    compact(cur, status);
-    compact(ids_, status);
-    compact(lengths_, status);
-    compact(travel_, status);
+    // Drops the tracks with keep[i] == 0 from every per-track vector.
+    auto keepTracks = [&](const std::vector<unsigned char>& keep) {
+      compact(before, keep);
+      compact(cur, keep);
+      compact(ids_, keep);
+      compact(lengths_, keep);
+      compact(travel_, keep);
+    };
+    keepTracks(status);
     if (cfg_.ransac && cur.size() >= 8) {
       // Undistorted points on a virtual pinhole with the camera's focal length, so that the
       // threshold is in pixels.
@@ -207,13 +211,7 @@ void FeatureTracker::process(const ImagePyramid& image, const Eigen::Matrix3d* R
       std::vector<unsigned char> inlier;
       const cv::Mat F = cv::findFundamentalMat(a, c, cv::FM_RANSAC, cfg_.ransacThreshold, cfg_.ransacConfidence, inlier);
       // A degenerate configuration (no motion, pure rotation, planar) may give no F: keep all.
-      if (!F.empty() && inlier.size() == cur.size()) {
-        compact(before, inlier);
-        compact(cur, inlier);
-        compact(ids_, inlier);
-        compact(lengths_, inlier);
-        compact(travel_, inlier);
-      }
+      if (!F.empty() && inlier.size() == cur.size()) keepTracks(inlier);
     }
     for (int& l : lengths_) ++l;
     for (std::size_t i = 0; i < cur.size(); ++i) {
@@ -229,13 +227,7 @@ void FeatureTracker::process(const ImagePyramid& image, const Eigen::Matrix3d* R
                    travel_[i] <= cfg_.maxTrackTravel);
         any |= !keep[i];
       }
-      if (any) {
-        compact(before, keep);
-        compact(cur, keep);
-        compact(ids_, keep);
-        compact(lengths_, keep);
-        compact(travel_, keep);
-      }
+      if (any) keepTracks(keep);
     }
     pts_ = std::move(cur);
     prevPts_ = std::move(before);

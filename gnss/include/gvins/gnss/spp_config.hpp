@@ -122,6 +122,11 @@ struct SppConfig {
 ///     max_iterations: 10
 ///     velocity: true
 ///     allow_unhealthy: false
+/// Why `bands` is not a valid band preference list for system s (as in SppConfig::bands), or an
+/// empty string when it is: every character a band of the system (GLONASS: also '1' and '2',
+/// its FDMA G1/G2), at least one.
+std::string bandListError(System s, std::string_view bands);
+
 SppConfig loadSppConfig(const std::string& path, const SppConfig& base = {});
 SppConfig parseSppConfig(std::string_view yaml, std::string_view name, const SppConfig& base = {});
 
