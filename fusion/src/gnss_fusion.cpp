@@ -357,16 +357,26 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
     }
   }
   const double q1 = rowGate ? sri::chiSquareQuantile(config_.rowGate, 1) : 0.0;
+  // All rows as [h | J] at once; the gate's h P hᵀ and J Σ_k Jᵀ of every row from two products.
+  const auto nr = static_cast<Eigen::Index>(rows.size());
+  Eigen::MatrixXd HJ(nr, dim + 9);
+  for (Eigen::Index i = 0; i < nr; ++i) {
+    const GnssRow& r = rows[static_cast<std::size_t>(i)];
+    rowVector(r, HJ.row(i).head(dim));
+    HJ.row(i).tail<9>() = r.H_earlier;
+  }
+  Eigen::VectorXd s2(nr);
+  if (haveP) {
+    s2 = (HJ.leftCols(dim) * P).cwiseProduct(HJ.leftCols(dim)).rowwise().sum() +
+         (HJ.rightCols<9>() * intCov).cwiseProduct(HJ.rightCols<9>()).rowwise().sum() + noise.diagonal();
+  }
   std::vector<int> keep;
-  Eigen::RowVectorXd h(dim);
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const GnssRow& r = rows[i];
     if (!std::isfinite(r.residual)) continue;
     if (haveP) {
-      rowVector(r, h);
-      const double s2 = noise(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)) +
-                        (r.H_earlier * intCov * r.H_earlier.transpose())(0, 0) + h.dot(h * P);
-      if (!(s2 > 0.0) || r.residual * r.residual > q1 * s2) continue;
+      const double v = s2[static_cast<Eigen::Index>(i)];
+      if (!(v > 0.0) || r.residual * r.residual > q1 * v) continue;
     }
     keep.push_back(static_cast<int>(i));
   }
@@ -382,10 +392,9 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
   const auto nk = static_cast<Eigen::Index>(keep.size());
   Eigen::MatrixXd A(nk, dim + 9 + 1);  // [h | J | r]
   for (Eigen::Index j = 0; j < nk; ++j) {
-    const GnssRow& r = rows[static_cast<std::size_t>(keep[static_cast<std::size_t>(j)])];
-    rowVector(r, A.row(j).head(dim));
-    A.row(j).segment<9>(dim) = r.H_earlier;
-    A(j, dim + 9) = r.residual;
+    const auto i = static_cast<std::size_t>(keep[static_cast<std::size_t>(j)]);
+    A.row(j).head(dim + 9) = HJ.row(static_cast<Eigen::Index>(i));
+    A(j, dim + 9) = rows[i].residual;
   }
   auto sigma = [&](Eigen::Index a, Eigen::Index b) { return noise(keep[static_cast<std::size_t>(a)], keep[static_cast<std::size_t>(b)]); };
   std::vector<std::pair<Eigen::Index, Eigen::Index>> groups;  // [begin, end) of coupled rows
@@ -466,7 +475,13 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
       if (config_.basePosition) rtk_->setBasePosition(*config_.basePosition);
     }
   }
-  const SppSolution spp = spp_->solve(rover);
+  // SPP only where it is used (frame initialisation, the clock before the clock block exists,
+  // vio+gpsvel): in the tight stage with clocks it is not needed.
+  std::optional<SppSolution> sppCache;
+  auto sppNow = [&]() -> const SppSolution& {
+    if (!sppCache) sppCache = spp_->solve(rover);
+    return *sppCache;
+  };
   // Dpsr needs only the single differences, formed in the tight stage about the antenna
   // estimate (RtkSolver::differences: no float filter, no ambiguity resolution); Ddcp runs the
   // whole RTK module for its fixed ambiguities.
@@ -506,8 +521,8 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
   if (clockBlock_.valid()) {
     const Eigen::VectorXd c = est.estimate(clockBlock_).vector.template cast<double>();
     dtr = (c[0] + c[c.size() - 1] * (rover.time - clockTime_)) / kC;
-  } else if (spp.valid()) {
-    for (const auto& b : spp.clockBias) {
+  } else if (sppNow().valid()) {
+    for (const auto& b : sppNow().clockBias) {
       if (b) {
         dtr = *b / kC;
         break;
@@ -526,7 +541,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
   ensureLever(est);
 
   if (stage_ == GnssFusionStage::kWaitingFix) {
-    if (!startFrame(est, spp, t_ns)) return finish();
+    if (!startFrame(est, sppNow(), t_ns)) return finish();
     stage_ = GnssFusionStage::kFrameInit;
   }
 
@@ -539,6 +554,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
   Eigen::MatrixXd noise;
 
   if (stage_ == GnssFusionStage::kFrameInit) {
+    const SppSolution& spp = sppNow();
     if (!spp.valid()) return finish();
     const Eigen::Matrix3d R_NE = anchor_.R_EN.transpose();
     const Eigen::Vector3d pN = R_NE * (spp.position - anchor_.ecef);
@@ -579,6 +595,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
     }
   } else {
     // Tight stage.
+    const SppSolution* sppVel = config_.mode == GnssFusionMode::kGpsVel ? &sppNow() : nullptr;
     const bool needClocks = config_.usesDoppler();
     std::vector<SatelliteModel> models = satelliteModels(rover, nav, k.x_E);
     if (needClocks && !clockBlock_.valid()) {
@@ -612,9 +629,9 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
         diag.push_back(r.variance);
       }
     }
-    if (config_.mode == GnssFusionMode::kGpsVel && spp.velocity.valid) {
+    if (sppVel && sppVel->velocity.valid) {
       const Eigen::Matrix3d R_NE = anchor_.R_EN.transpose();
-      const Eigen::Vector3d vN = R_NE * spp.velocity.velocity;
+      const Eigen::Vector3d vN = R_NE * sppVel->velocity.velocity;
       for (int a = 0; a < 3; ++a) {
         GnssRow r = velocityRow(vN, a, k);
         r.H_lever.setZero();
@@ -659,10 +676,10 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
     }
     noise = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows.size()), static_cast<Eigen::Index>(rows.size()));
     for (std::size_t i = 0; i < diag.size(); ++i) noise(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)) = diag[i];
-    if (config_.mode == GnssFusionMode::kGpsVel && spp.velocity.valid) {
+    if (sppVel && sppVel->velocity.valid) {
       const Eigen::Matrix3d R_NE = anchor_.R_EN.transpose();
       const Eigen::Index o = static_cast<Eigen::Index>(nIndependent) - 3;
-      noise.block<3, 3>(o, o) = R_NE * spp.velocity.covariance * R_NE.transpose() + 0.0025 * Eigen::Matrix3d::Identity();
+      noise.block<3, 3>(o, o) = R_NE * sppVel->velocity.covariance * R_NE.transpose() + 0.0025 * Eigen::Matrix3d::Identity();
     }
     if (!phase.empty()) {
       const Eigen::Index o = static_cast<Eigen::Index>(diag.size());

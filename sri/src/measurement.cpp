@@ -161,36 +161,39 @@ int Measurement<Scalar>::projectNuisance() {
     return m;
   }
   // Zero the nuisance column j below row j, from the bottom up, with rotations of adjacent rows;
-  // the rows j+1.. of the nuisance columns then span its left null space.
-  auto rotate = [](auto&& M, int a, int b, Scalar c, Scalar s) {
-    for (Eigen::Index col = 0; col < M.cols(); ++col) {
-      const Scalar x = M(a, col);
-      const Scalar y = M(b, col);
-      M(a, col) = c * x + s * y;
-      M(b, col) = c * y - s * x;
-    }
-  };
+  // the rows j+1.. of the nuisance columns then span its left null space. The rotations run on
+  // a row-major copy of [nuisance H r] (contiguous rows instead of strided column-major ones;
+  // the same operations element by element); columns < j of the nuisance are already zero in
+  // both rows and are skipped.
+  const int p = static_cast<int>(H_.cols());
+  const int w = q + p + 1;
+  RowMatrix<Scalar>& A = work_;
+  A.resize(m, w);
+  A.leftCols(q) = nuisance_;
+  A.middleCols(q, p) = H_;
+  A.col(q + p) = residual_;
   for (int j = 0; j < q; ++j) {
+    const int len = w - j;
     for (int i = m - 1; i > j; --i) {
-      const Scalar b = nuisance_(i, j);
+      Scalar* yrow = A.row(i).data() + j;
+      const Scalar b = yrow[0];
       if (b == Scalar(0)) continue;
-      const Scalar a = nuisance_(i - 1, j);
+      Scalar* xrow = A.row(i - 1).data() + j;
+      const Scalar a = xrow[0];
       const Scalar rho = std::hypot(a, b);
       const Scalar c = a / rho;
       const Scalar s = b / rho;
-      rotate(nuisance_, i - 1, i, c, s);
-      rotate(H_, i - 1, i, c, s);
-      const Scalar x = residual_(i - 1);
-      const Scalar y = residual_(i);
-      residual_(i - 1) = c * x + s * y;
-      residual_(i) = c * y - s * x;
+      for (int col = 0; col < len; ++col) {
+        const Scalar x = xrow[col];
+        const Scalar y = yrow[col];
+        xrow[col] = c * x + s * y;
+        yrow[col] = c * y - s * x;
+      }
     }
   }
   const int keep = m - q;
-  Matrix H = H_.bottomRows(keep);
-  Vector r = residual_.tail(keep);
-  H_ = std::move(H);
-  residual_ = std::move(r);
+  H_ = A.bottomRows(keep).middleCols(q, p);
+  residual_ = A.bottomRows(keep).col(q + p);
   nuisance_.resize(keep, 0);
   return q;
 }

@@ -216,8 +216,12 @@ GVINS_SRI_INLINE void householderImpl(RowMatrixView<Scalar> R, VectorView<Scalar
   // Narrow panels: the panel's columns of W are copied to a contiguous column-major block,
   // its reflectors broadcast to SIMD vectors for the register-blocked kernel.
   constexpr int L = B / static_cast<int>(sizeof(Scalar));
-  std::vector<Scalar> vc(static_cast<std::size_t>(kFusedPanel * m));
-  std::vector<Scalar> vb(static_cast<std::size_t>(kFusedPanel * m * L));
+  // Per-thread panel buffers, grown on demand and not cleared: every entry that is read was
+  // written first (rows < a of the panel). Saves an allocation and its zero fill per update.
+  static thread_local std::vector<Scalar> vc;
+  static thread_local std::vector<Scalar> vb;
+  if (vc.size() < static_cast<std::size_t>(kFusedPanel * m)) vc.resize(static_cast<std::size_t>(kFusedPanel * m));
+  if (vb.size() < static_cast<std::size_t>(kFusedPanel * m * L)) vb.resize(static_cast<std::size_t>(kFusedPanel * m * L));
   Scalar* vbp = vb.data();
   int a = 0;  // active rows: lead < end of the panel
   for (int j0 = lead[0]; j0 < k;) {

@@ -490,6 +490,13 @@ UpdateResult<Scalar> SriFilter<Scalar>::update(const Measurement<Scalar>& m,
     }
   }
   result.scheme = scheme;
+  bool gated = std::isfinite(options.max_chi2) && k > 0 && rows > 0;
+  for (int j = c0; j < n_ && gated; ++j) gated = rowPtr(j)[j] != Scalar(0);
+  if (gated) {
+    gate_backup_.resize(k, k + 1);
+    gate_backup_.leftCols(k) = view(c0, c0, k, k);
+    gate_backup_.col(k) = rview(c0, k);
+  }
   if (k > 0 && rows > 0) {
     if (scheme == RotationScheme::kGivens) {
       givensRowUpdate<Scalar>(view(c0, c0, k, k), rview(c0, k), W, z, lead_);
@@ -498,6 +505,11 @@ UpdateResult<Scalar> SriFilter<Scalar>::update(const Measurement<Scalar>& m,
     }
   }
   result.chi2 = z.squaredNorm() + m.discardedChiSquare();
+  if (gated && static_cast<double>(result.chi2) > options.max_chi2) {
+    view(c0, c0, k, k) = gate_backup_.leftCols(k);
+    rview(c0, k) = gate_backup_.col(k);
+    result.applied = false;
+  }
   return result;
 }
 
@@ -552,6 +564,21 @@ std::optional<ChiSquare<Scalar>> SriFilter<Scalar>::chiSquare(const Measurement<
     Rt->transpose().template triangularView<Eigen::Lower>().solveInPlace(Yt);
     // Predicted residual z' = z − J R⁻¹ r.
     zp.noalias() -= Yt.transpose() * rt;
+    if (rows > k && k > 0) {
+      // Many rows on few columns (e.g. a GNSS epoch: 130 rows on 28 columns): the same χ² in
+      // the k-dimensional form min_x ‖x‖² + ‖Y x − z'‖² = z'ᵀ (I + YYᵀ)⁻¹ z', i.e. the rows
+      // [Y z'] applied to a unit prior and the post-fit ‖e‖², O(rows·k²) instead of O(k·rows²).
+      RowMatrix<Scalar> I = RowMatrix<Scalar>::Identity(k, k);
+      Vector ri = Vector::Zero(k);
+      RowMatrix<Scalar> W = Yt.transpose();
+      std::vector<int> lead(static_cast<std::size_t>(rows), 0);
+      householderRowUpdate<Scalar>(RowMatrixView<Scalar>(I.data(), k, k, Eigen::OuterStride<>(k)),
+                                   VectorView<Scalar>(ri.data(), k),
+                                   RowMatrixView<Scalar>(W.data(), rows, k, Eigen::OuterStride<>(k)),
+                                   VectorView<Scalar>(zp.data(), rows), lead);
+      out.value = zp.squaredNorm() + m.discardedChiSquare();
+      return out;
+    }
     // χ² = z'ᵀ (I + YYᵀ)⁻¹ z' with UᵀU = I + YYᵀ: QR of the rows of Yᵀ stacked under the
     // identity (qr_update.hpp), then w = U⁻ᵀ z' by forward substitution.
     RowMatrix<Scalar> U = RowMatrix<Scalar>::Identity(rows, rows);

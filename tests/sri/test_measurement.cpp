@@ -228,6 +228,96 @@ TEST(Measurement, ChiSquareAgainstCovarianceFormula) {
   EXPECT_EQ(f.squareRootInformation(), R0);
 }
 
+// More rows than touched columns (a GNSS epoch: many satellites on a few trailing blocks) takes
+// the k-dimensional form of the χ²; same value as the covariance formula, double and float.
+TEST(Measurement, ChiSquareManyRowsOnFewColumns) {
+  std::mt19937 rng(11);
+  SriFilter<double> fd;
+  SriFilter<float> ff;
+  std::vector<BlockId> idd, idf;
+  for (int i = 0; i < 4; ++i) {
+    const Md L = randm(rng, 5, 3);
+    idd.push_back(fd.addBlock(BlockSpec::vector("x", 3), BlockEstimate<double>::zero(BlockKind::kVector, 3),
+                              Prior<double>::sqrtInformation(L)));
+    idf.push_back(ff.addBlock(BlockSpec::vector("x", 3), BlockEstimate<float>::zero(BlockKind::kVector, 3),
+                              Prior<float>::sqrtInformation(L.cast<float>())));
+  }
+  const Vd r0 = randm(rng, 12, 1);
+  fd.rawResidual() = r0;
+  ff.rawResidual() = r0.cast<float>();
+  const Md P = fd.fullCovariance();
+  const Vd mean = fd.solve();
+  constexpr int m = 40;  // rows on the 6 columns of the last two blocks
+  const Md H2 = randm(rng, m, 3), H3 = randm(rng, m, 3);
+  const Vd res = randm(rng, m, 1);
+  Md H = Md::Zero(m, 12);
+  H.middleCols(6, 3) = H2 / 0.3;
+  H.middleCols(9, 3) = H3 / 0.3;
+  const Vd nu = res / 0.3 - H * mean;
+  const Md S = H * P * H.transpose() + Md::Identity(m, m);
+  const double expect = nu.dot(S.ldlt().solve(nu));
+  Measurement<double> zd(m);
+  zd.jacobian(idd[2], 3) = H2;
+  zd.jacobian(idd[3], 3) = H3;
+  zd.residual() = res;
+  zd.whitenStdDev(0.3);
+  const auto cd = fd.chiSquare(zd);
+  ASSERT_TRUE(cd.has_value());
+  EXPECT_NEAR(cd->value, expect, 1e-10 * expect);
+  EXPECT_EQ(cd->dof, m);
+  Measurement<float> zf(m);
+  zf.jacobian(idf[2], 3) = H2.cast<float>();
+  zf.jacobian(idf[3], 3) = H3.cast<float>();
+  zf.residual() = res.cast<float>();
+  zf.whitenStdDev(0.3f);
+  const auto cf = ff.chiSquare(zf);
+  ASSERT_TRUE(cf.has_value());
+  EXPECT_NEAR(cf->value, expect, 1e-4 * expect);
+  // The update's post-fit ‖e‖² is the same χ².
+  EXPECT_NEAR(fd.update(zd).chi2, expect, 1e-10 * expect);
+}
+
+// UpdateOptions::max_chi2: rows whose χ² exceeds it leave [R r] exactly as it was; below it the
+// update is the ungated one.
+TEST(Measurement, GatedUpdateRestoresOnReject) {
+  std::mt19937 rng(12);
+  SriFilter<double> f, g;
+  std::vector<BlockId> ids, idg;
+  for (int i = 0; i < 3; ++i) {
+    const Md L = randm(rng, 4, 3);
+    ids.push_back(f.addBlock(BlockSpec::vector("x", 3), BlockEstimate<double>::zero(BlockKind::kVector, 3),
+                             Prior<double>::sqrtInformation(L)));
+    idg.push_back(g.addBlock(BlockSpec::vector("x", 3), BlockEstimate<double>::zero(BlockKind::kVector, 3),
+                             Prior<double>::sqrtInformation(L)));
+  }
+  auto rowsOn = [&](const std::vector<BlockId>& b, double scale) {
+    Measurement<double> z(10);
+    std::mt19937 r2(3);
+    z.jacobian(b[1], 3) = randm(r2, 10, 3);
+    z.jacobian(b[2], 3) = randm(r2, 10, 3);
+    z.residual() = scale * randm(r2, 10, 1);
+    z.whitenStdDev(0.5);
+    return z;
+  };
+  const Md R0 = f.squareRootInformation();
+  const Vd r0 = f.rawResidual();
+  const Measurement<double> big = rowsOn(ids, 100.0);
+  const double chi2 = f.chiSquare(big)->value;
+  UpdateOptions opt;
+  opt.max_chi2 = 0.5 * chi2;
+  const auto rej = f.update(big, opt);
+  EXPECT_FALSE(rej.applied);
+  EXPECT_NEAR(rej.chi2, chi2, 1e-9 * chi2);
+  EXPECT_EQ(f.squareRootInformation(), R0);
+  EXPECT_EQ(f.rawResidual(), r0);
+  opt.max_chi2 = 2.0 * chi2;
+  const auto acc = f.update(big, opt);
+  EXPECT_TRUE(acc.applied);
+  g.update(rowsOn(idg, 100.0));
+  EXPECT_EQ(f.squareRootInformation(), g.squareRootInformation());
+  EXPECT_EQ(f.rawResidual(), g.rawResidual());
+}
+
 TEST(Measurement, ErrorsAreReported) {
   SriFilter<double> f;
   const BlockId x = f.addBlock(BlockSpec::vector("x", 2), BlockEstimate<double>::zero(BlockKind::kVector, 2),

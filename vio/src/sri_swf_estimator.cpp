@@ -1260,19 +1260,15 @@ std::optional<sri::ChiSquare<Scalar>> SriSwfEstimator<Scalar>::chiSquare(const s
 template <typename Scalar>
 BackendUpdate<Scalar> SriSwfEstimator<Scalar>::update(const sri::Measurement<Scalar>& m, double gate_probability) {
   BackendUpdate<Scalar> out;
-  if (gate_probability < 1.0) {
-    const auto c = impl_->f.chiSquare(m);
-    if (c) {
-      out.chi2 = c->value;
-      out.dof = c->dof;
-      if (static_cast<double>(c->value) > sri::chiSquareQuantile(gate_probability, c->dof)) return out;
-    }
-  }
-  const sri::UpdateResult<Scalar> u = impl_->f.update(m);
-  if (gate_probability >= 1.0 || out.dof == 0) {
-    out.chi2 = u.chi2;
-    out.dof = u.dof;
-  }
+  // The gate is the update's own post-fit χ² (undone if too large, sri::UpdateOptions::max_chi2):
+  // for rows on the trailing blocks (GNSS) a copy of that block instead of chiSquare()'s solves.
+  sri::UpdateOptions opt;
+  const int dof = m.rows() + m.discardedRows();
+  if (gate_probability < 1.0 && dof > 0) opt.max_chi2 = sri::chiSquareQuantile(gate_probability, dof);
+  const sri::UpdateResult<Scalar> u = impl_->f.update(m, opt);
+  out.chi2 = u.chi2;
+  out.dof = u.dof;
+  if (!u.applied) return out;
   impl_->f.correct();
   out.applied = true;
   return out;

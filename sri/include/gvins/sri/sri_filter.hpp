@@ -50,6 +50,7 @@
 // docs/vio_estimator.md, "Float").
 #pragma once
 
+#include <limits>
 #include <optional>
 #include <span>
 #include <vector>
@@ -80,6 +81,12 @@ struct SriOptions {
 
 struct UpdateOptions {
   RotationScheme scheme = RotationScheme::kAuto;
+  /// Innovation gate: when the rows' χ² (the post-fit ‖e‖² of the update, = the χ² of
+  /// chiSquare()) exceeds this, the update is undone (the touched trailing block of [R r] is
+  /// restored) and UpdateResult::applied is false. Not applied when a touched column has no
+  /// information (zero pivot), as chiSquare() has no value then. Costs one copy of the trailing
+  /// block instead of chiSquare()'s solves.
+  double max_chi2 = std::numeric_limits<double>::infinity();
 };
 
 template <typename Scalar>
@@ -87,6 +94,7 @@ struct UpdateResult {
   Scalar chi2 = 0;  ///< Post-fit residual ‖e‖² of the rows, = innovation Mahalanobis distance.
   int dof = 0;      ///< Rows (including rows removed by Measurement::compress).
   RotationScheme scheme = RotationScheme::kBlockedHouseholder;  ///< Scheme used.
+  bool applied = true;  ///< False if UpdateOptions::max_chi2 rejected the rows.
 };
 
 template <typename Scalar>
@@ -218,6 +226,7 @@ class SriFilter {
   int n_ = 0;
   // Update workspace.
   RowMatrix<Scalar> work_;
+  RowMatrix<Scalar> gate_backup_;  // update(): trailing [R r] while max_chi2 is tested
   Vector work_z_;
   std::vector<int> lead_;
 };
