@@ -8,6 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "gvins/base/parse_error.hpp"
+#include "gvins/base/yaml_reader.hpp"
 #include "gvins/gnss/spp_config.hpp"
 
 namespace gvins {
@@ -28,86 +29,7 @@ const char* toString(RtkDynamics d) { return d == RtkDynamics::RandomWalk ? "ran
 
 namespace {
 
-/// Typed access to YAML nodes with errors that name file, line and key (the SPP options reader's
-/// approach).
-class Reader {
- public:
-  explicit Reader(std::string file) : file_(std::move(file)) {}
-
-  [[noreturn]] void fail(const YAML::Node& n, const std::string& key, const std::string& what) const {
-    const auto m = n.Mark();
-    throw ParseError(file_, m.line >= 0 ? m.line + 1 : 0, key, what);
-  }
-  template <class T>
-  T get(const YAML::Node& n, const std::string& key) const {
-    try {
-      return n.as<T>();
-    } catch (const YAML::Exception&) {
-      fail(n, key, "wrong type for '" + key + "'");
-    }
-  }
-  double number(const YAML::Node& n, const std::string& key, double lo, double hi) const {
-    if (!n.IsScalar()) fail(n, key, "'" + key + "' must be a number");
-    const double v = get<double>(n, key);
-    if (!(v >= lo && v <= hi)) {
-      std::ostringstream os;
-      os << "'" << key << "' = " << v << " is outside [" << lo << ", " << hi << "]";
-      fail(n, key, os.str());
-    }
-    return v;
-  }
-  int integer(const YAML::Node& n, const std::string& key, int lo, int hi) const {
-    if (!n.IsScalar()) fail(n, key, "'" + key + "' must be an integer");
-    const int v = get<int>(n, key);
-    if (v < lo || v > hi) {
-      fail(n, key, "'" + key + "' = " + std::to_string(v) + " is outside [" + std::to_string(lo) + ", " +
-                       std::to_string(hi) + "]");
-    }
-    return v;
-  }
-  bool boolean(const YAML::Node& n, const std::string& key) const {
-    if (!n.IsScalar()) fail(n, key, "'" + key + "' must be true or false");
-    return get<bool>(n, key);
-  }
-  std::string text(const YAML::Node& n, const std::string& key) const {
-    if (!n.IsScalar()) fail(n, key, "'" + key + "' must be a string");
-    return get<std::string>(n, key);
-  }
-  std::string key(const YAML::Node& k, const std::string& where) const {
-    if (!k.IsScalar()) fail(k, where, "keys of '" + where + "' must be plain names");
-    return k.Scalar();
-  }
-  template <class F>
-  void map(const YAML::Node& n, const std::string& where, const std::set<std::string>& known, F&& f) const {
-    if (!n.IsMap()) fail(n, where, "'" + where + "' must be a map");
-    for (auto it = n.begin(); it != n.end(); ++it) {
-      const std::string k = key(it->first, where);
-      const std::string full = where.empty() ? k : where + "." + k;
-      if (!known.count(k)) fail(it->first, full, "unknown key '" + full + "'");
-      f(k, full, it->second);
-    }
-  }
-  template <class F>
-  void perSystem(const YAML::Node& n, const std::string& where, F&& f) const {
-    if (!n.IsMap()) fail(n, where, "'" + where + "' must be a map of system letters");
-    for (auto it = n.begin(); it != n.end(); ++it) {
-      const std::string k = key(it->first, where);
-      const auto s = k.size() == 1 ? systemFromLetter(k[0]) : std::nullopt;
-      if (!s) fail(it->first, where + "." + k, "unknown system '" + k + "' (use G R E C J S I)");
-      f(*s, where + "." + k, it->second);
-    }
-  }
-  std::array<bool, kNumSystems> systems(const YAML::Node& n, const std::string& key) const {
-    try {
-      return parseSystemLetters(text(n, key));
-    } catch (const std::invalid_argument& e) {
-      fail(n, key, e.what());
-    }
-  }
-
- private:
-  std::string file_;
-};
+using Reader = YamlReader;  // base/yaml_reader.hpp
 
 void applyAr(const Reader& r, const YAML::Node& v, const std::string& where, RtkConfig& c) {
   static const std::set<std::string> kKeys = {
