@@ -365,9 +365,9 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
     rowVector(r, HJ.row(i).head(dim));
     HJ.row(i).tail<9>() = r.H_earlier;
   }
-  Eigen::VectorXd s2(nr);
+  Eigen::VectorXd gateVar(nr);  // σ² + J Σ_k Jᵀ + h P hᵀ per row
   if (haveP) {
-    s2 = (HJ.leftCols(dim) * P).cwiseProduct(HJ.leftCols(dim)).rowwise().sum() +
+    gateVar = (HJ.leftCols(dim) * P).cwiseProduct(HJ.leftCols(dim)).rowwise().sum() +
          (HJ.rightCols<9>() * intCov).cwiseProduct(HJ.rightCols<9>()).rowwise().sum() + noise.diagonal();
   }
   std::vector<int> keep;
@@ -375,7 +375,7 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
     const GnssRow& r = rows[i];
     if (!std::isfinite(r.residual)) continue;
     if (haveP) {
-      const double v = s2[static_cast<Eigen::Index>(i)];
+      const double v = gateVar[static_cast<Eigen::Index>(i)];
       if (!(v > 0.0) || r.residual * r.residual > q1 * v) continue;
     }
     keep.push_back(static_cast<int>(i));

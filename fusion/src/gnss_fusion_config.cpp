@@ -98,7 +98,8 @@ GnssFusionConfig parseGnssFusionConfig(std::string_view yaml, const std::string&
     } else if (key == "systems") {
       c.systems = rd.systems(v, f);
     } else if (key == "elevation_mask_deg") {
-      c.elevationMaskDeg = rd.number(v, f, 0.0, 89.999);
+      c.elevationMaskDeg = rd.number(v, f, 0.0, 90.0);
+      if (!(c.elevationMaskDeg < 90.0)) rd.fail(v, f, "'" + f + "' must be below 90");
     } else if (key == "ionosphere") {
       c.ionosphere = rd.choice(v, f, {"broadcast", "dual-frequency"}) == "broadcast" ? GnssIonosphere::kBroadcast
                                                                                       : GnssIonosphere::kDualFrequency;

@@ -164,10 +164,11 @@ int Measurement<Scalar>::projectNuisance() {
   // the rows j+1.. of the nuisance columns then span its left null space. The rotations run on
   // a row-major copy of [nuisance H r] (contiguous rows instead of strided column-major ones;
   // the same operations element by element); columns < j of the nuisance are already zero in
-  // both rows and are skipped.
+  // both rows and are skipped. The copy is a per-thread buffer (not a member: measurements are
+  // copied when stacked, and a member buffer would be copied with them).
   const int p = static_cast<int>(H_.cols());
   const int w = q + p + 1;
-  RowMatrix<Scalar>& A = work_;
+  static thread_local RowMatrix<Scalar> A;
   A.resize(m, w);
   A.leftCols(q) = nuisance_;
   A.middleCols(q, p) = H_;

@@ -490,9 +490,10 @@ UpdateResult<Scalar> SriFilter<Scalar>::update(const Measurement<Scalar>& m,
     }
   }
   result.scheme = scheme;
-  bool gated = std::isfinite(options.max_chi2) && k > 0 && rows > 0;
+  bool gated = std::isfinite(options.max_chi2);
   for (int j = c0; j < n_ && gated; ++j) gated = rowPtr(j)[j] != Scalar(0);
-  if (gated) {
+  const bool backup = gated && k > 0 && rows > 0;  // rows touching no column change nothing
+  if (backup) {
     gate_backup_.resize(k, k + 1);
     gate_backup_.leftCols(k) = view(c0, c0, k, k);
     gate_backup_.col(k) = rview(c0, k);
@@ -506,8 +507,10 @@ UpdateResult<Scalar> SriFilter<Scalar>::update(const Measurement<Scalar>& m,
   }
   result.chi2 = z.squaredNorm() + m.discardedChiSquare();
   if (gated && static_cast<double>(result.chi2) > options.max_chi2) {
-    view(c0, c0, k, k) = gate_backup_.leftCols(k);
-    rview(c0, k) = gate_backup_.col(k);
+    if (backup) {
+      view(c0, c0, k, k) = gate_backup_.leftCols(k);
+      rview(c0, k) = gate_backup_.col(k);
+    }
     result.applied = false;
   }
   return result;

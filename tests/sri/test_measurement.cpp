@@ -27,6 +27,13 @@ Md randm(std::mt19937& rng, int r, int c) {
   return m;
 }
 
+// A 3-vector block "x" at zero with the square-root information prior `sqrtInfo` (rows × 3).
+template <typename S>
+BlockId addVector3(SriFilter<S>& f, const Md& sqrtInfo) {
+  return f.addBlock(BlockSpec::vector("x", 3), BlockEstimate<S>::zero(BlockKind::kVector, 3),
+                    Prior<S>::sqrtInformation(sqrtInfo.cast<S>()));
+}
+
 TEST(Measurement, WhiteningVariants) {
   std::mt19937 rng(1);
   const int m = 4;
@@ -192,8 +199,7 @@ TEST(Measurement, ChiSquareAgainstCovarianceFormula) {
   SriFilter<double> f;
   std::vector<BlockId> ids;
   for (int i = 0; i < 4; ++i) {
-    ids.push_back(f.addBlock(BlockSpec::vector("x", 3), BlockEstimate<double>::zero(BlockKind::kVector, 3),
-                             Prior<double>::sqrtInformation(randm(rng, 5, 3))));
+    ids.push_back(addVector3(f, randm(rng, 5, 3)));
   }
   // A prior offset (r ≠ 0): the predicted residual must account for it.
   f.rawResidual() = randm(rng, 12, 1);
@@ -237,10 +243,8 @@ TEST(Measurement, ChiSquareManyRowsOnFewColumns) {
   std::vector<BlockId> idd, idf;
   for (int i = 0; i < 4; ++i) {
     const Md L = randm(rng, 5, 3);
-    idd.push_back(fd.addBlock(BlockSpec::vector("x", 3), BlockEstimate<double>::zero(BlockKind::kVector, 3),
-                              Prior<double>::sqrtInformation(L)));
-    idf.push_back(ff.addBlock(BlockSpec::vector("x", 3), BlockEstimate<float>::zero(BlockKind::kVector, 3),
-                              Prior<float>::sqrtInformation(L.cast<float>())));
+    idd.push_back(addVector3(fd, L));
+    idf.push_back(addVector3(ff, L));
   }
   const Vd r0 = randm(rng, 12, 1);
   fd.rawResidual() = r0;
@@ -285,10 +289,8 @@ TEST(Measurement, GatedUpdateRestoresOnReject) {
   std::vector<BlockId> ids, idg;
   for (int i = 0; i < 3; ++i) {
     const Md L = randm(rng, 4, 3);
-    ids.push_back(f.addBlock(BlockSpec::vector("x", 3), BlockEstimate<double>::zero(BlockKind::kVector, 3),
-                             Prior<double>::sqrtInformation(L)));
-    idg.push_back(g.addBlock(BlockSpec::vector("x", 3), BlockEstimate<double>::zero(BlockKind::kVector, 3),
-                             Prior<double>::sqrtInformation(L)));
+    ids.push_back(addVector3(f, L));
+    idg.push_back(addVector3(g, L));
   }
   auto rowsOn = [&](const std::vector<BlockId>& b, double scale) {
     Measurement<double> z(10);

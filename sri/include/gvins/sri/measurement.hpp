@@ -104,7 +104,6 @@ class Measurement {
 
   Matrix H_;         // rows × Σ block dims
   Matrix nuisance_;  // rows × nuisance dim
-  Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> work_;  // projectNuisance
   Vector residual_;
   std::vector<Entry> blocks_;
   bool whitened_ = false;

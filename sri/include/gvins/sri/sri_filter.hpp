@@ -83,9 +83,10 @@ struct UpdateOptions {
   RotationScheme scheme = RotationScheme::kAuto;
   /// Innovation gate: when the rows' χ² (the post-fit ‖e‖² of the update, = the χ² of
   /// chiSquare()) exceeds this, the update is undone (the touched trailing block of [R r] is
-  /// restored) and UpdateResult::applied is false. Not applied when a touched column has no
-  /// information (zero pivot), as chiSquare() has no value then. Costs one copy of the trailing
-  /// block instead of chiSquare()'s solves.
+  /// restored) and UpdateResult::applied is false. Not applied when a column from the first one
+  /// the rows touch onwards has no information (zero pivot; chiSquare() has no value when such a
+  /// column is touched or coupled). Costs one copy of the trailing block instead of
+  /// chiSquare()'s solves.
   double max_chi2 = std::numeric_limits<double>::infinity();
 };
 
