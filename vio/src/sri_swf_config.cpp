@@ -38,6 +38,7 @@ void SriSwfConfig::validate() const {
   req(chi2_probability > 0, "chi2_probability must be > 0 (>= 1 disables the gate)");
   req(max_msckf_per_frame >= 0, "max_msckf_per_frame must be >= 0");
   req(reanchor_sigma > 0, "reanchor_sigma must be positive");
+  req(position_random_walk >= 0 && std::isfinite(position_random_walk), "position_random_walk must be >= 0");
   req(zero_velocity_sigma > 0, "zero_velocity_sigma must be positive");
   req(first_estimate_delay >= 0, "first_estimate_delay must not be negative");
   req(init_window > 0.05 && init_window <= 30, "init.window must be in (0.05, 30] s");
@@ -149,6 +150,7 @@ SriSwfConfig parseRoot(const YAML::Node& root, const Ctx& c) {
       {"chi2_probability", d(cfg.chi2_probability, "chi2_probability")},
       {"max_msckf_per_frame", i(cfg.max_msckf_per_frame, "max_msckf_per_frame")},
       {"reanchor_sigma", d(cfg.reanchor_sigma, "reanchor_sigma")},
+      {"position_random_walk", d(cfg.position_random_walk, "position_random_walk")},
       {"zero_velocity_update", b(cfg.zero_velocity_update, "zero_velocity_update")},
       {"zero_velocity_sigma", d(cfg.zero_velocity_sigma, "zero_velocity_sigma")},
       {"first_estimate_jacobians", b(cfg.first_estimate_jacobians, "first_estimate_jacobians")},

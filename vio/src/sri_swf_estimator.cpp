@@ -431,6 +431,10 @@ struct SriSwfEstimator<Scalar>::Impl {
       }
     }
     Qd.diagonal().array() += 1e-14;  // keeps Q' positive definite for back-to-back frames
+    // Position random walk (SriSwfConfig::position_random_walk): white velocity noise of q m²/s
+    // on the position rows, q·Δt per step, so it does not depend on how the interval is split.
+    const double q_p = cfg.position_random_walk * cfg.position_random_walk * static_cast<double>(t - t_newest) * 1e-9;
+    for (int i = 3; i < 6; ++i) Qd(i, i) += q_p;
     sri::Propagation<Scalar> step;
     step.addNewBlock(BlockSpec::pose("imu_pose"), poseEstimate<Scalar>(s.R_WI, s.p_WI), Placement::after(newest.pose));
     Eigen::Matrix<double, 9, 1> x;
