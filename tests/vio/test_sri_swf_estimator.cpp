@@ -447,13 +447,15 @@ TEST(SriSwfBackend, ClientBlocksPropagateMarginalizeAndGatedUpdate) {
 TEST(SriSwfConfig, YamlValuesAndErrorsNameLineAndField) {
   const std::string dir = std::string(GVINS_TEST_DATA) + "/euroc/v101_static_stereo/mav0";
   const std::string text =
-      "window: 9\nmax_slam_features: 30\npixel_noise: 0.7\nprecision: float\ninit:\n  window: 0.8\n"
+      "window: 9\nmax_slam_features: 30\npixel_noise: 0.7\nprecision: float\nposition_random_walk: 0.002\n"
+      "init:\n  window: 0.8\n"
       "cameras: [cam0/sensor.yaml, cam1/sensor.yaml]\nimu_yaml: imu0/sensor.yaml\n";
   const SriSwfConfig c = parseSriSwfConfig(text, "cfg.yaml", dir);
   EXPECT_EQ(c.window, 9);
   EXPECT_EQ(c.max_slam_features, 30);
   EXPECT_DOUBLE_EQ(c.pixel_noise, 0.7);
   EXPECT_TRUE(c.use_float);
+  EXPECT_DOUBLE_EQ(c.position_random_walk, 0.002);
   EXPECT_DOUBLE_EQ(c.init_window, 0.8);
   ASSERT_EQ(c.cameras.size(), 2u);
   EXPECT_DOUBLE_EQ(c.cameras[0].intrinsics.fx, 458.654);
@@ -474,6 +476,7 @@ TEST(SriSwfConfig, YamlValuesAndErrorsNameLineAndField) {
   expectError("cameras: [cam0/sensor.yaml]\nprecision: half\n", 2, "precision");
   expectError("window: 5\n", 1, "cameras");
   expectError("cameras: [cam0/sensor.yaml]\nwindow: 1\n", 1, "window");
+  expectError("cameras: [cam0/sensor.yaml]\nposition_random_walk: -1e-3\n", 1, "position_random_walk");
 }
 
 // ------------------------------------------------------------------ real data
