@@ -424,17 +424,16 @@ struct SriSwfEstimator<Scalar>::Impl {
     ImuState s = newestState();
     Matrix15d Phi, Qd;
     prop.propagate(s, imuSpan(), t, &Phi, &Qd);
+    const double dt = static_cast<double>(t - t_newest) * 1e-9;
     if (cfg.first_estimate_jacobians) {
       if (auto it = fe_pose.find(newest.pose.value); it != fe_pose.end()) {
-        applyFirstEstimates(Phi, it->second.R_WI, it->second.p_WI, fe_v, s.p_WI, s.v_WI,
-                            static_cast<double>(t - t_newest) * 1e-9, cfg.gravity);
+        applyFirstEstimates(Phi, it->second.R_WI, it->second.p_WI, fe_v, s.p_WI, s.v_WI, dt, cfg.gravity);
       }
     }
     Qd.diagonal().array() += 1e-14;  // keeps Q' positive definite for back-to-back frames
     // Position random walk (SriSwfConfig::position_random_walk): white velocity noise of q m²/s
     // on the position rows, q·Δt per step, so it does not depend on how the interval is split.
-    const double q_p = cfg.position_random_walk * cfg.position_random_walk * static_cast<double>(t - t_newest) * 1e-9;
-    for (int i = 3; i < 6; ++i) Qd(i, i) += q_p;
+    Qd.diagonal().segment<3>(3).array() += cfg.position_random_walk * cfg.position_random_walk * dt;
     sri::Propagation<Scalar> step;
     step.addNewBlock(BlockSpec::pose("imu_pose"), poseEstimate<Scalar>(s.R_WI, s.p_WI), Placement::after(newest.pose));
     Eigen::Matrix<double, 9, 1> x;
