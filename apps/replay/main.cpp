@@ -1,5 +1,6 @@
 // gvins-replay: runs the SRI-GVINS pipeline (front end thread, SRI-SWF estimator, optional GNSS
 // fusion) over a dataset folder and writes trajectories, covariances, timing and GNSS outputs.
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -46,6 +47,12 @@ const char* kUsage =
     "  --lever-arm X,Y,Z      initial GNSS lever arm ^I p_r, m (default: the config, else\n"
     "                         lever_arm_m of a gvins-sim dataset.yaml, which is also the truth\n"
     "                         for the lever-arm error in the summary)\n"
+    "  --time-offset-calib on|off  estimate the camera-IMU time offset online (default: the\n"
+    "                         estimator config, else off)\n"
+    "  --time-offset S        camera-IMU time offset t_d (s, t_imu = t_cam + t_d): the value used,\n"
+    "                         or the start value when calibrating (default: the estimator config,\n"
+    "                         else 0; a gvins-sim dataset's cameras.time_offset_s is the truth for\n"
+    "                         the time-offset error in the summary)\n"
     "  --rover F --base F --nav F   GNSS files (default DATASET/gnss/rover.obs, base.obs, nav file)\n"
     "  --base-position X,Y,Z  base antenna ECEF (default: base.obs header)\n"
     "  --sensor-to-gpst NS    GPST ns = sensor stamp + NS (default 0: gvins-sim datasets are GPST)\n"
@@ -88,7 +95,8 @@ ReplaySummary run(const std::string& dataset, const vio::SriSwfConfig& ec, const
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string dataset, outDir, configPath, mode = "vio", leverCalib;
+  std::string dataset, outDir, configPath, mode = "vio", leverCalib, timeCalib;
+  std::optional<double> timeOffset;
   bool useFloat = false, quiet = false, images = false, noEval = false, skipBad = false, skipMissing = false;
   std::optional<double> start, duration, maxGap;
   std::optional<std::string> gapPolicy, rover, base, nav;
@@ -110,6 +118,12 @@ int main(int argc, char** argv) {
     else if (a == "--lever-arm-calib") {
       leverCalib = value();
       if (leverCalib != "on" && leverCalib != "off") usageError("--lever-arm-calib takes on or off");
+    } else if (a == "--time-offset-calib") {
+      timeCalib = value();
+      if (timeCalib != "on" && timeCalib != "off") usageError("--time-offset-calib takes on or off");
+    } else if (a == "--time-offset") {
+      timeOffset = toNumber(value(), a);
+      if (!(std::abs(*timeOffset) <= 1.0)) usageError("--time-offset must be within [-1, 1] s");
     } else if (a == "--rover") rover = value();
     else if (a == "--base") base = value();
     else if (a == "--nav") nav = value();
@@ -196,6 +210,9 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "gvins-replay: note: the dataset's IMU includes the Earth rotation, which the estimator does not model\n");
     }
     if (useFloat) ec.use_float = true;
+    if (!timeCalib.empty()) ec.calibrate_time_offset = timeCalib == "on";
+    if (timeOffset) ec.time_offset = *timeOffset;
+    if (info) opt.timeOffsetTruth = info->cameraTimeOffset;
 
     std::optional<GnssFusionConfig> gc;
     const std::optional<Eigen::Vector3d> trueLever = info ? info->leverArm : std::nullopt;

@@ -242,6 +242,9 @@ void ReplaySummary::writeMetrics(std::ostream& os) const {
   kv("lever_arm_y_m", l.y());
   kv("lever_arm_z_m", l.z());
   kv("lever_arm_error_m", leverArm && leverArmTruth ? (*leverArm - *leverArmTruth).norm() : kNaN);
+  kv("time_offset_ms", timeOffset ? *timeOffset * 1e3 : kNaN);
+  kv("time_offset_sigma_ms", timeOffsetSigma ? *timeOffsetSigma * 1e3 : kNaN);
+  kv("time_offset_error_ms", timeOffset && timeOffsetTruth ? (*timeOffset - *timeOffsetTruth) * 1e3 : kNaN);
 }
 
 void ReplaySummary::print(std::ostream& os) const {
@@ -276,6 +279,11 @@ void ReplaySummary::print(std::ostream& os) const {
     std::string t = f("%.3f", leverArm->x()) + f(" %.3f", leverArm->y()) + f(" %.3f m", leverArm->z());
     if (leverArmTruth) t += f(" (error %.3f m)", (*leverArm - *leverArmTruth).norm());
     row("lever arm", t);
+  }
+  if (timeOffset) {
+    std::string t = f("%.3f ms", *timeOffset * 1e3) + f(" (sigma %.3f ms", timeOffsetSigma.value_or(0.0) * 1e3);
+    if (timeOffsetTruth) t += f(", error %.3f ms", (*timeOffset - *timeOffsetTruth) * 1e3);
+    row("camera-IMU time offset", t + ")");
   }
   row("dataset / wall / CPU time [s]", f("%.2f", datasetSeconds) + f(" / %.2f", wallSeconds) + f(" / %.2f", cpuSeconds));
   row("real-time factor", f("%.2fx", realTimeFactor()));
@@ -449,6 +457,7 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
 
   // Main loop.
   std::size_t imuNext = 0;
+  const std::int64_t imuLead = est.imuLeadNs();
   const std::int64_t imuStart = opt.start_s > 0.0 ? tFirst - 2'000'000'000 : imu.front().t_ns;
   while (imuNext < imu.size() && imu[imuNext].t_ns < imuStart) ++imuNext;
   std::int64_t lastImu = -1;
@@ -487,7 +496,7 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
       lastImu = s.t_ns;
       ++sum.imuSamples;
       ++imuNext;
-      if (s.t_ns >= frame->t_ns) break;
+      if (s.t_ns >= frame->t_ns + imuLead) break;
     }
     const ReplayEstimator::FrameOutcome r = est.processFrame(*frame);
     ++sum.framesProcessed;
@@ -633,6 +642,11 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
   if (firstTight >= 0 && firstT >= 0) sum.frameInitSeconds = static_cast<double>(firstTight - firstT) * 1e-9;
   if (gnss) sum.leverArm = gnss->leverArm();
   sum.leverArmTruth = opt.leverArmTruth;
+  if (const auto td = est.timeOffset()) {
+    sum.timeOffset = td->value;
+    sum.timeOffsetSigma = td->sigma;
+  }
+  sum.timeOffsetTruth = opt.timeOffsetTruth;
 
   if (opt.evaluate && ds.hasGroundTruth() && poses.size() >= 2) {
     vio::EvaluationOptions eo2;

@@ -31,6 +31,9 @@ SimDatasetInfo parseSimDatasetInfo(std::string_view yaml, const std::string& fil
     if (const YAML::Node m = g["model"]) info.gravityModel = r.choice(m, "gravity.model", {"flat", "rotating"});
     if (const YAML::Node m = g["magnitude_mps2"]) info.gravity = r.number(m, "gravity.magnitude_mps2", 9.7, 9.9);
   }
+  if (const YAML::Node c = root["cameras"]; c && c.IsMap()) {
+    if (const YAML::Node t = c["time_offset_s"]) info.cameraTimeOffset = r.number(t, "cameras.time_offset_s", -0.5, 0.5);
+  }
   return info;
 }
 

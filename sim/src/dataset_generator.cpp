@@ -204,10 +204,15 @@ GenerationSummary generateDataset(const Scenario& sc, const fs::path& dir, const
   std::vector<std::int64_t> stamps;
   std::vector<double> times;
   if (!sc.cameras.empty()) {
-    const auto nFrames = static_cast<std::size_t>(std::floor(duration * sc.cameraRate + 1e-9)) + 1;
+    // Images at true (IMU) times t_k, stamped t_k − t_d (Scenario::cameraTimeOffset); the first
+    // image is taken at the start or t_d later, so that no stamp precedes the IMU.
+    const std::int64_t td = std::llround(sc.cameraTimeOffset * 1e9);
+    const std::int64_t first = std::max<std::int64_t>(td, 0);
+    const auto nFrames =
+        static_cast<std::size_t>(std::floor((duration - static_cast<double>(first) * 1e-9) * sc.cameraRate + 1e-9)) + 1;
     for (std::size_t k = 0; k < nFrames; ++k) {
-      const std::int64_t off = std::llround(static_cast<double>(k) * 1e9 / sc.cameraRate);
-      stamps.push_back(sc.frame.startStampNs() + off);
+      const std::int64_t off = first + std::llround(static_cast<double>(k) * 1e9 / sc.cameraRate);
+      stamps.push_back(sc.frame.startStampNs() + off - td);
       times.push_back(static_cast<double>(off) * 1e-9);
     }
   }
@@ -415,7 +420,8 @@ GenerationSummary generateDataset(const Scenario& sc, const fs::path& dir, const
       f << "\n";
     }
     f << "cameras:\n  output: " << (features ? "features" : "images") << "\n  rate_hz: ";
-    f.num(sc.cameraRate) << "\n  frames: ";
+    f.num(sc.cameraRate) << "\n  time_offset_s: ";
+    f.num(sc.cameraTimeOffset) << "  # t_imu = t_cam + time_offset_s\n  frames: ";
     f.integer(static_cast<std::int64_t>(stamps.size()))
         << "\n  stamp: \"mid-exposure of the centre row\"\n  exposure_s: ";
     f.num(sc.imaging.exposure) << "\n  line_time_s: ";

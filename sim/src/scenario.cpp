@@ -298,8 +298,9 @@ vio::CameraCalibration parseCamera(const Reader& r, const YAML::Node& n, const s
 }
 
 void parseCameras(const Reader& r, const YAML::Node& n, Scenario& sc) {
-  r.map(n, "cameras", {"rate_hz", "output", "png_compression", "imaging", "features", "list"});
+  r.map(n, "cameras", {"rate_hz", "time_offset_s", "output", "png_compression", "imaging", "features", "list"});
   if (n["rate_hz"]) sc.cameraRate = r.number(n["rate_hz"], "cameras.rate_hz", 0.1, 1000.0);
+  if (n["time_offset_s"]) sc.cameraTimeOffset = r.number(n["time_offset_s"], "cameras.time_offset_s", -0.5, 0.5);
   if (n["output"]) {
     const std::string o = r.string(n["output"], "cameras.output");
     if (o != "images" && o != "features") r.fail(n["output"], "cameras.output", "expected images or features");

@@ -302,6 +302,14 @@ TEST(SensorYaml, KalibrCamchainAndImuYaml) {
   EXPECT_LT((cams[0].T_BS - c0.T_BS).norm(), 1e-12);
   EXPECT_LT((cams[1].T_BS - c1.T_BS).norm(), 1e-12);
   EXPECT_DOUBLE_EQ(cams[1].intrinsics.cx, 379.999);
+  EXPECT_EQ(cams[0].time_offset, 0.0);  // no timeshift_cam_imu
+  // Kalibr's timeshift_cam_imu (t_imu = t_cam + shift) is the camera's time offset.
+  const std::string shifted = text.substr(0, text.find("cam1:")) + "  timeshift_cam_imu: -0.0042\n";
+  EXPECT_DOUBLE_EQ(parseKalibrCamchain(shifted, "cc.yaml")[0].time_offset, -0.0042);
+  expectParseError([&] { parseKalibrCamchain(shifted.substr(0, shifted.size() - 8) + "x\n", "cc.yaml"); }, 13,
+                   "cam0.timeshift_cam_imu");
+  expectParseError([&] { parseKalibrCamchain(shifted.substr(0, shifted.size() - 8) + "3.0\n", "cc.yaml"); }, 13,
+                   "cam0.timeshift_cam_imu", "within");
   expectParseError([] { parseKalibrCamchain("cam0:\n  camera_model: pinhole\n", "cc.yaml"); }, 2, "intrinsics", "missing");
   expectParseError([] { parseKalibrCamchain("foo: 1\n", "cc.yaml"); }, 0, "cam0");
 

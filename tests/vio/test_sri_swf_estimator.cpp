@@ -91,6 +91,29 @@ TEST(SriSwfJacobians, CameraPointAndProjectionMatchFiniteDifferences) {
   }
 }
 
+// Camera-IMU time offset: the observation of a clone moved by dt along its angular rate and
+// velocity, d(x/z, y/z)/d dt against central differences in dt, at dt = 0 and at 8 ms.
+TEST(SriSwfJacobians, TimeOffsetColumnMatchesFiniteDifferences) {
+  const Geometry g;
+  const Vector3d w(0.4, -0.9, 1.3), v(7.5, -2.0, 0.6);
+  for (const double dt0 : {0.0, 0.008}) {
+    for (const CameraExtrinsic& e : {g.ext0, g.ext1}) {
+      const CameraPoint cp = cameraPoint(poseAfter(g.pose, w, v, dt0), e, g.p_W);
+      const Eigen::Vector2d J = projectionJacobian(cp.p_C) * timeOffsetJacobian(cp, w, v);
+      const double h = 1e-6;
+      const Eigen::Vector2d Jn = (project(cameraPoint(poseAfter(g.pose, w, v, dt0 + h), e, g.p_W).p_C) -
+                                  project(cameraPoint(poseAfter(g.pose, w, v, dt0 - h), e, g.p_W).p_C)) /
+                                 (2 * h);
+      ASSERT_GT(Jn.norm(), 0.01);  // the motion moves the point in the image
+      EXPECT_LT((J - Jn).norm(), 1e-6 * Jn.norm()) << "dt0 " << dt0 << ": " << J.transpose() << " vs " << Jn.transpose();
+    }
+  }
+  // poseAfter integrates a constant rate exactly: two steps equal one.
+  const PoseEstimate a = poseAfter(poseAfter(g.pose, w, v, 0.003), w, v, 0.005), b = poseAfter(g.pose, w, v, 0.008);
+  EXPECT_LT((a.R_WI - b.R_WI).norm(), 1e-12);
+  EXPECT_LT((a.p_WI - b.p_WI).norm(), 1e-12);
+}
+
 TEST(SriSwfJacobians, InverseDepthFeatureAndReanchoringMatchFiniteDifferences) {
   const Geometry g;
   const Vector3d f = inverseDepthOf(g.p_W, g.anchor, g.ext0);
@@ -448,6 +471,7 @@ TEST(SriSwfConfig, YamlValuesAndErrorsNameLineAndField) {
   const std::string dir = std::string(GVINS_TEST_DATA) + "/euroc/v101_static_stereo/mav0";
   const std::string text =
       "window: 9\nmax_slam_features: 30\npixel_noise: 0.7\nprecision: float\nposition_random_walk: 0.002\n"
+      "time_offset: -0.003\ncalibrate_time_offset: true\ntime_offset_sigma: 0.002\n"
       "init:\n  window: 0.8\n"
       "cameras: [cam0/sensor.yaml, cam1/sensor.yaml]\nimu_yaml: imu0/sensor.yaml\n";
   const SriSwfConfig c = parseSriSwfConfig(text, "cfg.yaml", dir);
@@ -457,6 +481,9 @@ TEST(SriSwfConfig, YamlValuesAndErrorsNameLineAndField) {
   EXPECT_TRUE(c.use_float);
   EXPECT_DOUBLE_EQ(c.position_random_walk, 0.002);
   EXPECT_DOUBLE_EQ(c.init_window, 0.8);
+  EXPECT_DOUBLE_EQ(c.time_offset, -0.003);
+  EXPECT_TRUE(c.calibrate_time_offset);
+  EXPECT_DOUBLE_EQ(c.time_offset_sigma, 0.002);
   ASSERT_EQ(c.cameras.size(), 2u);
   EXPECT_DOUBLE_EQ(c.cameras[0].intrinsics.fx, 458.654);
   EXPECT_DOUBLE_EQ(c.imu.gyroscope_noise_density, 1.6968e-04);
@@ -477,6 +504,9 @@ TEST(SriSwfConfig, YamlValuesAndErrorsNameLineAndField) {
   expectError("window: 5\n", 1, "cameras");
   expectError("cameras: [cam0/sensor.yaml]\nwindow: 1\n", 1, "window");
   expectError("cameras: [cam0/sensor.yaml]\nposition_random_walk: -1e-3\n", 1, "position_random_walk");
+  expectError("cameras: [cam0/sensor.yaml]\ntime_offset_sigma: 0\n", 1, "time_offset_sigma");
+  expectError("cameras: [cam0/sensor.yaml]\ntime_offset: 2.5\n", 1, "time_offset");
+  expectError("cameras: [cam0/sensor.yaml]\ntime_offset: 5ms\n", 2, "time_offset");
 }
 
 // ------------------------------------------------------------------ real data

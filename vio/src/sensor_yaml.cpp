@@ -264,6 +264,12 @@ std::vector<CameraCalibration> parseKalibrCamchain(std::string_view text, const 
       cal.T_BS.setIdentity();
       cal.T_BS.topLeftCorner<3, 3>() = T_ci.topLeftCorner<3, 3>().transpose();
       cal.T_BS.topRightCorner<3, 1>() = -T_ci.topLeftCorner<3, 3>().transpose() * T_ci.topRightCorner<3, 1>();
+      if (const YAML::Node ts = child(cn, "timeshift_cam_imu", c, false); ts.IsDefined()) {
+        cal.time_offset = scalarDouble(ts, c, key + ".timeshift_cam_imu");
+        if (!(std::abs(cal.time_offset) <= 1.0)) {
+          fail(c, lineOf(ts), key + ".timeshift_cam_imu", "must be within [-1, 1] s");
+        }
+      }
       cams.push_back(cal);
     }
     if (cams.empty()) fail(c, 0, "cam0", "no cameras (cam0, cam1, ...) in the camchain file");

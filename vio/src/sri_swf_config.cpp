@@ -49,7 +49,9 @@ void SriSwfConfig::validate() const {
           init_gyro_bias_sigma > 0 && init_accel_bias_sigma > 0,
       "init sigmas must be positive");
   req(extrinsic_rotation_sigma > 0 && extrinsic_translation_sigma > 0, "extrinsic sigmas must be positive");
-  req(!calibrate_time_offset, "calibrate_time_offset is not supported yet");
+  req(std::isfinite(time_offset) && std::abs(time_offset) <= 1.0, "time_offset must be in [-1, 1] s");
+  req(std::isfinite(time_offset_sigma) && time_offset_sigma > 0 && time_offset_sigma <= 0.1,
+      "time_offset_sigma must be in (0, 0.1] s");
 }
 
 namespace {
@@ -158,7 +160,9 @@ SriSwfConfig parseRoot(const YAML::Node& root, const Ctx& c) {
       {"calibrate_extrinsics", b(cfg.calibrate_extrinsics, "calibrate_extrinsics")},
       {"extrinsic_rotation_sigma", d(cfg.extrinsic_rotation_sigma, "extrinsic_rotation_sigma")},
       {"extrinsic_translation_sigma", d(cfg.extrinsic_translation_sigma, "extrinsic_translation_sigma")},
+      {"time_offset", d(cfg.time_offset, "time_offset")},
       {"calibrate_time_offset", b(cfg.calibrate_time_offset, "calibrate_time_offset")},
+      {"time_offset_sigma", d(cfg.time_offset_sigma, "time_offset_sigma")},
       {"precision",
        [&](const YAML::Node& n) {
          const std::string s = str(n, c, "precision");
@@ -195,6 +199,8 @@ SriSwfConfig parseRoot(const YAML::Node& root, const Ctx& c) {
        }},
   };
   walk(root, c, "", top);
+  // A Kalibr camchain's timeshift_cam_imu is the time offset unless `time_offset` is given.
+  if (have_cams && !root["time_offset"]) cfg.time_offset = cfg.cameras.front().time_offset;
   if (!have_cams) fail(c, lineOf(root), "cameras", "missing (cameras: [...] or camchain: ...)");
   try {
     cfg.validate();

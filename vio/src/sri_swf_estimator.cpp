@@ -96,12 +96,26 @@ struct SriSwfEstimator<Scalar>::Impl {
   std::deque<Clone> clones;
   std::vector<CameraExtrinsic> ext_fixed;
   std::vector<BlockId> ext_ids;  // calibrate_extrinsics
+  BlockId td_id;                 // calibrate_time_offset: t_d (1-dim)
+  // Motion of each clone at its IMU time τ = t_cam + td (time-offset calibration): body angular
+  // rate (bias-corrected), world velocity and the t_d estimate τ was made with.
+  struct CloneMotion {
+    Eigen::Vector3d w = Eigen::Vector3d::Zero();
+    Eigen::Vector3d v = Eigen::Vector3d::Zero();
+    double td = 0.0;
+  };
+  std::unordered_map<std::uint64_t, CloneMotion> clone_motion;
   std::vector<double> sigma_n;   // per camera: pixel noise in normalised units
   std::unordered_map<std::uint64_t, Track> tracks;
   std::unordered_map<std::uint64_t, Slam> slam;
   std::deque<FeatureFrame> init_frames;
   std::deque<FeatureFrame> recent;  // frames of the last init_window (zero-velocity detection)
   std::unordered_map<std::uint64_t, PoseEstimate> pose_cache;
+  std::unordered_map<std::uint64_t, PoseEstimate> obs_pose_cache;  // poses at the image times
+  void clearCaches() {
+    pose_cache.clear();
+    obs_pose_cache.clear();
+  }
   // First estimates (first_estimate_jacobians): of every clone (its propagated pose) and of the
   // newest velocity.
   std::unordered_map<std::uint64_t, PoseEstimate> fe_pose;
@@ -156,6 +170,39 @@ struct SriSwfEstimator<Scalar>::Impl {
     if (it == pose_cache.end()) it = pose_cache.emplace(id.value, poseOf(f.nominal(id))).first;
     return it->second;
   }
+  /// Current t_d (s): the filter's estimate when calibrating, else the configured value.
+  double timeOffset() const {
+    if (td_id.valid()) return static_cast<double>(f.nominal(td_id).vector(0));
+    return cfg.time_offset;
+  }
+  /// Pose of clone `id` at the time its image was taken: the clone itself unless the time offset
+  /// is calibrated, then the clone moved by its angular rate and velocity over t̂_d − td(clone).
+  const PoseEstimate& obsPose(BlockId id) {
+    if (!td_id.valid()) return pose(id);
+    auto it = obs_pose_cache.find(id.value);
+    if (it != obs_pose_cache.end()) return it->second;
+    PoseEstimate P = pose(id);
+    if (auto m = clone_motion.find(id.value); m != clone_motion.end()) {
+      P = poseAfter(P, m->second.w, m->second.v, timeOffset() - m->second.td);
+    }
+    return obs_pose_cache.emplace(id.value, P).first->second;
+  }
+  /// ∂p_C/∂t_d of an observation from clone `id` (cp: its CameraPoint at the Jacobian's pose).
+  Eigen::Vector3d timeOffsetColumn(BlockId id, const CameraPoint& cp) const {
+    const auto m = clone_motion.find(id.value);
+    if (m == clone_motion.end()) return Eigen::Vector3d::Zero();
+    return timeOffsetJacobian(cp, m->second.w, m->second.v);
+  }
+  void recordCloneMotion(BlockId id, const ImuState& s, double td) {
+    if (!cfg.calibrate_time_offset) return;
+    CloneMotion m;
+    m.v = s.v_WI;
+    if (imuCovers(s.t_ns, s.t_ns)) m.w = interpolateImu(imuSpan(), s.t_ns).gyro - s.bg;
+    m.td = td;
+    clone_motion[id.value] = m;
+  }
+  double frame_td = 0.0;  // t_d the current frame was shifted by (s, exact to the ns)
+
   /// Linearisation point of a clone for Jacobians: its first estimate, or the current estimate.
   const PoseEstimate& poseJ(BlockId id) {
     if (cfg.first_estimate_jacobians) {
@@ -219,6 +266,14 @@ struct SriSwfEstimator<Scalar>::Impl {
         setExact(ext_ids.back(), poseEstimate<double>(ext_fixed[c].R_IC, ext_fixed[c].p_IC));
       }
     }
+    if (cfg.calibrate_time_offset) {
+      Eigen::Matrix<Scalar, 1, 1> x0, sd0;
+      x0 << static_cast<Scalar>(frame_td);
+      sd0 << static_cast<Scalar>(cfg.time_offset_sigma);
+      td_id = f.addBlock(BlockSpec::vector("time_offset", 1), BlockEstimate<Scalar>::fromVector(x0),
+                         sri::Prior<Scalar>::stdDevs(sd0));
+      setExact(td_id, BlockEstimate<double>::fromVector(Eigen::Matrix<double, 1, 1>(frame_td)));
+    }
     Eigen::Matrix<double, 9, 1> x;
     x << s.v_WI, s.bg, s.ba;
     Eigen::Matrix<double, 9, 1> sd;
@@ -231,6 +286,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     newest = {pid, eid};
     t_newest = s.t_ns;
     clones.push_back({pid, s.t_ns});
+    recordCloneMotion(pid, s, frame_td);
     fe_pose[pid.value] = poseOf(f.nominal(pid));  // the gauge pose: its prior fixes it anyway
     fe_v = s.v_WI;
     t_init = s.t_ns;
@@ -413,7 +469,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     if (!ok && stereo() && cfg.init_in_motion) ok = tryMotion();
     if (ok) {
       init_frames.clear();
-      pose_cache.clear();
+      clearCaches();
       addObservations(frame);
     }
     return ok;
@@ -450,6 +506,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     newest = {ids[0], ids[1]};
     t_newest = t;
     clones.push_back({ids[0], t});
+    recordCloneMotion(ids[0], s, frame_td);
     // Clones get first estimates once the initialisation transient is over (first_estimate_delay).
     if (static_cast<double>(t - t_init) * 1e-9 >= cfg.first_estimate_delay) {
       fe_pose[ids[0].value] = poseOf(f.nominal(ids[0]));
@@ -481,7 +538,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
     std::vector<Eigen::Vector3d> centres;
     for (const Obs& o : obs) {
-      const PoseEstimate& P = pose(o.clone);
+      const PoseEstimate& P = obsPose(o.clone);
       const CameraExtrinsic e = ext(o.cam);
       const Eigen::Vector3d b = (P.R_WI * e.R_IC * Eigen::Vector3d(o.z.x(), o.z.y(), 1.0)).normalized();
       const Eigen::Vector3d c = P.p_WI + P.R_WI * e.p_IC;
@@ -493,7 +550,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(A);
     if (es.eigenvalues()(0) < 1e-9 * es.eigenvalues()(2)) return false;
     p_W = A.ldlt().solve(rhs);
-    const PoseEstimate& P0 = pose(obs[0].clone);
+    const PoseEstimate& P0 = obsPose(obs[0].clone);
     const CameraExtrinsic e0 = ext(obs[0].cam);
     const CameraPoint c0 = cameraPoint(P0, e0, p_W);
     if (!(c0.p_C.z() > cfg.min_depth)) return false;
@@ -503,7 +560,7 @@ struct SriSwfEstimator<Scalar>::Impl {
       Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
       Eigen::Vector3d g = Eigen::Vector3d::Zero();
       for (const Obs& o : obs) {
-        const CameraPoint cp = cameraPoint(pose(o.clone), ext(o.cam), ap.p_W);
+        const CameraPoint cp = cameraPoint(obsPose(o.clone), ext(o.cam), ap.p_W);
         if (!(cp.p_C.z() > 1e-6)) return false;
         const Eigen::Vector2d r = o.z - cp.p_C.head<2>() / cp.p_C.z();
         const Eigen::Matrix<double, 2, 3> J = projectionJacobian(cp.p_C) * cp.J_point * ap.J_feature;
@@ -519,7 +576,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     p_W = anchoredPoint(fpar, P0, e0).p_W;
     double depth0 = 0.0, base = 0.0;
     for (std::size_t k = 0; k < obs.size(); ++k) {
-      const double z = cameraPoint(pose(obs[k].clone), ext(obs[k].cam), p_W).p_C.z();
+      const double z = cameraPoint(obsPose(obs[k].clone), ext(obs[k].cam), p_W).p_C.z();
       if (!(z >= cfg.min_depth && z <= cfg.max_depth)) return false;
       if (k == 0) depth0 = z;
       base = std::max(base, (centres[k] - centres[0]).norm());
@@ -543,6 +600,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     if (anchor.valid()) add(anchor, 6);
     for (const Obs& o : obs) add(o.clone, 6);
     for (BlockId e : ext_ids) add(e, 6);
+    if (td_id.valid()) add(td_id, 1);
     m.addBlocks(decl_ids, decl_dims);
   }
 
@@ -554,7 +612,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     for (std::size_t k = 0; k < obs.size(); ++k) {
       const Obs& o = obs[k];
       const int r = 2 * static_cast<int>(k);
-      const CameraPoint cp = cameraPoint(pose(o.clone), ext(o.cam), p_W);
+      const CameraPoint cp = cameraPoint(obsPose(o.clone), ext(o.cam), p_W);
       const CameraPoint cj = cfg.first_estimate_jacobians ? cameraPoint(poseJ(o.clone), ext(o.cam), p_W) : cp;
       const double is = 1.0 / sigma_n[static_cast<std::size_t>(o.cam)];
       const Eigen::Matrix<double, 2, 3> Jp = is * projectionJacobian(cj.p_C);
@@ -562,6 +620,9 @@ struct SriSwfEstimator<Scalar>::Impl {
       if (!ext_ids.empty()) {
         m.jacobian(ext_ids[static_cast<std::size_t>(o.cam)], 6).middleRows(r, 2) +=
             (Jp * cj.J_ext).template cast<Scalar>();
+      }
+      if (td_id.valid()) {
+        m.jacobian(td_id, 1).middleRows(r, 2) += (Jp * timeOffsetColumn(o.clone, cj)).template cast<Scalar>();
       }
       N.middleRows(r, 2) = (Jp * cj.J_point).template cast<Scalar>();
       m.residual().segment(r, 2) = (is * (o.z - cp.p_C.head<2>() / cp.p_C.z())).template cast<Scalar>();
@@ -581,7 +642,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     for (std::size_t k = 0; k < obs.size(); ++k) {
       const Obs& o = obs[k];
       const int r = 2 * static_cast<int>(k);
-      const CameraPoint cp = cameraPoint(pose(o.clone), ext(o.cam), ap.p_W);
+      const CameraPoint cp = cameraPoint(obsPose(o.clone), ext(o.cam), ap.p_W);
       if (!(cp.p_C.z() > cfg.min_depth)) return false;
       const CameraPoint cj = fej ? cameraPoint(poseJ(o.clone), ext(o.cam), apj.p_W) : cp;
       const double is = 1.0 / sigma_n[static_cast<std::size_t>(o.cam)];
@@ -594,6 +655,9 @@ struct SriSwfEstimator<Scalar>::Impl {
         m.jacobian(ext_ids[0], 6).middleRows(r, 2) += (A * apj.J_ext).template cast<Scalar>();
         m.jacobian(ext_ids[static_cast<std::size_t>(o.cam)], 6).middleRows(r, 2) +=
             (Jp * cj.J_ext).template cast<Scalar>();
+      }
+      if (td_id.valid()) {
+        m.jacobian(td_id, 1).middleRows(r, 2) += (Jp * timeOffsetColumn(o.clone, cj)).template cast<Scalar>();
       }
       m.residual().segment(r, 2) = (is * (o.z - cp.p_C.head<2>() / cp.p_C.z())).template cast<Scalar>();
     }
@@ -695,6 +759,11 @@ struct SriSwfEstimator<Scalar>::Impl {
       ids.push_back(e);
       pw_off[e.value] = off;
       off += 6;
+    }
+    if (td_id.valid()) {
+      ids.push_back(td_id);
+      pw_off[td_id.value] = off;
+      off += 1;
     }
     Pw = f.covariance(ids).template cast<double>();
     const Eigen::LLT<Eigen::MatrixXd> llt(Pw.reverse());  // J Pw J = L Lᵀ → Pw = (JLJ)(JLJ)ᵀ
@@ -853,9 +922,19 @@ struct SriSwfEstimator<Scalar>::Impl {
     return N;
   }
 
-  FrameResult process(const FeatureFrame& frame) {
+  /// Frames enter in IMU time: t_cam + t̂_d (rounded to the ns; frame_td is the exact shift).
+  FrameResult process(const FeatureFrame& input) {
+    const double td = timeOffset();
+    const auto shift = static_cast<std::int64_t>(std::llround(td * 1e9));
+    frame_td = static_cast<double>(shift) * 1e-9;
+    if (shift == 0) return processImuTime(input);
+    FeatureFrame shifted = input;
+    shifted.t_ns += shift;
+    return processImuTime(shifted);
+  }
+  FrameResult processImuTime(const FeatureFrame& frame) {
     FrameResult res;
-    pose_cache.clear();
+    clearCaches();
     if (!initialized) {
       res.initialized = tryInitialize(frame);
       trimImu();
@@ -971,7 +1050,7 @@ struct SriSwfEstimator<Scalar>::Impl {
       f.correct();
       notify("correct");
     }
-    pose_cache.clear();
+    clearCaches();
     windowCovariance();
 
     // 2. Candidates: lost tracks and window-long tracks.
@@ -1055,7 +1134,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     }
     f.correct();
     notify("correct");
-    pose_cache.clear();
+    clearCaches();
 
     // 3. Marginalization: lost SLAM features, oldest clone (after re-anchoring).
     std::vector<BlockId> marg = lost_slam;
@@ -1066,6 +1145,7 @@ struct SriSwfEstimator<Scalar>::Impl {
       marg.push_back(oldest);
       clones.pop_front();
       fe_pose.erase(oldest.value);
+      clone_motion.erase(oldest.value);
       for (auto& [id, tr] : tracks) {
         auto& o = tr.obs;
         const auto n0 = o.size();
@@ -1077,7 +1157,7 @@ struct SriSwfEstimator<Scalar>::Impl {
       f.marginalize(marg);
       notify("marginalize");
     }
-    pose_cache.clear();
+    clearCaches();
     trimImu();
     res.slam_features = static_cast<int>(slam.size());
     return res;
@@ -1141,6 +1221,23 @@ Eigen::Matrix4d SriSwfEstimator<Scalar>::cameraExtrinsic(int cam) const {
   T.topLeftCorner<3, 3>() = e.R_IC;
   T.topRightCorner<3, 1>() = e.p_IC;
   return T;
+}
+
+template <typename Scalar>
+typename SriSwfEstimator<Scalar>::TimeOffset SriSwfEstimator<Scalar>::timeOffset() const {
+  TimeOffset t;
+  t.value = impl_->timeOffset();
+  if (impl_->td_id.valid()) {
+    const sri::BlockId id = impl_->td_id;
+    t.sigma = std::sqrt(static_cast<double>(impl_->f.covariance(std::span<const sri::BlockId>(&id, 1))(0, 0)));
+  }
+  return t;
+}
+
+template <typename Scalar>
+std::int64_t SriSwfEstimator<Scalar>::imuLeadNs() const {
+  const double lead = config_.time_offset + (config_.calibrate_time_offset ? 5.0 * config_.time_offset_sigma : 0.0);
+  return lead > 0.0 ? static_cast<std::int64_t>(std::ceil(lead * 1e9)) : 0;
 }
 
 template <typename Scalar>

@@ -52,4 +52,15 @@ Eigen::Vector3d inverseDepthOf(const Eigen::Vector3d& p_W, const PoseEstimate& a
   return {p.x() * iz, p.y() * iz, iz};
 }
 
+PoseEstimate poseAfter(const PoseEstimate& pose, const Eigen::Vector3d& w, const Eigen::Vector3d& v, double dt) {
+  PoseEstimate p;
+  p.R_WI = pose.R_WI * so3::exp(w * dt);
+  p.p_WI = pose.p_WI + v * dt;
+  return p;
+}
+
+Eigen::Vector3d timeOffsetJacobian(const CameraPoint& cp, const Eigen::Vector3d& w, const Eigen::Vector3d& v) {
+  return cp.J_pose.leftCols<3>() * w + cp.J_pose.rightCols<3>() * v;
+}
+
 }  // namespace gvins::vio

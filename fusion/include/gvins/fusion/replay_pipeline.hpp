@@ -7,7 +7,7 @@
 // when a GNSS client is given.
 //
 // Order of work, one consumer thread: for each camera frame (in time order) every IMU sample up to
-// the frame time is added, the frame is processed, the pose and its covariance are written, then
+// the frame time (plus the estimator's imuLeadNs, for a camera-IMU time offset) is added, the frame is processed, the pose and its covariance are written, then
 // every rover epoch whose time tag is <= the newest state time is handed to the GNSS client with
 // the base epoch at or before it. Images are decoded on a loader thread and tracked on the front
 // end thread (FrontendThread), so loading, tracking and estimation overlap.
@@ -63,6 +63,14 @@ class ReplayEstimator {
   virtual bool initialized() const = 0;
   virtual vio::ImuState newestImuState() const = 0;
   virtual vio::Matrix6d poseCovariance() const = 0;
+  /// How far past a frame's stamp (ns) the IMU must be added before processFrame: a camera-IMU
+  /// time offset puts the frame at IMU time stamp + t_d.
+  virtual std::int64_t imuLeadNs() const { return 0; }
+  /// Camera-IMU time offset estimate and its 1-σ (s), when the estimator calibrates one.
+  struct TimeOffset {
+    double value = 0.0, sigma = 0.0;
+  };
+  virtual std::optional<TimeOffset> timeOffset() const { return std::nullopt; }
 };
 
 /// Result of one GNSS epoch as the outputs need it.
@@ -114,6 +122,8 @@ struct ReplayOptions {
   std::string modeName = "vio";  ///< for the summary and output headers
   /// The true GNSS lever arm (gvins-sim dataset.yaml), for the lever-arm error in metrics.csv.
   std::optional<Eigen::Vector3d> leverArmTruth;
+  /// The true camera-IMU time offset (gvins-sim dataset.yaml cameras.time_offset_s), s.
+  std::optional<double> timeOffsetTruth;
   bool progress = true;
   /// Evaluate against the dataset's ground truth at the end (table + SVG plots in outDir).
   bool evaluate = true;
@@ -156,6 +166,8 @@ struct ReplaySummary {
   Accuracy global;  ///< GNSS antenna solutions after the frame initialisation, ENU, no alignment
   double frameInitSeconds = kNaN;  ///< from the first processed frame to the first tight GNSS epoch
   std::optional<Eigen::Vector3d> leverArm, leverArmTruth;  ///< final estimate; options' truth
+  /// Camera-IMU time offset (s): final estimate and 1-σ when calibrated; options' truth.
+  std::optional<double> timeOffset, timeOffsetSigma, timeOffsetTruth;
   /// GNSS modes with DATASET/truth/groundtruth_ecef.csv: accuracy of the GNSS antenna solutions
   /// (global_ecef.csv) against the true antenna track, in ENU at the first truth point, no
   /// alignment (rotation rows are meaningless there: the antenna has no orientation).

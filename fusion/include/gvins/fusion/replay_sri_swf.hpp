@@ -22,6 +22,12 @@ class SriSwfReplayEstimator final : public ReplayEstimator {
   bool initialized() const override { return est_.initialized(); }
   vio::ImuState newestImuState() const override { return est_.newestImuState(); }
   vio::Matrix6d poseCovariance() const override { return est_.poseCovariance(); }
+  std::int64_t imuLeadNs() const override { return est_.imuLeadNs(); }
+  std::optional<TimeOffset> timeOffset() const override {
+    if (!est_.config().calibrate_time_offset || !est_.initialized()) return std::nullopt;
+    const auto t = est_.timeOffset();
+    return TimeOffset{t.value, t.sigma};
+  }
   vio::SriSwfEstimator<Scalar>& estimator() { return est_; }
 
  private:

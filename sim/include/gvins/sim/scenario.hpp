@@ -44,6 +44,9 @@ struct Scenario {
 
   ImuSimConfig imu;
   double cameraRate = 20.0;  ///< Hz
+  /// Camera-IMU time offset t_d, s (`cameras.time_offset_s`): an image taken at IMU time t is
+  /// stamped t − t_d, so that t_imu = t_cam + t_d (Kalibr's timeshift_cam_imu convention).
+  double cameraTimeOffset = 0.0;
   CameraOutput output = CameraOutput::Images;
   int pngCompression = 1;    ///< 0-9 (zlib level)
   std::vector<vio::CameraCalibration> cameras;

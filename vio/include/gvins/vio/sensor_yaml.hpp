@@ -21,6 +21,9 @@ struct CameraCalibration {
   /// frame is the IMU frame.
   Eigen::Matrix4d T_BS = Eigen::Matrix4d::Identity();
   double rate_hz = 0.0;  ///< 0 if not given
+  /// Camera-IMU time offset, s: t_imu = t_cam + time_offset (Kalibr camchain timeshift_cam_imu;
+  /// 0 if not given).
+  double time_offset = 0.0;
 };
 
 struct ImuCalibration {

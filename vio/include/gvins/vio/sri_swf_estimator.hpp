@@ -108,7 +108,17 @@ struct SriSwfConfig {
   bool calibrate_extrinsics = false;
   double extrinsic_rotation_sigma = 0.01;     ///< rad
   double extrinsic_translation_sigma = 0.01;  ///< m
-  bool calibrate_time_offset = false;         ///< not supported yet: the constructor throws
+  /// Camera-IMU time offset t_d, s: a frame stamped t_cam was taken at IMU time t_cam + t_d
+  /// (Kalibr's timeshift_cam_imu convention). The value used when calibrate_time_offset is off
+  /// and the start value when it is on.
+  double time_offset = 0.0;
+  /// Online time-offset calibration (Li & Mourikis 2014, "Online temporal calibration for
+  /// camera-IMU systems: theory and algorithms", IJRR 33(7)): t_d is a 1-dim parameter block; a
+  /// clone made at IMU time τ = t_cam + t̂_d (the estimate then) stands for the image taken at
+  /// τ + (t_d − t̂_d), predicted from the clone with its angular rate and velocity at τ, so every
+  /// visual row gets ∂z/∂t_d = ∂z/∂[δθ; δp] · [ω; v].
+  bool calibrate_time_offset = false;
+  double time_offset_sigma = 0.005;  ///< s, prior 1-σ of t_d around time_offset
 
   /// Precision the application should instantiate (SriSwfEstimator<float> or <double>).
   bool use_float = false;
@@ -126,7 +136,7 @@ struct SriSwfConfig {
 ///          motion_frames, position_sigma, yaw_sigma, tilt_sigma, velocity_sigma,
 ///          gyro_bias_sigma, accel_bias_sigma}, zero_velocity_update, zero_velocity_sigma,
 ///   first_estimate_jacobians, first_estimate_delay, calibrate_extrinsics, extrinsic_rotation_sigma, extrinsic_translation_sigma,
-///   calibrate_time_offset, precision: double | float,
+///   time_offset, calibrate_time_offset, time_offset_sigma, precision: double | float,
 ///   cameras: [<EuRoC camera sensor.yaml path>, ...]  or  camchain: <Kalibr camchain path>
 /// Relative paths are relative to the YAML file's folder. Errors: gvins::ParseError naming the
 /// file, line and field.
@@ -184,6 +194,17 @@ class SriSwfEstimator final : public EstimatorBackend<Scalar> {
   int slamFeatureCount() const;
   /// Extrinsic pose T_IC of camera `cam` (estimated when calibrate_extrinsics).
   Eigen::Matrix4d cameraExtrinsic(int cam) const;
+  /// Camera-IMU time offset t_d (s, SriSwfConfig::time_offset) and its 1-σ: the estimate when
+  /// calibrate_time_offset (σ from the filter), else the configured value with σ = 0.
+  struct TimeOffset {
+    double value = 0.0;
+    double sigma = 0.0;
+  };
+  TimeOffset timeOffset() const;
+  /// How far past a frame's stamp the IMU must reach before processFrame (ns, ≥ 0): the
+  /// configured offset plus five prior σ when calibrating. A frame whose IMU time t_cam + t̂_d is
+  /// not covered by the buffer is skipped.
+  std::int64_t imuLeadNs() const;
   /// The underlying filter (tests, diagnostics).
   const sri::SriFilter<Scalar>& filter() const;
   /// The four unobservable directions (columns: global yaw about the z axis through the origin,

@@ -53,6 +53,14 @@ struct AnchoredPoint {
 
 AnchoredPoint anchoredPoint(const Eigen::Vector3d& f, const PoseEstimate& anchor, const CameraExtrinsic& ext0);
 
+/// Camera-IMU time offset (Li & Mourikis 2014): the pose dt seconds after `pose` with the body
+/// angular rate w (rad/s, IMU frame) and the world velocity v held constant,
+///   R_WI Exp(w dt),  p_WI + v dt.
+PoseEstimate poseAfter(const PoseEstimate& pose, const Eigen::Vector3d& w, const Eigen::Vector3d& v, double dt);
+/// d p_C / d dt of cameraPoint(poseAfter(pose, w, v, dt), ext, p_W), given that CameraPoint:
+/// J_pose [w; v] (exact: d/d dt of R Exp(w dt) is the right perturbation w).
+Eigen::Vector3d timeOffsetJacobian(const CameraPoint& cp, const Eigen::Vector3d& w, const Eigen::Vector3d& v);
+
 /// Inverse-depth parameters (α, β, ρ) of a world point in camera 0 of `anchor`, and
 /// ∂f/∂p_C (3×3) for the chain rule (p_C the point in that camera).
 Eigen::Vector3d inverseDepthOf(const Eigen::Vector3d& p_W, const PoseEstimate& anchor, const CameraExtrinsic& ext0,
