@@ -471,7 +471,7 @@ TEST(SriSwfConfig, YamlValuesAndErrorsNameLineAndField) {
   const std::string dir = std::string(GVINS_TEST_DATA) + "/euroc/v101_static_stereo/mav0";
   const std::string text =
       "window: 9\nmax_slam_features: 30\npixel_noise: 0.7\nprecision: float\nposition_random_walk: 0.002\n"
-      "time_offset: -0.003\ncalibrate_time_offset: true\ntime_offset_sigma: 0.002\n"
+      "time_offset: -0.003\ncalibrate_time_offset: true\ntime_offset_sigma: 0.002\nsurface_noise: 0.001\n"
       "init:\n  window: 0.8\n"
       "cameras: [cam0/sensor.yaml, cam1/sensor.yaml]\nimu_yaml: imu0/sensor.yaml\n";
   const SriSwfConfig c = parseSriSwfConfig(text, "cfg.yaml", dir);
@@ -484,6 +484,7 @@ TEST(SriSwfConfig, YamlValuesAndErrorsNameLineAndField) {
   EXPECT_DOUBLE_EQ(c.time_offset, -0.003);
   EXPECT_TRUE(c.calibrate_time_offset);
   EXPECT_DOUBLE_EQ(c.time_offset_sigma, 0.002);
+  EXPECT_DOUBLE_EQ(c.surface_noise, 0.001);
   ASSERT_EQ(c.cameras.size(), 2u);
   EXPECT_DOUBLE_EQ(c.cameras[0].intrinsics.fx, 458.654);
   EXPECT_DOUBLE_EQ(c.imu.gyroscope_noise_density, 1.6968e-04);
@@ -505,6 +506,7 @@ TEST(SriSwfConfig, YamlValuesAndErrorsNameLineAndField) {
   expectError("cameras: [cam0/sensor.yaml]\nwindow: 1\n", 1, "window");
   expectError("cameras: [cam0/sensor.yaml]\nposition_random_walk: -1e-3\n", 1, "position_random_walk");
   expectError("cameras: [cam0/sensor.yaml]\ntime_offset_sigma: 0\n", 1, "time_offset_sigma");
+  expectError("cameras: [cam0/sensor.yaml]\nsurface_noise: -0.001\n", 1, "surface_noise");
   expectError("cameras: [cam0/sensor.yaml]\ntime_offset: 2.5\n", 1, "time_offset");
   expectError("cameras: [cam0/sensor.yaml]\ntime_offset: 5ms\n", 2, "time_offset");
 }

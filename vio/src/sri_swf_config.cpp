@@ -30,6 +30,7 @@ void SriSwfConfig::validate() const {
           imu.accelerometer_random_walk > 0 && imu.rate_hz > 0,
       "imu noise parameters must be positive");
   req(pixel_noise > 0 && std::isfinite(pixel_noise), "pixel_noise must be positive");
+  req(surface_noise >= 0 && std::isfinite(surface_noise), "surface_noise must be >= 0");
   req(window >= 3 && window <= 100, "window must be in [3, 100]");
   req(max_slam_features >= 0 && max_slam_features <= 1000, "max_slam_features must be in [0, 1000]");
   req(min_track_msckf >= 2, "min_track_msckf must be >= 2");
@@ -143,6 +144,7 @@ SriSwfConfig parseRoot(const YAML::Node& root, const Ctx& c) {
   std::map<std::string, Handler> top = {
       {"gravity", d(cfg.gravity, "gravity")},
       {"pixel_noise", d(cfg.pixel_noise, "pixel_noise")},
+      {"surface_noise", d(cfg.surface_noise, "surface_noise")},
       {"window", i(cfg.window, "window")},
       {"max_slam_features", i(cfg.max_slam_features, "max_slam_features")},
       {"min_track_msckf", i(cfg.min_track_msckf, "min_track_msckf")},

@@ -139,6 +139,12 @@ struct SriSwfEstimator<Scalar>::Impl {
   }
 
   bool stereo() const { return cfg.cameras.size() > 1; }
+  /// 1 / σ of an observation in normalised coordinates: pixel noise and surface noise at `depth`.
+  double inverseSigma(int cam, double depth) const {
+    const double sp = sigma_n[static_cast<std::size_t>(cam)];
+    const double ss = cfg.surface_noise / depth;
+    return 1.0 / std::sqrt(sp * sp + ss * ss);
+  }
 
   double chi2Threshold(int dof) const {
     if (cfg.chi2_probability >= 1.0) return std::numeric_limits<double>::infinity();
@@ -614,7 +620,7 @@ struct SriSwfEstimator<Scalar>::Impl {
       const int r = 2 * static_cast<int>(k);
       const CameraPoint cp = cameraPoint(obsPose(o.clone), ext(o.cam), p_W);
       const CameraPoint cj = cfg.first_estimate_jacobians ? cameraPoint(poseJ(o.clone), ext(o.cam), p_W) : cp;
-      const double is = 1.0 / sigma_n[static_cast<std::size_t>(o.cam)];
+      const double is = inverseSigma(o.cam, cp.p_C.z());
       const Eigen::Matrix<double, 2, 3> Jp = is * projectionJacobian(cj.p_C);
       m.jacobian(o.clone, 6).middleRows(r, 2) += (Jp * cj.J_pose).template cast<Scalar>();
       if (!ext_ids.empty()) {
@@ -645,7 +651,7 @@ struct SriSwfEstimator<Scalar>::Impl {
       const CameraPoint cp = cameraPoint(obsPose(o.clone), ext(o.cam), ap.p_W);
       if (!(cp.p_C.z() > cfg.min_depth)) return false;
       const CameraPoint cj = fej ? cameraPoint(poseJ(o.clone), ext(o.cam), apj.p_W) : cp;
-      const double is = 1.0 / sigma_n[static_cast<std::size_t>(o.cam)];
+      const double is = inverseSigma(o.cam, cp.p_C.z());
       const Eigen::Matrix<double, 2, 3> Jp = is * projectionJacobian(cj.p_C);
       const Eigen::Matrix<double, 2, 3> A = Jp * cj.J_point;
       m.jacobian(s.block, 3).middleRows(r, 2) += (A * apj.J_feature).template cast<Scalar>();

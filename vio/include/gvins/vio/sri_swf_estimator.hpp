@@ -46,12 +46,16 @@ struct SriSwfConfig {
   /// 1 (mono) or 2 (stereo) cameras; T_BS is the camera pose in the IMU frame (T_IC).
   std::vector<CameraCalibration> cameras;
   double pixel_noise = 1.0;  ///< px, 1-σ per axis (mapped to normalised coordinates by 1/f)
+  /// m, 1-σ of where on the observed surface a feature is, across the ray: adds (σ_s / depth)²
+  /// to the normalised-coordinate variance of every observation, so that features very close to
+  /// the camera (a down-looking camera on the ground) do not get weights growing with 1/depth.
+  double surface_noise = 0.003;
 
   // ---- window and features
   int window = 11;             ///< pose clones kept (the newest pose included)
   int max_slam_features = 50;  ///< SLAM features in the state at most
   int min_track_msckf = 3;     ///< frames a lost track needs for an MSCKF update
-  double min_depth = 0.2;      ///< m, triangulated depth bounds (all observing cameras)
+  double min_depth = 0.5;      ///< m, triangulated depth bounds (all observing cameras)
   double max_depth = 500.0;
   /// Minimum ratio of triangulation baseline to depth (rejects near-degenerate tracks).
   double min_baseline_ratio = 0.005;
@@ -130,7 +134,7 @@ struct SriSwfConfig {
 /// YAML configuration (all keys optional except cameras, unknown keys are errors):
 ///   imu: {gyroscope_noise_density, gyroscope_random_walk, accelerometer_noise_density,
 ///         accelerometer_random_walk, rate_hz}  or  imu_yaml: <EuRoC/Kalibr imu yaml path>
-///   gravity, pixel_noise, window, max_slam_features, min_track_msckf, min_depth, max_depth,
+///   gravity, pixel_noise, surface_noise, window, max_slam_features, min_track_msckf, min_depth, max_depth,
 ///   min_baseline_ratio, chi2_probability, max_msckf_per_frame, reanchor_sigma, position_random_walk,
 ///   init: {window, static_max_accel_std, static_max_gyro_std, static_max_parallax, in_motion,
 ///          motion_frames, position_sigma, yaw_sigma, tilt_sigma, velocity_sigma,
