@@ -12,7 +12,6 @@
 #include <fstream>
 #include <sstream>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 #include "gvins/base/local_frame.hpp"
@@ -22,6 +21,7 @@
 #include "gvins/sim/dataset_generator.hpp"
 #include "gvins/sim/scenario.hpp"
 #include "gvins/vio/sensor_yaml.hpp"
+#include "process_scratch_folder.hpp"
 
 namespace gvins::fusion {
 namespace {
@@ -32,17 +32,7 @@ const Eigen::Vector3d kLever(0.08, 0.0, 0.18);
 constexpr double kOutageStart = 35.0, kOutageLength = 60.0;  // s of flight time
 
 /// Everything of this process goes below one folder, removed when the process ends.
-const fs::path& scratch() {
-  struct Folder {
-    fs::path path = fs::temp_directory_path() / ("gvins_replay_sim_" + std::to_string(::getpid()));
-    ~Folder() {
-      std::error_code ec;
-      fs::remove_all(path, ec);
-    }
-  };
-  static const Folder f;
-  return f.path;
-}
+const fs::path& scratch() { return test::processScratchFolder("gvins_replay_sim_"); }
 
 /// The dataset, simulated once: a 120 s figure-eight at 30 m and 6 m/s with a 3° attitude wobble
 /// (rotational excitation for the lever arm), rover 5 Hz, base 1 Hz 3 km away.

@@ -5,13 +5,12 @@
 // σ, and the trajectory against runs that ignore the offset or are given it, in double and float.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 #include "gvins/fusion/replay_pipeline.hpp"
@@ -21,6 +20,7 @@
 #include "gvins/sim/scenario.hpp"
 #include "gvins/vio/euroc_csv.hpp"
 #include "gvins/vio/sensor_yaml.hpp"
+#include "process_scratch_folder.hpp"
 
 namespace gvins::fusion {
 namespace {
@@ -29,17 +29,8 @@ namespace fs = std::filesystem;
 
 constexpr double kTimeOffset = 0.015;  // s
 
-const fs::path& scratch() {
-  struct Folder {
-    fs::path path = fs::temp_directory_path() / ("gvins_time_offset_" + std::to_string(::getpid()));
-    ~Folder() {
-      std::error_code ec;
-      fs::remove_all(path, ec);
-    }
-  };
-  static const Folder f;
-  return f.path;
-}
+/// Everything of this process goes below one folder, removed when the process ends.
+const fs::path& scratch() { return test::processScratchFolder("gvins_time_offset_"); }
 
 /// The paper-like flight 60m-400m-8m/s (config/uav_60m_400m_8mps.yaml) as feature tracks, no GNSS.
 const fs::path& dataset() {
