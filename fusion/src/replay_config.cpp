@@ -101,6 +101,13 @@ ReplayConfig parseReplayConfig(std::string_view text, const std::string& file, c
             if (!(o.frontend.tracker.maxTrackTravel >= 0.0)) {
               throw ParseError(file, lineOf(x), name, "must not be negative (0: unlimited)");
             }
+          } else if (k == "align_templates") {
+            o.frontend.tracker.alignTemplates = boolean(x, file, name);
+          } else if (k == "template_max_track_travel_px") {
+            o.frontend.tracker.templateMaxTrackTravel = number(x, file, name);
+            if (!(o.frontend.tracker.templateMaxTrackTravel >= 0.0)) {
+              throw ParseError(file, lineOf(x), name, "must not be negative (0: unlimited)");
+            }
           } else {
             throw ParseError(file, lineOf(r.first), name, "unknown key");
           }

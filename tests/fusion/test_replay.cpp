@@ -692,6 +692,14 @@ TEST(ReplayParsers, Config) {
   EXPECT_EQ(t.options.frontend.tracker.maxTrackTravel, 80.0);
   e = err("replay:\n  max_track_length: 2.5\n");
   EXPECT_EQ(e.field(), "replay.max_track_length");
+  const ReplayConfig u = parseReplayConfig("replay:\n  align_templates: false\n  template_max_track_travel_px: 120\n", "r.yaml");
+  EXPECT_FALSE(u.options.frontend.tracker.alignTemplates);
+  EXPECT_EQ(u.options.frontend.tracker.templateMaxTrackTravel, 120.0);
+  e = err("replay:\n  align_templates: sometimes\n");
+  EXPECT_EQ(e.field(), "replay.align_templates");
+  e = err("replay:\n  template_max_track_travel_px: -3\n");
+  EXPECT_EQ(e.field(), "replay.template_max_track_travel_px");
+  EXPECT_EQ(e.line(), 2);
   e = err("replay:\n  start_s: 0\n  max_track_travel_px: -1\n");
   EXPECT_EQ(e.field(), "replay.max_track_travel_px");
   EXPECT_EQ(e.line(), 3);

@@ -285,7 +285,8 @@ TEST(Frontend, TracksEndAfterTheirImageTravelAndTheGridRefills) {
   const cv::Mat a = ds.loadImage(0, 0);
   for (const double cap : {15.0, 0.0}) {
     FeatureTrackerConfig cfg = trackerConfig();
-    cfg.maxTrackTravel = cap;
+    cfg.maxTrackTravel = cap;  // plain KLT tracks
+    cfg.templateMaxTrackTravel = cap;  // tracks refined against their template
     cfg.travelMinTrackLength = 0;
     cfg.maxTrackLength = 0;
     FeatureTracker tr(CameraModel(ds.cameraCalibration(0).intrinsics), cfg);

@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
+#include <utility>
 
 #include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
 namespace gvins::vio {
@@ -20,7 +23,10 @@ template <class T>
 void compact(std::vector<T>& v, const std::vector<unsigned char>& keep) {
   std::size_t j = 0;
   for (std::size_t i = 0; i < v.size(); ++i) {
-    if (keep[i]) v[j++] = v[i];
+    if (keep[i]) {
+      if (j != i) v[j] = std::move(v[i]);
+      ++j;
+    }
   }
   v.resize(j);
 }
@@ -93,6 +99,15 @@ FeatureTracker::FeatureTracker(const CameraModel& camera, const FeatureTrackerCo
 void FeatureTracker::process(const ImagePyramid& image, const Eigen::Matrix3d* R_cur_prev, FrontendTiming* timing) {
   FrontendTiming local;
   FrontendTiming& tm = timing ? *timing : local;
+  if (cfg_.alignTemplates) {
+    const auto ts = Clock::now();
+    if (cfg_.patchSmoothing > 0.0) {
+      cv::GaussianBlur(image.image(), smooth_, cv::Size(0, 0), cfg_.patchSmoothing);
+    } else {
+      smooth_ = image.image();
+    }
+    tm.tracking += msSince(ts);
+  }
   if (!prev_.empty() && !pts_.empty()) {
     auto t0 = Clock::now();
     const std::size_t n = pts_.size();
@@ -195,8 +210,44 @@ void FeatureTracker::process(const ImagePyramid& image, const Eigen::Matrix3d* R
       compact(ids_, keep);
       compact(lengths_, keep);
       compact(travel_, keep);
+      compact(templates_, keep);
+      compact(warps_, keep);
     };
     keepTracks(status);
+    if (cfg_.alignTemplates) {
+      const auto ta = Clock::now();
+      const float maxCorr2 = static_cast<float>(cfg_.templateMaxCorrection * cfg_.templateMaxCorrection);
+      std::vector<unsigned char> aligned(cur.size(), 1);
+      for (std::size_t i = 0; i < cur.size(); ++i) {
+        if (templates_[i].empty()) continue;
+        AffineWarp w = warps_[i];
+        if (R_cur_prev) {
+          // The rotation's local image Jacobian at the previous position turns the patch shape.
+          const auto moved = [&](float du, float dv) -> std::optional<Eigen::Vector2d> {
+            const Eigen::Vector3d b = *R_cur_prev * cam_.bearing({before[i].x + du, before[i].y + dv});
+            return cam_.project(b);
+          };
+          const auto px = moved(1.f, 0.f), mx = moved(-1.f, 0.f), py = moved(0.f, 1.f), my = moved(0.f, -1.f);
+          if (px && mx && py && my) {
+            Eigen::Matrix2f J;
+            J.col(0) = (0.5 * (*px - *mx)).cast<float>();
+            J.col(1) = (0.5 * (*py - *my)).cast<float>();
+            w.A = J * w.A;
+          }
+        }
+        w.t = Eigen::Vector2f(cur[i].x, cur[i].y);
+        const PatchAlignResult r = templates_[i].align(smooth_, w, cfg_.patch);
+        const float dx = w.t.x() - cur[i].x, dy = w.t.y() - cur[i].y;
+        if (!r.ok || dx * dx + dy * dy > maxCorr2) {
+          aligned[i] = 0;
+          continue;
+        }
+        cur[i] = cv::Point2f(w.t.x(), w.t.y());
+        warps_[i] = w;
+      }
+      keepTracks(aligned);
+      tm.tracking += msSince(ta);
+    }
     if (cfg_.ransac && cur.size() >= 8) {
       // Undistorted points on a virtual pinhole with the camera's focal length, so that the
       // threshold is in pixels.
@@ -218,13 +269,13 @@ void FeatureTracker::process(const ImagePyramid& image, const Eigen::Matrix3d* R
       const float dx = cur[i].x - before[i].x, dy = cur[i].y - before[i].y;
       travel_[i] += std::sqrt(dx * dx + dy * dy);
     }
-    if (cfg_.maxTrackLength > 0 || cfg_.maxTrackTravel > 0.0) {
+    if (cfg_.maxTrackLength > 0 || cfg_.maxTrackTravel > 0.0 || cfg_.templateMaxTrackTravel > 0.0) {
       std::vector<unsigned char> keep(lengths_.size());
       bool any = false;
       for (std::size_t i = 0; i < keep.size(); ++i) {
+        const double maxTravel = templates_[i].empty() ? cfg_.maxTrackTravel : cfg_.templateMaxTrackTravel;
         keep[i] = (cfg_.maxTrackLength <= 0 || lengths_[i] <= cfg_.maxTrackLength) &&
-                  (cfg_.maxTrackTravel <= 0.0 || lengths_[i] < cfg_.travelMinTrackLength ||
-                   travel_[i] <= cfg_.maxTrackTravel);
+                  (maxTravel <= 0.0 || lengths_[i] < cfg_.travelMinTrackLength || travel_[i] <= maxTravel);
         any |= !keep[i];
       }
       if (any) keepTracks(keep);
@@ -244,6 +295,10 @@ void FeatureTracker::process(const ImagePyramid& image, const Eigen::Matrix3d* R
     lengths_.push_back(1);
     travel_.push_back(0.0f);
     prevPts_.push_back(pts_[i]);
+    templates_.emplace_back();
+    warps_.emplace_back();
+    if (cfg_.alignTemplates && !templates_.back().extract(smooth_, pts_[i], cfg_.patch)) templates_.back() = AffinePatch();
+    warps_.back().t = Eigen::Vector2f(pts_[i].x, pts_[i].y);
   }
   tm.detection += msSince(t0);
   prev_ = image;

@@ -14,6 +14,9 @@
 //     max_track_travel_px: 50    # image front end: end tracks (10 images or older) once they
 //                                # have moved 50 px since detection (0: never)
 //     max_track_length: 0        # ... or after this many images (0: never)
+//     align_templates: true      # refine every tracked position against the track's
+//                                # detection patch (affine warp, gain, bias): no chained drift
+//     template_max_track_travel_px: 0  # travel limit for template-refined tracks (0: never)
 //   estimator: sri_swf.yaml      # SRI-SWF configuration file (sri_swf_estimator.hpp), relative
 //                                # to this file; default: noise and cameras from the dataset
 //   gnss_fusion: { ... }         # GnssFusion options (gnss_fusion_config.hpp), read by its parser

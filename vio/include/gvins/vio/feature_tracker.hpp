@@ -12,6 +12,7 @@
 #include <opencv2/core/mat.hpp>
 #include <opencv2/core/types.hpp>
 
+#include "gvins/vio/affine_patch.hpp"
 #include "gvins/vio/camera_model.hpp"
 #include "gvins/vio/feature_detector.hpp"
 #include "gvins/vio/feature_frame.hpp"
@@ -76,6 +77,20 @@ struct FeatureTrackerConfig {
   /// observation of a feature as the same point with white noise, turns that into a biased,
   /// overconfident state. Measured on the rendered demo flight in docs/vio_frontend.md.
   double maxTrackTravel = 50.0;  ///< px (0: no limit)
+  /// Every tracked position is refined by aligning the track's template (its patch in the
+  /// detection image) with the image under an affine warp with gain and bias (affine_patch.hpp):
+  /// the position then no longer accumulates the chained KLT's drift. Tracks whose alignment
+  /// fails, or lands more than templateMaxCorrection px from the KLT position, are ended. Tracks
+  /// whose template could not be taken (untextured in some direction of the affine warp) stay
+  /// plain KLT tracks.
+  bool alignTemplates = true;
+  PatchAlignParams patch;
+  /// σ (px) of the Gaussian that smooths the images for the templates and their alignment (0:
+  /// none); see affine_patch.hpp.
+  double patchSmoothing = 1.0;
+  double templateMaxCorrection = 2.0;  ///< px
+  /// Travel limit (as maxTrackTravel) for tracks refined against their template; 0: no limit.
+  double templateMaxTrackTravel = 0.0;
   /// Tracks younger than this many images are not ended by their travel (a fast rotation can
   /// move every feature by > maxTrackTravel in one step; such tracks keep the observations the
   /// estimator needs before they are cut).
@@ -114,6 +129,9 @@ class FeatureTracker {
   std::vector<std::uint64_t> ids_;
   std::vector<int> lengths_;
   std::vector<float> travel_;
+  std::vector<AffinePatch> templates_;  // empty: no template (plain KLT track)
+  std::vector<AffineWarp> warps_;
+  cv::Mat smooth_;  // the current image smoothed for the templates (buffer kept between frames)
   std::uint64_t nextId_ = 0;
 };
 
