@@ -304,7 +304,9 @@ TEST(Frontend, TracksEndAfterTheirImageTravelAndTheGridRefills) {
       for (std::size_t i = 0; i < tr.ids().size(); ++i) {
         const int steps = tr.trackLengths()[i] - 1;
         if (steps > 0) stepErr.push_back(std::abs(tr.trackTravel()[i] - 4.0 * steps) / steps);
-        if (cap > 0.0) EXPECT_LE(tr.trackTravel()[i], cap);
+        if (cap > 0.0) {
+          EXPECT_LE(tr.trackTravel()[i], cap);
+        }
       }
     }
     // The recorded travel is the sum of the 4 px steps (a few tracks near the reflected border

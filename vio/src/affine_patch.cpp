@@ -29,8 +29,8 @@ inline bool inside(const cv::Mat& img, float x, float y) {
 }  // namespace
 
 bool AffinePatch::extract(const cv::Mat& image, const cv::Point2f& c, const PatchAlignParams& p) {
-  values_.clear();
-  sd_.clear();
+  centred_.resize(0);
+  sd_.resize(6, 0);
   const int h = p.halfSize;
   if (h < 1 || image.empty() || image.type() != CV_8UC1) return false;
   const float e = static_cast<float>(h + 1);
@@ -44,35 +44,31 @@ bool AffinePatch::extract(const cv::Mat& image, const cv::Point2f& c, const Patc
     }
   }
   const int n = 2 * h + 1;
-  values_.resize(static_cast<std::size_t>(n * n));
-  sd_.resize(values_.size());
-  Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
-  double sum = 0.0;
+  Eigen::VectorXf values(n * n);
+  Eigen::Matrix<float, 6, Eigen::Dynamic, Eigen::RowMajor> sd(6, n * n);
   for (int v = -h; v <= h; ++v) {
     for (int u = -h; u <= h; ++u) {
       auto at = [&](int du, int dv) { return s[static_cast<std::size_t>((v + dv + h + 1) * w + u + du + h + 1)]; };
       const float gx = 0.5f * (at(1, 0) - at(-1, 0)), gy = 0.5f * (at(0, 1) - at(0, -1));
       const auto fu = static_cast<float>(u), fv = static_cast<float>(v);
-      const std::size_t k = static_cast<std::size_t>((v + h) * n + u + h);
-      values_[k] = at(0, 0);
-      sum += at(0, 0);
+      const int k = (v + h) * n + u + h;
+      values(k) = at(0, 0);
       // ∂W/∂p of W(x; p) = [(1 + p1) u + p3 v + p5; p2 u + (1 + p4) v + p6] at p = 0.
-      sd_[k] << gx * fu, gy * fu, gx * fv, gy * fv, gx, gy;
-      H += sd_[k].cast<double>() * sd_[k].cast<double>().transpose();
+      sd.col(k) << gx * fu, gy * fu, gx * fv, gy * fv, gx, gy;
     }
   }
-  mean_ = static_cast<float>(sum / static_cast<double>(values_.size()));
-  double ss = 0.0;
-  for (float x : values_) ss += (x - mean_) * (x - mean_);
-  norm_ = static_cast<float>(std::sqrt(ss));
+  const double mean = values.cast<double>().mean();
+  const Eigen::VectorXf centred = (values.cast<double>().array() - mean).matrix().cast<float>();
+  const float norm = centred.norm();
+  const Eigen::Matrix<double, 6, 6> H = sd.cast<double>() * sd.cast<double>().transpose();
   // An untextured or edge-only patch does not fix all six parameters.
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(H, Eigen::EigenvaluesOnly);
   const double lmin = eig.eigenvalues()(0), lmax = eig.eigenvalues()(5);
-  if (!(lmax > 0.0) || !(lmin > 1e-6 * lmax) || !(norm_ > 0.0f)) {
-    values_.clear();
-    sd_.clear();
-    return false;
-  }
+  if (!(lmax > 0.0) || !(lmin > 1e-6 * lmax) || !(norm > 0.0f)) return false;
+  centred_ = centred;
+  sd_ = sd;
+  sdTemplate_ = sd_ * centred_;
+  norm_ = norm;
   hessianInverse_ = H.inverse().cast<float>();
   translationHessianInverse_ = H.bottomRightCorner<2, 2>().inverse().cast<float>();
   half_ = h;
@@ -84,7 +80,9 @@ PatchAlignResult AffinePatch::align(const cv::Mat& image, AffineWarp& W, const P
   if (empty() || image.empty() || image.type() != CV_8UC1) return res;
   const int h = half_, n = 2 * h + 1;
   const auto fh = static_cast<float>(h);
-  std::vector<float> I(values_.size());
+  // Per-thread buffer of the warped patch (no allocation per call).
+  thread_local Eigen::VectorXf I;
+  I.resize(centred_.size());
   const float lo = 1.0f - p.maxShapeChange, hi = 1.0f / lo;
   // Translation only until the centre is within a tenth of a pixel (at most half of the
   // iterations): far from the optimum the six-parameter step couples shape and shift badly.
@@ -99,37 +97,31 @@ PatchAlignResult AffinePatch::align(const cv::Mat& image, AffineWarp& W, const P
         if (!inside(image, q.x(), q.y())) return res;
       }
     }
-    double sumI = 0.0;
+    const Eigen::Vector2f du = W.A.col(0);
     for (int v = -h; v <= h; ++v) {
       // Row start and step of the warped grid: q(u, v) = A (u, v) + t.
       const Eigen::Vector2f row = W.A * Eigen::Vector2f(-fh, static_cast<float>(v)) + W.t;
-      const Eigen::Vector2f du = W.A.col(0);
+      float* out = I.data() + (v + h) * n;
       for (int u = 0; u < n; ++u) {
-        const float x = row.x() + du.x() * static_cast<float>(u), y = row.y() + du.y() * static_cast<float>(u);
-        const std::size_t k = static_cast<std::size_t>((v + h) * n + u);
-        I[k] = sample(image, x, y);
-        sumI += I[k];
+        out[u] = sample(image, row.x() + du.x() * static_cast<float>(u), row.y() + du.y() * static_cast<float>(u));
       }
     }
-    const float meanI = static_cast<float>(sumI / static_cast<double>(I.size()));
-    double sIT = 0.0, sII = 0.0;
-    for (std::size_t k = 0; k < I.size(); ++k) {
-      const double a = I[k] - meanI, b = values_[k] - mean_;
-      sIT += a * b;
-      sII += a * a;
-    }
+    // Centred warped patch; gain and bias that map it onto the template (least squares):
+    // gain·(I − Ī) − (T − T̄) is the error, so the steepest-descent product is
+    // gain·(SD·(I − Ī)) − SD·(T − T̄).
+    const float meanI = I.sum() / static_cast<float>(I.size());
+    I.array() -= meanI;
+    const double sII = I.squaredNorm(), sIT = I.dot(centred_);
     if (!(sII > 0.0)) return res;
     res.correlation = static_cast<float>(sIT / (std::sqrt(sII) * static_cast<double>(norm_)));
-    // Gain and bias that map the warped patch onto the template (least squares).
     const auto gain = static_cast<float>(sIT / sII);
-    const float bias = mean_ - gain * meanI;
-    Eigen::Matrix<float, 6, 1> b = Eigen::Matrix<float, 6, 1>::Zero();
-    for (std::size_t k = 0; k < I.size(); ++k) b += sd_[k] * (gain * I[k] + bias - values_[k]);
     Eigen::Matrix<float, 6, 1> dp = Eigen::Matrix<float, 6, 1>::Zero();
     if (shape) {
+      const Eigen::Matrix<float, 6, 1> b = gain * (sd_ * I) - sdTemplate_;
       dp = hessianInverse_ * b;
     } else {
-      dp.tail<2>() = translationHessianInverse_ * b.tail<2>();
+      const Eigen::Vector2f b = gain * (sd_.bottomRows<2>() * I) - sdTemplate_.tail<2>();
+      dp.tail<2>() = translationHessianInverse_ * b;
       ++translationSteps;
     }
     // W ← W ∘ W(Δp)⁻¹ (B&M eq. (32)): W(Δp)(x) = ΔA x + Δt, its inverse ΔA⁻¹ (x − Δt).

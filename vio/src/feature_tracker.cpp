@@ -47,7 +47,7 @@ void ImagePyramid::build(const cv::Mat& gray, const KltParams& p) {
 
 void trackKlt(const ImagePyramid& from, const ImagePyramid& to, const std::vector<cv::Point2f>& pts,
               std::vector<cv::Point2f>& out, std::vector<unsigned char>& status, const KltParams& p,
-              bool useGuess) {
+              bool useGuess, const std::vector<unsigned char>* backward) {
   status.assign(pts.size(), 0);
   if (pts.empty()) {
     out.clear();
@@ -76,6 +76,10 @@ void trackKlt(const ImagePyramid& from, const ImagePyramid& to, const std::vecto
   for (std::size_t i = 0; i < pts.size(); ++i) {
     const cv::Point2f& q = out[i];
     if (!st[i] || !(q.x >= b && q.y >= b && q.x <= xMax && q.y <= yMax)) continue;
+    if (backward && !(*backward)[i]) {
+      status[i] = 1;
+      continue;
+    }
     idx.push_back(i);
     fwd.push_back(q);
     back.push_back(pts[i] + (q - predicted[i]));
@@ -126,6 +130,12 @@ void FeatureTracker::process(const ImagePyramid& image, const Eigen::Matrix3d* R
     // First pass: the tracks with a prediction through the shallow pyramid.
     std::vector<std::size_t> idx;
     std::vector<cv::Point2f> from, to, predicted;
+    // Tracks refined against their template below are verified there (correlation and
+    // correction limits); the KLT backward pass is only for the others.
+    std::vector<unsigned char> backward;
+    const auto needsBackward = [&](std::size_t i) -> unsigned char {
+      return !(cfg_.alignTemplates && cfg_.templatesReplaceBackwardCheck && !templates_[i].empty());
+    };
     if (cfg_.predictedLevels >= 0 && cfg_.predictedLevels < cfg_.klt.levels) {
       // With a rotation every track has its prediction. Without, tracks continue their last
       // image step (constant image motion); new ones take the median step of those when there
@@ -162,13 +172,14 @@ void FeatureTracker::process(const ImagePyramid& image, const Eigen::Matrix3d* R
         }
         idx.push_back(i);
         from.push_back(pts_[i]);
+        backward.push_back(needsBackward(i));
       }
       if (!idx.empty()) {
         predicted = to;
         KltParams p = cfg_.klt;
         p.levels = cfg_.predictedLevels;
         std::vector<unsigned char> st;
-        trackKlt(prev_, image, from, to, st, p, true);
+        trackKlt(prev_, image, from, to, st, p, true, &backward);
         // A shallow pyramid can settle on a wrong but forward-backward consistent match far from
         // its start: only small corrections of the prediction are accepted.
         const float maxCorr2 = static_cast<float>(cfg_.predictedMaxCorrection * cfg_.predictedMaxCorrection);
@@ -185,15 +196,17 @@ void FeatureTracker::process(const ImagePyramid& image, const Eigen::Matrix3d* R
     idx.clear();
     from.clear();
     to.clear();
+    backward.clear();
     for (std::size_t i = 0; i < n; ++i) {
       if (status[i]) continue;
       idx.push_back(i);
       from.push_back(pts_[i]);
       to.push_back(start[i]);
+      backward.push_back(needsBackward(i));
     }
     if (!idx.empty()) {
       std::vector<unsigned char> st;
-      trackKlt(prev_, image, from, to, st, cfg_.klt, R_cur_prev != nullptr);
+      trackKlt(prev_, image, from, to, st, cfg_.klt, R_cur_prev != nullptr, &backward);
       for (std::size_t k = 0; k < idx.size(); ++k) {
         cur[idx[k]] = to[k];
         status[idx[k]] = st[k];

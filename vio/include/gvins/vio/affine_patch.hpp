@@ -51,7 +51,7 @@ class AffinePatch {
   /// Samples the template centred at `centre` from the 8-bit gray `image`. False (and an empty
   /// template) if the patch and its gradient border are not inside the image.
   bool extract(const cv::Mat& image, const cv::Point2f& centre, const PatchAlignParams& params);
-  bool empty() const { return values_.empty(); }
+  bool empty() const { return centred_.size() == 0; }
 
   /// Refines `warp` (initial guess in, result out) so that the image under the warp matches the
   /// template. Fails (result.ok false, warp unspecified) when the patch leaves the image, the
@@ -61,11 +61,15 @@ class AffinePatch {
 
  private:
   int half_ = 0;
-  std::vector<float> values_;                // template intensities, row-major (2h+1)²
-  std::vector<Eigen::Matrix<float, 6, 1>> sd_;  // steepest-descent images ∇T ∂W/∂p
+  // Template intensities minus their mean, row-major (2h+1)² (empty: no template).
+  Eigen::VectorXf centred_;
+  // Steepest-descent images ∇T ∂W/∂p, one row per parameter (rows are contiguous, so the
+  // per-iteration products with the warped patch are vectorised dot products).
+  Eigen::Matrix<float, 6, Eigen::Dynamic, Eigen::RowMajor> sd_;
+  Eigen::Matrix<float, 6, 1> sdTemplate_;    // sd_ · centred_
   Eigen::Matrix<float, 6, 6> hessianInverse_;
   Eigen::Matrix2f translationHessianInverse_;
-  float mean_ = 0.0f, norm_ = 0.0f;          // template mean and sqrt(Σ (T − mean)²)
+  float norm_ = 0.0f;                        // sqrt(Σ (T − mean)²)
 };
 
 }  // namespace gvins::vio

@@ -49,10 +49,12 @@ class ImagePyramid {
 
 /// Lucas-Kanade from `from` to `to` for `pts`. If `useGuess`, `out` holds initial positions in
 /// `to` (same size as pts); otherwise it is overwritten. status[i] = 1 if tracked forward, back
-/// to within maxForwardBackward of pts[i], and inside the border of `to`.
+/// to within maxForwardBackward of pts[i], and inside the border of `to`. With `backward`
+/// (same size as pts), only points with backward[i] != 0 get the backward check (the others are
+/// verified by the caller, e.g. against their template).
 void trackKlt(const ImagePyramid& from, const ImagePyramid& to, const std::vector<cv::Point2f>& pts,
-              std::vector<cv::Point2f>& out, std::vector<unsigned char>& status, const KltParams& params,
-              bool useGuess);
+              std::vector<cv::Point2f>& out, std::vector<unsigned char>& status, const KltParams& p,
+              bool useGuess = false, const std::vector<unsigned char>* backward = nullptr);
 
 struct FeatureTrackerConfig {
   GridDetectorConfig grid;
@@ -89,6 +91,10 @@ struct FeatureTrackerConfig {
   /// none); see affine_patch.hpp.
   double patchSmoothing = 1.0;
   double templateMaxCorrection = 2.0;  ///< px
+  /// Tracks with a template skip the KLT forward-backward check: the template alignment
+  /// (correlation >= patch.minCorrelation, within templateMaxCorrection of the KLT result)
+  /// verifies them instead, at half the KLT cost.
+  bool templatesReplaceBackwardCheck = true;
   /// Travel limit (as maxTrackTravel) for tracks refined against their template; 0: no limit.
   double templateMaxTrackTravel = 0.0;
   /// Tracks younger than this many images are not ended by their travel (a fast rotation can
