@@ -150,6 +150,13 @@ TEST(SriSwfJacobians, InverseDepthFeatureAndReanchoringMatchFiniteDifferences) {
   });
   EXPECT_LT((D * cb.J_point * ap.J_feature - Rf).norm(), 1e-6 * Rf.norm());
   EXPECT_LT((D * cb.J_pose - Rb).norm(), 1e-6 * Rb.norm());
+  // With respect to the extrinsic of camera 0, which both anchors use (online calibration).
+  const auto Re = numericJacobian<6>([&](const Eigen::Matrix<double, 6, 1>& d) {
+    const CameraExtrinsic e = perturbExt(g.ext0, d);
+    return Eigen::VectorXd(inverseDepthOf(anchoredPoint(f, g.anchor, e).p_W, g.pose, e));
+  });
+  ASSERT_GT(Re.norm(), 1e-3);
+  EXPECT_LT((D * (cb.J_point * ap.J_ext + cb.J_ext) - Re).norm(), 1e-6 * Re.norm());
 }
 
 TEST(SriSwfJacobians, PropagationTransitionMatchesFiniteDifferences) {

@@ -175,3 +175,4 @@ TEST(SriSwfNullspace, FloatUpdatesKeepTheNullspace) {
 
 }  // namespace
 }  // namespace gvins::vio
+
