@@ -727,6 +727,48 @@ typename SriFilter<Scalar>::Matrix SriFilter<Scalar>::covariance(
 }
 
 template <typename Scalar>
+typename SriFilter<Scalar>::Matrix SriFilter<Scalar>::covarianceFactor(
+    std::span<const BlockId> ids) const {
+  int c = n_;
+  int s = 0;
+  for (BlockId id : ids) {
+    const BlockInfo& b = layout_.block(id);
+    c = std::min(c, b.offset);
+    s += b.dim;
+  }
+  if (s == 0) return Matrix();
+  std::vector<int> keep;
+  RowMatrix<Scalar> copy;
+  const auto Rt = informedTrailing(c, keep, copy);
+  if (!Rt) {
+    throw std::domain_error(
+        "sri::SriFilter::covarianceFactor: a later block without information is coupled to the others");
+  }
+  std::vector<int> pos(static_cast<std::size_t>(n_ - c), -1);
+  for (std::size_t a = 0; a < keep.size(); ++a) pos[static_cast<std::size_t>(keep[a])] = static_cast<int>(a);
+  const int k = static_cast<int>(keep.size());
+  // X = R_t⁻¹, upper triangular: column j solves R_t x = e_j on its first j + 1 rows.
+  Matrix X = Matrix::Zero(k, k);
+  for (int j = 0; j < k; ++j) {
+    X(j, j) = Scalar(1);
+    Rt->topLeftCorner(j + 1, j + 1).template triangularView<Eigen::Upper>().solveInPlace(X.col(j).head(j + 1));
+  }
+  Matrix F(s, k);
+  int row = 0;
+  for (BlockId id : ids) {
+    const BlockInfo& b = layout_.block(id);
+    for (int q = 0; q < b.dim; ++q, ++row) {
+      const int p = pos[static_cast<std::size_t>(b.offset - c + q)];
+      if (p < 0) {
+        throw std::domain_error("sri::SriFilter::covarianceFactor: block '" + b.name + "' has no information");
+      }
+      F.row(row) = X.row(p);
+    }
+  }
+  return F;
+}
+
+template <typename Scalar>
 typename SriFilter<Scalar>::Matrix SriFilter<Scalar>::fullCovariance() const {
   Matrix Rinv = Matrix::Identity(n_, n_);
   if (n_ == 0) return Rinv;

@@ -408,6 +408,10 @@ TEST(Measurement, UninformativePriorGivesLeastSquares) {
   // Marginal covariance of a: (HᵀH/σ²)⁻¹, although b (behind it) has no information at all.
   const Md Pa = (H.transpose() * H / 0.04).inverse();
   EXPECT_LT((f.covariance(std::vector<BlockId>{a}) - Pa).norm(), 1e-12);
+  const Md Fa = f.covarianceFactor(std::vector<BlockId>{a});
+  EXPECT_EQ(Fa.cols(), 3);  // b's uninformed columns are left out
+  EXPECT_LT((Fa * Fa.transpose() - Pa).norm(), 1e-12);
+  EXPECT_THROW(f.covarianceFactor(std::vector<BlockId>{b}), std::domain_error);
   // Gating a new measurement of a works; one that involves b cannot be gated yet.
   Measurement<double> za(1);
   za.jacobian(a, 3) = Eigen::RowVector3d(1, -1, 0.5);

@@ -299,6 +299,9 @@ class Lockstep {
         for (std::size_t b = 0; b < idx.size(); ++b) expect(a, b) = kf_.P(idx[a], idx[b]);
       }
       max_double_p_ = std::max(max_double_p_, relErr(Pm, expect));
+      // The factor form (F Fᵀ, no covariance formed) gives the same marginal.
+      const Md Fm = sd_.covarianceFactor(ids);
+      max_double_p_ = std::max(max_double_p_, relErr(Md(Fm * Fm.transpose()), expect));
     }
   }
 

@@ -751,18 +751,19 @@ struct SriSwfEstimator<Scalar>::Impl {
     out.setWhitened();
   }
 
-  // Window covariance for gating MSCKF-type rows (clones and extrinsics only): one marginal
-  // covariance per frame (trailing block of R) and its factor Pw = U Uᵀ with U upper triangular
-  // (Cholesky of the reversed matrix), then χ² = zᵀ(I + G Gᵀ)⁻¹z with G = H U per feature. H is
-  // zero before the first block it touches (s), so G = H[:, s:] U[s:, s:] (a triangular
-  // product) and I + G Gᵀ a rank update: about half the flops of H Pw Hᵀ, and fewer for short
-  // tracks on the newest clones. Cheaper than SriFilter::chiSquare's per-feature triangular
-  // solve and QR. Valid when r = 0 (right after correct()). Two exact bounds decide most
-  // features without G: I ≤ I + G Gᵀ ≤ (1 + ‖H‖²_F tr(Pw)) I, so χ² ≤ ‖z‖² (accept when ‖z‖² is
-  // below the threshold) and χ² ≥ ‖z‖² / (1 + ‖H‖²_F tr(Pw)) (reject when that is above it).
-  Eigen::MatrixXd Pw, Uw;
+  // Window covariance for gating MSCKF-type rows (clones, extrinsics, time offset): once per
+  // frame a factor Pw = F Fᵀ (SriFilter::covarianceFactor: the window's rows of the inverse of
+  // the trailing block of R, which starts at the oldest clone; no covariance is formed), then
+  // χ² = zᵀ(I + G Gᵀ)⁻¹z with G = H F per feature. H is zero before the first block it touches
+  // (s), and the window blocks lead the trailing block in this order, so F[s:, :s] = 0 and
+  // G = H[:, s:] F[s:, s:] (fewer flops for short tracks on the newest clones); I + G Gᵀ is a
+  // rank update. Cheaper than SriFilter::chiSquare's per-feature triangular solve and QR. Valid
+  // when r = 0 (right after correct()). Two exact bounds decide most features without G:
+  // I ≤ I + G Gᵀ ≤ (1 + ‖H‖²_F tr(Pw)) I, so χ² ≤ ‖z‖² (accept when ‖z‖² is below the
+  // threshold) and χ² ≥ ‖z‖² / (1 + ‖H‖²_F tr(Pw)) (reject when that is above it).
+  Eigen::MatrixXd Fw;
   double pw_trace = 0.0;
-  bool uw_ok = false;
+  bool fw_leading_triangular = false;
   std::unordered_map<std::uint64_t, int> pw_off;
   mutable Eigen::MatrixXd gate_H, gate_G, gate_S;
   mutable Eigen::VectorXd gate_z;
@@ -785,11 +786,14 @@ struct SriSwfEstimator<Scalar>::Impl {
       pw_off[td_id.value] = off;
       off += 1;
     }
-    Pw = f.covariance(ids).template cast<double>();
-    const Eigen::LLT<Eigen::MatrixXd> llt(Pw.reverse());  // J Pw J = L Lᵀ → Pw = (JLJ)(JLJ)ᵀ
-    uw_ok = llt.info() == Eigen::Success;
-    if (uw_ok) Uw = Eigen::MatrixXd(llt.matrixL()).reverse();
-    pw_trace = Pw.trace();
+    Fw = f.covarianceFactor(ids).template cast<double>();
+    pw_trace = Fw.squaredNorm();
+    // The structure the gate uses (checked, not assumed: client blocks could sit in between).
+    const int d = static_cast<int>(Fw.rows());
+    fw_leading_triangular = Fw.cols() >= d;
+    for (int j = 0; j < d && fw_leading_triangular; ++j) {
+      fw_leading_triangular = Fw.col(j).tail(d - j - 1).isZero(0.0);
+    }
   }
   bool gateWindow(const Meas& m) const {
     if (cfg.chi2_probability >= 1.0) return true;
@@ -800,7 +804,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     double hh = 0.0;
     for (int i = 0; i < m.numBlocks(); ++i) hh += static_cast<double>(m.jacobianAt(i).squaredNorm());
     if (zz > thr * (1.0 + hh * pw_trace)) return false;
-    const int d = static_cast<int>(Pw.cols());
+    const int d = static_cast<int>(Fw.rows());
     int s0 = d;
     for (int i = 0; i < m.numBlocks(); ++i) s0 = std::min(s0, pw_off.at(m.blockId(i).value));
     const int k = d - s0;
@@ -808,15 +812,14 @@ struct SriSwfEstimator<Scalar>::Impl {
     for (int i = 0; i < m.numBlocks(); ++i) {
       gate_H.middleCols(pw_off.at(m.blockId(i).value) - s0, m.blockDim(i)) = m.jacobianAt(i).template cast<double>();
     }
-    gate_S.setIdentity(rows, rows);
-    if (uw_ok) {
-      gate_G.noalias() = gate_H * Uw.bottomRightCorner(k, k).template triangularView<Eigen::Upper>();
-      gate_S.template selfadjointView<Eigen::Lower>().rankUpdate(gate_G);
+    const int cols = static_cast<int>(Fw.cols());
+    if (fw_leading_triangular) {
+      gate_G.noalias() = gate_H * Fw.bottomRightCorner(k, cols - s0);
     } else {
-      const auto Pk = Pw.bottomRightCorner(k, k);
-      gate_G.noalias() = gate_H * Pk;
-      gate_S.noalias() += gate_G * gate_H.transpose();
+      gate_G.noalias() = gate_H * Fw.bottomRows(k);
     }
+    gate_S.setIdentity(rows, rows);
+    gate_S.template selfadjointView<Eigen::Lower>().rankUpdate(gate_G);
     const Eigen::LLT<Eigen::MatrixXd> llt(gate_S);
     if (llt.info() != Eigen::Success) return false;
     gate_z = m.residual().template cast<double>();

@@ -178,6 +178,15 @@ class SriFilter {
   /// R alone then does not give the covariance (it would need a pseudo-inverse); give such
   /// blocks a weak prior instead of none, or marginalize them.
   Matrix covariance(std::span<const BlockId> ids) const;
+  /// A factor F of the same marginal covariance, P = F Fᵀ, without forming P: the rows of
+  /// R_t⁻¹ (R_t the informed trailing part of R from the first listed block, inverted column by
+  /// column with forward substitutions, about k³/6 operations for k trailing columns) that belong
+  /// to the listed blocks, in the listed order; F has one column per informed trailing column.
+  /// When the listed blocks are consecutive in the state, in the listed order, from the first
+  /// trailing column, the leading square part of F is upper triangular (rows of a block see only
+  /// its own and later columns), so rows H that are zero on the first s columns need only
+  /// F.bottomRightCorner(rows − s, cols − s). Same errors as covariance().
+  Matrix covarianceFactor(std::span<const BlockId> ids) const;
   /// Full covariance R⁻¹R⁻ᵀ (for tests and debugging; O(n³)).
   Matrix fullCovariance() const;
 
