@@ -100,18 +100,25 @@ void trackKlt(const ImagePyramid& from, const ImagePyramid& to, const std::vecto
 FeatureTracker::FeatureTracker(const CameraModel& camera, const FeatureTrackerConfig& config)
     : cam_(camera), cfg_(config), detector_(config.grid) {}
 
+void FeatureTracker::prepareTemplates(const cv::Mat& image) {
+  if (!cfg_.alignTemplates) return;
+  if (cfg_.patchSmoothing > 0.0) {
+    cv::GaussianBlur(image, smooth_, cv::Size(0, 0), cfg_.patchSmoothing);
+  } else {
+    smooth_ = image;
+  }
+  smoothOf_ = image.data;
+}
+
 void FeatureTracker::process(const ImagePyramid& image, const Eigen::Matrix3d* R_cur_prev, FrontendTiming* timing) {
   FrontendTiming local;
   FrontendTiming& tm = timing ? *timing : local;
-  if (cfg_.alignTemplates) {
+  if (cfg_.alignTemplates && smoothOf_ != image.image().data) {
     const auto ts = Clock::now();
-    if (cfg_.patchSmoothing > 0.0) {
-      cv::GaussianBlur(image.image(), smooth_, cv::Size(0, 0), cfg_.patchSmoothing);
-    } else {
-      smooth_ = image.image();
-    }
+    prepareTemplates(image.image());
     tm.tracking += msSince(ts);
   }
+  smoothOf_ = nullptr;
   if (!prev_.empty() && !pts_.empty()) {
     auto t0 = Clock::now();
     const std::size_t n = pts_.size();

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include <Eigen/LU>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace gvins::vio {
@@ -46,7 +47,7 @@ struct StereoFrontend::Impl {
   FeatureTracker tracker;
   std::optional<CameraModel> cam1;
   std::optional<StereoMatcher> matcher;
-  cv::Ptr<cv::CLAHE> clahe;
+  cv::Ptr<cv::CLAHE> clahe, claheRight;
   std::uint64_t frames = 0;
   // Last cam1 pixel of each stereo-matched feature, for the next prediction, by increasing id
   // (the tracker keeps its ids sorted: survivors in order, new ones appended).
@@ -68,7 +69,10 @@ struct StereoFrontend::Impl {
       // x_c1 = T_C1B T_BC0 x_c0.
       matcher.emplace(tracker.camera(), *cam1, inverse(c1->T_BS) * c0.T_BS, cfg.stereo);
     }
-    if (c.equalize == Equalization::Clahe) clahe = cv::createCLAHE(3.0, cv::Size(8, 8));
+    if (c.equalize == Equalization::Clahe) {
+      clahe = cv::createCLAHE(3.0, cv::Size(8, 8));
+      claheRight = cv::createCLAHE(3.0, cv::Size(8, 8));
+    }
   }
 };
 
@@ -101,25 +105,31 @@ FeatureFrame StereoFrontend::process(std::int64_t t_ns, const cv::Mat& leftIn, c
 
   auto t0 = Clock::now();
   const std::size_t slot = out.index % 2;
-  cv::Mat left = leftIn, right = rightIn;
-  if (s.cfg.equalize == Equalization::Clahe) {
-    s.clahe->apply(leftIn, s.equalized[slot]);
-    left = s.equalized[slot];
-    if (doStereo) {
-      s.clahe->apply(rightIn, s.equalizedRight);
-      right = s.equalizedRight;
-    }
-  } else if (s.cfg.equalize == Equalization::Histogram) {
-    cv::equalizeHist(leftIn, s.equalized[slot]);
-    left = s.equalized[slot];
-    if (doStereo) {
-      cv::equalizeHist(rightIn, s.equalizedRight);
-      right = s.equalizedRight;
-    }
-  }
   ImagePyramid& leftPyr = s.leftPyr[slot];
-  leftPyr.build(left, s.cfg.tracker.klt);
-  if (doStereo) s.rightPyr.build(right, s.cfg.tracker.klt);
+  // Equalisation and pyramid of each image, and the left image's smoothing for the templates:
+  // the two images are independent, so they are prepared in parallel (OpenCV's thread pool).
+  auto prepare = [&](int which) {
+    const cv::Mat& in = which == 0 ? leftIn : rightIn;
+    cv::Mat& eq = which == 0 ? s.equalized[slot] : s.equalizedRight;
+    cv::Mat img = in;
+    if (s.cfg.equalize == Equalization::Clahe) {
+      // cv::CLAHE keeps state per object: one per image side.
+      (which == 0 ? s.clahe : s.claheRight)->apply(in, eq);
+      img = eq;
+    } else if (s.cfg.equalize == Equalization::Histogram) {
+      cv::equalizeHist(in, eq);
+      img = eq;
+    }
+    (which == 0 ? leftPyr : s.rightPyr).build(img, s.cfg.tracker.klt);
+    if (which == 0) s.tracker.prepareTemplates(leftPyr.image());
+  };
+  if (doStereo) {
+    cv::parallel_for_(cv::Range(0, 2), [&](const cv::Range& r) {
+      for (int i = r.start; i < r.end; ++i) prepare(i);
+    });
+  } else {
+    prepare(0);
+  }
   out.timing.pyramid = msSince(t0);
 
   s.tracker.process(leftPyr, R_cur_prev, &out.timing);

@@ -115,6 +115,10 @@ class FeatureTracker {
   /// (e.g. from the gyro); tracks then start at the rotation-predicted pixels.
   void process(const ImagePyramid& image, const Eigen::Matrix3d* R_cur_prev = nullptr,
                FrontendTiming* timing = nullptr);
+  /// Optional first half of process() for the same image (8-bit gray, the pyramid's level 0):
+  /// smooths it for the template alignment, so that a caller can do this on another thread
+  /// while it builds other images' pyramids. process() skips the smoothing when it was prepared.
+  void prepareTemplates(const cv::Mat& image);
 
   const std::vector<cv::Point2f>& points() const { return pts_; }
   /// Position of each feature in the previous image (new features: their current position).
@@ -138,6 +142,7 @@ class FeatureTracker {
   std::vector<AffinePatch> templates_;  // empty: no template (plain KLT track)
   std::vector<AffineWarp> warps_;
   cv::Mat smooth_;  // the current image smoothed for the templates (buffer kept between frames)
+  const unsigned char* smoothOf_ = nullptr;  // pixels smooth_ was made from (prepareTemplates)
   std::uint64_t nextId_ = 0;
 };
 
