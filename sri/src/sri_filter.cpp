@@ -692,36 +692,42 @@ std::optional<typename SriFilter<Scalar>::ConstView> SriFilter<Scalar>::informed
 }
 
 template <typename Scalar>
-typename SriFilter<Scalar>::Matrix SriFilter<Scalar>::covariance(
-    std::span<const BlockId> ids) const {
+std::optional<typename SriFilter<Scalar>::ConstView> SriFilter<Scalar>::listedTrailing(
+    std::span<const BlockId> ids, const char* who, std::vector<int>& columns, RowMatrix<Scalar>& copy) const {
+  columns.clear();
   int c = n_;
-  int s = 0;
-  for (BlockId id : ids) {
-    const BlockInfo& b = layout_.block(id);
-    c = std::min(c, b.offset);
-    s += b.dim;
-  }
-  if (s == 0) return Matrix();
+  for (BlockId id : ids) c = std::min(c, layout_.block(id).offset);
+  if (c == n_) return std::nullopt;
   std::vector<int> keep;
-  RowMatrix<Scalar> copy;
   const auto Rt = informedTrailing(c, keep, copy);
   if (!Rt) {
-    throw std::domain_error(
-        "sri::SriFilter::covariance: a later block without information is coupled to the others");
+    throw std::domain_error(std::string("sri::SriFilter::") + who +
+                            ": a later block without information is coupled to the others");
   }
   // Position of every trailing column in the reduced factor (−1: dropped).
   std::vector<int> pos(static_cast<std::size_t>(n_ - c), -1);
   for (std::size_t a = 0; a < keep.size(); ++a) pos[static_cast<std::size_t>(keep[a])] = static_cast<int>(a);
-  Matrix Y = Matrix::Zero(static_cast<Eigen::Index>(keep.size()), s);
-  int col = 0;
   for (BlockId id : ids) {
     const BlockInfo& b = layout_.block(id);
-    for (int q = 0; q < b.dim; ++q, ++col) {
+    for (int q = 0; q < b.dim; ++q) {
       const int p = pos[static_cast<std::size_t>(b.offset - c + q)];
-      if (p < 0) throw std::domain_error("sri::SriFilter::covariance: block '" + b.name + "' has no information");
-      Y(p, col) = Scalar(1);
+      if (p < 0) throw std::domain_error(std::string("sri::SriFilter::") + who + ": block '" + b.name + "' has no information");
+      columns.push_back(p);
     }
   }
+  return Rt;
+}
+
+template <typename Scalar>
+typename SriFilter<Scalar>::Matrix SriFilter<Scalar>::covariance(
+    std::span<const BlockId> ids) const {
+  std::vector<int> cols;
+  RowMatrix<Scalar> copy;
+  const auto Rt = listedTrailing(ids, "covariance", cols, copy);
+  if (!Rt) return Matrix();
+  const int s = static_cast<int>(cols.size());
+  Matrix Y = Matrix::Zero(Rt->rows(), s);
+  for (int col = 0; col < s; ++col) Y(cols[static_cast<std::size_t>(col)], col) = Scalar(1);
   Rt->transpose().template triangularView<Eigen::Lower>().solveInPlace(Y);
   return Y.transpose() * Y;
 }
@@ -729,42 +735,19 @@ typename SriFilter<Scalar>::Matrix SriFilter<Scalar>::covariance(
 template <typename Scalar>
 typename SriFilter<Scalar>::Matrix SriFilter<Scalar>::covarianceFactor(
     std::span<const BlockId> ids) const {
-  int c = n_;
-  int s = 0;
-  for (BlockId id : ids) {
-    const BlockInfo& b = layout_.block(id);
-    c = std::min(c, b.offset);
-    s += b.dim;
-  }
-  if (s == 0) return Matrix();
-  std::vector<int> keep;
+  std::vector<int> cols;
   RowMatrix<Scalar> copy;
-  const auto Rt = informedTrailing(c, keep, copy);
-  if (!Rt) {
-    throw std::domain_error(
-        "sri::SriFilter::covarianceFactor: a later block without information is coupled to the others");
-  }
-  std::vector<int> pos(static_cast<std::size_t>(n_ - c), -1);
-  for (std::size_t a = 0; a < keep.size(); ++a) pos[static_cast<std::size_t>(keep[a])] = static_cast<int>(a);
-  const int k = static_cast<int>(keep.size());
+  const auto Rt = listedTrailing(ids, "covarianceFactor", cols, copy);
+  if (!Rt) return Matrix();
+  const int k = static_cast<int>(Rt->rows());
   // X = R_t⁻¹, upper triangular: column j solves R_t x = e_j on its first j + 1 rows.
   Matrix X = Matrix::Zero(k, k);
   for (int j = 0; j < k; ++j) {
     X(j, j) = Scalar(1);
     Rt->topLeftCorner(j + 1, j + 1).template triangularView<Eigen::Upper>().solveInPlace(X.col(j).head(j + 1));
   }
-  Matrix F(s, k);
-  int row = 0;
-  for (BlockId id : ids) {
-    const BlockInfo& b = layout_.block(id);
-    for (int q = 0; q < b.dim; ++q, ++row) {
-      const int p = pos[static_cast<std::size_t>(b.offset - c + q)];
-      if (p < 0) {
-        throw std::domain_error("sri::SriFilter::covarianceFactor: block '" + b.name + "' has no information");
-      }
-      F.row(row) = X.row(p);
-    }
-  }
+  Matrix F(static_cast<Eigen::Index>(cols.size()), k);
+  for (std::size_t r = 0; r < cols.size(); ++r) F.row(static_cast<Eigen::Index>(r)) = X.row(cols[r]);
   return F;
 }
 

@@ -26,6 +26,7 @@
 #include "gvins/sim/scenario.hpp"
 #include "gvins/vio/sensor_yaml.hpp"
 #include "process_scratch_folder.hpp"
+#include "sim_feature_dataset.hpp"
 
 namespace gvins::fusion {
 namespace {
@@ -37,33 +38,17 @@ const fs::path& scratch() { return test::processScratchFolder("gvins_extrinsics_
 const fs::path& dataset() {
   static const fs::path dir = [] {
     const fs::path d = scratch() / "dataset";
-    const std::string y =
-        "name: extrinsics_test\n"
-        "origin: {latitude_deg: 35.134707705, longitude_deg: 136.977577939, height_m: 104.853}\n"
-        "start_gpst: \"2024-06-24 08:20:00\"\n"
+    test::simulateStereoFeatureDataset(
+        d, "extrinsics_test",
         "trajectory: {type: flight, pattern: figure_eight, height_m: 30, length_m: 220, speed_mps: 6, laps: 1,\n"
-        "             heading_deg: 30, takeoff_landing: false, hover_start_s: 3, hover_end_s: 2, wobble_deg: 0.3}\n"
-        "imu: {rate_hz: 250}\n"
-        "cameras:\n"
-        "  rate_hz: 20\n"
-        "  output: features\n"
-        "  list:\n"
-        "    - {name: cam0, look: down, position_m: [0.06, 0.06, -0.04], mount_rpy_deg: [0.4, -0.3, 0.2]}\n"
-        "    - {name: cam1, look: down, position_m: [0.06, -0.06, -0.04], mount_rpy_deg: [-0.2, 0.3, -0.4]}\n"
-        "gnss: none\n";
-    const sim::Scenario sc = sim::parseScenario(y, "extrinsics_test.yaml");
-    sim::GenerationOptions opt;
-    opt.seed = 211;
-    opt.threads = 2;
-    sim::generateDataset(sc, d, opt);
+        "             heading_deg: 30, takeoff_landing: false, hover_start_s: 3, hover_end_s: 2, wobble_deg: 0.3}\n",
+        "", 211);
     return d;
   }();
   return dir;
 }
 
-vio::CameraCalibration trueCamera(int k) {
-  return vio::readCameraSensorYaml((dataset() / "mav0" / ("cam" + std::to_string(k)) / "sensor.yaml").string());
-}
+vio::CameraCalibration trueCamera(int k) { return test::datasetCamera(dataset(), k); }
 
 /// T_BS moved by a rotation of `deg` about `axis` (body frame) and a translation `dp` (m).
 Eigen::Matrix4d perturbed(const Eigen::Matrix4d& T, double deg, const Eigen::Vector3d& axis, const Eigen::Vector3d& dp) {
@@ -98,9 +83,7 @@ struct CalibSetup {
 
 CalibRun replay(const std::string& name, Given given, const CalibSetup& su) {
   const fs::path d = dataset();
-  vio::SriSwfConfig ec;
-  ec.gravity = *readSimDatasetInfo(d.string())->gravity;
-  ec.imu = vio::readImuSensorYaml((d / "mav0" / "imu0" / "sensor.yaml").string()).noise;
+  vio::SriSwfConfig ec = test::datasetEstimatorConfig(d);
   vio::CameraCalibration c0 = trueCamera(0), c1 = trueCamera(1);
   const Eigen::Matrix4d T0 = c0.T_BS, T1 = c1.T_BS;
   if (given != Given::Truth) {

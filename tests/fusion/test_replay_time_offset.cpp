@@ -21,6 +21,7 @@
 #include "gvins/vio/euroc_csv.hpp"
 #include "gvins/vio/sensor_yaml.hpp"
 #include "process_scratch_folder.hpp"
+#include "sim_feature_dataset.hpp"
 
 namespace gvins::fusion {
 namespace {
@@ -36,26 +37,11 @@ const fs::path& scratch() { return test::processScratchFolder("gvins_time_offset
 const fs::path& dataset() {
   static const fs::path dir = [] {
     const fs::path d = scratch() / "dataset";
-    const std::string y =
-        "name: time_offset_test\n"
-        "origin: {latitude_deg: 35.134707705, longitude_deg: 136.977577939, height_m: 104.853}\n"
-        "start_gpst: \"2024-06-24 08:20:00\"\n"
+    test::simulateStereoFeatureDataset(
+        d, "time_offset_test",
         "trajectory: {type: flight, pattern: lawnmower, height_m: 60, length_m: 400, speed_mps: 8,\n"
-        "             climb_rate_mps: 3, rows: 2, row_spacing_m: 50, heading_deg: 300, wobble_deg: 0.3}\n"
-        "imu: {rate_hz: 250}\n"
-        "cameras:\n"
-        "  rate_hz: 20\n"
-        "  time_offset_s: " + std::to_string(kTimeOffset) + "\n"
-        "  output: features\n"
-        "  list:\n"
-        "    - {name: cam0, look: down, position_m: [0.06, 0.06, -0.04], mount_rpy_deg: [0.4, -0.3, 0.2]}\n"
-        "    - {name: cam1, look: down, position_m: [0.06, -0.06, -0.04], mount_rpy_deg: [-0.2, 0.3, -0.4]}\n"
-        "gnss: none\n";
-    const sim::Scenario sc = sim::parseScenario(y, "time_offset_test.yaml");
-    sim::GenerationOptions opt;
-    opt.seed = 105;
-    opt.threads = 2;
-    sim::generateDataset(sc, d, opt);
+        "             climb_rate_mps: 3, rows: 2, row_spacing_m: 50, heading_deg: 300, wobble_deg: 0.3}\n",
+        "  time_offset_s: " + std::to_string(kTimeOffset) + "\n", 105);
     return d;
   }();
   return dir;
@@ -67,11 +53,7 @@ struct ReplayRun {
 
 ReplayRun replay(const std::string& name, bool useFloat, bool calibrate, double timeOffset) {
   const fs::path d = dataset();
-  vio::SriSwfConfig ec;
-  ec.gravity = *readSimDatasetInfo(d.string())->gravity;
-  ec.imu = vio::readImuSensorYaml((d / "mav0" / "imu0" / "sensor.yaml").string()).noise;
-  ec.cameras.push_back(vio::readCameraSensorYaml((d / "mav0" / "cam0" / "sensor.yaml").string()));
-  ec.cameras.push_back(vio::readCameraSensorYaml((d / "mav0" / "cam1" / "sensor.yaml").string()));
+  vio::SriSwfConfig ec = test::datasetEstimatorConfig(d);
   ec.use_float = useFloat;
   ec.calibrate_time_offset = calibrate;
   ec.time_offset = timeOffset;

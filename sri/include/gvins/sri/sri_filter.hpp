@@ -224,6 +224,10 @@ class SriFilter {
   /// `copy` holds the reduced factor when one was needed. nullopt if a column without
   /// information is coupled to the others (see covariance()).
   std::optional<ConstView> informedTrailing(int c, std::vector<int>& keep, RowMatrix<Scalar>& copy) const;
+  // The informed trailing factor from the first listed block (nullopt: no columns listed) and
+  // the position in it of every listed column, in order; the errors of covariance() (`who`).
+  std::optional<ConstView> listedTrailing(std::span<const BlockId> ids, const char* who, std::vector<int>& columns,
+                                          RowMatrix<Scalar>& copy) const;
 
   SriOptions options_;
   StateLayout layout_;
