@@ -101,6 +101,12 @@ ReplayConfig parseReplayConfig(std::string_view text, const std::string& file, c
             if (!(o.frontend.tracker.maxTrackTravel >= 0.0)) {
               throw ParseError(file, lineOf(x), name, "must not be negative (0: unlimited)");
             }
+          } else if (k == "klt_window_px") {
+            const double n = number(x, file, name);
+            if (!(n >= 5.0 && n <= 61.0) || n != static_cast<double>(static_cast<int>(n)) || static_cast<int>(n) % 2 == 0) {
+              throw ParseError(file, lineOf(x), name, "expected an odd whole number of pixels in [5, 61]");
+            }
+            o.frontend.tracker.klt.window = static_cast<int>(n);
           } else if (k == "align_templates") {
             o.frontend.tracker.alignTemplates = boolean(x, file, name);
           } else if (k == "template_max_track_travel_px") {

@@ -695,6 +695,11 @@ TEST(ReplayParsers, Config) {
   const ReplayConfig u = parseReplayConfig("replay:\n  align_templates: false\n  template_max_track_travel_px: 120\n", "r.yaml");
   EXPECT_FALSE(u.options.frontend.tracker.alignTemplates);
   EXPECT_EQ(u.options.frontend.tracker.templateMaxTrackTravel, 120.0);
+  EXPECT_EQ(parseReplayConfig("replay:\n  klt_window_px: 11\n", "r.yaml").options.frontend.tracker.klt.window, 11);
+  for (const char* bad : {"replay:\n  klt_window_px: 12\n", "replay:\n  klt_window_px: 3\n", "replay:\n  klt_window_px: 9.5\n"}) {
+    e = err(bad);
+    EXPECT_EQ(e.field(), "replay.klt_window_px") << bad;
+  }
   e = err("replay:\n  align_templates: sometimes\n");
   EXPECT_EQ(e.field(), "replay.align_templates");
   e = err("replay:\n  template_max_track_travel_px: -3\n");

@@ -14,6 +14,7 @@
 //     max_track_travel_px: 50    # image front end: end tracks (10 images or older) once they
 //                                # have moved 50 px since detection (0: never)
 //     max_track_length: 0        # ... or after this many images (0: never)
+//     klt_window_px: 21          # KLT window side (odd, 5-61); 11 is faster, see docs/replay.md
 //     align_templates: true      # refine every tracked position against the track's
 //                                # detection patch (affine warp, gain, bias): no chained drift
 //     template_max_track_travel_px: 0  # travel limit for template-refined tracks (0: never)
