@@ -175,4 +175,3 @@ TEST(SriSwfNullspace, FloatUpdatesKeepTheNullspace) {
 
 }  // namespace
 }  // namespace gvins::vio
-

@@ -317,7 +317,7 @@ void FeatureTracker::process(const ImagePyramid& image, const Eigen::Matrix3d* R
     prevPts_.push_back(pts_[i]);
     templates_.emplace_back();
     warps_.emplace_back();
-    if (cfg_.alignTemplates && !templates_.back().extract(smooth_, pts_[i], cfg_.patch)) templates_.back() = AffinePatch();
+    if (cfg_.alignTemplates) templates_.back().extract(smooth_, pts_[i], cfg_.patch);  // stays empty if it fails
     warps_.back().t = Eigen::Vector2f(pts_[i].x, pts_[i].y);
   }
   tm.detection += msSince(t0);

@@ -108,27 +108,34 @@ FeatureFrame StereoFrontend::process(std::int64_t t_ns, const cv::Mat& leftIn, c
   ImagePyramid& leftPyr = s.leftPyr[slot];
   // Equalisation and pyramid of each image, and the left image's smoothing for the templates:
   // the two images are independent, so they are prepared in parallel (OpenCV's thread pool).
-  auto prepare = [&](int which) {
-    const cv::Mat& in = which == 0 ? leftIn : rightIn;
-    cv::Mat& eq = which == 0 ? s.equalized[slot] : s.equalizedRight;
+  // cv::CLAHE keeps state per object: one per image side.
+  auto prepare = [&](const cv::Mat& in, cv::Mat& eq, const cv::Ptr<cv::CLAHE>& clahe, ImagePyramid& pyr) {
     cv::Mat img = in;
     if (s.cfg.equalize == Equalization::Clahe) {
-      // cv::CLAHE keeps state per object: one per image side.
-      (which == 0 ? s.clahe : s.claheRight)->apply(in, eq);
+      clahe->apply(in, eq);
       img = eq;
     } else if (s.cfg.equalize == Equalization::Histogram) {
       cv::equalizeHist(in, eq);
       img = eq;
     }
-    (which == 0 ? leftPyr : s.rightPyr).build(img, s.cfg.tracker.klt);
-    if (which == 0) s.tracker.prepareTemplates(leftPyr.image());
+    pyr.build(img, s.cfg.tracker.klt);
+  };
+  auto prepareLeft = [&] {
+    prepare(leftIn, s.equalized[slot], s.clahe, leftPyr);
+    s.tracker.prepareTemplates(leftPyr.image());
   };
   if (doStereo) {
     cv::parallel_for_(cv::Range(0, 2), [&](const cv::Range& r) {
-      for (int i = r.start; i < r.end; ++i) prepare(i);
+      for (int i = r.start; i < r.end; ++i) {
+        if (i == 0) {
+          prepareLeft();
+        } else {
+          prepare(rightIn, s.equalizedRight, s.claheRight, s.rightPyr);
+        }
+      }
     });
   } else {
-    prepare(0);
+    prepareLeft();
   }
   out.timing.pyramid = msSince(t0);
 
