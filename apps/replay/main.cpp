@@ -62,6 +62,9 @@ const char* kUsage =
     "  --skip-bad-images      skip frames whose images cannot be decoded (counted)\n"
     "  --skip-missing-images  drop listed images that do not exist (counted)\n"
     "  --images               use images even if the dataset has feature tracks\n"
+    "  --save-tracks DIR      images: also write the front end's tracks to DIR as a feature-only\n"
+    "                         dataset (links to the rest of DATASET); replaying DIR runs the\n"
+    "                         estimator on the same tracks without the front end\n"
     "  --no-eval              no accuracy table/plots\n"
     "  -q, --quiet            no progress line\n"
     "  -h, --help             this text\n"
@@ -97,6 +100,7 @@ ReplaySummary run(const std::string& dataset, const vio::SriSwfConfig& ec, const
 int main(int argc, char** argv) {
   std::string dataset, outDir, configPath, mode = "vio", leverCalib, timeCalib;
   std::optional<double> timeOffset;
+  std::string saveTracks;
   bool useFloat = false, quiet = false, images = false, noEval = false, skipBad = false, skipMissing = false;
   std::optional<double> start, duration, maxGap;
   std::optional<std::string> gapPolicy, rover, base, nav;
@@ -161,6 +165,7 @@ int main(int argc, char** argv) {
     } else if (a == "--skip-bad-images") skipBad = true;
     else if (a == "--skip-missing-images") skipMissing = true;
     else if (a == "--images") images = true;
+    else if (a == "--save-tracks") saveTracks = value();
     else if (a == "--no-eval") noEval = true;
     else if (a == "-q" || a == "--quiet") quiet = true;
     else if (!a.empty() && a[0] == '-') usageError("unknown option " + a);
@@ -185,6 +190,7 @@ int main(int argc, char** argv) {
     if (skipBad) opt.skipBadImages = true;
     if (skipMissing) opt.skipMissingImages = true;
     if (images) opt.useFeatureTracks = false;
+    if (!saveTracks.empty()) opt.saveTracksDir = saveTracks;
     if (noEval) opt.evaluate = false;
     if (rover) opt.roverObs = *rover;
     if (base) opt.baseObs = *base;

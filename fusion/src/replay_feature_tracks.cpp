@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <filesystem>
+#include <stdexcept>
+#include <system_error>
 
 #include "gvins/base/line_reader.hpp"
 #include "gvins/base/text_fields.hpp"
@@ -117,6 +120,105 @@ vio::FeatureFrame FeatureTrackFrames::frame(std::size_t i) {
   std::sort(lengths.begin(), lengths.end());
   lengths_ = std::move(lengths);
   return f;
+}
+
+namespace fs = std::filesystem;
+
+struct FeatureTrackDatasetWriter::File {
+  std::string path;
+  std::FILE* f = nullptr;
+  ~File() {
+    if (f) std::fclose(f);
+  }
+};
+
+namespace {
+
+void linkEntry(const fs::path& target, const fs::path& link) {
+  std::error_code ec;
+  fs::create_symlink(fs::absolute(target), link, ec);
+  if (ec) throw std::runtime_error("cannot create the link " + link.string() + ": " + ec.message());
+}
+
+void makeDir(const fs::path& d) {
+  std::error_code ec;
+  fs::create_directories(d, ec);
+  if (ec || !fs::is_directory(d)) throw std::runtime_error("cannot create the folder " + d.string());
+}
+
+bool isCameraDir(const fs::directory_entry& e) {
+  const std::string n = e.path().filename().string();
+  return e.is_directory() && n.size() > 3 && n.compare(0, 3, "cam") == 0 &&
+         n.find_first_not_of("0123456789", 3) == std::string::npos;
+}
+
+}  // namespace
+
+FeatureTrackDatasetWriter::FeatureTrackDatasetWriter(const std::string& sourceDataset, const std::string& dir,
+                                                     int cameras) {
+  if (cameras < 1 || cameras > 2) throw std::invalid_argument("FeatureTrackDatasetWriter: 1 or 2 cameras");
+  const fs::path src(sourceDataset), dst(dir);
+  if (fs::exists(dst) && !(fs::is_directory(dst) && fs::is_empty(dst)))
+    throw std::runtime_error("track dataset folder " + dst.string() + " exists and is not empty");
+  fs::path srcMav0 = src / "mav0";
+  makeDir(dst / "mav0");
+  if (fs::is_directory(srcMav0)) {
+    for (const auto& e : fs::directory_iterator(src))
+      if (e.path().filename() != "mav0") linkEntry(e.path(), dst / e.path().filename());
+  } else {
+    srcMav0 = src;
+  }
+  for (const auto& e : fs::directory_iterator(srcMav0)) {
+    const fs::path name = e.path().filename();
+    if (!isCameraDir(e)) {
+      linkEntry(e.path(), dst / "mav0" / name);
+      continue;
+    }
+    makeDir(dst / "mav0" / name);
+    for (const auto& c : fs::directory_iterator(e.path())) {
+      const fs::path cn = c.path().filename();
+      if (cn == "data" || cn == "features.csv") continue;  // images; the tracks are written here
+      linkEntry(c.path(), dst / "mav0" / name / cn);
+    }
+  }
+  for (int c = 0; c < cameras; ++c) {
+    auto file = std::make_unique<File>();
+    const fs::path camDir = dst / "mav0" / ("cam" + std::to_string(c));
+    makeDir(camDir);
+    file->path = (camDir / "features.csv").string();
+    file->f = std::fopen(file->path.c_str(), "w");
+    if (!file->f) throw std::runtime_error("cannot create " + file->path);
+    std::fputs("#timestamp [ns],landmark_id,u [px],v [px]  (tracks of the gvins-replay image front end)\n", file->f);
+    files_.push_back(std::move(file));
+  }
+}
+
+FeatureTrackDatasetWriter::~FeatureTrackDatasetWriter() = default;
+
+void FeatureTrackDatasetWriter::write(const vio::FeatureFrame& frame) {
+  order_.clear();
+  for (std::size_t i = 0; i < frame.features.size(); ++i) order_.emplace_back(frame.features[i].id, i);
+  std::sort(order_.begin(), order_.end());
+  for (std::size_t c = 0; c < files_.size(); ++c) {
+    std::FILE* f = files_[c]->f;
+    for (const auto& [id, i] : order_) {
+      const vio::FeatureObservation& o = frame.features[i];
+      if (c == 1 && !o.stereo) continue;
+      const Eigen::Vector2d& px = c == 0 ? o.pixel0 : o.pixel1;
+      std::fprintf(f, "%lld,%llu,%.6f,%.6f\n", static_cast<long long>(frame.t_ns), static_cast<unsigned long long>(id),
+                   px.x(), px.y());
+    }
+  }
+}
+
+void FeatureTrackDatasetWriter::close() {
+  for (auto& file : files_) {
+    if (!file->f) continue;
+    const bool bad = std::ferror(file->f) != 0;
+    const bool closeFailed = std::fclose(file->f) != 0;
+    file->f = nullptr;
+    if (bad || closeFailed) throw std::runtime_error("write error on " + file->path);
+  }
 }
 
 }  // namespace gvins::fusion

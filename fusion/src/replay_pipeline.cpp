@@ -415,6 +415,9 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
     }
   } join{fe, loader};
   std::vector<std::size_t> trackIndex;  // tracks: the selected stamp indices
+  std::unique_ptr<FeatureTrackDatasetWriter> trackWriter;
+  if (tracks && !opt.saveTracksDir.empty())
+    throw std::invalid_argument("--save-tracks needs the image front end; this dataset is replayed from its feature tracks (add --images)");
   if (tracks) {
     model0 = std::make_unique<vio::CameraModel>(ds.cameraCalibration(0).intrinsics);
     std::vector<TrackStamp> c1;
@@ -428,6 +431,8 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
       if (trackFrames->stamp(i) >= tFirst && trackFrames->stamp(i) <= tLast) trackIndex.push_back(i);
   } else {
     const bool stereo = ds.cameraCount() > 1 && opt.frontend.useStereo;
+    if (!opt.saveTracksDir.empty())
+      trackWriter = std::make_unique<FeatureTrackDatasetWriter>(dataset, opt.saveTracksDir, stereo ? 2 : 1);
     fe = std::make_unique<vio::FrontendThread>(
         vio::StereoFrontend(opt.frontend, ds.cameraCalibration(0), stereo ? &ds.cameraCalibration(1) : nullptr));
     loader = std::thread([&, stereo] {
@@ -475,6 +480,7 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
     } else {
       frame = fe->pop();
       if (!frame) break;
+      if (trackWriter) trackWriter->write(*frame);
     }
     // IMU up to the first sample at or after the frame time.
     while (imuNext < imu.size()) {
@@ -608,6 +614,7 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
     if (loaderError) std::rethrow_exception(loaderError);
   }
   sum.skippedBadImages = badImages.load();
+  if (trackWriter) trackWriter->close();
 
   tum.close();
   cov.close();

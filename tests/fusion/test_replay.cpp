@@ -79,6 +79,7 @@ class StubEstimator : public ReplayEstimator {
  public:
   std::vector<std::int64_t> imuTimes, frameTimes;
   std::vector<std::size_t> featureCounts;
+  std::vector<vio::FeatureFrame> frames;
   bool orderOk = true;
   double zNoise = 0.0;         ///< ±zNoise alternating on z
   std::int64_t stateStride = 0;  ///< reported state time = frame time + (frames − 1)·stride
@@ -103,6 +104,7 @@ class StubEstimator : public ReplayEstimator {
     if (!frameTimes.empty() && f.t_ns <= frameTimes.back()) orderOk = false;
     frameTimes.push_back(f.t_ns);
     featureCounts.push_back(f.features.size());
+    frames.push_back(f);
     FrameOutcome o;
     o.initialized = initialized();
     o.updated = o.initialized;
@@ -637,6 +639,60 @@ TEST(Replay, FeatureTrackDatasetReplacesTheFrontEnd) {
   EXPECT_EQ(s.framesProcessed, 3u);
   EXPECT_EQ(est.featureCounts, (std::vector<std::size_t>{3, 4, 3}));
   EXPECT_TRUE(est.orderOk);
+}
+
+// --save-tracks: the front end's tracks of the real V1_01 images written as a feature-only
+// dataset; replaying that folder hands the estimator the same frames (stamps, ids, pixels to the
+// written 1e-6 px, normalised coordinates through the same camera model, stereo matches).
+TEST(Replay, SavedFrontEndTracksReplayAsTheSameFrames) {
+  const fs::path root = scratch("save_tracks");
+  StubEstimator images;
+  ReplayOptions o = quietOptions(root / "out_images");
+  o.saveTracksDir = (root / "tracks").string();
+  runReplay(kV101.string(), images, nullptr, o);
+  ASSERT_TRUE(fs::is_regular_file(root / "tracks" / "mav0" / "cam0" / "features.csv"));
+  ASSERT_TRUE(fs::is_regular_file(root / "tracks" / "mav0" / "cam1" / "features.csv"));
+  EXPECT_TRUE(fs::is_symlink(root / "tracks" / "mav0" / "imu0"));
+  EXPECT_FALSE(fs::exists(root / "tracks" / "mav0" / "cam0" / "data"));  // no images
+
+  StubEstimator tracks;
+  const ReplaySummary s = runReplay((root / "tracks").string(), tracks, nullptr, quietOptions(root / "out_tracks"));
+  EXPECT_TRUE(s.featureTracks);
+  ASSERT_EQ(tracks.frames.size(), images.frames.size());
+  std::size_t stereo = 0, total = 0;
+  for (std::size_t i = 0; i < images.frames.size(); ++i) {
+    const vio::FeatureFrame& a = images.frames[i];
+    const vio::FeatureFrame& b = tracks.frames[i];
+    EXPECT_EQ(a.t_ns, b.t_ns);
+    ASSERT_EQ(a.features.size(), b.features.size()) << "frame " << i;
+    std::map<std::uint64_t, const vio::FeatureObservation*> byId;
+    for (const auto& f : b.features) byId[f.id] = &f;
+    for (const auto& f : a.features) {
+      ASSERT_EQ(byId.count(f.id), 1u) << "frame " << i << " id " << f.id;
+      const vio::FeatureObservation& g = *byId[f.id];
+      EXPECT_LT((f.pixel0 - g.pixel0).cwiseAbs().maxCoeff(), 5.1e-7);
+      EXPECT_LT((f.normalized0 - g.normalized0).norm(), 1e-8);
+      EXPECT_EQ(f.stereo, g.stereo);
+      if (f.stereo && g.stereo) {
+        EXPECT_LT((f.pixel1 - g.pixel1).cwiseAbs().maxCoeff(), 5.1e-7);
+        EXPECT_LT((f.normalized1 - g.normalized1).norm(), 1e-8);
+        ++stereo;
+      }
+      // Track lengths: counted again from consecutive stamps, equal while the first frame's
+      // tracks have not been cut by the written range.
+      EXPECT_EQ(f.trackLength, g.trackLength) << "frame " << i << " id " << f.id;
+      ++total;
+    }
+  }
+  EXPECT_GT(total, 24u * 50u);
+  EXPECT_GT(stereo, total / 2);
+
+  // The folder must be new or empty; a dataset of tracks has no front end to record.
+  StubEstimator again;
+  EXPECT_THROW(runReplay(kV101.string(), again, nullptr, o), std::runtime_error);
+  ReplayOptions o2 = quietOptions(root / "out_again");
+  o2.saveTracksDir = (root / "tracks2").string();
+  EXPECT_THROW(runReplay((root / "tracks").string(), again, nullptr, o2), std::invalid_argument);
 }
 
 TEST(ReplayParsers, FeatureTracksMalformed) {

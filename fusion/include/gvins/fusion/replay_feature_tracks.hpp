@@ -6,9 +6,15 @@
 // instead of running the image front end.
 // Errors: gvins::ParseError naming file, line and field (malformed numbers, wrong column count,
 // decreasing stamps, a landmark listed twice at one stamp).
+//
+// FeatureTrackDatasetWriter is the inverse: it records the tracks of the image front end as a
+// feature-only dataset (gvins-replay --save-tracks DIR), so that the estimator can be replayed,
+// compared or tuned on exactly the same tracks without running the front end again.
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -52,6 +58,29 @@ class FeatureTrackFrames {
   const vio::CameraModel* model1_;
   std::size_t cam1Next_ = 0;
   std::vector<std::pair<std::uint64_t, int>> lengths_;  ///< sorted by id: track length so far
+};
+
+/// Writes a feature-only dataset folder `dir` next to an image dataset: mav0/camN/features.csv
+/// from FeatureFrames (pixel0 → cam0, pixel1 of stereo observations → cam1; pixels with 6
+/// decimals, rows of a stamp by increasing id) and symbolic links to everything else of the
+/// source dataset (IMU, camN/data.csv and sensor.yaml, ground truth, gnss/, dataset.yaml), not
+/// to the images. A frame without features leaves no row (its stamp is then skipped by a replay
+/// of the tracks). Throws std::runtime_error naming the path if `dir` exists and is not empty or
+/// a file cannot be created.
+class FeatureTrackDatasetWriter {
+ public:
+  FeatureTrackDatasetWriter(const std::string& sourceDataset, const std::string& dir, int cameras);
+  ~FeatureTrackDatasetWriter();
+  FeatureTrackDatasetWriter(const FeatureTrackDatasetWriter&) = delete;
+  FeatureTrackDatasetWriter& operator=(const FeatureTrackDatasetWriter&) = delete;
+  void write(const vio::FeatureFrame& frame);
+  /// Flushes and closes the files; throws std::runtime_error on a write error.
+  void close();
+
+ private:
+  struct File;
+  std::vector<std::unique_ptr<File>> files_;  // one per camera
+  std::vector<std::pair<std::uint64_t, std::size_t>> order_;
 };
 
 }  // namespace gvins::fusion

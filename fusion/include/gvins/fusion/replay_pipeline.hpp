@@ -113,6 +113,10 @@ struct ReplayOptions {
   double start_s = 0.0, duration_s = 0.0;
   /// Use camN/features.csv when present instead of images (auto), or force images.
   bool useFeatureTracks = true;
+  /// Images mode: also write the front end's tracks as a feature-only dataset in this folder
+  /// (FeatureTrackDatasetWriter; empty: no). Replaying that folder runs the estimator on the
+  /// same tracks without the front end.
+  std::string saveTracksDir;
   /// GNSS inputs; empty: <dataset>/gnss/rover.obs, base.obs and the navigation file found there.
   std::string roverObs, baseObs, navFile;
   std::optional<Eigen::Vector3d> basePosition;  ///< default: base.obs header position
