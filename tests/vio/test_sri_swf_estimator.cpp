@@ -479,6 +479,7 @@ TEST(SriSwfConfig, YamlValuesAndErrorsNameLineAndField) {
   const std::string text =
       "window: 9\nmax_slam_features: 30\npixel_noise: 0.7\nprecision: float\nposition_random_walk: 0.002\n"
       "time_offset: -0.003\ncalibrate_time_offset: true\ntime_offset_sigma: 0.002\nsurface_noise: 0.001\n"
+      "attitude_random_walk: 3.0e-4\nfloat_householder: false\n"
       "init:\n  window: 0.8\n"
       "cameras: [cam0/sensor.yaml, cam1/sensor.yaml]\nimu_yaml: imu0/sensor.yaml\n";
   const SriSwfConfig c = parseSriSwfConfig(text, "cfg.yaml", dir);
@@ -492,6 +493,16 @@ TEST(SriSwfConfig, YamlValuesAndErrorsNameLineAndField) {
   EXPECT_TRUE(c.calibrate_time_offset);
   EXPECT_DOUBLE_EQ(c.time_offset_sigma, 0.002);
   EXPECT_DOUBLE_EQ(c.surface_noise, 0.001);
+  EXPECT_DOUBLE_EQ(c.attitude_random_walk, 3.0e-4);
+  EXPECT_FALSE(c.float_householder);
+  EXPECT_TRUE(SriSwfConfig{}.float_householder);
+  {
+    // float_householder reaches the filter: kAuto's float switch at 10³, or never (Householder).
+    SriSwfConfig h = c;
+    h.float_householder = true;
+    EXPECT_DOUBLE_EQ(SriSwfEstimator<float>(c).filter().options().auto_givens_ratio_float, 1e3);
+    EXPECT_TRUE(std::isinf(SriSwfEstimator<float>(h).filter().options().auto_givens_ratio_float));
+  }
   ASSERT_EQ(c.cameras.size(), 2u);
   EXPECT_DOUBLE_EQ(c.cameras[0].intrinsics.fx, 458.654);
   EXPECT_DOUBLE_EQ(c.imu.gyroscope_noise_density, 1.6968e-04);
@@ -514,6 +525,8 @@ TEST(SriSwfConfig, YamlValuesAndErrorsNameLineAndField) {
   expectError("cameras: [cam0/sensor.yaml]\nposition_random_walk: -1e-3\n", 1, "position_random_walk");
   expectError("cameras: [cam0/sensor.yaml]\ntime_offset_sigma: 0\n", 1, "time_offset_sigma");
   expectError("cameras: [cam0/sensor.yaml]\nsurface_noise: -0.001\n", 1, "surface_noise");
+  expectError("cameras: [cam0/sensor.yaml]\nattitude_random_walk: -1e-4\n", 1, "attitude_random_walk");
+  expectError("cameras: [cam0/sensor.yaml]\nfloat_householder: maybe\n", 2, "float_householder");
   expectError("cameras: [cam0/sensor.yaml]\ntime_offset: 2.5\n", 1, "time_offset");
   expectError("cameras: [cam0/sensor.yaml]\ntime_offset: 5ms\n", 2, "time_offset");
 }

@@ -40,6 +40,7 @@ void SriSwfConfig::validate() const {
   req(max_msckf_per_frame >= 0, "max_msckf_per_frame must be >= 0");
   req(reanchor_sigma > 0, "reanchor_sigma must be positive");
   req(position_random_walk >= 0 && std::isfinite(position_random_walk), "position_random_walk must be >= 0");
+  req(attitude_random_walk >= 0 && std::isfinite(attitude_random_walk), "attitude_random_walk must be >= 0");
   req(zero_velocity_sigma > 0, "zero_velocity_sigma must be positive");
   req(first_estimate_delay >= 0, "first_estimate_delay must not be negative");
   req(init_window > 0.05 && init_window <= 30, "init.window must be in (0.05, 30] s");
@@ -155,6 +156,7 @@ SriSwfConfig parseRoot(const YAML::Node& root, const Ctx& c) {
       {"max_msckf_per_frame", i(cfg.max_msckf_per_frame, "max_msckf_per_frame")},
       {"reanchor_sigma", d(cfg.reanchor_sigma, "reanchor_sigma")},
       {"position_random_walk", d(cfg.position_random_walk, "position_random_walk")},
+      {"attitude_random_walk", d(cfg.attitude_random_walk, "attitude_random_walk")},
       {"zero_velocity_update", b(cfg.zero_velocity_update, "zero_velocity_update")},
       {"zero_velocity_sigma", d(cfg.zero_velocity_sigma, "zero_velocity_sigma")},
       {"first_estimate_jacobians", b(cfg.first_estimate_jacobians, "first_estimate_jacobians")},
@@ -165,6 +167,7 @@ SriSwfConfig parseRoot(const YAML::Node& root, const Ctx& c) {
       {"time_offset", d(cfg.time_offset, "time_offset")},
       {"calibrate_time_offset", b(cfg.calibrate_time_offset, "calibrate_time_offset")},
       {"time_offset_sigma", d(cfg.time_offset_sigma, "time_offset_sigma")},
+      {"float_householder", b(cfg.float_householder, "float_householder")},
       {"precision",
        [&](const YAML::Node& n) {
          const std::string s = str(n, c, "precision");

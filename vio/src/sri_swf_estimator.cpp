@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <type_traits>
 #include <unordered_set>
@@ -127,7 +128,13 @@ struct SriSwfEstimator<Scalar>::Impl {
     if (observer) observer(step);
   }
 
-  explicit Impl(const SriSwfConfig& c) : cfg(c), prop(c.imu, c.gravity) {
+  static sri::SriOptions filterOptions(const SriSwfConfig& c) {
+    sri::SriOptions o;
+    if (c.float_householder) o.auto_givens_ratio_float = std::numeric_limits<double>::infinity();
+    return o;
+  }
+
+  explicit Impl(const SriSwfConfig& c) : cfg(c), f(filterOptions(c)), prop(c.imu, c.gravity) {
     for (const CameraCalibration& cam : c.cameras) {
       CameraExtrinsic e;
       e.R_IC = Eigen::Quaterniond(Eigen::Matrix3d(cam.T_BS.topLeftCorner<3, 3>())).normalized().toRotationMatrix();
@@ -510,6 +517,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     // Position random walk (SriSwfConfig::position_random_walk): white velocity noise of q m²/s
     // on the position rows, q·Δt per step, so it does not depend on how the interval is split.
     Qd.diagonal().segment<3>(3).array() += cfg.position_random_walk * cfg.position_random_walk * dt;
+    Qd.diagonal().segment<3>(0).array() += cfg.attitude_random_walk * cfg.attitude_random_walk * dt;
     sri::Propagation<Scalar> step;
     step.addNewBlock(BlockSpec::pose("imu_pose"), poseEstimate<Scalar>(s.R_WI, s.p_WI), Placement::after(newest.pose));
     Eigen::Matrix<double, 9, 1> x;

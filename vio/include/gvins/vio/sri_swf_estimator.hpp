@@ -74,6 +74,10 @@ struct SriSwfConfig {
   /// 4.5e-3 (1 mm per 20 Hz frame) → float within 2 % of double, NEES 1.8, double itself 3 %
   /// better. 0 disables it.
   double position_random_walk = 4.5e-3;
+  /// rad/√s, white angular-rate noise added to the rotation rows of every IMU propagation
+  /// (σ² Δt), on top of the gyroscope noise; the rotation counterpart of position_random_walk.
+  /// 0 (default) disables it.
+  double attitude_random_walk = 0.0;
 
   // ---- initialisation
   double init_window = 1.0;          ///< s of IMU used by the static test / gravity mean
@@ -133,6 +137,16 @@ struct SriSwfConfig {
 
   /// Precision the application should instantiate (SriSwfEstimator<float> or <double>).
   bool use_float = false;
+  /// Rotations of a float filter's QR steps (updates, propagation, including the GNSS rows a
+  /// backend client adds): true (default) always blocked Householder; false sri's kAuto, which
+  /// switches a step to Givens rotations when its rows are 10³ heavier than the lightest pivot
+  /// of R they meet (sri::SriOptions::auto_givens_ratio_float). In VIO that is almost every
+  /// step (the unobservable directions keep light pivots), and the Givens chains' rounding moves
+  /// the float estimate away from the double one on long flights: ten simulated flights (feature
+  /// tracks) float − double RMSE +1.1 % on average, up to +6.7 % with kAuto, −0.01 % and within
+  /// ±0.7 % with Householder; a rendered 3 km flight +45 % vs +1.8 % (docs/vio_estimator.md).
+  /// Double filters are not affected (their switch is at 10¹⁰).
+  bool float_householder = true;
 
   /// Throws std::invalid_argument naming the first bad value.
   void validate() const;
@@ -143,11 +157,12 @@ struct SriSwfConfig {
 ///         accelerometer_random_walk, rate_hz}  or  imu_yaml: <EuRoC/Kalibr imu yaml path>
 ///   gravity, pixel_noise, surface_noise, window, max_slam_features, min_track_msckf, min_depth, max_depth,
 ///   min_baseline_ratio, chi2_probability, max_msckf_per_frame, reanchor_sigma, position_random_walk,
+///   attitude_random_walk,
 ///   init: {window, static_max_accel_std, static_max_gyro_std, static_max_parallax, in_motion,
 ///          motion_frames, position_sigma, yaw_sigma, tilt_sigma, velocity_sigma,
 ///          gyro_bias_sigma, accel_bias_sigma}, zero_velocity_update, zero_velocity_sigma,
 ///   first_estimate_jacobians, first_estimate_delay, calibrate_extrinsics, extrinsic_rotation_sigma, extrinsic_translation_sigma,
-///   time_offset, calibrate_time_offset, time_offset_sigma, precision: double | float,
+///   time_offset, calibrate_time_offset, time_offset_sigma, precision: double | float, float_householder,
 ///   cameras: [<EuRoC camera sensor.yaml path>, ...]  or  camchain: <Kalibr camchain path>
 /// Relative paths are relative to the YAML file's folder. Errors: gvins::ParseError naming the
 /// file, line and field.
