@@ -409,38 +409,58 @@ std::vector<BlockId> SriFilter<Scalar>::propagate(const Propagation<Scalar>& ste
 template <typename Scalar>
 UpdateResult<Scalar> SriFilter<Scalar>::update(const Measurement<Scalar>& m,
                                                const UpdateOptions& options) {
-  if (!m.isWhitened()) throw std::logic_error("sri::SriFilter::update: rows are not whitened");
-  if (m.nuisanceDim() != 0) {
-    throw std::logic_error("sri::SriFilter::update: project the nuisance columns out first");
-  }
+  return update(std::span<const Measurement<Scalar>>(&m, 1), options);
+}
+
+template <typename Scalar>
+UpdateResult<Scalar> SriFilter<Scalar>::update(std::span<const Measurement<Scalar>> parts,
+                                               const UpdateOptions& options) {
   UpdateResult<Scalar> result;
-  result.dof = m.rows() + m.discardedRows();
-  const int rows = m.rows();
-  // Column offset of every measurement block in the state.
-  const int nb = m.numBlocks();
-  std::vector<int> boff(static_cast<std::size_t>(nb));
-  for (int b = 0; b < nb; ++b) {
-    const BlockInfo& info = layout_.block(m.blockId(b));
-    if (info.dim != m.blockDim(b)) {
-      throw std::invalid_argument("sri::SriFilter::update: Jacobian of block '" + info.name +
-                                  "' has the wrong number of columns");
+  int rows = 0;
+  Scalar discardedChi2 = 0;
+  for (const Measurement<Scalar>& m : parts) {
+    if (!m.isWhitened()) throw std::logic_error("sri::SriFilter::update: rows are not whitened");
+    if (m.nuisanceDim() != 0) {
+      throw std::logic_error("sri::SriFilter::update: project the nuisance columns out first");
     }
-    boff[static_cast<std::size_t>(b)] = info.offset;
+    result.dof += m.rows() + m.discardedRows();
+    discardedChi2 += m.discardedChiSquare();
+    rows += m.rows();
   }
-  // First non-zero column of every row.
+  // Column offset of every block of every part in the state (parts in turn, blocks in order).
+  std::vector<int> boff;
+  for (const Measurement<Scalar>& m : parts) {
+    for (int b = 0; b < m.numBlocks(); ++b) {
+      const BlockInfo& info = layout_.block(m.blockId(b));
+      if (info.dim != m.blockDim(b)) {
+        throw std::invalid_argument("sri::SriFilter::update: Jacobian of block '" + info.name +
+                                    "' has the wrong number of columns");
+      }
+      boff.push_back(info.offset);
+    }
+  }
+  // First non-zero column of every row (rows numbered through the parts in turn).
   std::vector<int> rowLead(static_cast<std::size_t>(rows), n_);
-  for (int b = 0; b < nb; ++b) {
-    const auto J = m.jacobianAt(b);
-    const int o = boff[static_cast<std::size_t>(b)];
-    for (int i = 0; i < rows; ++i) {
-      int& l = rowLead[static_cast<std::size_t>(i)];
-      if (o >= l) continue;
-      for (int q = 0; q < J.cols() && o + q < l; ++q) {
-        if (J(i, q) != Scalar(0)) {
-          l = o + q;
-          break;
+  {
+    int r0 = 0;
+    std::size_t bo = 0;
+    for (const Measurement<Scalar>& m : parts) {
+      for (int b = 0; b < m.numBlocks(); ++b) {
+        const auto J = m.jacobianAt(b);
+        const int o = boff[bo + static_cast<std::size_t>(b)];
+        for (int i = 0; i < m.rows(); ++i) {
+          int& l = rowLead[static_cast<std::size_t>(r0 + i)];
+          if (o >= l) continue;
+          for (int q = 0; q < J.cols() && o + q < l; ++q) {
+            if (J(i, q) != Scalar(0)) {
+              l = o + q;
+              break;
+            }
+          }
         }
       }
+      r0 += m.rows();
+      bo += static_cast<std::size_t>(m.numBlocks());
     }
   }
   const int c0 = rows > 0 ? *std::min_element(rowLead.begin(), rowLead.end()) : n_;
@@ -450,6 +470,8 @@ UpdateResult<Scalar> SriFilter<Scalar>::update(const Measurement<Scalar>& m,
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
     return rowLead[static_cast<std::size_t>(a)] < rowLead[static_cast<std::size_t>(b)];
   });
+  std::vector<int> slot(static_cast<std::size_t>(rows));  // sorted position of every row
+  for (int s = 0; s < rows; ++s) slot[static_cast<std::size_t>(order[static_cast<std::size_t>(s)])] = s;
   // Stack [W z]: rows sorted by lead, columns c0..n−1.
   const std::size_t wsize = static_cast<std::size_t>(rows) * static_cast<std::size_t>(std::max(k, 1));
   if (static_cast<std::size_t>(work_.size()) < wsize) work_.resize(static_cast<Eigen::Index>(wsize), 1);
@@ -458,17 +480,28 @@ UpdateResult<Scalar> SriFilter<Scalar>::update(const Measurement<Scalar>& m,
   VectorView<Scalar> z(work_z_.data(), rows);
   lead_.resize(static_cast<std::size_t>(rows));
   if (k > 0) W.setZero();
-  for (int s = 0; s < rows; ++s) {
-    const int i = order[static_cast<std::size_t>(s)];
-    z(s) = m.residual()(i);
-    lead_[static_cast<std::size_t>(s)] = rowLead[static_cast<std::size_t>(i)] - c0;
-    for (int b = 0; b < nb; ++b) {
-      // Columns of the block before c0 are zero in every row by the definition of c0.
-      const auto J = m.jacobianAt(b);
-      const int o = boff[static_cast<std::size_t>(b)];
-      const int skip = std::max(0, c0 - o);
-      const int len = static_cast<int>(J.cols()) - skip;
-      if (len > 0) W.row(s).segment(o + skip - c0, len) = J.row(i).tail(len);
+  {
+    int r0 = 0;
+    std::size_t bo = 0;
+    for (const Measurement<Scalar>& m : parts) {
+      for (int i = 0; i < m.rows(); ++i) {
+        const int s = slot[static_cast<std::size_t>(r0 + i)];
+        z(s) = m.residual()(i);
+        lead_[static_cast<std::size_t>(s)] = rowLead[static_cast<std::size_t>(r0 + i)] - c0;
+      }
+      for (int b = 0; b < m.numBlocks(); ++b) {
+        // Columns of the block before c0 are zero in every row by the definition of c0.
+        const auto J = m.jacobianAt(b);
+        const int o = boff[bo + static_cast<std::size_t>(b)];
+        const int skip = std::max(0, c0 - o);
+        const int len = static_cast<int>(J.cols()) - skip;
+        if (len <= 0) continue;
+        for (int i = 0; i < m.rows(); ++i) {
+          W.row(slot[static_cast<std::size_t>(r0 + i)]).segment(o + skip - c0, len) = J.row(i).tail(len);
+        }
+      }
+      r0 += m.rows();
+      bo += static_cast<std::size_t>(m.numBlocks());
     }
   }
   // Rotation scheme.
@@ -505,7 +538,7 @@ UpdateResult<Scalar> SriFilter<Scalar>::update(const Measurement<Scalar>& m,
       householderRowUpdate<Scalar>(view(c0, c0, k, k), rview(c0, k), W, z, lead_);
     }
   }
-  result.chi2 = z.squaredNorm() + m.discardedChiSquare();
+  result.chi2 = z.squaredNorm() + discardedChi2;
   if (gated && static_cast<double>(result.chi2) > options.max_chi2) {
     if (backup) {
       view(c0, c0, k, k) = gate_backup_.leftCols(k);

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <map>
 #include <random>
+#include <span>
 #include <vector>
 
 #include "covariance_kf.hpp"
@@ -364,6 +365,75 @@ TEST_P(SriVsKalman, RandomLinearGaussianProblems) {
   EXPECT_LT(dp, 1e-9);
   EXPECT_LT(fx, 1e-4);
   EXPECT_LT(fp, 1e-4);
+}
+
+// update(parts): the rows of several measurements at once (SLAM re-observations of one frame),
+// against the information form (Λ += Σ HᵀH, η += Σ Hᵀz, computed densely) and against update()
+// of the stacked measurement (same rows, same order: the same numbers).
+TEST(SriFilterUpdate, PartsEqualTheInformationSumAndTheirStack) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  auto rnd = [&](int r, int c) {
+    Md m(r, c);
+    for (int i = 0; i < r; ++i)
+      for (int j = 0; j < c; ++j) m(i, j) = u(rng);
+    return m;
+  };
+  SriFilter<double> a, b;
+  std::vector<BlockId> ids;
+  const int dims[] = {3, 3, 6, 6, 9};
+  for (int d : dims) {
+    const Vd x0 = rnd(d, 1);
+    const Md L = rnd(d, d) + 3.0 * Md::Identity(d, d);
+    const auto prior = Prior<double>::covariance(L * L.transpose());
+    const auto est = BlockEstimate<double>::fromVector(x0);
+    ids.push_back(a.addBlock(BlockSpec::vector("b", d), est, prior));
+    b.addBlock(BlockSpec::vector("b", d), est, prior);
+  }
+  // Three parts: one on blocks 0 and 2, one on 1, 2 and 4 (compressed: discarded rows), one on 3.
+  std::vector<Measurement<double>> parts(3);
+  const std::vector<std::vector<int>> uses = {{0, 2}, {1, 2, 4}, {3}};
+  const int rowsOf[] = {4, 30, 2};
+  for (int p = 0; p < 3; ++p) {
+    parts[p].reset(rowsOf[p]);
+    for (int k : uses[p]) parts[p].jacobian(ids[k], dims[k]) = rnd(rowsOf[p], dims[k]);
+    parts[p].residual() = rnd(rowsOf[p], 1);
+    parts[p].setWhitened();
+  }
+  parts[1].compress();
+  EXPECT_GT(parts[1].discardedRows(), 0);
+  const Md Rb = a.squareRootInformation();
+  const Vd rb = a.residual();
+  Md Lam = Rb.transpose() * Rb;
+  Vd eta = Rb.transpose() * rb;
+  int rows = 0;
+  for (const auto& m : parts) {
+    Md H = Md::Zero(m.rows(), a.dim());
+    for (int q = 0; q < m.numBlocks(); ++q) H.middleCols(a.layout().block(m.blockId(q)).offset, m.blockDim(q)) = m.jacobianAt(q);
+    Lam += H.transpose() * H;
+    eta += H.transpose() * m.residual();
+    rows += m.rows();
+  }
+  const UpdateResult<double> ua = a.update(std::span<const Measurement<double>>(parts));
+  const Md Ra = a.squareRootInformation();
+  const Vd ra = a.residual();
+  EXPECT_LT(relErr(Ra.transpose() * Ra, Lam), 1e-12);
+  EXPECT_LT(relErr(Ra.transpose() * ra, eta), 1e-12);
+  EXPECT_EQ(ua.dof, 4 + 30 + 2);
+  // The stacked measurement, block by block.
+  Measurement<double> stack(rows);
+  int r0 = 0;
+  for (const auto& m : parts) {
+    for (int q = 0; q < m.numBlocks(); ++q) stack.jacobian(m.blockId(q), m.blockDim(q)).middleRows(r0, m.rows()) = m.jacobianAt(q);
+    stack.residual().segment(r0, m.rows()) = m.residual();
+    r0 += m.rows();
+  }
+  stack.setWhitened();
+  const UpdateResult<double> us = b.update(stack);
+  EXPECT_EQ((Ra - b.squareRootInformation()).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ((ra - b.residual()).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_NEAR(ua.chi2, us.chi2 + parts[1].discardedChiSquare(), 1e-12 * ua.chi2);
+  EXPECT_EQ(us.dof + parts[1].discardedRows(), ua.dof);
 }
 
 INSTANTIATE_TEST_SUITE_P(Schemes, SriVsKalman,

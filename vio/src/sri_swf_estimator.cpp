@@ -1041,10 +1041,9 @@ struct SriSwfEstimator<Scalar>::Impl {
         }
       }
       if (!parts.empty()) {
-        stackAll(parts, total);
         backup_R = f.rawR();
         backup_r = f.rawResidual();
-        const sri::UpdateResult<Scalar> u = f.update(total);
+        const sri::UpdateResult<Scalar> u = f.update(std::span<const Meas>(parts));
         if (static_cast<double>(u.chi2) <= chi2Threshold(u.dof)) {
           res.updated = true;
         } else {
@@ -1059,8 +1058,7 @@ struct SriSwfEstimator<Scalar>::Impl {
             }
           }
           if (!kept.empty()) {
-            stackAll(kept, total);
-            f.update(total);
+            f.update(std::span<const Meas>(kept));
             res.updated = true;
           }
         }

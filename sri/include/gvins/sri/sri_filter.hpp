@@ -159,6 +159,10 @@ class SriFilter {
   /// stacking measurements first). Throws std::logic_error if the rows are not whitened or still
   /// have nuisance columns, std::out_of_range for an unknown block.
   UpdateResult<Scalar> update(const Measurement<Scalar>& m, const UpdateOptions& options = {});
+  /// The rows of several measurements at once, as if stacked into one (the same result as
+  /// update() of their stack, without forming it): parts may share blocks; dof and χ² are
+  /// those of all rows.
+  UpdateResult<Scalar> update(std::span<const Measurement<Scalar>> parts, const UpdateOptions& options = {});
   /// Mahalanobis distance of a candidate measurement without forming a covariance (triangular
   /// solve with the trailing block of R from the first touched column). nullopt if it touches
   /// state without information, or if the trailing block has a coupled zero pivot (see
