@@ -49,6 +49,25 @@ Eigen::Block<typename Measurement<Scalar>::Matrix> Measurement<Scalar>::jacobian
 }
 
 template <typename Scalar>
+void Measurement<Scalar>::rotateRows(int a, int b, Scalar c, Scalar s) {
+  if (a < 0 || b < 0 || a >= rows() || b >= rows() || a == b) {
+    throw std::invalid_argument("sri::Measurement::rotateRows: bad row pair");
+  }
+  auto rot = [&](Matrix& M) {
+    for (Eigen::Index col = 0; col < M.cols(); ++col) {
+      const Scalar x = M(a, col), y = M(b, col);
+      M(a, col) = c * x + s * y;
+      M(b, col) = c * y - s * x;
+    }
+  };
+  rot(H_);
+  rot(nuisance_);
+  const Scalar x = residual_(a), y = residual_(b);
+  residual_(a) = c * x + s * y;
+  residual_(b) = c * y - s * x;
+}
+
+template <typename Scalar>
 void Measurement<Scalar>::addBlocks(std::span<const BlockId> ids, std::span<const int> dims) {
   if (ids.size() != dims.size()) throw std::invalid_argument("sri::Measurement::addBlocks: ids and dims differ in size");
   int add = 0;

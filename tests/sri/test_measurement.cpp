@@ -3,6 +3,7 @@
 // the chi-square test, uninformative priors and partially observed states, setEstimate.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 #include <stdexcept>
 #include <vector>
@@ -375,6 +376,34 @@ TEST(Measurement, AddBlocksDeclaresColumnsOnce) {
   EXPECT_THROW(z.addBlocks(ids, bad), std::invalid_argument);
   const int shortDims[] = {3, 2};
   EXPECT_THROW(z.addBlocks(ids, shortDims), std::invalid_argument);
+}
+
+// rotateRows: the Givens rotation of two rows of [H nuisance r], against the explicit product.
+TEST(Measurement, RotateRowsAppliesTheGivensRotation) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1, 1);
+  Measurement<double> z(4);
+  const BlockId a{1}, b{2};
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 3; ++j) z.jacobian(a, 3)(i, j) = u(rng);
+    z.jacobian(b, 1)(i, 0) = u(rng);
+    z.nuisance(2)(i, 0) = u(rng);
+    z.nuisance(2)(i, 1) = u(rng);
+    z.residual()(i) = u(rng);
+  }
+  Md M(4, 7);
+  M << z.stackedJacobian(), Md(z.nuisance(2)), z.residual();
+  const double th = 0.7, c = std::cos(th), s = std::sin(th);
+  Md G = Md::Identity(4, 4);
+  G(1, 1) = c, G(1, 3) = s, G(3, 1) = -s, G(3, 3) = c;
+  const Md expect = G * M;
+  z.rotateRows(1, 3, c, s);
+  Md got(4, 7);
+  got << z.stackedJacobian(), Md(z.nuisance(2)), z.residual();
+  EXPECT_LT((got - expect).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_NEAR(z.jacobianAt(0)(1, 0), expect(1, 0), 1e-15);  // mutable and const views agree
+  EXPECT_THROW(z.rotateRows(1, 1, c, s), std::invalid_argument);
+  EXPECT_THROW(z.rotateRows(0, 4, c, s), std::invalid_argument);
 }
 
 // Uninformative priors: the update is then ordinary weighted least squares; unobserved

@@ -707,27 +707,14 @@ struct SriSwfEstimator<Scalar>::Impl {
       if (m.blockId(i) == id) b = i;
     }
     if (b < 0) return;
-    const int nb = m.numBlocks();
     for (int j = 0; j < d; ++j) {
       for (int i = rows - 1; i > j; --i) {
-        auto F = m.jacobian(id, d);
+        auto F = m.jacobianAt(b);
         const Scalar y = F(i, j);
         if (y == Scalar(0)) continue;
         const Scalar x = F(i - 1, j);
         const Scalar rho = std::hypot(x, y);
-        const Scalar c = x / rho, sn = y / rho;
-        for (int q = 0; q < nb; ++q) {
-          auto J = m.jacobian(m.blockId(q), m.blockDim(q));
-          for (int col = 0; col < J.cols(); ++col) {
-            const Scalar a = J(i - 1, col), bb = J(i, col);
-            J(i - 1, col) = c * a + sn * bb;
-            J(i, col) = c * bb - sn * a;
-          }
-        }
-        auto& r = m.residual();
-        const Scalar a = r(i - 1), bb = r(i);
-        r(i - 1) = c * a + sn * bb;
-        r(i) = c * bb - sn * a;
+        m.rotateRows(i - 1, i, x / rho, y / rho);
         F(i, j) = Scalar(0);
       }
     }

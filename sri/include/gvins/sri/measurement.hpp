@@ -56,6 +56,13 @@ class Measurement {
     const Entry& e = blocks_[static_cast<std::size_t>(i)];
     return H_.block(0, e.col, rows(), e.dim);
   }
+  Eigen::Block<Matrix> jacobianAt(int i) {
+    const Entry& e = blocks_[static_cast<std::size_t>(i)];
+    return H_.block(0, e.col, rows(), e.dim);
+  }
+  /// Rotates rows a and b (Jacobians, nuisance and residual) by the Givens rotation
+  /// [row a; row b] ← [c s; −s c] [row a; row b]; whitened rows stay whitened.
+  void rotateRows(int a, int b, Scalar c, Scalar s);
   /// All block columns side by side (rows() × Σ dims), in insertion order.
   const Matrix& stackedJacobian() const { return H_; }
 
