@@ -485,15 +485,170 @@ struct SriSwfEstimator<Scalar>::Impl {
     return true;
   }
 
+  // Mono in-motion alignment (no stereo depth), over the last init_mono_motion_frames frames
+  // F_0..F_N−1, in the IMU frame I_0 of F_0, with the gyro-integrated rotations R_0j and the
+  // preintegrated positions α_j (ImuIntegration, biases zero):
+  //  1. structure up to scale: the frame k with the largest rotation-compensated parallax to F_0
+  //     gives the baseline direction of the camera centres (C_k − C_0 ⊥ f_0 × f_k for every
+  //     feature, f the rays in I_0: smallest singular vector; sign from the depths), and the
+  //     features of F_0 and F_k are triangulated with a unit baseline;
+  //  2. every frame's camera centre c̄_j (same unknown scale) from the bearings of those points,
+  //     linear least squares as in the stereo alignment;
+  //  3. s c̄_j = C_j − C_0 = v₀ Δt_j + ½ g Δt_j² + α_j + (R_0j − I) p_IC: linear in (s, v₀, g);
+  //     then |g| is fixed to the configured value and its direction refined on the sphere (two
+  //     tangent unknowns, four iterations, as in VINS-Mono's gravity refinement).
+  // The metric scale comes from the accelerometer, so the motion needs acceleration; the
+  // alignment is rejected if the scale is not positive, the free |g| is more than 1 m/s² off, the
+  // parallax is below 2° or fewer than 20 features are tracked through the window.
+  bool tryMotionMono() {
+    const int N = cfg.init_mono_motion_frames;
+    if (static_cast<int>(init_frames.size()) < N) return false;
+    const std::size_t first = init_frames.size() - static_cast<std::size_t>(N);
+    const FeatureFrame& F0 = init_frames[first];
+    const std::int64_t t0 = F0.t_ns;
+    const std::int64_t tN = init_frames.back().t_ns;
+    if (!imuCovers(t0, tN)) return false;
+    const CameraExtrinsic& e0 = ext_fixed[0];
+    const int M = N - 1;  // later frames
+    std::vector<Eigen::Matrix3d> R0(static_cast<std::size_t>(M));
+    std::vector<Eigen::Vector3d> alpha(static_cast<std::size_t>(M));
+    std::vector<double> dts(static_cast<std::size_t>(M));
+    for (int j = 0; j < M; ++j) {
+      const FeatureFrame& Fj = init_frames[first + 1 + static_cast<std::size_t>(j)];
+      ImuIntegration integ(cfg.imu, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+      integ.integrate(imuSpan(), t0, Fj.t_ns);
+      R0[static_cast<std::size_t>(j)] = integ.gamma();
+      alpha[static_cast<std::size_t>(j)] = integ.alpha();
+      dts[static_cast<std::size_t>(j)] = static_cast<double>(Fj.t_ns - t0) * 1e-9;
+    }
+    // Rays in I_0 of every feature of F_0 in every later frame that sees it.
+    auto ray = [](const Eigen::Vector2d& n) { return Eigen::Vector3d(n.x(), n.y(), 1.0).normalized(); };
+    std::unordered_map<std::uint64_t, Eigen::Vector3d> f0;
+    for (const FeatureObservation& o : F0.features) f0.emplace(o.id, e0.R_IC * ray(o.normalized0));
+    std::vector<std::unordered_map<std::uint64_t, Eigen::Vector3d>> fj(static_cast<std::size_t>(M));
+    int kbest = -1;
+    double best = 0.0;
+    for (int j = 0; j < M; ++j) {
+      std::vector<double> par;
+      for (const FeatureObservation& o : init_frames[first + 1 + static_cast<std::size_t>(j)].features) {
+        auto it = f0.find(o.id);
+        if (it == f0.end()) continue;
+        const Eigen::Vector3d r = R0[static_cast<std::size_t>(j)] * e0.R_IC * ray(o.normalized0);
+        fj[static_cast<std::size_t>(j)].emplace(o.id, r);
+        par.push_back(std::acos(std::clamp(r.dot(it->second), -1.0, 1.0)));
+      }
+      if (par.size() < 20) continue;
+      const double med = median(par);
+      if (med > best) {
+        best = med;
+        kbest = j;
+      }
+    }
+    if (kbest < 0 || best < 2.0 * M_PI / 180.0) return false;
+    const auto& fk = fj[static_cast<std::size_t>(kbest)];
+    // 1. Baseline direction and unit-baseline structure (relative to C_0).
+    Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
+    for (const auto& [id, rk] : fk) {
+      const Eigen::Vector3d n = f0.at(id).cross(rk);
+      if (n.norm() > 1e-9) S += n.normalized() * n.normalized().transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(S);
+    Eigen::Vector3d d = es.eigenvectors().col(0);
+    std::unordered_map<std::uint64_t, Eigen::Vector3d> pts;
+    auto triangulateAll = [&](const Eigen::Vector3d& base) {
+      pts.clear();
+      int positive = 0;
+      for (const auto& [id, rk] : fk) {
+        const Eigen::Vector3d& r0 = f0.at(id);
+        // P = λ r0 = base + μ rk (least squares in λ, μ).
+        Eigen::Matrix<double, 3, 2> A;
+        A << r0, -rk;
+        const Eigen::Vector2d lm = (A.transpose() * A).ldlt().solve(A.transpose() * base);
+        if (lm(0) > 0 && lm(1) > 0) {
+          ++positive;
+          pts.emplace(id, lm(0) * r0);
+        }
+      }
+      return positive;
+    };
+    const int pos = triangulateAll(d);
+    if (triangulateAll(-d) > pos) d = -d;
+    if (triangulateAll(d) < 20) return false;
+    // 2. Camera centres c̄_j of all later frames from the bearings of the points.
+    std::vector<Eigen::Vector3d> cbar(static_cast<std::size_t>(M));
+    for (int j = 0; j < M; ++j) {
+      Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+      Eigen::Vector3d g = Eigen::Vector3d::Zero();
+      int n = 0;
+      for (const auto& [id, r] : fj[static_cast<std::size_t>(j)]) {
+        auto it = pts.find(id);
+        if (it == pts.end()) continue;
+        const Eigen::Matrix3d K = so3::skew(r);  // r × (P − c) = 0
+        H += K.transpose() * K;
+        g += K.transpose() * (K * it->second);
+        ++n;
+      }
+      if (n < 10) return false;
+      cbar[static_cast<std::size_t>(j)] = H.ldlt().solve(g);
+    }
+    // 3. s c̄_j − v₀ Δt_j − ½ g Δt_j² = α_j + (R_0j − I) p_IC; x = [s; v₀; g] or, with g = G·dir
+    // + T δ, [s; v₀; δ].
+    auto solve = [&](const Eigen::Vector3d& g0, const Eigen::MatrixXd& T, Eigen::Matrix<double, 7, 1>& x) {
+      const int nx = 4 + static_cast<int>(T.cols());
+      Eigen::MatrixXd A = Eigen::MatrixXd::Zero(nx, nx);
+      Eigen::VectorXd b = Eigen::VectorXd::Zero(nx);
+      for (int j = 0; j < M; ++j) {
+        const double dt = dts[static_cast<std::size_t>(j)];
+        Eigen::MatrixXd J(3, nx);
+        J.col(0) = cbar[static_cast<std::size_t>(j)];
+        J.block(0, 1, 3, 3) = -dt * Eigen::Matrix3d::Identity();
+        J.rightCols(nx - 4) = -0.5 * dt * dt * T;
+        const Eigen::Vector3d y = alpha[static_cast<std::size_t>(j)] +
+                                  (R0[static_cast<std::size_t>(j)] - Eigen::Matrix3d::Identity()) * e0.p_IC +
+                                  0.5 * dt * dt * g0;
+        A += J.transpose() * J;
+        b += J.transpose() * y;
+      }
+      const Eigen::VectorXd sol = A.ldlt().solve(b);
+      x.head(4) = sol.head(4);
+      x.tail(3) = g0 + T * sol.tail(nx - 4);
+    };
+    Eigen::Matrix<double, 7, 1> x;
+    solve(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity(), x);
+    if (!(x(0) > 0.0) || std::abs(x.tail(3).norm() - cfg.gravity) > 1.0) return false;
+    Eigen::Vector3d gdir = x.tail(3).normalized();
+    for (int it = 0; it < 4; ++it) {
+      Eigen::Matrix<double, 3, 2> T;
+      const Eigen::Vector3d e1 = gdir.unitOrthogonal();
+      T << e1, gdir.cross(e1);
+      solve(cfg.gravity * gdir, T, x);
+      gdir = x.tail(3).normalized();
+    }
+    solve(cfg.gravity * gdir, Eigen::MatrixXd(3, 0), x);
+    if (!(x(0) > 0.0)) return false;
+    const Eigen::Vector3d gb = x.tail(3);
+    ImuState s;
+    s.t_ns = t0;
+    s.R_WI = Eigen::Quaterniond::FromTwoVectors(-gb.normalized(), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    s.v_WI = s.R_WI * Eigen::Vector3d(x.segment(1, 3));
+    prop.propagate(s, imuSpan(), tN);
+    const double tilt = 1.5 * cfg.init_tilt_sigma;
+    const Eigen::Matrix3d Pw =
+        Eigen::Vector3d(tilt * tilt, tilt * tilt, cfg.init_yaw_sigma * cfg.init_yaw_sigma).asDiagonal();
+    createState(s, Pw, 3.0 * cfg.init_velocity_sigma, cfg.init_gyro_bias_sigma);
+    return true;
+  }
+
   bool tryInitialize(const FeatureFrame& frame) {
     init_frames.push_back(frame);
     const std::int64_t horizon = static_cast<std::int64_t>(cfg.init_window * 1e9);
-    while (init_frames.size() > static_cast<std::size_t>(cfg.init_motion_frames) &&
+    const int keep = stereo() ? cfg.init_motion_frames : cfg.init_mono_motion_frames;
+    while (init_frames.size() > static_cast<std::size_t>(keep) &&
            frame.t_ns - init_frames.front().t_ns > horizon) {
       init_frames.pop_front();
     }
     bool ok = tryStatic(frame);
-    if (!ok && stereo() && cfg.init_in_motion) ok = tryMotion();
+    if (!ok && cfg.init_in_motion) ok = stereo() ? tryMotion() : tryMotionMono();
     if (ok) {
       init_frames.clear();
       clearCaches();
