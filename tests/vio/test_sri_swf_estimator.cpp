@@ -362,6 +362,7 @@ TEST(SriSwfSimulation, MonoInitialisesInMotion) {
     sc.build();
     SriSwfConfig cfg = sc.config();
     cfg.cameras.resize(1);
+    cfg.init_mono_in_motion = true;
     SriSwfEstimator<double> est(cfg);
     std::size_t k = 0;
     int init_frame = -1;
@@ -395,6 +396,7 @@ TEST(SriSwfSimulation, MonoInitialisesInMotion) {
   sc.build();
   SriSwfConfig cfg = sc.config();
   cfg.cameras.resize(1);
+  cfg.init_mono_in_motion = true;
   cfg.static_max_accel_std = 1e-9;
   SriSwfEstimator<double> est(cfg);
   std::size_t k = 0;
@@ -533,7 +535,7 @@ TEST(SriSwfConfig, YamlValuesAndErrorsNameLineAndField) {
       "window: 9\nmax_slam_features: 30\npixel_noise: 0.7\nprecision: float\nposition_random_walk: 0.002\n"
       "time_offset: -0.003\ncalibrate_time_offset: true\ntime_offset_sigma: 0.002\nsurface_noise: 0.001\n"
       "attitude_random_walk: 3.0e-4\nfloat_householder: false\n"
-      "init:\n  window: 0.8\n  mono_motion_frames: 25\n"
+      "init:\n  window: 0.8\n  mono_motion_frames: 25\n  mono_in_motion: true\n  mono_max_scale_sigma: 0.02\n"
       "cameras: [cam0/sensor.yaml, cam1/sensor.yaml]\nimu_yaml: imu0/sensor.yaml\n";
   const SriSwfConfig c = parseSriSwfConfig(text, "cfg.yaml", dir);
   EXPECT_EQ(c.window, 9);
@@ -543,6 +545,9 @@ TEST(SriSwfConfig, YamlValuesAndErrorsNameLineAndField) {
   EXPECT_DOUBLE_EQ(c.position_random_walk, 0.002);
   EXPECT_DOUBLE_EQ(c.init_window, 0.8);
   EXPECT_EQ(c.init_mono_motion_frames, 25);
+  EXPECT_TRUE(c.init_mono_in_motion);
+  EXPECT_FALSE(SriSwfConfig{}.init_mono_in_motion);
+  EXPECT_DOUBLE_EQ(c.init_mono_max_scale_sigma, 0.02);
   EXPECT_DOUBLE_EQ(c.time_offset, -0.003);
   EXPECT_TRUE(c.calibrate_time_offset);
   EXPECT_DOUBLE_EQ(c.time_offset_sigma, 0.002);

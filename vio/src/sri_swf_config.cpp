@@ -48,6 +48,7 @@ void SriSwfConfig::validate() const {
       "init static thresholds must be positive");
   req(init_motion_frames >= 3, "init.motion_frames must be >= 3");
   req(init_mono_motion_frames >= 5, "init.mono_motion_frames must be >= 5");
+  req(init_mono_max_scale_sigma > 0 && std::isfinite(init_mono_max_scale_sigma), "init.mono_max_scale_sigma must be > 0");
   req(init_position_sigma > 0 && init_yaw_sigma > 0 && init_tilt_sigma > 0 && init_velocity_sigma > 0 &&
           init_gyro_bias_sigma > 0 && init_accel_bias_sigma > 0,
       "init sigmas must be positive");
@@ -129,7 +130,9 @@ SriSwfConfig parseRoot(const YAML::Node& root, const Ctx& c) {
       {"static_max_parallax", d(cfg.static_max_parallax, "init.static_max_parallax")},
       {"in_motion", b(cfg.init_in_motion, "init.in_motion")},
       {"motion_frames", i(cfg.init_motion_frames, "init.motion_frames")},
+      {"mono_in_motion", b(cfg.init_mono_in_motion, "init.mono_in_motion")},
       {"mono_motion_frames", i(cfg.init_mono_motion_frames, "init.mono_motion_frames")},
+      {"mono_max_scale_sigma", d(cfg.init_mono_max_scale_sigma, "init.mono_max_scale_sigma")},
       {"position_sigma", d(cfg.init_position_sigma, "init.position_sigma")},
       {"yaw_sigma", d(cfg.init_yaw_sigma, "init.yaw_sigma")},
       {"tilt_sigma", d(cfg.init_tilt_sigma, "init.tilt_sigma")},

@@ -499,7 +499,10 @@ struct SriSwfEstimator<Scalar>::Impl {
   //     tangent unknowns, four iterations, as in VINS-Mono's gravity refinement).
   // The metric scale comes from the accelerometer, so the motion needs acceleration; the
   // alignment is rejected if the scale is not positive, the free |g| is more than 1 m/s² off, the
-  // parallax is below 2° or fewer than 20 features are tracked through the window.
+  // parallax is below 2°, fewer than 20 features are tracked through the window, or the scale's
+  // relative 1-σ (fit residuals, gravity direction free) exceeds init_mono_max_scale_sigma.
+  // Off by default (init_mono_in_motion): with weak acceleration and the gyro bias unknown it
+  // can accept a wrong scale (docs/vio_estimator.md, "Initialisation").
   bool tryMotionMono() {
     const int N = cfg.init_mono_motion_frames;
     if (static_cast<int>(init_frames.size()) < N) return false;
@@ -593,6 +596,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     }
     // 3. s c̄_j − v₀ Δt_j − ½ g Δt_j² = α_j + (R_0j − I) p_IC; x = [s; v₀; g] or, with g = G·dir
     // + T δ, [s; v₀; δ].
+    double scaleSigma = 0.0;  // 1-σ of s from the last solve (residual-based)
     auto solve = [&](const Eigen::Vector3d& g0, const Eigen::MatrixXd& T, Eigen::Matrix<double, 7, 1>& x) {
       const int nx = 4 + static_cast<int>(T.cols());
       Eigen::MatrixXd A = Eigen::MatrixXd::Zero(nx, nx);
@@ -612,6 +616,17 @@ struct SriSwfEstimator<Scalar>::Impl {
       const Eigen::VectorXd sol = A.ldlt().solve(b);
       x.head(4) = sol.head(4);
       x.tail(3) = g0 + T * sol.tail(nx - 4);
+      double rss = 0.0;
+      for (int j = 0; j < M; ++j) {
+        const double dt = dts[static_cast<std::size_t>(j)];
+        const Eigen::Vector3d e = x(0) * cbar[static_cast<std::size_t>(j)] - dt * x.segment(1, 3) -
+                                  0.5 * dt * dt * x.tail(3) - alpha[static_cast<std::size_t>(j)] -
+                                  (R0[static_cast<std::size_t>(j)] - Eigen::Matrix3d::Identity()) * e0.p_IC;
+        rss += e.squaredNorm();
+      }
+      const double var = rss / std::max(1, 3 * M - nx);
+      const Eigen::MatrixXd Ai = A.inverse();
+      scaleSigma = std::sqrt(std::max(0.0, var * Ai(0, 0)));
     };
     Eigen::Matrix<double, 7, 1> x;
     solve(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity(), x);
@@ -624,8 +639,9 @@ struct SriSwfEstimator<Scalar>::Impl {
       solve(cfg.gravity * gdir, T, x);
       gdir = x.tail(3).normalized();
     }
+    const double sSigma = scaleSigma;  // with the gravity direction free (tangent unknowns)
     solve(cfg.gravity * gdir, Eigen::MatrixXd(3, 0), x);
-    if (!(x(0) > 0.0)) return false;
+    if (!(x(0) > 0.0) || sSigma > cfg.init_mono_max_scale_sigma * x(0)) return false;
     const Eigen::Vector3d gb = x.tail(3);
     ImuState s;
     s.t_ns = t0;
@@ -648,7 +664,13 @@ struct SriSwfEstimator<Scalar>::Impl {
       init_frames.pop_front();
     }
     bool ok = tryStatic(frame);
-    if (!ok && cfg.init_in_motion) ok = stereo() ? tryMotion() : tryMotionMono();
+    if (!ok && cfg.init_in_motion) {
+      if (stereo()) {
+        ok = tryMotion();
+      } else if (cfg.init_mono_in_motion) {
+        ok = tryMotionMono();
+      }
+    }
     if (ok) {
       init_frames.clear();
       clearCaches();

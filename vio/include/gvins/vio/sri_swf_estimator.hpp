@@ -84,9 +84,16 @@ struct SriSwfConfig {
   double static_max_accel_std = 0.15;  ///< m/s², per-axis std of the accelerometer at rest
   double static_max_gyro_std = 0.02;   ///< rad/s
   double static_max_parallax = 1.0;    ///< px, median feature displacement over the window
-  bool init_in_motion = true;          ///< linear visual-inertial alignment (stereo and mono)
+  bool init_in_motion = true;          ///< linear visual-inertial alignment (stereo; mono see below)
+  /// Mono rigs: also try the mono in-motion alignment (experimental, off: it needs strong
+  /// acceleration within init_mono_motion_frames and assumes zero gyro bias; measured in
+  /// docs/vio_estimator.md). Without it a mono rig initialises at a standstill.
+  bool init_mono_in_motion = false;
   int init_motion_frames = 10;         ///< frames used by the stereo in-motion alignment
   int init_mono_motion_frames = 20;    ///< frames used by the mono in-motion alignment (≥ 5)
+  /// Mono in-motion alignment: largest relative 1-σ of the metric scale (from the fit's residuals
+  /// with the gravity direction free) that is accepted; below it the motion lacked acceleration.
+  double init_mono_max_scale_sigma = 0.05;
   double init_position_sigma = 1e-3;   ///< m (gauge: the VIO frame is defined by the start)
   double init_yaw_sigma = 1e-3;        ///< rad (gauge)
   double init_tilt_sigma = 0.02;       ///< rad, roll/pitch
@@ -160,7 +167,7 @@ struct SriSwfConfig {
 ///   min_baseline_ratio, chi2_probability, max_msckf_per_frame, reanchor_sigma, position_random_walk,
 ///   attitude_random_walk,
 ///   init: {window, static_max_accel_std, static_max_gyro_std, static_max_parallax, in_motion,
-///          motion_frames, mono_motion_frames, position_sigma, yaw_sigma, tilt_sigma, velocity_sigma,
+///          motion_frames, mono_in_motion, mono_motion_frames, mono_max_scale_sigma, position_sigma, yaw_sigma, tilt_sigma, velocity_sigma,
 ///          gyro_bias_sigma, accel_bias_sigma}, zero_velocity_update, zero_velocity_sigma,
 ///   first_estimate_jacobians, first_estimate_delay, calibrate_extrinsics, extrinsic_rotation_sigma, extrinsic_translation_sigma,
 ///   time_offset, calibrate_time_offset, time_offset_sigma, precision: double | float, float_householder,
