@@ -402,6 +402,21 @@ struct SriSwfEstimator<Scalar>::Impl {
   }
 
   // Linear visual-inertial alignment over the buffered stereo frames (in motion).
+  // State from an in-motion alignment: gravity gb and velocity vb in the IMU frame at t0
+  // (attitude from gravity, yaw 0), propagated to tN; tilt prior 1.5× init_tilt_sigma, velocity
+  // prior 3× init_velocity_sigma.
+  void createMovingState(std::int64_t t0, std::int64_t tN, const Eigen::Vector3d& gb, const Eigen::Vector3d& vb) {
+    ImuState s;
+    s.t_ns = t0;
+    s.R_WI = Eigen::Quaterniond::FromTwoVectors(-gb.normalized(), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    s.v_WI = s.R_WI * vb;
+    prop.propagate(s, imuSpan(), tN);
+    const double tilt = 1.5 * cfg.init_tilt_sigma;
+    const Eigen::Matrix3d Pw =
+        Eigen::Vector3d(tilt * tilt, tilt * tilt, cfg.init_yaw_sigma * cfg.init_yaw_sigma).asDiagonal();
+    createState(s, Pw, 3.0 * cfg.init_velocity_sigma, cfg.init_gyro_bias_sigma);
+  }
+
   bool tryMotion() {
     const int N = cfg.init_motion_frames;
     if (static_cast<int>(init_frames.size()) < N) return false;
@@ -473,15 +488,7 @@ struct SriSwfEstimator<Scalar>::Impl {
       sdd += dts[k] * dts[k];
     }
     const Eigen::Vector3d vb = sv / sdd;
-    ImuState s;
-    s.t_ns = t0;
-    s.R_WI = Eigen::Quaterniond::FromTwoVectors(-gb.normalized(), Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    s.v_WI = s.R_WI * vb;
-    prop.propagate(s, imuSpan(), tN);
-    const double tilt = 1.5 * cfg.init_tilt_sigma;
-    const Eigen::Matrix3d Pw =
-        Eigen::Vector3d(tilt * tilt, tilt * tilt, cfg.init_yaw_sigma * cfg.init_yaw_sigma).asDiagonal();
-    createState(s, Pw, 3.0 * cfg.init_velocity_sigma, cfg.init_gyro_bias_sigma);
+    createMovingState(t0, tN, gb, vb);
     return true;
   }
 
@@ -643,15 +650,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     solve(cfg.gravity * gdir, Eigen::MatrixXd(3, 0), x);
     if (!(x(0) > 0.0) || sSigma > cfg.init_mono_max_scale_sigma * x(0)) return false;
     const Eigen::Vector3d gb = x.tail(3);
-    ImuState s;
-    s.t_ns = t0;
-    s.R_WI = Eigen::Quaterniond::FromTwoVectors(-gb.normalized(), Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    s.v_WI = s.R_WI * Eigen::Vector3d(x.segment(1, 3));
-    prop.propagate(s, imuSpan(), tN);
-    const double tilt = 1.5 * cfg.init_tilt_sigma;
-    const Eigen::Matrix3d Pw =
-        Eigen::Vector3d(tilt * tilt, tilt * tilt, cfg.init_yaw_sigma * cfg.init_yaw_sigma).asDiagonal();
-    createState(s, Pw, 3.0 * cfg.init_velocity_sigma, cfg.init_gyro_bias_sigma);
+    createMovingState(t0, tN, gb, Eigen::Vector3d(x.segment(1, 3)));
     return true;
   }
 
