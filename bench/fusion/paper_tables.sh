@@ -19,7 +19,7 @@
 # Definitions (docs/replay.md, metrics.csv of gvins-replay):
 #   Tran. (GNSS modes): RMSE of the GNSS antenna solutions against the true antenna track in ENU,
 #         no alignment, from the first tightly coupled GNSS update on (global_position_rmse_m).
-#   Tran. (VIO): RMSE after a 4-DoF alignment on the first 10 % of the path (VIO navigating from
+#   Tran. (VIO): RMSE after a 4-DoF alignment on the first 10 % of the horizontal path (VIO navigating from
 #         a known start; local_start_aligned_position_rmse_m); in brackets the RMSE after the
 #         best 4-DoF alignment of the whole flight (local_position_rmse_m).
 #   Vel.: RMSE of the body-frame velocity R^T v against the truth (local_body_velocity_rmse_mps),
@@ -221,7 +221,7 @@ function check(name, pass, detail) { printf "| %s | %s | %s |\n", name, pass ? "
 END {
   nf = split(flights, fl, ",")
   printf "## SRI-GVINS on the simulated paper-like UAV flights (%s)\n", kind
-  printf "\nTran. [m] / Vel. [m/s]. GNSS modes: antenna RMSE in ENU without alignment from the first tightly coupled update on; VIO: 4-DoF aligned on the first 10 %% of the path (in brackets: on the whole flight). Vel.: body-frame velocity RMSE.\n"
+  printf "\nTran. [m] / Vel. [m/s]. GNSS modes: antenna RMSE in ENU without alignment from the first tightly coupled update on; VIO: 4-DoF aligned on the first 10 %% of the horizontal path (in brackets: on the whole flight). Vel.: body-frame velocity RMSE.\n"
   table("Table I: Psr and Dopp (paper Table I)", "psr dopp gpsvel vio", "VIO+Dopp+Psr,VIO+Dopp,VIO+Gps_vel,VIO")
   table("Table II: Dpsr and Ddcp (paper Table II)", "ddcp dpsr psr psr_noint", "VIO+Dopp+Ddcp,VIO+Dopp+Dpsr,VIO+Dopp+Psr,VIO+Dopp+Psr wo.inte")
   table("Table III: GNSS-IMU lever arm, VIO+Dopp+Psr (paper Table IV; poor = 0.3 m error in x)", "lever_poor_calib lever_poor_nocalib lever_good_calib psr", "poor extr + w.calib,poor extr + wo.calib,good extr + w.calib,good extr + wo.calib")
