@@ -109,6 +109,8 @@ ReplayConfig parseReplayConfig(std::string_view text, const std::string& file, c
             o.frontend.tracker.klt.window = static_cast<int>(n);
           } else if (k == "align_templates") {
             o.frontend.tracker.alignTemplates = boolean(x, file, name);
+          } else if (k == "template_translation_fallback") {
+            o.frontend.tracker.patch.translationFallback = boolean(x, file, name);
           } else if (k == "template_max_track_travel_px") {
             o.frontend.tracker.templateMaxTrackTravel = number(x, file, name);
             if (!(o.frontend.tracker.templateMaxTrackTravel >= 0.0)) {

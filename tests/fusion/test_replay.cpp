@@ -800,6 +800,11 @@ TEST(ReplayParsers, Config) {
   EXPECT_FALSE(u.options.frontend.tracker.alignTemplates);
   EXPECT_EQ(u.options.frontend.tracker.templateMaxTrackTravel, 120.0);
   EXPECT_EQ(parseReplayConfig("replay:\n  klt_window_px: 11\n", "r.yaml").options.frontend.tracker.klt.window, 11);
+  EXPECT_FALSE(ReplayOptions{}.frontend.tracker.patch.translationFallback);
+  EXPECT_TRUE(parseReplayConfig("replay:\n  template_translation_fallback: true\n", "r.yaml")
+                  .options.frontend.tracker.patch.translationFallback);
+  e = err("replay:\n  template_translation_fallback: 2\n");
+  EXPECT_EQ(e.field(), "replay.template_translation_fallback");
   for (const char* bad : {"replay:\n  klt_window_px: 12\n", "replay:\n  klt_window_px: 3\n", "replay:\n  klt_window_px: 9.5\n"}) {
     e = err(bad);
     EXPECT_EQ(e.field(), "replay.klt_window_px") << bad;

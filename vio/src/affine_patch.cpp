@@ -1,6 +1,7 @@
 #include "gvins/vio/affine_patch.hpp"
 
 #include <cmath>
+#include <optional>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -88,13 +89,23 @@ PatchAlignResult AffinePatch::align(const cv::Mat& image, AffineWarp& W, const P
   // iterations): far from the optimum the six-parameter step couples shape and shift badly.
   bool shape = false;
   int translationSteps = 0;
+  // translationFallback: the warp at the switch to the shape stage and its correlation.
+  std::optional<AffineWarp> translated;
+  float translatedCorrelation = 0.0f;
+  const auto fallback = [&]() -> PatchAlignResult {
+    if (!p.translationFallback || !translated) return res;
+    W = *translated;
+    res.correlation = translatedCorrelation;
+    res.ok = translatedCorrelation >= p.minCorrelation;
+    return res;
+  };
   for (int it = 0; it < p.maxIterations; ++it) {
     res.iterations = it + 1;
     // The warped patch is a parallelogram: inside the image if its corners are.
     for (const float su : {-fh, fh}) {
       for (const float sv : {-fh, fh}) {
         const Eigen::Vector2f q = W.A * Eigen::Vector2f(su, sv) + W.t;
-        if (!inside(image, q.x(), q.y())) return res;
+        if (!inside(image, q.x(), q.y())) return fallback();
       }
     }
     const Eigen::Vector2f du = W.A.col(0);
@@ -112,7 +123,7 @@ PatchAlignResult AffinePatch::align(const cv::Mat& image, AffineWarp& W, const P
     const float meanI = I.sum() / static_cast<float>(I.size());
     I.array() -= meanI;
     const double sII = I.squaredNorm(), sIT = I.dot(centred_);
-    if (!(sII > 0.0)) return res;
+    if (!(sII > 0.0)) return fallback();
     res.correlation = static_cast<float>(sIT / (std::sqrt(sII) * static_cast<double>(norm_)));
     const auto gain = static_cast<float>(sIT / sII);
     Eigen::Matrix<float, 6, 1> dp = Eigen::Matrix<float, 6, 1>::Zero();
@@ -127,17 +138,22 @@ PatchAlignResult AffinePatch::align(const cv::Mat& image, AffineWarp& W, const P
     // W ← W ∘ W(Δp)⁻¹ (B&M eq. (32)): W(Δp)(x) = ΔA x + Δt, its inverse ΔA⁻¹ (x − Δt).
     Eigen::Matrix2f dA;
     dA << 1.0f + dp(0), dp(2), dp(1), 1.0f + dp(3);
-    if (!(std::abs(dA.determinant()) > 1e-3f)) return res;
+    if (!(std::abs(dA.determinant()) > 1e-3f)) return fallback();
     const Eigen::Matrix2f A = W.A * dA.inverse();
     const Eigen::Vector2f t = W.t - A * dp.tail<2>();
     const float step = (t - W.t).norm();
+    const AffineWarp before = W;
     W.A = A;
     W.t = t;
-    if (!std::isfinite(step)) return res;
+    if (!std::isfinite(step)) return fallback();
     const Eigen::JacobiSVD<Eigen::Matrix2f> svd(W.A);
-    if (!(svd.singularValues()(1) >= lo && svd.singularValues()(0) <= hi)) return res;
+    if (!(svd.singularValues()(1) >= lo && svd.singularValues()(0) <= hi)) return fallback();
     if (!shape) {
       shape = step < 0.1f || 2 * translationSteps >= p.maxIterations;
+      if (shape && step < 0.1f) {
+        translated = before;  // converged in translation: the last measured warp
+        translatedCorrelation = res.correlation;
+      }
       continue;
     }
     if (step < p.epsilon) {
@@ -145,7 +161,7 @@ PatchAlignResult AffinePatch::align(const cv::Mat& image, AffineWarp& W, const P
       return res;
     }
   }
-  return res;
+  return fallback();
 }
 
 }  // namespace gvins::vio

@@ -401,7 +401,6 @@ struct SriSwfEstimator<Scalar>::Impl {
     return d;
   }
 
-  // Linear visual-inertial alignment over the buffered stereo frames (in motion).
   // State from an in-motion alignment: gravity gb and velocity vb in the IMU frame at t0
   // (attitude from gravity, yaw 0), propagated to tN; tilt prior 1.5× init_tilt_sigma, velocity
   // prior 3× init_velocity_sigma.
@@ -417,6 +416,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     createState(s, Pw, 3.0 * cfg.init_velocity_sigma, cfg.init_gyro_bias_sigma);
   }
 
+  // Linear visual-inertial alignment over the buffered stereo frames (in motion).
   bool tryMotion() {
     const int N = cfg.init_motion_frames;
     if (static_cast<int>(init_frames.size()) < N) return false;

@@ -37,6 +37,11 @@ struct PatchAlignParams {
   float epsilon = 0.005f;        ///< px: stop once the centre moves less than this
   float minCorrelation = 0.9f;   ///< normalized cross-correlation of the aligned patch, [−1, 1]
   float maxShapeChange = 0.5f;   ///< singular values of A must stay in [1 − c, 1/(1 − c)]
+  /// When the six-parameter (shape) stage fails after the translation stage converged (shape
+  /// out of bounds, no convergence, singular step: typical of patches with texture in one
+  /// direction only, e.g. a close, magnified ground), return the translation-stage warp instead,
+  /// accepted if its correlation reaches minCorrelation.
+  bool translationFallback = false;
 };
 
 struct PatchAlignResult {
