@@ -418,6 +418,8 @@ UpdateResult<Scalar> SriFilter<Scalar>::update(std::span<const Measurement<Scala
   UpdateResult<Scalar> result;
   int rows = 0;
   Scalar discardedChi2 = 0;
+  // Column offset of every block of every part in the state (parts in turn, blocks in order).
+  std::vector<int> boff;
   for (const Measurement<Scalar>& m : parts) {
     if (!m.isWhitened()) throw std::logic_error("sri::SriFilter::update: rows are not whitened");
     if (m.nuisanceDim() != 0) {
@@ -426,10 +428,6 @@ UpdateResult<Scalar> SriFilter<Scalar>::update(std::span<const Measurement<Scala
     result.dof += m.rows() + m.discardedRows();
     discardedChi2 += m.discardedChiSquare();
     rows += m.rows();
-  }
-  // Column offset of every block of every part in the state (parts in turn, blocks in order).
-  std::vector<int> boff;
-  for (const Measurement<Scalar>& m : parts) {
     for (int b = 0; b < m.numBlocks(); ++b) {
       const BlockInfo& info = layout_.block(m.blockId(b));
       if (info.dim != m.blockDim(b)) {

@@ -581,9 +581,15 @@ struct SriSwfEstimator<Scalar>::Impl {
       }
       return positive;
     };
-    const int pos = triangulateAll(d);
-    if (triangulateAll(-d) > pos) d = -d;
-    if (triangulateAll(d) < 20) return false;
+    // Sign of the baseline: the one with more positive depths (pts then holds its points).
+    const int forward = triangulateAll(d);
+    int triangulated = triangulateAll(-d);
+    if (triangulated > forward) {
+      d = -d;
+    } else {
+      triangulated = triangulateAll(d);
+    }
+    if (triangulated < 20) return false;
     // 2. Camera centres c̄_j of all later frames from the bearings of the points.
     std::vector<Eigen::Vector3d> cbar(static_cast<std::size_t>(M));
     for (int j = 0; j < M; ++j) {
@@ -602,8 +608,7 @@ struct SriSwfEstimator<Scalar>::Impl {
       cbar[static_cast<std::size_t>(j)] = H.ldlt().solve(g);
     }
     // 3. s c̄_j − v₀ Δt_j − ½ g Δt_j² = α_j + (R_0j − I) p_IC; x = [s; v₀; g] or, with g = G·dir
-    // + T δ, [s; v₀; δ].
-    double scaleSigma = 0.0;  // 1-σ of s from the last solve (residual-based)
+    // + T δ, [s; v₀; δ]. Returns the 1-σ of s from the fit residuals.
     auto solve = [&](const Eigen::Vector3d& g0, const Eigen::MatrixXd& T, Eigen::Matrix<double, 7, 1>& x) {
       const int nx = 4 + static_cast<int>(T.cols());
       Eigen::MatrixXd A = Eigen::MatrixXd::Zero(nx, nx);
@@ -632,21 +637,20 @@ struct SriSwfEstimator<Scalar>::Impl {
         rss += e.squaredNorm();
       }
       const double var = rss / std::max(1, 3 * M - nx);
-      const Eigen::MatrixXd Ai = A.inverse();
-      scaleSigma = std::sqrt(std::max(0.0, var * Ai(0, 0)));
+      return std::sqrt(std::max(0.0, var * A.inverse()(0, 0)));
     };
     Eigen::Matrix<double, 7, 1> x;
     solve(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity(), x);
     if (!(x(0) > 0.0) || std::abs(x.tail(3).norm() - cfg.gravity) > 1.0) return false;
     Eigen::Vector3d gdir = x.tail(3).normalized();
+    double sSigma = 0.0;  // of the last refinement, i.e. with the gravity direction free
     for (int it = 0; it < 4; ++it) {
       Eigen::Matrix<double, 3, 2> T;
       const Eigen::Vector3d e1 = gdir.unitOrthogonal();
       T << e1, gdir.cross(e1);
-      solve(cfg.gravity * gdir, T, x);
+      sSigma = solve(cfg.gravity * gdir, T, x);
       gdir = x.tail(3).normalized();
     }
-    const double sSigma = scaleSigma;  // with the gravity direction free (tangent unknowns)
     solve(cfg.gravity * gdir, Eigen::MatrixXd(3, 0), x);
     if (!(x(0) > 0.0) || sSigma > cfg.init_mono_max_scale_sigma * x(0)) return false;
     const Eigen::Vector3d gb = x.tail(3);
