@@ -25,6 +25,7 @@
 // bound of t, which also limits the span.
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "gvins/ephemeris/ephemeris_store.hpp"
 
@@ -296,8 +297,21 @@ EphemerisChoice<GlonassEphemeris> EphemerisStore::chooseGlonass(SatId sat, const
   return edges.choice(pickGlonass(glonass_[satIndex(sat)], t, bound, policy, &edges));
 }
 
+void EphemerisStore::setPrecise(std::shared_ptr<const PreciseEphemeris> precise) {
+  precise_ = std::move(precise);
+  ++revision_;
+}
+
+std::optional<SatelliteState> EphemerisStore::preciseState(SatId sat, const GpsTime& t) const {
+  if (!precise_ || !sat.valid()) return std::nullopt;
+  auto st = precise_->satelliteState(sat, t);
+  if (st) st->precise = true;
+  return st;
+}
+
 std::optional<SatelliteState> EphemerisStore::satelliteState(SatId sat, const GpsTime& t,
                                                              const EphemerisSelection& policy) const {
+  if (auto st = preciseState(sat, t)) return st;
   if (sat.system == System::Glonass) {
     if (const auto* g = selectGlonass(sat, t, policy)) return glonassSatelliteState(*g, t);
     return std::nullopt;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -10,6 +11,7 @@
 #include "gvins/ephemeris/glonass_ephemeris.hpp"
 #include "gvins/ephemeris/ionosphere_parameters.hpp"
 #include "gvins/ephemeris/kepler_ephemeris.hpp"
+#include "gvins/ephemeris/precise_ephemeris.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "gvins/ephemeris/satellite_state.hpp"
 
@@ -64,10 +66,18 @@ class EphemerisStore {
   /// Changes whenever records are added: choices made before are then out of date.
   std::uint64_t revision() const { return revision_; }
 
-  /// Satellite state at transmit time t from the selected record; std::nullopt when there is no
-  /// usable record.
+  /// Satellite state at transmit time t: from the precise products where they are set and cover
+  /// the satellite at t (SatelliteState::precise), else from the selected broadcast record;
+  /// std::nullopt when there is neither.
   std::optional<SatelliteState> satelliteState(SatId sat, const GpsTime& t,
                                                const EphemerisSelection& policy = {}) const;
+  /// Precise orbit/clock products (SP3, RINEX clock) preferred over the broadcast records for the
+  /// satellite states; the broadcast records still give group delays, GLONASS channels and the
+  /// ionosphere parameters. nullptr: broadcast only. Changes revision().
+  void setPrecise(std::shared_ptr<const PreciseEphemeris> precise);
+  const PreciseEphemeris* precise() const { return precise_.get(); }
+  /// The precise state alone (std::nullopt without products or coverage).
+  std::optional<SatelliteState> preciseState(SatId sat, const GpsTime& t) const;
   /// Group delay (s) for a pseudorange on `code` from the record selected at t (0 if none).
   double groupDelay(SatId sat, ObsCode code, const GpsTime& t,
                     const EphemerisSelection& policy = {}) const;
@@ -97,6 +107,7 @@ class EphemerisStore {
   IonosphereParameters iono_;
   GlonassChannels channels_;
   std::optional<int> leapSeconds_;
+  std::shared_ptr<const PreciseEphemeris> precise_;
   std::uint64_t revision_ = 0;
 };
 

@@ -22,6 +22,9 @@ struct SatelliteState {
   double accuracy = 0.0;    ///< broadcast URA/SISA/FT in m (0 = unknown)
   int iode = 0;             ///< issue of data of the record used
   bool healthy = true;
+  /// From precise products (SP3/RINEX clock; gvins/ephemeris/precise_ephemeris.hpp), not from a
+  /// broadcast record.
+  bool precise = false;
 };
 
 /// Keplerian orbit (IS-GPS-200 table 20-IV; Galileo OS SIS ICD 5.1.1; BeiDou GEO rotation per

@@ -1,0 +1,94 @@
+// EphemerisStore with precise products: the precise state wins where the products cover a
+// satellite (flagged SatelliteState::precise), the broadcast record serves everything else, and
+// group delays keep coming from the broadcast records.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <string>
+
+#include "gvins/base/constants.hpp"
+#include "gvins/ephemeris/ephemeris_store.hpp"
+#include "gvins/ephemeris/precise_ephemeris.hpp"
+#include "gvins/ephemeris/rinex_nav.hpp"
+#include "gvins/ephemeris/sp3.hpp"
+
+using namespace gvins;
+
+namespace {
+
+const std::string kNagoya = std::string(GVINS_TEST_DATA) + "/gnss/nagoya_static_2024/base.nav.gz";
+
+// SP3 data of one satellite: its broadcast orbit shifted by `offset` (m) and its broadcast clock
+// (without the relativistic term, as SP3 clocks are) shifted by `clockOffset` (s), every 300 s
+// over [from, to].
+Sp3Data shiftedProducts(const EphemerisStore& nav, SatId sat, const GpsTime& from, const GpsTime& to,
+                        const Eigen::Vector3d& offset, double clockOffset) {
+  Sp3Data d;
+  d.interval = 300.0;
+  d.satellites = {sat};
+  d.accuracyExponent = {4};
+  const double c = constants::kSpeedOfLight;
+  for (GpsTime t = from; t <= to; t = t + 300.0) {
+    const auto st = nav.satelliteState(sat, t);
+    EXPECT_TRUE(st.has_value());
+    Sp3Epoch ep;
+    ep.time = t;
+    Sp3Record r;
+    r.sat = sat;
+    r.position = st->position + offset;
+    r.clock = st->clockBias + 2.0 * st->position.dot(st->velocity) / (c * c) + clockOffset;
+    ep.records.push_back(r);
+    d.epochs.push_back(ep);
+  }
+  return d;
+}
+
+}  // namespace
+
+TEST(PreciseStore, PreciseStatesReplaceBroadcastWhereTheyCover) {
+  EphemerisStore nav;
+  nav.add(readRinexNav(kNagoya));
+  const SatId g = SatId::parse("G05").value(), e = SatId::parse("E04").value();
+  CalendarTime c;
+  c.year = 2024;
+  c.month = 6;
+  c.day = 24;
+  c.hour = 8;
+  c.minute = 20;
+  const GpsTime t0 = GpsTime::fromCalendar(c);
+  ASSERT_TRUE(nav.satelliteState(g, t0));
+  ASSERT_TRUE(nav.satelliteState(e, t0));
+  const Eigen::Vector3d offset(1.0, -2.0, 0.5);
+  auto precise = std::make_shared<PreciseEphemeris>();
+  precise->add(shiftedProducts(nav, g, t0 - 1200.0, t0 + 3600.0, offset, 1e-8));
+  const std::uint64_t rev = nav.revision();
+  nav.setPrecise(precise);
+  EXPECT_NE(nav.revision(), rev);
+
+  // Covered: the precise state, 1 m / 2 m / 0.5 m and 10 ns off the broadcast one.
+  const GpsTime t = t0 + 123.4;
+  EphemerisStore broadcastOnly;
+  broadcastOnly.add(readRinexNav(kNagoya));
+  const auto b = broadcastOnly.satelliteState(g, t);
+  const auto p = nav.satelliteState(g, t);
+  ASSERT_TRUE(b && p);
+  EXPECT_TRUE(p->precise);
+  EXPECT_FALSE(b->precise);
+  EXPECT_LT((p->position - b->position - offset).norm(), 0.01);  // 300 s nodes of a Kepler orbit
+  EXPECT_NEAR(p->clockBias - b->clockBias, 1e-8, 1e-11);          // relativistic term restored
+  EXPECT_LT((p->velocity - b->velocity).norm(), 1e-3);
+  // Not in the products, or outside their span: the broadcast record.
+  const auto pe = nav.satelliteState(e, t);
+  ASSERT_TRUE(pe);
+  EXPECT_FALSE(pe->precise);
+  const auto late = nav.satelliteState(g, t0 + 3 * 3600.0);
+  ASSERT_TRUE(late);
+  EXPECT_FALSE(late->precise);
+  // Group delays still from the broadcast record.
+  EXPECT_EQ(nav.groupDelay(g, ObsCode{'1', 'C'}, t), broadcastOnly.groupDelay(g, ObsCode{'1', 'C'}, t));
+  EXPECT_NE(nav.groupDelay(g, ObsCode{'1', 'C'}, t), 0.0);
+  // Switching the products off again.
+  nav.setPrecise(nullptr);
+  EXPECT_FALSE(nav.satelliteState(g, t)->precise);
+}
