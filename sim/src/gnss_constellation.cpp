@@ -96,7 +96,8 @@ const GnssConstellation::Sat* GnssConstellation::find(SatId sat) const {
   return i < 0 ? nullptr : &data_[static_cast<std::size_t>(i)];
 }
 
-bool GnssConstellation::bracket(const Sat& s, const GpsTime& t, int& i, int& j, double& w, double& wDot) const {
+bool GnssConstellation::bracket(const Sat& s, const GpsTime& t, int& i, int& j, double& w, double& wDot,
+                                double extension) const {
   const auto& r = s.records;
   const int n = static_cast<int>(r.size());
   // First record with ref > t.
@@ -107,11 +108,11 @@ bool GnssConstellation::bracket(const Sat& s, const GpsTime& t, int& i, int& j, 
   wDot = 0.0;
   if (k == 0) {
     i = j = 0;
-    return std::fabs(t - r[0].ref) <= r[0].halfWindow;
+    return std::fabs(t - r[0].ref) <= r[0].halfWindow + extension;
   }
   if (k == n) {
     i = j = n - 1;
-    return std::fabs(t - r[n - 1].ref) <= r[n - 1].halfWindow;
+    return std::fabs(t - r[n - 1].ref) <= r[n - 1].halfWindow + extension;
   }
   i = k - 1;
   j = k;
@@ -124,6 +125,16 @@ bool GnssConstellation::bracket(const Sat& s, const GpsTime& t, int& i, int& j, 
       return true;
     }
     if (r[j].ref - t <= r[j].halfWindow) {
+      i = j;
+      return true;
+    }
+    // In the gap: the nearer record's continuation, within the extension.
+    const double di = (t - r[i].ref) - r[i].halfWindow, dj = (r[j].ref - t) - r[j].halfWindow;
+    if (di <= dj && di <= extension) {
+      j = i;
+      return true;
+    }
+    if (dj < di && dj <= extension) {
       i = j;
       return true;
     }
@@ -148,12 +159,12 @@ std::optional<int> GnssConstellation::glonassChannel(SatId sat) const {
   return channels_.get(sat.prn);
 }
 
-std::optional<GnssSatelliteState> GnssConstellation::state(SatId sat, const GpsTime& t) const {
+std::optional<GnssSatelliteState> GnssConstellation::state(SatId sat, const GpsTime& t, double extension) const {
   const Sat* s = find(sat);
   if (!s) return std::nullopt;
   int i, j;
   double w, wDot;
-  if (!bracket(*s, t, i, j, w, wDot)) return std::nullopt;
+  if (!bracket(*s, t, i, j, w, wDot, extension)) return std::nullopt;
   auto eval = [&](int k) {
     const Record& r = s->records[static_cast<std::size_t>(k)];
     return r.kepler ? keplerSatelliteState(*r.kepler, t) : glonassSatelliteState(*r.glonass, t);

@@ -313,7 +313,7 @@ const std::set<std::string> kReceiverKeys = {"rate_hz", "elevation_mask_deg", "c
 void apply(const Reader& r, const YAML::Node& g, const std::string& file, GnssSimConfig& c) {
   static const std::set<std::string> kKeys = {
       "navigation", "systems",     "signals",     "signal_satellites", "cn0_offset_db", "code_noise_factor",
-      "include_unhealthy", "satellite_errors", "troposphere", "ionosphere", "shapiro", "rover", "base",
+      "include_unhealthy", "satellite_errors", "precise_products", "troposphere", "ionosphere", "shapiro", "rover", "base",
       "rtcm",       "error_terms"};
   r.map(g, "gnss", kKeys, [&](const std::string& k, const std::string& full, const YAML::Node& v) {
     if (k == "navigation") {
@@ -368,6 +368,22 @@ void apply(const Reader& r, const YAML::Node& g, const std::string& file, GnssSi
           });
         }
       });
+    } else if (k == "precise_products") {
+      r.map(v, full, {"write", "orbit_interval_s", "clock_interval_s", "sisre_m"},
+            [&](const std::string& pk, const std::string& pf, const YAML::Node& pv) {
+              auto& p = c.preciseProducts;
+              if (pk == "write") {
+                p.write = r.boolean(pv, pf);
+              } else if (pk == "orbit_interval_s") {
+                p.orbitInterval = r.number(pv, pf, 1.0, 3600.0);
+              } else if (pk == "clock_interval_s") {
+                p.clockInterval = r.number(pv, pf, 1.0, 3600.0);
+              } else {
+                r.perSystem(pv, pf, [&](System s, const std::string& xf, const YAML::Node& xv) {
+                  p.sisre[systemIndex(s)] = r.number(xv, xf, 0.0, 100.0);
+                });
+              }
+            });
     } else if (k == "troposphere") {
       r.map(v, full,
             {"relative_humidity", "hydrostatic_scale_sigma", "wet_scale_sigma", "layer_height_m", "residual"},

@@ -12,6 +12,7 @@
 #include "gvins/base/constants.hpp"
 #include "gvins/base/rinex_obs_writer.hpp"
 #include "gvins/sim/gnss_epoch_generator.hpp"
+#include "gvins/sim/gnss_precise_products.hpp"
 #include "gvins/sim/gnss_rtcm_stream.hpp"
 #include "gvins/sim/gnss_truth_writer.hpp"
 
@@ -206,6 +207,11 @@ GnssSimSummary GnssSimulator::run(const NavData& nav, const Trajectory& trajecto
     std::ofstream f = openOut("nav.rnx");
     writeRinexNav(f, nav, "SRI-GVINS gvins-sim");
     if (!f) throw std::runtime_error("writing nav.rnx failed");
+  }
+  if (config_.preciseProducts.write) {
+    const GnssPreciseProducts products = makePreciseProducts(world.constellation(), config_.preciseProducts, world.start(),
+                                                             world.start() + world.duration(), seed);
+    for (const auto& p : writePreciseProducts(products, dir)) sum.files.push_back(p);
   }
   // Constants of the run.
   {

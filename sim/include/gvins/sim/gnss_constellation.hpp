@@ -47,8 +47,10 @@ class GnssConstellation {
   const std::vector<SatId>& satellites() const { return sats_; }
   /// Whether the truth is defined at t (some record within its validity window).
   bool covers(SatId sat, const GpsTime& t) const;
-  /// True state at t; std::nullopt when not covered.
-  std::optional<GnssSatelliteState> state(SatId sat, const GpsTime& t) const;
+  /// True state at t; std::nullopt when not covered. With `extension` > 0 also up to that many
+  /// seconds beyond the validity windows, from the nearest record (the smooth continuation of the
+  /// truth at the window's edge; for products that need interpolation nodes around the run).
+  std::optional<GnssSatelliteState> state(SatId sat, const GpsTime& t, double extension = 0.0) const;
   /// Broadcast group delay of a pseudorange on `code` (s), blended like the clock.
   double groupDelay(SatId sat, ObsCode code, const GpsTime& t) const;
   /// GLONASS FDMA channel (from the navigation data).
@@ -71,7 +73,7 @@ class GnssConstellation {
   };
   const Sat* find(SatId sat) const;
   // Indices of the records blended at t and the weight of the second; false if not covered.
-  bool bracket(const Sat& s, const GpsTime& t, int& i, int& j, double& w, double& wDot) const;
+  bool bracket(const Sat& s, const GpsTime& t, int& i, int& j, double& w, double& wDot, double extension = 0.0) const;
 
   GpsTime start_;
   std::vector<SatId> sats_;

@@ -196,6 +196,20 @@ struct GnssSatelliteErrorConfig {
   std::array<double, kNumSystems> sisre{0.5, 1.5, 0.25, 0.8, 0.5, 1.0, 1.0};
 };
 
+/// Precise orbit and clock products written with the broadcast navigation file (gnss/precise.sp3,
+/// gnss/precise.clk), as a user would download IGS/MGEX final products or decode real-time SSR:
+/// the true orbits and clocks of the simulation plus small per-satellite errors (a constant and a
+/// drift, split over radial/along/cross/clock like the broadcast SISRE).
+struct GnssPreciseProductsConfig {
+  bool write = true;
+  double orbitInterval = 300.0;  ///< s (MGEX final orbits: 300 s; IGS final: 900 s)
+  double clockInterval = 30.0;   ///< s (IGS final clocks: 30 s)
+  /// Signal-in-space range error of the products per system, m. Defaults after the IGS final
+  /// products' stated accuracy (orbits ~2.5 cm, clocks ~75 ps; igs.org/products) for GPS and the
+  /// MGEX assessments for the others (Montenbruck et al. 2017, Adv. Space Res. 59(7)).
+  std::array<double, kNumSystems> sisre{0.02, 0.04, 0.03, 0.06, 0.05, 0.1, 0.1};
+};
+
 /// Satellites that transmit a signal (e.g. BeiDou B2I only from BDS-2 satellites C01-C18: BDS-3
 /// broadcasts B1I and B3I but not B2I, BDS-SIS-ICD-B1I 3.0 and B3I 1.0).
 struct GnssSignalSatellites {
@@ -235,6 +249,7 @@ struct GnssSimConfig {
       {{System::Qzss, {'5', 'Q'}}, 0.5}, {{System::Gps, {'2', 'W'}}, 1.5},
       {{System::Glonass, {'1', 'C'}}, 1.4}, {{System::Glonass, {'2', 'C'}}, 1.4}};
   GnssSatelliteErrorConfig satelliteErrors;
+  GnssPreciseProductsConfig preciseProducts;
   GnssTroposphereConfig troposphere;
   GnssIonosphereConfig ionosphere;
   /// Shapiro (relativistic) signal delay, ~2 cm (IERS Conventions 2010, eq. 11.17).
