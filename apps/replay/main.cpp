@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <sstream>
+#include <vector>
 #include <string>
 
 #include "gvins/base/parse_error.hpp"
@@ -54,6 +55,10 @@ const char* kUsage =
     "                         else 0; a gvins-sim dataset's cameras.time_offset_s is the truth for\n"
     "                         the time-offset error in the summary)\n"
     "  --rover F --base F --nav F   GNSS files (default DATASET/gnss/rover.obs, base.obs, nav file)\n"
+    "  --sp3 F --clk F        precise orbit / clock products, repeatable (default: the *.sp3 and\n"
+    "                         *.clk files in DATASET/gnss); they replace the broadcast orbits and\n"
+    "                         clocks where they cover a satellite\n"
+    "  --broadcast            broadcast orbits and clocks only (ignore precise products)\n"
     "  --base-position X,Y,Z  base antenna ECEF (default: base.obs header)\n"
     "  --sensor-to-gpst NS    GPST ns = sensor stamp + NS (default 0: gvins-sim datasets are GPST)\n"
     "  --start S --duration S replay a part (seconds after the first frame)\n"
@@ -104,6 +109,8 @@ int main(int argc, char** argv) {
   bool useFloat = false, quiet = false, images = false, noEval = false, skipBad = false, skipMissing = false;
   std::optional<double> start, duration, maxGap;
   std::optional<std::string> gapPolicy, rover, base, nav;
+  std::vector<std::string> sp3Files, clockFiles;
+  bool broadcastOnly = false;
   std::optional<Eigen::Vector3d> basePos, leverArm;
   std::int64_t sensorToGpst = 0;
   for (int i = 1; i < argc; ++i) {
@@ -131,6 +138,9 @@ int main(int argc, char** argv) {
     } else if (a == "--rover") rover = value();
     else if (a == "--base") base = value();
     else if (a == "--nav") nav = value();
+    else if (a == "--sp3") sp3Files.push_back(value());
+    else if (a == "--clk") clockFiles.push_back(value());
+    else if (a == "--broadcast") broadcastOnly = true;
     else if (a == "--base-position") {
       std::string s = value();
       for (char& c : s)
@@ -195,6 +205,9 @@ int main(int argc, char** argv) {
     if (rover) opt.roverObs = *rover;
     if (base) opt.baseObs = *base;
     if (nav) opt.navFile = *nav;
+    opt.sp3Files = sp3Files;
+    opt.clockFiles = clockFiles;
+    opt.broadcastOnly = broadcastOnly;
     opt.basePosition = basePos;
     opt.sensorToGpst_ns = sensorToGpst;
 

@@ -6,12 +6,14 @@
 #endif
 
 #include <chrono>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -21,7 +23,10 @@
 #include "gvins/base/parse_error.hpp"
 #include "gvins/base/rinex_obs_reader.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
+#include "gvins/ephemeris/precise_ephemeris.hpp"
+#include "gvins/ephemeris/rinex_clock.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
+#include "gvins/ephemeris/sp3.hpp"
 #include "gvins/gnss/accuracy_statistics.hpp"
 #include "gvins/gnss/pos_reader.hpp"
 #include "gvins/gnss/pos_writer.hpp"
@@ -31,12 +36,14 @@
 namespace {
 
 const char* kUsage =
-    "usage: gvins-spp [options] -o OUT.pos OBS NAV [NAV...]\n"
+    "usage: gvins-spp [options] -o OUT.pos OBS NAV [NAV...] [ORBIT.sp3...] [CLOCK.clk...]\n"
     "       gvins-spp --score FILE.pos --truth X,Y,Z | --truth-llh LAT,LON,H\n"
     "\n"
     "Single point positioning from RINEX observations (2.10/2.11, 3.0x; plain or .gz) and\n"
     "broadcast navigation files (RINEX 2/3/4, merged). Writes one RTKLIB-style .pos row per\n"
-    "solved epoch, prints progress and a summary to stderr.\n"
+    "solved epoch, prints progress and a summary to stderr. Precise products among the inputs\n"
+    "(SP3-c/d orbits *.sp3, RINEX clocks *.clk, plain or .gz; told apart by their names) replace\n"
+    "the broadcast orbits and clocks where they cover a satellite.\n"
     "\n"
     "  -o FILE            output .pos file ('-' for stdout); required\n"
     "  --config F.yaml    options from the 'spp:' section of a YAML file (see docs); command-line\n"
@@ -254,7 +261,25 @@ int main(int argc, char** argv) {
   // Navigation data.
   EphemerisStore nav;
   try {
-    for (std::size_t i = 1; i < args.inputs.size(); ++i) nav.add(readRinexNav(args.inputs[i]));
+    auto precise = std::make_shared<PreciseEphemeris>();
+    bool haveOrbits = false;
+    for (std::size_t i = 1; i < args.inputs.size(); ++i) {
+      std::string lower = args.inputs[i];
+      for (char& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+      if (lower.size() > 3 && lower.ends_with(".gz")) lower.resize(lower.size() - 3);
+      if (lower.ends_with(".sp3")) {
+        precise->add(readSp3(args.inputs[i]));
+        haveOrbits = true;
+      } else if (lower.ends_with(".clk") || lower.ends_with(".clk_30s")) {
+        precise->add(readRinexClock(args.inputs[i]));
+      } else {
+        nav.add(readRinexNav(args.inputs[i]));
+      }
+    }
+    if (haveOrbits) {
+      if (!args.quiet) std::fprintf(stderr, "precise products: %zu satellites\n", precise->satellites().size());
+      nav.setPrecise(std::move(precise));
+    }
   } catch (const ParseError& e) {
     printError(e);
     return 1;

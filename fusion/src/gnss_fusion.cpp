@@ -100,6 +100,7 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     m.velocity = tx->state.velocity;
     m.clockBias = tx->state.clockBias;
     m.clockDrift = tx->state.clockDrift;
+    m.precise = tx->state.precise;
     m.groupDelay = nav.groupDelay(so.sat, s->code, tx->transmitTime);
     m.wavelength = kC / *f;
     m.azel = azimuthElevation(g, x, m.position);
@@ -118,8 +119,9 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     // ionosphere (Klobuchar corrects about half of the delay; IS-GPS-200N 20.3.3.5.2.5).
     // Broadcast orbit/clock error (SISRE) of the system: a bias per satellite, in the variance so
     // that systems with poorer broadcast products weigh less.
-    const double ephemerisVariance =
-        std::pow(config_.ephemerisError[static_cast<std::size_t>(systemIndex(so.sat.system))], 2);
+    // Precise products (SP3/RINEX clock) where the store has them: centimetres instead.
+    const auto& ephemerisError = tx->state.precise ? config_.preciseEphemerisError : config_.ephemerisError;
+    const double ephemerisVariance = std::pow(ephemerisError[static_cast<std::size_t>(systemIndex(so.sat.system))], 2);
     m.codeVariance = std::pow(config_.codeSigma, 2) * (0.5 + 0.5 / (sinEl * sinEl)) + std::pow(0.3 * m.ionosphere, 2) +
                      ephemerisVariance;
     // Dual frequency: the ionosphere-free pair with the first other band tracked (`bands`: the

@@ -113,6 +113,10 @@ GnssFusionConfig parseGnssFusionConfig(std::string_view yaml, const std::string&
       rd.perSystem(v, f, [&](System sys, const std::string& fs, const YAML::Node& e) {
         c.ephemerisError[static_cast<std::size_t>(systemIndex(sys))] = rd.number(e, fs, 0.0, kMax);
       });
+    } else if (key == "precise_ephemeris_error_m") {
+      rd.perSystem(v, f, [&](System sys, const std::string& fs, const YAML::Node& e) {
+        c.preciseEphemerisError[static_cast<std::size_t>(systemIndex(sys))] = rd.number(e, fs, 0.0, kMax);
+      });
     } else if (key == "code_sigma") {
       c.codeSigma = positive(v, f);
     } else if (key == "doppler_sigma") {
@@ -141,7 +145,7 @@ GnssFusionConfig parseGnssFusionConfig(std::string_view yaml, const std::string&
   };
   static const std::set<std::string> kKeys = {
       "mode", "lever_arm", "calibrate_lever_arm", "lever_arm_sigma", "min_rotation_rate", "systems",
-      "elevation_mask_deg", "ionosphere", "bands", "ephemeris_error_m", "code_sigma", "doppler_sigma",
+      "elevation_mask_deg", "ionosphere", "bands", "ephemeris_error_m", "precise_ephemeris_error_m", "code_sigma", "doppler_sigma",
       "clock_bias_random_walk", "clock_drift_random_walk", "row_gate", "epoch_gate", "frame_yaw_sigma_deg",
       "frame_min_speed", "outage_reset", "clock_ransac_threshold", "base_position", "max_base_age"};
   if (const YAML::Node section = root["gnss_fusion"]) {

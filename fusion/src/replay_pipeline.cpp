@@ -25,7 +25,10 @@
 #include "gvins/base/parse_error.hpp"
 #include "gvins/base/rinex_obs_reader.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
+#include "gvins/ephemeris/precise_ephemeris.hpp"
+#include "gvins/ephemeris/rinex_clock.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
+#include "gvins/ephemeris/sp3.hpp"
 #include "gvins/fusion/replay_feature_tracks.hpp"
 #include "gvins/gnss/base_reader.hpp"
 #include "gvins/gnss/pos_writer.hpp"
@@ -69,6 +72,22 @@ class OutFile {
 
 /// The navigation file of a gvins-sim gnss/ folder: the first regular file that is neither an
 /// observation file nor the RTCM stream.
+// Precise products in a dataset's gnss folder: *.sp3 and *.clk (also *.SP3, *.CLK, *.sp3.gz,
+// *.clk.gz and the IGS long names *_ORB.SP3, *_CLK.CLK), sorted by name (consecutive days).
+void findPreciseProducts(const fs::path& dir, std::vector<std::string>& sp3, std::vector<std::string>& clk) {
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    if (!e.is_regular_file()) continue;
+    std::string lower = e.path().filename().string();
+    for (char& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    if (lower.ends_with(".gz")) lower.resize(lower.size() - 3);
+    if (lower.ends_with(".sp3")) sp3.push_back(e.path().string());
+    else if (lower.ends_with(".clk") || lower.ends_with(".clk_30s")) clk.push_back(e.path().string());
+  }
+  std::sort(sp3.begin(), sp3.end());
+  std::sort(clk.begin(), clk.end());
+}
+
 std::string findNavFile(const fs::path& dir) {
   std::vector<fs::path> c;
   std::error_code ec;
@@ -217,6 +236,7 @@ void ReplaySummary::writeMetrics(std::ostream& os) const {
   kv("gnss_epochs", static_cast<double>(gnssEpochs));
   kv("gnss_epochs_updated", static_cast<double>(gnssEpochsUpdated));
   kv("gnss_epochs_fixed", static_cast<double>(gnssEpochsFixed));
+  kv("precise_satellites", static_cast<double>(preciseSatellites));
   kv("frame_init_s", frameInitSeconds);
   auto acc = [&](const std::string& p, const Accuracy& a) {
     kv((p + "position_rmse_m").c_str(), a.positionRmse);
@@ -273,6 +293,8 @@ void ReplaySummary::print(std::ostream& os) const {
                            std::to_string(gnssEpochsFixed) + " RTK fixed), " + std::to_string(gnssEpochsSkipped) +
                            " before VIO initialisation");
     row("GNSS [ms/epoch]", f("mean %.3f", gnssMsMean) + f(" (%.3f ms per frame)", gnssMsPerFrame));
+    row("orbits/clocks", preciseSatellites > 0 ? "precise products, " + std::to_string(preciseSatellites) + " satellites"
+                                               : std::string("broadcast"));
     if (std::isfinite(frameInitSeconds)) row("frame initialised", f("%.1f s after the first frame", frameInitSeconds));
   }
   if (leverArm) {
@@ -337,6 +359,19 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
     if (!fs::exists(roverPath)) throw ParseError(roverPath, 0, "rover", "GNSS mode needs the rover observation file");
     if (navPath.empty()) throw ParseError(gdir.string(), 0, "navigation", "no navigation file in the gnss folder (use --nav)");
     g.nav.add(readRinexNav(navPath));
+    if (!opt.broadcastOnly) {
+      std::vector<std::string> sp3 = opt.sp3Files, clk = opt.clockFiles;
+      if (sp3.empty() && clk.empty()) findPreciseProducts(gdir, sp3, clk);
+      if (!sp3.empty()) {
+        auto precise = std::make_shared<PreciseEphemeris>();
+        for (const std::string& f : sp3) precise->add(readSp3(f));
+        for (const std::string& f : clk) precise->add(readRinexClock(f));
+        sum.preciseSatellites = precise->satellites().size();
+        g.nav.setPrecise(std::move(precise));
+      } else if (!clk.empty()) {
+        throw ParseError(clk.front(), 0, "precise clock", "clock files need an SP3 orbit file (use --sp3)");
+      }
+    }
     RinexObsReaderOptions ro;
     ro.skipBadEpochs = true;
     g.rover = std::make_unique<RinexObsReader>(roverPath, ro);

@@ -174,6 +174,15 @@ bool SppSolver::gatherMeasurements(const ObsEpoch& epoch, SppSolution& sol, std:
     st->position -= st->velocity * dts;
     st->clockBias -= st->clockDrift * dts;
     if (std::abs(dts) > 0.01) st = ge ? glonassSatelliteState(*ge, ttx) : keplerSatelliteState(*ke, ttx);
+    // Precise products, where set and covering, replace the broadcast orbit and clock (the
+    // broadcast record still gives the group delays). The transmit time from the broadcast clock
+    // is within a few ns (< 0.1 mm of satellite motion) of that from the precise clock.
+    if (st && nav_.precise()) {
+      if (auto p = nav_.preciseState(so.sat, ttx)) {
+        p->healthy = st->healthy;
+        st = p;
+      }
+    }
     if (!st || (!st->healthy && !cfg.ephemeris.allowUnhealthy) || !st->position.allFinite() ||
         st->position.norm() < 1e7) {
       out.use = SatelliteUse::NoEphemeris;
@@ -329,8 +338,9 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
       }
       double var = cfg.weighting.codeVariance(m.sat.system, m.azel.elevation, m.snr) * m.noiseFactor * m.noiseFactor;
       var += ionoVar + tropoVar;
-      double eph = cfg.ephemerisError[systemIndex(m.sat.system)];
-      if (m.state.accuracy > cfg.ephemerisAlarmAccuracy && cfg.ephemerisAlarmAccuracy > 0.0) {
+      double eph = m.state.precise ? cfg.preciseEphemerisError[systemIndex(m.sat.system)]
+                                   : cfg.ephemerisError[systemIndex(m.sat.system)];
+      if (!m.state.precise && m.state.accuracy > cfg.ephemerisAlarmAccuracy && cfg.ephemerisAlarmAccuracy > 0.0) {
         eph = std::max(eph, std::min(m.state.accuracy, 1000.0));
       }
       var += eph * eph;

@@ -30,7 +30,7 @@ void apply(const Reader& r, const YAML::Node& spp, SppConfig& c) {
   static const std::set<std::string> kKeys = {
       "systems", "elevation_mask_deg", "snr_mask_dbhz", "frequencies", "bands", "ionosphere", "troposphere",
       "relative_humidity", "meteo", "weighting", "ionosphere_model_error", "troposphere_zenith_error_m",
-      "ephemeris_error_m", "ephemeris_alarm_accuracy_m", "fault_exclusion", "robust", "ionosphere_estimation", "max_gdop", "isb_prior_sigma_m", "isb_random_walk_m2ps", "qzss_gps_clock",
+      "ephemeris_error_m", "ephemeris_alarm_accuracy_m", "precise_ephemeris_error_m", "fault_exclusion", "robust", "ionosphere_estimation", "max_gdop", "isb_prior_sigma_m", "isb_random_walk_m2ps", "qzss_gps_clock",
       "max_iterations", "velocity", "allow_unhealthy"};
   r.map(spp, "spp", kKeys, [&](const std::string& k, const std::string& full, const YAML::Node& v) {
     if (k == "systems") {
@@ -97,6 +97,10 @@ void apply(const Reader& r, const YAML::Node& spp, SppConfig& c) {
     } else if (k == "ephemeris_error_m") {
       r.perSystem(v, full, [&](System s, const std::string& f2, const YAML::Node& b) {
         c.ephemerisError[systemIndex(s)] = r.number(b, f2, 0.0, 1000.0);
+      });
+    } else if (k == "precise_ephemeris_error_m") {
+      r.perSystem(v, full, [&](System s, const std::string& f2, const YAML::Node& b) {
+        c.preciseEphemerisError[systemIndex(s)] = r.number(b, f2, 0.0, 1000.0);
       });
     } else if (k == "ephemeris_alarm_accuracy_m") {
       c.ephemerisAlarmAccuracy = r.number(v, full, 0.0, 1e6);

@@ -16,6 +16,8 @@
 //                                         # default: the SPP's order with GPS/QZSS L5 before L2)
 //     ephemeris_error_m: {G: 0.6, R: 5}   # per system: broadcast orbit/clock error (SISRE) added to
 //                                         # the psr variance (default: the SPP's ephemeris_error_m)
+//     precise_ephemeris_error_m: {G: 0.05} # the same for satellites from precise products (SP3/clock;
+//                                         # default: the SPP's precise_ephemeris_error_m)
 //     code_sigma: 0.6                     # m at zenith; variance (a² + a²/sin²(el)) style
 //     doppler_sigma: 0.1                  # m/s at zenith
 //     clock_bias_random_walk: 0.1         # m/√s per constellation bias
@@ -80,6 +82,9 @@ struct GnssFusionConfig {
   /// the SPP's error budget (SppConfig::ephemerisError: GPS 0.6, GLONASS 5 with its FDMA code
   /// biases, Galileo 0.3, BeiDou 1.0, QZSS 0.6 m).
   std::array<double, kNumSystems> ephemerisError = SppConfig{}.ephemerisError;
+  /// The same for satellites whose orbit and clock come from precise products
+  /// (SppConfig::preciseEphemerisError: GPS/Galileo 5 cm).
+  std::array<double, kNumSystems> preciseEphemerisError = SppConfig{}.preciseEphemerisError;
 
   static std::array<std::string, kNumSystems> defaultBands() {
     std::array<std::string, kNumSystems> b = SppConfig{}.bands;

@@ -103,6 +103,7 @@ struct SatelliteModel {
   ObsCode code2;                ///< its second signal, and the combination
   double ifA1 = 1.0, ifA2 = 0.0;  ///< P = a1·P(code) + a2·P(code2)
   double wavelength = 0.0;  ///< m
+  bool precise = false;     ///< orbit and clock from precise products (SP3/RINEX clock)
   AzEl azel;
   double pseudorange = 0.0; ///< m
   bool hasDoppler = false;

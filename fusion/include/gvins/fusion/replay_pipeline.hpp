@@ -119,6 +119,11 @@ struct ReplayOptions {
   std::string saveTracksDir;
   /// GNSS inputs; empty: <dataset>/gnss/rover.obs, base.obs and the navigation file found there.
   std::string roverObs, baseObs, navFile;
+  /// Precise orbit (SP3) and clock (RINEX clock) files; empty: the *.sp3 / *.clk files (also
+  /// gzipped) in <dataset>/gnss. Where they cover a satellite they replace its broadcast orbit and
+  /// clock (EphemerisStore::setPrecise). broadcastOnly: use none.
+  std::vector<std::string> sp3Files, clockFiles;
+  bool broadcastOnly = false;
   std::optional<Eigen::Vector3d> basePosition;  ///< default: base.obs header position
   /// GPST (ns since the GPS epoch) = sensor stamp + this. 0 for gvins-sim datasets, whose sensor
   /// stamps are GPST; set it to replay GNSS files against a recording stamped on another clock.
@@ -144,6 +149,8 @@ struct ReplaySummary {
   double frontendMsMean = 0.0, frontendMsMax = 0.0, estimatorMsMean = 0.0, estimatorMsMax = 0.0;
   double gnssMsMean = 0.0;  ///< per epoch
   std::size_t gnssEpochs = 0, gnssEpochsUpdated = 0, gnssEpochsFixed = 0, gnssEpochsSkipped = 0;
+  /// Satellites with precise products loaded (0: broadcast orbits and clocks only).
+  std::size_t preciseSatellites = 0;
   double realTimeFactor() const { return wallSeconds > 0.0 ? datasetSeconds / wallSeconds : 0.0; }
   double estimatorMsMedian = 0.0;
   double gnssMsPerFrame = 0.0;   ///< GNSS time summed over the run / processed frames
