@@ -83,7 +83,7 @@ struct GnssFusionConfig {
   /// biases, Galileo 0.3, BeiDou 1.0, QZSS 0.6 m).
   std::array<double, kNumSystems> ephemerisError = SppConfig{}.ephemerisError;
   /// The same for satellites whose orbit and clock come from precise products
-  /// (SppConfig::preciseEphemerisError: GPS/Galileo 5 cm).
+  /// (SppConfig::preciseEphemerisError: GPS/Galileo 5 cm; GLONASS 5 m for its FDMA code biases).
   std::array<double, kNumSystems> preciseEphemerisError = SppConfig{}.preciseEphemerisError;
 
   static std::array<std::string, kNumSystems> defaultBands() {

@@ -72,9 +72,11 @@ struct SppConfig {
   std::array<double, kNumSystems> ephemerisError{0.6, 5.0, 0.3, 1.0, 0.6, 2.0, 2.0};
   double ephemerisAlarmAccuracy = 10.0;
   /// The same for satellites whose state comes from precise products (SP3/RINEX clock, see
-  /// EphemerisStore::setPrecise), m: IGS final products ~2-3 cm, MGEX GLONASS/BeiDou ~5-10 cm
-  /// (igs.org/products; Montenbruck et al. 2017, Adv. Space Res. 59(7)), with a margin.
-  std::array<double, kNumSystems> preciseEphemerisError{0.05, 0.1, 0.05, 0.1, 0.1, 0.2, 0.2};
+  /// EphemerisStore::setPrecise), m: IGS final products ~2-3 cm, MGEX BeiDou/QZSS ~5-10 cm
+  /// (igs.org/products; Montenbruck et al. 2017, Adv. Space Res. 59(7)), with a margin. GLONASS
+  /// keeps the 5 m of the broadcast budget: it is the receiver's FDMA inter-frequency code bias,
+  /// which precise products do not remove.
+  std::array<double, kNumSystems> preciseEphemerisError{0.05, 5.0, 0.05, 0.1, 0.1, 0.2, 0.2};
   FaultExclusionOptions faultExclusion;
   RobustEstimation robust;
   IonosphereEstimation ionosphereEstimation;
