@@ -8,6 +8,9 @@
 #include <sstream>
 
 #include "gvins/base/geodetic.hpp"
+#include "gvins/ephemeris/ephemeris_store.hpp"
+#include "gvins/ephemeris/rinex_nav.hpp"
+#include "gvins/ephemeris/sp3.hpp"
 #include "gvins/gnss/accuracy_statistics.hpp"
 #include "gvins/gnss/pos_reader.hpp"
 
@@ -129,4 +132,74 @@ TEST(SppCli, BadArgumentsAndBadFiles) {
   EXPECT_EQ(noeph.code, 3) << noeph.err;
   EXPECT_NE(noeph.err.find("no ephemeris"), std::string::npos) << noeph.err;
   for (const char* n : {"m.pos", "s.pos", "cut.obs", "t.pos", "e.pos"}) std::filesystem::remove(tmp(n));
+}
+
+// Precise products among the inputs (told apart by name): an SP3 file holding the broadcast
+// orbits and clocks of the GPS satellites (clocks without the relativistic term, as SP3 clocks
+// are; 300 s nodes) gives the broadcast solution again to interpolation accuracy, and the tool
+// says it used them; a broken SP3 file stops it with the file and line.
+TEST(SppCli, PreciseProductsAmongTheInputs) {
+  using namespace gvins;
+  const std::string nav = kData + "/gnss/nagoya_static_2024/base.nav.gz";
+  const std::string obs = kData + "/gnss/nagoya_static_2024/rover.obs.gz";
+  EphemerisStore store;
+  store.add(readRinexNav(nav));
+  CalendarTime c;
+  c.year = 2024;
+  c.month = 6;
+  c.day = 24;
+  c.hour = 8;
+  const GpsTime t0 = GpsTime::fromCalendar(c);
+  Sp3Data d;
+  d.interval = 300.0;
+  for (SatId s : store.satellites())
+    if (s.system == System::Gps) d.satellites.push_back(s);
+  d.accuracyExponent.assign(d.satellites.size(), 3);
+  const double cl = 299792458.0;
+  for (double dt = 0.0; dt <= 3600.0; dt += 300.0) {
+    Sp3Epoch ep;
+    ep.time = t0 + dt;
+    for (SatId s : d.satellites) {
+      Sp3Record r;
+      r.sat = s;
+      if (const auto st = store.satelliteState(s, ep.time)) {
+        r.position = st->position;
+        r.clock = st->clockBias + 2.0 * st->position.dot(st->velocity) / (cl * cl);
+      }
+      ep.records.push_back(r);
+    }
+    d.epochs.push_back(ep);
+  }
+  const std::string sp3 = tmp("p.sp3"), broken = tmp("b.sp3");
+  {
+    std::ofstream f(sp3);
+    writeSp3(f, d);
+    std::ofstream g(broken);
+    std::ostringstream ss;
+    writeSp3(ss, d);
+    g << ss.str().substr(0, ss.str().size() / 2) << "*  2024  6 24  8 59  0.00000000\nPG99 x\n";
+  }
+  // GPS only, and the broadcast error budget for the precise states too: the same weights, so
+  // only the satellite states can differ.
+  const std::string cfg = tmp("p.yaml");
+  std::ofstream(cfg) << "spp:\n  precise_ephemeris_error_m: {G: 0.6}\n";
+  const std::string a = tmp("a.pos"), b = tmp("b.pos");
+  const CliRun plain = run("--config " + cfg + " --systems G -o " + a + " " + obs + " " + nav);
+  const CliRun precise = run("--config " + cfg + " --systems G -o " + b + " " + obs + " " + nav + " " + sp3);
+  ASSERT_EQ(plain.code, 0) << plain.err;
+  ASSERT_EQ(precise.code, 0) << precise.err;
+  EXPECT_NE(precise.err.find("precise products: " + std::to_string(d.satellites.size()) + " satellites"),
+            std::string::npos)
+      << precise.err;
+  const PosFile fa = readPosFile(a), fb = readPosFile(b);
+  ASSERT_EQ(fa.solutions.size(), fb.solutions.size());
+  double maxDiff = 0.0;
+  for (std::size_t i = 0; i < fa.solutions.size(); ++i)
+    maxDiff = std::max(maxDiff, (fa.solutions[i].position - fb.solutions[i].position).norm());
+  std::printf("largest position difference broadcast vs SP3 of the same orbits: %.4f m\n", maxDiff);
+  EXPECT_LT(maxDiff, 0.01);  // mm-level SP3 rounding and interpolation
+  const CliRun bad = run("-q -o " + b + " " + obs + " " + nav + " " + broken);
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_NE(bad.err.find(broken), std::string::npos) << bad.err;
+  for (const std::string& f : {sp3, broken, a, b, cfg}) std::filesystem::remove(f);
 }
