@@ -22,6 +22,8 @@
 #   Tran. (VIO): RMSE after a 4-DoF alignment on the first 10 % of the horizontal path (VIO navigating from
 #         a known start; local_start_aligned_position_rmse_m); in brackets the RMSE after the
 #         best 4-DoF alignment of the whole flight (local_position_rmse_m).
+#   Psr runs use the precise orbit/clock products that gvins-sim writes into each dataset
+#         (gnss/precise.sp3, precise.clk); psr_bcast is the same run with broadcast records only.
 #   Vel.: RMSE of the body-frame velocity R^T v against the truth (local_body_velocity_rmse_mps),
 #         independent of any alignment, as the paper's body velocity.
 set -euo pipefail
@@ -42,7 +44,7 @@ while [ $# -gt 0 ]; do
     --flights) FLIGHTS=$2; shift ;;
     --force) FORCE=1 ;;
     --keep-data) KEEP=1 ;;
-    -h|--help) sed -n '2,27p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,29p' "$0"; exit 0 ;;
     *) echo "paper_tables.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
   shift
