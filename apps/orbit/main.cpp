@@ -1,16 +1,26 @@
-// gvins-orbit: satellite positions, velocities and clocks from broadcast navigation files.
+// gvins-orbit: satellite positions, velocities and clocks from broadcast navigation files and
+// precise products, and the broadcast orbit/clock errors against the products.
+#include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "gvins/base/parse_error.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
+#include "gvins/ephemeris/orbit_comparison.hpp"
+#include "gvins/ephemeris/precise_ephemeris.hpp"
+#include "gvins/ephemeris/rinex_clock.hpp"
+#include "gvins/ephemeris/sp3.hpp"
 
 namespace {
 
 const char* kUsage =
-    "usage: gvins-orbit NAV... --time \"YYYY-MM-DD HH:MM:SS[.ffffff]\" [--gpst|--utc] [options]\n"
+    "usage: gvins-orbit NAV... [ORBIT.sp3...] [CLOCK.clk...] --time \"YYYY-MM-DD HH:MM:SS[.ffffff]\"\n"
+    "                   [--gpst|--utc] [--compare [--duration S] [--step S]] [options]\n"
     "\n"
     "Prints the state of every satellite with a usable broadcast ephemeris at the given time\n"
     "(taken as the signal transmit time), one CSV row per satellite:\n"
@@ -21,6 +31,16 @@ const char* kUsage =
     "\n"
     "NAV       RINEX navigation files, versions 2.10/2.11, 3.0x or 4.0x, plain or gzip-compressed;\n"
     "          several files are merged.\n"
+    "ORBIT/CLOCK  precise products (SP3-c/d *.sp3, RINEX clock *.clk, plain or .gz; told apart by\n"
+    "          name): where they cover a satellite its state comes from them.\n"
+    "--compare broadcast minus precise instead of states (needs an SP3 file), one row per\n"
+    "          satellite and epoch: gpst,sat,radial_m,along_m,cross_m,clock_m,sisre_m (orbit in the\n"
+    "          precise state's radial/along/cross frame, clock as c*dt; SISRE after Montenbruck et\n"
+    "          al. 2018 with the per-epoch mean clock difference of each system removed, which a\n"
+    "          receiver clock absorbs); RMS per system on stderr. No satellite antenna offsets are\n"
+    "          applied: IGS SP3 orbits are centres of mass, broadcast ones antenna phase centres.\n"
+    "--duration S, --step S   with --compare: epochs T, T+step, ... up to T+duration (default one\n"
+    "          epoch; step 300 s).\n"
     "--time T  epoch, \"YYYY-MM-DD HH:MM:SS\" with optional fraction (also \"YYYY-MM-DDTHH:MM:SS\").\n"
     "--gpst    T is GPS time (default).\n"
     "--utc     T is UTC (converted with the leap-second table).\n"
@@ -47,9 +67,10 @@ bool parseTime(const char* text, gvins::CalendarTime& c) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<std::string> files;
+  std::vector<std::string> files, sp3Files, clockFiles;
   const char* timeText = nullptr;
-  bool utc = false, unhealthy = false, realtime = false;
+  bool utc = false, unhealthy = false, realtime = false, compare = false;
+  double duration = 0.0, step = 300.0;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "-h" || a == "--help") {
@@ -69,12 +90,38 @@ int main(int argc, char** argv) {
       unhealthy = true;
     } else if (a == "--realtime") {
       realtime = true;
+    } else if (a == "--compare") {
+      compare = true;
+    } else if (a == "--duration" || a == "--step") {
+      char* end = nullptr;
+      const double v = i + 1 < argc ? std::strtod(argv[i + 1], &end) : NAN;
+      if (i + 1 >= argc || end == argv[i + 1] || *end != '\0' || !(v >= 0.0 && v <= 30.0 * 86400.0) ||
+          (a == "--step" && !(v >= 1.0))) {
+        std::fprintf(stderr, "gvins-orbit: %s needs a number of seconds (%s)\n", a.c_str(),
+                     a == "--step" ? "1 s to 30 days" : "0 to 30 days");
+        return 2;
+      }
+      ++i;
+      (a == "--duration" ? duration : step) = v;
     } else if (a.size() > 1 && a[0] == '-') {
       std::fprintf(stderr, "gvins-orbit: unknown option '%s' (see --help)\n", a.c_str());
       return 2;
     } else {
-      files.push_back(a);
+      std::string lower = a;
+      for (char& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+      if (lower.size() > 3 && lower.compare(lower.size() - 3, 3, ".gz") == 0) lower.resize(lower.size() - 3);
+      auto ends = [&](const char* x) {
+        const std::size_t n = std::strlen(x);
+        return lower.size() >= n && lower.compare(lower.size() - n, n, x) == 0;
+      };
+      if (ends(".sp3")) sp3Files.push_back(a);
+      else if (ends(".clk") || ends(".clk_30s")) clockFiles.push_back(a);
+      else files.push_back(a);
     }
+  }
+  if (compare && sp3Files.empty()) {
+    std::fprintf(stderr, "gvins-orbit: --compare needs a precise orbit file (*.sp3)\n");
+    return 2;
   }
   if (files.empty() || !timeText) {
     std::fprintf(stderr, "gvins-orbit: %s\n%s", files.empty() ? "no navigation file given" : "--time is required",
@@ -100,10 +147,77 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
+  std::shared_ptr<gvins::PreciseEphemeris> precise;
+  if (!sp3Files.empty()) {
+    precise = std::make_shared<gvins::PreciseEphemeris>();
+    try {
+      for (const auto& f : sp3Files) precise->add(gvins::readSp3(f));
+      for (const auto& f : clockFiles) precise->add(gvins::readRinexClock(f));
+    } catch (const gvins::ParseError& e) {
+      std::fprintf(stderr, "gvins-orbit: %s\n", e.what());
+      return 1;
+    }
+  } else if (!clockFiles.empty()) {
+    std::fprintf(stderr, "gvins-orbit: clock files need an SP3 orbit file\n");
+    return 2;
+  }
 
   gvins::EphemerisSelection policy;
   policy.allowUnhealthy = unhealthy;
   if (realtime) policy.futureTolerance = -1.0;
+  if (compare) {
+    // Broadcast minus precise, epoch after epoch; the clock differences of each system are
+    // referred to their mean at the epoch for the SISRE.
+    struct Acc {
+      double r2 = 0, a2 = 0, c2 = 0, k2 = 0, s2 = 0;
+      int n = 0;
+    };
+    std::map<int, Acc> acc;
+    std::printf("gpst,sat,radial_m,along_m,cross_m,clock_m,sisre_m\n");
+    int epochs = 0;
+    for (double dt = 0.0; dt <= duration + 1e-9; dt += step) {
+      const gvins::GpsTime te = t + dt;
+      std::vector<std::pair<gvins::SatId, gvins::OrbitDifference>> rows;
+      double sum[gvins::kNumSystems] = {};
+      int cnt[gvins::kNumSystems] = {};
+      for (const gvins::SatId sat : store.satellites()) {
+        const auto b = store.satelliteState(sat, te, policy);
+        const auto p = precise->satelliteState(sat, te);
+        if (!b || !p) continue;
+        const gvins::OrbitDifference d = gvins::orbitDifference(*b, *p);
+        rows.emplace_back(sat, d);
+        sum[gvins::systemIndex(sat.system)] += d.clock;
+        ++cnt[gvins::systemIndex(sat.system)];
+      }
+      for (const auto& [sat, d] : rows) {
+        const int si = gvins::systemIndex(sat.system);
+        const double mean = sum[si] / cnt[si];
+        const double e = gvins::sisre(sat, d, mean);
+        std::printf("%s,%s,%.4f,%.4f,%.4f,%.4f,%.4f\n", te.toString(3).c_str(), sat.str().c_str(), d.radial, d.along,
+                    d.cross, d.clock, e);
+        Acc& a = acc[si];
+        a.r2 += d.radial * d.radial;
+        a.a2 += d.along * d.along;
+        a.c2 += d.cross * d.cross;
+        a.k2 += (d.clock - mean) * (d.clock - mean);
+        a.s2 += e * e;
+        ++a.n;
+      }
+      ++epochs;
+    }
+    std::fflush(stdout);
+    std::fprintf(stderr, "gvins-orbit: broadcast minus precise, %d epoch(s) from %s GPST, RMS [m]\n", epochs,
+                 t.toString(3).c_str());
+    std::fprintf(stderr, "  system     rows   radial    along    cross  clock-mean    SISRE\n");
+    for (const auto& [si, a] : acc) {
+      const auto rms = [&](double x) { return std::sqrt(x / a.n); };
+      std::fprintf(stderr, "  %-8s %6d %8.3f %8.3f %8.3f %11.3f %8.3f\n",
+                   std::string(gvins::systemName(static_cast<gvins::System>(si))).c_str(), a.n, rms(a.r2), rms(a.a2),
+                   rms(a.c2), rms(a.k2), rms(a.s2));
+    }
+    return acc.empty() ? 3 : 0;
+  }
+  if (precise) store.setPrecise(precise);
   int perSystem[gvins::kNumSystems] = {};
   std::printf("sat,x,y,z,vx,vy,vz,clock_s,drift_s_per_s\n");
   for (const gvins::SatId sat : store.satellites()) {

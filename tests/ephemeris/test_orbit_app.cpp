@@ -2,14 +2,23 @@
 // error handling. Needs the gvins-orbit target built (it is part of every full build).
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <sstream>
 #include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
 
 #include "gvins/base/line_reader.hpp"
+#include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
+#include "gvins/ephemeris/sp3.hpp"
 
 namespace {
 
@@ -113,4 +122,74 @@ TEST(OrbitApp, ErrorsAreClear) {
   const AppRun help = run("--help");
   EXPECT_EQ(help.status, 0);
   EXPECT_NE(help.out.find("sat,x,y,z,vx,vy,vz,clock_s,drift_s_per_s"), std::string::npos);
+}
+
+// --compare against an SP3 file made from the broadcast GPS orbits displaced by a known
+// radial/along/cross offset and clocks by a common 0.2 m: the rows give back the offsets (with
+// the opposite sign: broadcast minus precise), and the SISRE, with the common clock removed,
+// sqrt((0.98·0.3)² + (1.2² + 0.5²)/49) = 0.348 m (Montenbruck et al. 2018 GPS weights).
+TEST(OrbitApp, CompareRecoversKnownOrbitAndClockOffsets) {
+  const std::string nav = kData + "/gnss/nagoya_static_2024/base.nav.gz";
+  gvins::EphemerisStore store;
+  store.add(gvins::readRinexNav(nav));
+  gvins::CalendarTime c;
+  c.year = 2024;
+  c.month = 6;
+  c.day = 24;
+  c.hour = 8;
+  const gvins::GpsTime t0 = gvins::GpsTime::fromCalendar(c);
+  gvins::Sp3Data d;
+  d.interval = 300.0;
+  for (gvins::SatId s : store.satellites())
+    if (s.system == gvins::System::Gps) d.satellites.push_back(s);
+  const double kc = 299792458.0;
+  for (double dt = 0.0; dt <= 3600.0; dt += 300.0) {
+    gvins::Sp3Epoch ep;
+    ep.time = t0 + dt;
+    for (gvins::SatId s : d.satellites) {
+      gvins::Sp3Record r;
+      r.sat = s;
+      if (const auto st = store.satelliteState(s, ep.time)) {
+        const Eigen::Vector3d rh = st->position.normalized();
+        const Eigen::Vector3d ch = st->position.cross(st->velocity).normalized();
+        const Eigen::Vector3d ah = ch.cross(rh);
+        r.position = st->position + 0.3 * rh - 1.2 * ah + 0.5 * ch;
+        r.clock = st->clockBias + 2.0 * st->position.dot(st->velocity) / (kc * kc) + 0.2 / kc;
+      }
+      ep.records.push_back(r);
+    }
+    d.epochs.push_back(ep);
+  }
+  const std::string sp3 = (std::filesystem::temp_directory_path() / ("gvins_orbit_" + std::to_string(::getpid()) + ".sp3")).string();
+  {
+    std::ofstream f(sp3);
+    gvins::writeSp3(f, d);
+  }
+  const AppRun r = run(nav + " " + sp3 + " --time \"2024-06-24 08:20:00\" --compare --duration 600 --step 300", false);
+  ASSERT_EQ(r.status, 0) << r.out;
+  std::istringstream in(r.out);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "gpst,sat,radial_m,along_m,cross_m,clock_m,sisre_m");
+  int rows = 0;
+  while (std::getline(in, line)) {
+    std::vector<double> v;
+    std::stringstream ls(line);
+    std::string cell;
+    for (int k = 0; std::getline(ls, cell, ','); ++k)
+      if (k >= 2) v.push_back(std::stod(cell));
+    ASSERT_EQ(v.size(), 5u) << line;
+    // Interpolation and SP3 rounding: 1 mm.
+    EXPECT_NEAR(v[0], -0.3, 2e-3) << line;
+    EXPECT_NEAR(v[1], 1.2, 2e-3) << line;
+    EXPECT_NEAR(v[2], -0.5, 2e-3) << line;
+    EXPECT_NEAR(v[3], -0.2, 2e-3) << line;
+    EXPECT_NEAR(v[4], 0.348, 2e-3) << line;
+    ++rows;
+  }
+  EXPECT_GT(rows, 3 * 8);  // three epochs of the GPS satellites with records
+  std::filesystem::remove(sp3);
+  const AppRun noSp3 = run(nav + " --time \"2024-06-24 08:20:00\" --compare");
+  EXPECT_EQ(noSp3.status, 2);
+  EXPECT_NE(noSp3.out.find("--compare needs a precise orbit file"), std::string::npos) << noSp3.out;
 }
