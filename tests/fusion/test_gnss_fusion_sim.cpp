@@ -235,6 +235,21 @@ TEST(GnssFusionSim, FrameInitialisationConvergesAndPseudorangeFusion) {
   EXPECT_GT(r.psr.used, 5 * r.epochs);
 }
 
+// The antenna at the simulated truth of an epoch (state, lever arm; N = the simulator's W).
+AntennaKinematics truthKinematics(const Scenario& sc, const sim::GnssSimEpoch& e) {
+  const double tf = sc.frame.flightTime(e.truth.time);
+  const sim::TrajectoryState ts = sc.traj->evaluate(tf);
+  GnssStateValues s;
+  s.newest.t_ns = sc.frame.stampNs(tf);
+  s.newest.R_WI = ts.R_WB;
+  s.newest.p_WI = ts.p_WB;
+  s.newest.v_WI = ts.v_WB;
+  s.omegaMeasured = ts.omega_B;
+  s.lever = kLever;
+  s.anchor = GnssAnchor::at(sc.frame.originEcef());
+  return antennaKinematics(s);
+}
+
 // Residuals at the simulated truth (state, frame, lever arm, true receiver clocks) equal the
 // simulated error terms that the models do not contain: on the primary band with the broadcast
 // ionosphere, and for the dual-frequency ionosphere-free pairs (whose ionospheric terms cancel).
@@ -249,17 +264,7 @@ TEST_P(GnssFusionSimResiduals, AtTruthAreTheSimulatedErrors) {
   int n = 0, nd = 0, nif = 0;
   for (const sim::GnssSimEpoch& e : sc.epochs) {
     if (e.role != sim::GnssReceiverRole::Rover || n > 2000) continue;
-    const double tf = sc.frame.flightTime(e.truth.time);
-    const sim::TrajectoryState ts = sc.traj->evaluate(tf);
-    GnssStateValues s;
-    s.newest.t_ns = sc.frame.stampNs(tf);
-    s.newest.R_WI = ts.R_WB;
-    s.newest.p_WI = ts.p_WB;
-    s.newest.v_WI = ts.v_WB;
-    s.omegaMeasured = ts.omega_B;
-    s.lever = kLever;
-    s.anchor = GnssAnchor::at(sc.frame.originEcef());  // N = the simulator's W
-    const AntennaKinematics k = antennaKinematics(s);
+    const AntennaKinematics k = truthKinematics(sc, e);
     ASSERT_LT((k.x_E - e.truth.antennaPosition).norm(), 1e-3);
     ASSERT_LT((k.u_E - e.truth.antennaVelocity).norm(), 1e-6);
     for (const SatelliteModel& m : fusion.satelliteModels(e.obs, sc.nav, k.x_E)) {
@@ -339,17 +344,7 @@ TEST(GnssFusionSim, PreciseProductsRemoveTheBroadcastOrbitClockError) {
     precise = 0;
     for (const sim::GnssSimEpoch& e : sc.epochs) {
       if (e.role != sim::GnssReceiverRole::Rover || n > 3000) continue;
-      const double tf = sc.frame.flightTime(e.truth.time);
-      const sim::TrajectoryState ts = sc.traj->evaluate(tf);
-      GnssStateValues s;
-      s.newest.t_ns = sc.frame.stampNs(tf);
-      s.newest.R_WI = ts.R_WB;
-      s.newest.p_WI = ts.p_WB;
-      s.newest.v_WI = ts.v_WB;
-      s.omegaMeasured = ts.omega_B;
-      s.lever = kLever;
-      s.anchor = GnssAnchor::at(sc.frame.originEcef());
-      const AntennaKinematics k = antennaKinematics(s);
+      const AntennaKinematics k = truthKinematics(sc, e);
       for (const SatelliteModel& m : fusion.satelliteModels(e.obs, nav, k.x_E)) {
         if (!m.ionosphereFree) continue;
         std::size_t i = 0;
