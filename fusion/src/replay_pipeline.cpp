@@ -376,6 +376,15 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
     ro.skipBadEpochs = true;
     g.rover = std::make_unique<RinexObsReader>(roverPath, ro);
     g.haveRover = g.rover->next(g.nextRover);
+    // Products of another day than the observations: every state would silently be broadcast.
+    if (const PreciseEphemeris* p = g.nav.precise(); p && g.haveRover) {
+      const auto [first, last] = p->span();
+      if (g.nextRover.time < first || last < g.nextRover.time) {
+        std::fprintf(stderr, "[gvins-replay] warning: the precise products cover %s to %s GPST, the rover starts at %s: "
+                             "broadcast orbits and clocks are used where they do not reach\n",
+                     first.toString(0).c_str(), last.toString(0).c_str(), g.nextRover.time.toString(0).c_str());
+      }
+    }
     if (fs::exists(basePath)) {
       // RINEX (header position + antenna delta) or RTCM 3 (1005/1006, possibly only after some
       // epochs; its ephemerides join the store); RTCM times of week resolve against the rover.

@@ -18,6 +18,9 @@
 
 #include "gvins/base/parse_error.hpp"
 #include "gvins/base/rinex_obs_reader.hpp"
+#include "gvins/ephemeris/ephemeris_store.hpp"
+#include "gvins/ephemeris/rinex_nav.hpp"
+#include "gvins/ephemeris/sp3.hpp"
 #include "gvins/fusion/replay_config.hpp"
 #include "gvins/fusion/replay_feature_tracks.hpp"
 #include "gvins/fusion/replay_pipeline.hpp"
@@ -359,6 +362,63 @@ TEST(Replay, GnssEpochsHandedOverUpToTheNewestState) {
   EXPECT_EQ(std::count_if(kml.begin(), kml.end(), [](const std::string& l) { return std::count(l.begin(), l.end(), ',') == 2; }), 1);
   // One epoch only: the evaluation needs two, so it says why it could not evaluate.
   EXPECT_TRUE(s.globalEvaluationTable.empty()) << s.globalEvaluationTable;
+}
+
+// Precise products in the dataset's gnss folder are loaded (precise_satellites); products of
+// another day than the rover observations are loaded too but the replay warns that they do not
+// reach the rover epochs.
+TEST(Replay, PreciseProductsInTheGnssFolder) {
+  const fs::path g = kData / "gnss" / "geonet_0759_3040_2005";
+  const auto stamps = cameraStamps(kV101 / "mav0" / "cam0" / "data.csv");
+  RinexObsHeader rh;
+  const auto rover = readRinexObs((g / "07590920.05o.gz").string(), &rh);
+  EphemerisStore nav;
+  nav.add(readRinexNav((g / "07590920.05n.gz").string()));
+  // SP3 of the broadcast GPS orbits over [start, start + 1 h].
+  auto products = [&](const GpsTime& start) {
+    Sp3Data d;
+    d.interval = 900.0;
+    for (SatId s : nav.satellites()) d.satellites.push_back(s);
+    for (double dt = 0.0; dt <= 3600.0; dt += 900.0) {
+      Sp3Epoch ep;
+      ep.time = start + dt;
+      for (SatId s : d.satellites) {
+        Sp3Record r;
+        r.sat = s;
+        if (const auto st = nav.satelliteState(s, rover[0].time)) {
+          r.position = st->position;
+          r.clock = st->clockBias;
+        }
+        ep.records.push_back(r);
+      }
+      d.epochs.push_back(ep);
+    }
+    std::ostringstream os;
+    writeSp3(os, d);
+    return os.str();
+  };
+  const auto ns = [](const GpsTime& t) {
+    return t.wholeSeconds() * 1'000'000'000LL + static_cast<std::int64_t>(std::llround(t.fraction() * 1e9));
+  };
+  for (const bool sameDay : {true, false}) {
+    const fs::path d = copyV101(sameDay ? "sp3_same" : "sp3_other");
+    fs::create_directories(d / "gnss");
+    writeText(d / "gnss" / "products.sp3", products(rover[0].time - 1800.0 + (sameDay ? 0.0 : 86400.0)));
+    StubEstimator est;
+    StubGnss gnss;
+    ReplayOptions o = quietOptions(d.parent_path() / ("out_" + d.filename().string()));
+    o.sensorToGpst_ns = ns(rover[1].time) + 10'000'000 - stamps[2];
+    o.roverObs = (g / "07590920.05o.gz").string();
+    o.baseObs = (g / "30400920.05o.gz").string();
+    o.navFile = (g / "07590920.05n.gz").string();
+    ::testing::internal::CaptureStderr();
+    const ReplaySummary s = runReplay(d.string(), est, &gnss, o);
+    const std::string err = ::testing::internal::GetCapturedStderr();
+    EXPECT_EQ(s.preciseSatellites, nav.satellites().size());
+    EXPECT_EQ(err.find("precise products cover") != std::string::npos, !sameDay) << err;
+    o.broadcastOnly = true;
+    EXPECT_EQ(runReplay(d.string(), est, &gnss, o).preciseSatellites, 0u);
+  }
 }
 
 TEST(Replay, GlobalAccuracyAgainstEcefTruth) {
