@@ -3,6 +3,7 @@
 
     psr_error_attribution.py DATASET [--run OUTDIR] [--bands G:152,J:152]
                              [--ephemeris-error G:0.6,R:5,E:0.3,C:1,J:0.6] [--sigma 0.6] [--mask 10]
+                             [--from S] [--until S]
 
 DATASET: gvins-sim output simulated with `gnss: error_terms: true` (gnss/truth/rover_errors.csv).
 Each error term (broadcast orbit/clock error, troposphere residual, code multipath, code noise),
@@ -11,7 +12,8 @@ ENU offset by weighted least squares over all epochs with a clock per system and
 error a perfect VIO + psr filter would keep. Weights as the psr rows: (sigma k)^2 (1/2 + 1/(2
 sin^2 el)) + ephemeris_error^2, k the IF noise factor (defaults: the fusion's; a given
 --ephemeris-error replaces the whole list, systems not named get 0). With --run (a gvins-replay OUTDIR), the
-epochs start at the first tight epoch and the filter's mean ENU error is printed alongside.
+epochs start at the first tight epoch and the filter's mean ENU error is printed alongside;
+--from/--until keep only the epochs that many seconds after that start (a window of the flight).
 NLOS-affected satellites are left out (the filter's gate rejects them). docs/gnss_fusion.md."""
 import bisect, collections, math, sys
 
@@ -85,6 +87,7 @@ def main(args):
     order = {'G': '152', 'J': '152', 'E': '157', 'C': '276', 'R': '12'}
     order.update(per_system(opt(args, '--bands', ''), str))
     start = -1.0
+    t_from, t_until = float(opt(args, '--from', '0')), float(opt(args, '--until', '1e9'))
     if run:
         for line in open(run + '/gnss_epochs.csv'):
             v = line.split(',')
@@ -105,6 +108,8 @@ def main(args):
     b = {t: [0.0] * 3 for t in TERMS}
     for tag in sorted(rows):
         if (tag * 1e-9) % 604800 < start - 1e-6:
+            continue
+        if not start + t_from - 1e-6 <= (tag * 1e-9) % 604800 <= start + t_until + 1e-6:
             continue
         by_clock = collections.defaultdict(list)
         for sat, sig in rows[tag].items():

@@ -212,6 +212,7 @@ GnssSimSummary GnssSimulator::run(const NavData& nav, const Trajectory& trajecto
     const GnssPreciseProducts products = makePreciseProducts(world.constellation(), config_.preciseProducts, world.start(),
                                                              world.start() + world.duration(), seed);
     for (const auto& p : writePreciseProducts(products, dir)) sum.files.push_back(p);
+    sum.preciseSatellites = products.orbits.satellites.size();
   }
   // Constants of the run.
   {
@@ -291,6 +292,8 @@ void GnssSimSummary::print(std::ostream& os) const {
     for (const auto& [type, n] : rtcmMessages) os << " " << type << "x" << n;
     os << "\n";
   }
+  if (preciseSatellites > 0)
+    os << "  precise products: precise.sp3, precise.clk (" << preciseSatellites << " satellites)\n";
 }
 
 }  // namespace gvins::sim

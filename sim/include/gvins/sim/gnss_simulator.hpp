@@ -13,6 +13,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <iosfwd>
@@ -47,6 +48,8 @@ struct GnssSimSummary {
   std::int64_t rtcmBytes = 0;
   std::map<int, std::int64_t> rtcmMessages;
   std::vector<std::filesystem::path> files;
+  /// Satellites in the precise products (0: none written).
+  std::size_t preciseSatellites = 0;
 
   /// A short table for the tool's output.
   void print(std::ostream& os) const;
