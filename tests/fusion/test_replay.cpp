@@ -18,6 +18,7 @@
 
 #include "gvins/base/parse_error.hpp"
 #include "gvins/base/rinex_obs_reader.hpp"
+#include "gvins/ephemeris/broadcast_sp3.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "gvins/ephemeris/sp3.hpp"
@@ -374,27 +375,10 @@ TEST(Replay, PreciseProductsInTheGnssFolder) {
   const auto rover = readRinexObs((g / "07590920.05o.gz").string(), &rh);
   EphemerisStore nav;
   nav.add(readRinexNav((g / "07590920.05n.gz").string()));
-  // SP3 of the broadcast GPS orbits over [start, start + 1 h].
+  // SP3 of the broadcast orbits over [start, start + 1 h].
   auto products = [&](const GpsTime& start) {
-    Sp3Data d;
-    d.interval = 900.0;
-    for (SatId s : nav.satellites()) d.satellites.push_back(s);
-    for (double dt = 0.0; dt <= 3600.0; dt += 900.0) {
-      Sp3Epoch ep;
-      ep.time = start + dt;
-      for (SatId s : d.satellites) {
-        Sp3Record r;
-        r.sat = s;
-        if (const auto st = nav.satelliteState(s, rover[0].time)) {
-          r.position = st->position;
-          r.clock = st->clockBias;
-        }
-        ep.records.push_back(r);
-      }
-      d.epochs.push_back(ep);
-    }
     std::ostringstream os;
-    writeSp3(os, d);
+    writeSp3(os, broadcastSp3(nav, start, start + 3600.0, 900.0));
     return os.str();
   };
   const auto ns = [](const GpsTime& t) {

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "gvins/base/geodetic.hpp"
+#include "gvins/ephemeris/broadcast_sp3.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "gvins/ephemeris/sp3.hpp"
@@ -150,26 +151,10 @@ TEST(SppCli, PreciseProductsAmongTheInputs) {
   c.day = 24;
   c.hour = 8;
   const GpsTime t0 = GpsTime::fromCalendar(c);
-  Sp3Data d;
-  d.interval = 300.0;
+  std::vector<SatId> gps;
   for (SatId s : store.satellites())
-    if (s.system == System::Gps) d.satellites.push_back(s);
-  d.accuracyExponent.assign(d.satellites.size(), 3);
-  const double cl = 299792458.0;
-  for (double dt = 0.0; dt <= 3600.0; dt += 300.0) {
-    Sp3Epoch ep;
-    ep.time = t0 + dt;
-    for (SatId s : d.satellites) {
-      Sp3Record r;
-      r.sat = s;
-      if (const auto st = store.satelliteState(s, ep.time)) {
-        r.position = st->position;
-        r.clock = st->clockBias + 2.0 * st->position.dot(st->velocity) / (cl * cl);
-      }
-      ep.records.push_back(r);
-    }
-    d.epochs.push_back(ep);
-  }
+    if (s.system == System::Gps) gps.push_back(s);
+  const Sp3Data d = broadcastSp3(store, t0, t0 + 3600.0, 300.0, gps);
   const std::string sp3 = tmp("p.sp3"), broken = tmp("b.sp3");
   {
     std::ofstream f(sp3);
