@@ -1,8 +1,8 @@
 // gvins-orbit: satellite positions, velocities and clocks from broadcast navigation files and
 // precise products, and the broadcast orbit/clock errors against the products.
-#include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <map>
 #include <memory>
@@ -12,9 +12,7 @@
 #include "gvins/base/parse_error.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/ephemeris/orbit_comparison.hpp"
-#include "gvins/ephemeris/precise_ephemeris.hpp"
-#include "gvins/ephemeris/rinex_clock.hpp"
-#include "gvins/ephemeris/sp3.hpp"
+#include "gvins/ephemeris/precise_product_files.hpp"
 
 namespace {
 
@@ -107,16 +105,11 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "gvins-orbit: unknown option '%s' (see --help)\n", a.c_str());
       return 2;
     } else {
-      std::string lower = a;
-      for (char& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-      if (lower.size() > 3 && lower.compare(lower.size() - 3, 3, ".gz") == 0) lower.resize(lower.size() - 3);
-      auto ends = [&](const char* x) {
-        const std::size_t n = std::strlen(x);
-        return lower.size() >= n && lower.compare(lower.size() - n, n, x) == 0;
-      };
-      if (ends(".sp3")) sp3Files.push_back(a);
-      else if (ends(".clk") || ends(".clk_30s")) clockFiles.push_back(a);
-      else files.push_back(a);
+      switch (gvins::preciseFileKind(a)) {
+        case gvins::PreciseFileKind::kOrbit: sp3Files.push_back(a); break;
+        case gvins::PreciseFileKind::kClock: clockFiles.push_back(a); break;
+        case gvins::PreciseFileKind::kOther: files.push_back(a); break;
+      }
     }
   }
   if (compare && sp3Files.empty()) {
@@ -149,10 +142,8 @@ int main(int argc, char** argv) {
   }
   std::shared_ptr<gvins::PreciseEphemeris> precise;
   if (!sp3Files.empty()) {
-    precise = std::make_shared<gvins::PreciseEphemeris>();
     try {
-      for (const auto& f : sp3Files) precise->add(gvins::readSp3(f));
-      for (const auto& f : clockFiles) precise->add(gvins::readRinexClock(f));
+      precise = gvins::readPreciseProducts(sp3Files, clockFiles);
     } catch (const gvins::ParseError& e) {
       std::fprintf(stderr, "gvins-orbit: %s\n", e.what());
       return 1;

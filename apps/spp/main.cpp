@@ -6,14 +6,12 @@
 #endif
 
 #include <chrono>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <iostream>
 #include <map>
-#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -23,10 +21,8 @@
 #include "gvins/base/parse_error.hpp"
 #include "gvins/base/rinex_obs_reader.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
-#include "gvins/ephemeris/precise_ephemeris.hpp"
-#include "gvins/ephemeris/rinex_clock.hpp"
+#include "gvins/ephemeris/precise_product_files.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
-#include "gvins/ephemeris/sp3.hpp"
 #include "gvins/gnss/accuracy_statistics.hpp"
 #include "gvins/gnss/pos_reader.hpp"
 #include "gvins/gnss/pos_writer.hpp"
@@ -261,22 +257,16 @@ int main(int argc, char** argv) {
   // Navigation data.
   EphemerisStore nav;
   try {
-    auto precise = std::make_shared<PreciseEphemeris>();
-    bool haveOrbits = false;
+    std::vector<std::string> orbits, clocks;
     for (std::size_t i = 1; i < args.inputs.size(); ++i) {
-      std::string lower = args.inputs[i];
-      for (char& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-      if (lower.size() > 3 && lower.ends_with(".gz")) lower.resize(lower.size() - 3);
-      if (lower.ends_with(".sp3")) {
-        precise->add(readSp3(args.inputs[i]));
-        haveOrbits = true;
-      } else if (lower.ends_with(".clk") || lower.ends_with(".clk_30s")) {
-        precise->add(readRinexClock(args.inputs[i]));
-      } else {
-        nav.add(readRinexNav(args.inputs[i]));
+      switch (preciseFileKind(args.inputs[i])) {
+        case PreciseFileKind::kOrbit: orbits.push_back(args.inputs[i]); break;
+        case PreciseFileKind::kClock: clocks.push_back(args.inputs[i]); break;
+        case PreciseFileKind::kOther: nav.add(readRinexNav(args.inputs[i])); break;
       }
     }
-    if (haveOrbits) {
+    if (!orbits.empty()) {
+      auto precise = readPreciseProducts(orbits, clocks);
       if (!args.quiet) std::fprintf(stderr, "precise products: %zu satellites\n", precise->satellites().size());
       nav.setPrecise(std::move(precise));
     }

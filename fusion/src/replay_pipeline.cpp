@@ -25,10 +25,8 @@
 #include "gvins/base/parse_error.hpp"
 #include "gvins/base/rinex_obs_reader.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
-#include "gvins/ephemeris/precise_ephemeris.hpp"
-#include "gvins/ephemeris/rinex_clock.hpp"
+#include "gvins/ephemeris/precise_product_files.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
-#include "gvins/ephemeris/sp3.hpp"
 #include "gvins/fusion/replay_feature_tracks.hpp"
 #include "gvins/gnss/base_reader.hpp"
 #include "gvins/gnss/pos_writer.hpp"
@@ -70,24 +68,22 @@ class OutFile {
   std::ofstream f_;
 };
 
-/// The navigation file of a gvins-sim gnss/ folder: the first regular file that is neither an
-/// observation file nor the RTCM stream.
-// Precise products in a dataset's gnss folder: *.sp3 and *.clk (also *.SP3, *.CLK, *.sp3.gz,
-// *.clk.gz and the IGS long names *_ORB.SP3, *_CLK.CLK), sorted by name (consecutive days).
+// Precise products in a dataset's gnss folder (preciseFileKind: *.sp3, *.clk, also gzipped or
+// upper case), sorted by name (consecutive days).
 void findPreciseProducts(const fs::path& dir, std::vector<std::string>& sp3, std::vector<std::string>& clk) {
   std::error_code ec;
   for (const auto& e : fs::directory_iterator(dir, ec)) {
     if (!e.is_regular_file()) continue;
-    std::string lower = e.path().filename().string();
-    for (char& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-    if (lower.ends_with(".gz")) lower.resize(lower.size() - 3);
-    if (lower.ends_with(".sp3")) sp3.push_back(e.path().string());
-    else if (lower.ends_with(".clk") || lower.ends_with(".clk_30s")) clk.push_back(e.path().string());
+    const PreciseFileKind kind = preciseFileKind(e.path().string());
+    if (kind == PreciseFileKind::kOrbit) sp3.push_back(e.path().string());
+    else if (kind == PreciseFileKind::kClock) clk.push_back(e.path().string());
   }
   std::sort(sp3.begin(), sp3.end());
   std::sort(clk.begin(), clk.end());
 }
 
+/// The navigation file of a gvins-sim gnss/ folder: the first regular file that is neither an
+/// observation file nor the RTCM stream.
 std::string findNavFile(const fs::path& dir) {
   std::vector<fs::path> c;
   std::error_code ec;
@@ -363,9 +359,7 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
       std::vector<std::string> sp3 = opt.sp3Files, clk = opt.clockFiles;
       if (sp3.empty() && clk.empty()) findPreciseProducts(gdir, sp3, clk);
       if (!sp3.empty()) {
-        auto precise = std::make_shared<PreciseEphemeris>();
-        for (const std::string& f : sp3) precise->add(readSp3(f));
-        for (const std::string& f : clk) precise->add(readRinexClock(f));
+        auto precise = readPreciseProducts(sp3, clk);
         sum.preciseSatellites = precise->satellites().size();
         g.nav.setPrecise(std::move(precise));
       } else if (!clk.empty()) {

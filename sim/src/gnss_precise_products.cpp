@@ -117,24 +117,16 @@ GnssPreciseProducts makePreciseProducts(const GnssConstellation& constellation, 
 
 std::vector<std::filesystem::path> writePreciseProducts(const GnssPreciseProducts& products,
                                                         const std::filesystem::path& dir) {
-  std::vector<std::filesystem::path> files;
-  const auto sp3 = dir / "precise.sp3";
-  {
-    std::ofstream f(sp3, std::ios::binary);
-    if (!f) throw std::runtime_error("cannot create " + sp3.string());
-    writeSp3(f, products.orbits);
-    if (!f) throw std::runtime_error("writing " + sp3.string() + " failed");
-  }
-  files.push_back(sp3);
-  const auto clk = dir / "precise.clk";
-  {
-    std::ofstream f(clk, std::ios::binary);
-    if (!f) throw std::runtime_error("cannot create " + clk.string());
-    writeRinexClock(f, products.clocks);
-    if (!f) throw std::runtime_error("writing " + clk.string() + " failed");
-  }
-  files.push_back(clk);
-  return files;
+  auto write = [&](const char* name, auto&& writer) {
+    const auto path = dir / name;
+    std::ofstream f(path, std::ios::binary);
+    if (!f) throw std::runtime_error("cannot create " + path.string());
+    writer(f);
+    if (!f) throw std::runtime_error("writing " + path.string() + " failed");
+    return path;
+  };
+  return {write("precise.sp3", [&](std::ostream& os) { writeSp3(os, products.orbits); }),
+          write("precise.clk", [&](std::ostream& os) { writeRinexClock(os, products.clocks); })};
 }
 
 }  // namespace gvins::sim

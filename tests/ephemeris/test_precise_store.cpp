@@ -26,22 +26,13 @@ const std::string kNagoya = std::string(GVINS_TEST_DATA) + "/gnss/nagoya_static_
 // over [from, to].
 Sp3Data shiftedProducts(const EphemerisStore& nav, SatId sat, const GpsTime& from, const GpsTime& to,
                         const Eigen::Vector3d& offset, double clockOffset) {
-  Sp3Data d;
-  d.interval = 300.0;
-  d.satellites = {sat};
+  Sp3Data d = broadcastSp3(nav, from, to, 300.0, {sat});
   d.accuracyExponent = {4};
-  const double c = constants::kSpeedOfLight;
-  for (GpsTime t = from; t <= to; t = t + 300.0) {
-    const auto st = nav.satelliteState(sat, t);
-    EXPECT_TRUE(st.has_value());
-    Sp3Epoch ep;
-    ep.time = t;
-    Sp3Record r;
-    r.sat = sat;
-    r.position = st->position + offset;
-    r.clock = st->clockBias + 2.0 * st->position.dot(st->velocity) / (c * c) + clockOffset;
-    ep.records.push_back(r);
-    d.epochs.push_back(ep);
+  for (Sp3Epoch& ep : d.epochs) {
+    Sp3Record& r = ep.records.front();
+    EXPECT_TRUE(r.position.allFinite() && std::isfinite(r.clock));  // a broadcast state at every node
+    r.position += offset;
+    r.clock += clockOffset;
   }
   return d;
 }
