@@ -59,6 +59,8 @@ const char* kUsage =
     "                         *.clk files in DATASET/gnss); they replace the broadcast orbits and\n"
     "                         clocks where they cover a satellite\n"
     "  --broadcast            broadcast orbits and clocks only (ignore precise products)\n"
+    "  --carrier-smoothing S  psr modes: Hatch window of the carrier-smoothed pseudoranges, s\n"
+    "                         (default: gnss_fusion.carrier_smoothing, 100; 0 = raw codes)\n"
     "  --base-position X,Y,Z  base antenna ECEF (default: base.obs header)\n"
     "  --sensor-to-gpst NS    GPST ns = sensor stamp + NS (default 0: gvins-sim datasets are GPST)\n"
     "  --start S --duration S replay a part (seconds after the first frame)\n"
@@ -104,7 +106,7 @@ ReplaySummary run(const std::string& dataset, const vio::SriSwfConfig& ec, const
 
 int main(int argc, char** argv) {
   std::string dataset, outDir, configPath, mode = "vio", leverCalib, timeCalib;
-  std::optional<double> timeOffset;
+  std::optional<double> timeOffset, carrierSmoothing;
   std::string saveTracks;
   bool useFloat = false, quiet = false, images = false, noEval = false, skipBad = false, skipMissing = false;
   std::optional<double> start, duration, maxGap;
@@ -141,6 +143,10 @@ int main(int argc, char** argv) {
     else if (a == "--sp3") sp3Files.push_back(value());
     else if (a == "--clk") clockFiles.push_back(value());
     else if (a == "--broadcast") broadcastOnly = true;
+    else if (a == "--carrier-smoothing") {
+      carrierSmoothing = toNumber(value(), a);
+      if (!(*carrierSmoothing >= 0.0 && *carrierSmoothing <= 3600.0)) usageError("--carrier-smoothing must be within 0..3600 s");
+    }
     else if (a == "--base-position") {
       std::string s = value();
       for (char& c : s)
@@ -241,6 +247,7 @@ int main(int argc, char** argv) {
       if (!leverCalib.empty()) gc->calibrateLeverArm = leverCalib == "on";
       if (!gc->leverArmGiven && trueLever) gc->leverArm = *trueLever;
       if (leverArm) gc->leverArm = *leverArm;
+      if (carrierSmoothing) gc->carrierSmoothing = *carrierSmoothing;
       opt.leverArmTruth = trueLever;
     }
     const ReplaySummary s = ec.use_float ? run<float>(dataset, ec, gc, opt) : run<double>(dataset, ec, gc, opt);

@@ -24,6 +24,7 @@
 #include "gvins/ephemeris/precise_product_files.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "gvins/gnss/accuracy_statistics.hpp"
+#include "gvins/gnss/carrier_smoothing.hpp"
 #include "gvins/gnss/pos_reader.hpp"
 #include "gvins/gnss/pos_writer.hpp"
 #include "gvins/gnss/spp.hpp"
@@ -53,6 +54,8 @@ const char* kUsage =
     "  --iono MODEL       off | broadcast | dual-frequency (default broadcast: Klobuchar, BeiDou's\n"
     "                     own parameters for BeiDou)\n"
     "  --tropo MODEL      off | saastamoinen (default; Niell mapping)\n"
+    "  --smooth S         carrier-smoothed pseudoranges, Hatch window S seconds (e.g. 100; default\n"
+    "                     0 = raw codes); with --freq 2 --iono dual-frequency free of divergence\n"
     "  --no-fde           no fault detection and exclusion\n"
     "  --no-velocity      no Doppler velocity (velocity columns are zeros)\n"
     "  --xyz              ECEF x/y/z columns instead of latitude/longitude/height\n"
@@ -76,6 +79,7 @@ struct Args {
   std::optional<double> elmask, snrmask;
   std::optional<int> freq;
   std::optional<std::string> iono, tropo;
+  double smooth = 0.0;
   bool noFde = false, noVelocity = false, xyz = false, strict = false, quiet = false;
   int timeDecimals = 3;
   std::optional<Eigen::Vector3d> truth;
@@ -129,6 +133,9 @@ Args parseArgs(int argc, char** argv) {
       a.iono = value(i, o);
     } else if (o == "--tropo") {
       a.tropo = value(i, o);
+    } else if (o == "--smooth") {
+      a.smooth = parseNumber(o, value(i, o));
+      if (a.smooth < 0.0 || a.smooth > 3600.0) usageError("--smooth must be within 0..3600 s");
     } else if (o == "--no-fde") {
       a.noFde = true;
     } else if (o == "--no-velocity") {
@@ -265,6 +272,10 @@ int main(int argc, char** argv) {
         case PreciseFileKind::kOther: nav.add(readRinexNav(args.inputs[i])); break;
       }
     }
+    if (orbits.empty() && !clocks.empty()) {
+      std::fprintf(stderr, "gvins-spp: error: clock files need an SP3 orbit file\n");
+      return 2;
+    }
     if (!orbits.empty()) {
       auto precise = readPreciseProducts(orbits, clocks);
       if (!args.quiet) std::fprintf(stderr, "precise products: %zu satellites\n", precise->satellites().size());
@@ -320,6 +331,15 @@ int main(int argc, char** argv) {
   popt.headerFields.emplace_back("navi sys", systemsText(cfg));
   std::snprintf(buf, sizeof buf, "%d", cfg.frequencies);
   popt.headerFields.emplace_back("freqs", buf);
+  std::optional<CarrierSmoother> smoother;
+  if (args.smooth > 0.0) {
+    CarrierSmoothingOptions so;
+    so.window = args.smooth;
+    smoother.emplace(so);
+    std::snprintf(buf, sizeof buf, "%.0f s", args.smooth);
+    popt.headerFields.emplace_back("carrier smoothing", buf);
+  }
+
   PosWriter writer(*out, popt);
 
   std::optional<AccuracyStatistics> stats;
@@ -345,6 +365,7 @@ int main(int argc, char** argv) {
       break;
     }
     ++epochs;
+    if (smoother) smoother->apply(epoch, hdr.glonassChannels);
     const SppSolution sol = solver.solve(epoch);
     ++statusCount[sol.status];
     for (const auto& s : sol.satellites) ++useCount[static_cast<int>(s.use)];

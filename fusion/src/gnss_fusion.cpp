@@ -122,7 +122,12 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     // Precise products (SP3/RINEX clock) where the store has them: centimetres instead.
     const auto& ephemerisError = tx->state.precise ? config_.preciseEphemerisError : config_.ephemerisError;
     const double ephemerisVariance = std::pow(ephemerisError[static_cast<std::size_t>(systemIndex(so.sat.system))], 2);
-    m.codeVariance = std::pow(config_.codeSigma, 2) * (0.5 + 0.5 / (sinEl * sinEl)) + std::pow(0.3 * m.ionosphere, 2) +
+    // Carrier-smoothed code: noise and multipath averaged over the arc (CarrierSmoother), down
+    // to `smoothed_code_factor` of the raw sigma.
+    const double smoothingFactor =
+        smoother_ ? std::max(config_.smoothedCodeFactor, smoother_->noiseFactor(so.sat)) : 1.0;
+    m.codeVariance = std::pow(config_.codeSigma * smoothingFactor, 2) * (0.5 + 0.5 / (sinEl * sinEl)) +
+                     std::pow(0.3 * m.ionosphere, 2) +
                      ephemerisVariance;
     // Dual frequency: the ionosphere-free pair with the first other band tracked (`bands`: the
     // SPP band order, GPS/QZSS L5 before L2), group delays combined alike; its noise is the
@@ -143,8 +148,8 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
         m.code2 = s2->code;
         m.ifA1 = c.a1;
         m.ifA2 = c.a2;
-        m.codeVariance =
-            std::pow(config_.codeSigma * c.noiseFactor(), 2) * (0.5 + 0.5 / (sinEl * sinEl)) + ephemerisVariance;
+        m.codeVariance = std::pow(config_.codeSigma * c.noiseFactor() * smoothingFactor, 2) *
+                             (0.5 + 0.5 / (sinEl * sinEl)) + ephemerisVariance;
         break;
       }
     }
@@ -457,11 +462,11 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
 }
 
 template <typename Scalar>
-GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& est, const ObsEpoch& rover,
+GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& est, const ObsEpoch& roverRaw,
                                                  const ObsEpoch* base, const EphemerisStore& nav) {
   const auto wall0 = std::chrono::steady_clock::now();
   GnssEpochReport rep;
-  rep.time = rover.time;
+  rep.time = roverRaw.time;
   auto finish = [&]() {
     rep.stage = stage_;
     rep.elapsedMicroseconds =
@@ -469,6 +474,18 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
     return rep;
   };
   if (config_.mode == GnssFusionMode::kVio) return finish();
+  // Undifferenced pseudoranges carrier-smoothed (every epoch, also before the VIO is ready, so
+  // that the arcs are long when the rows start); the RTK module keeps the raw epoch.
+  if (config_.carrierSmoothing > 0.0 && config_.usesPseudorange() && !config_.usesDifferences()) {
+    if (!smoother_) {
+      CarrierSmoothingOptions o;
+      o.window = config_.carrierSmoothing;
+      smoother_ = std::make_unique<CarrierSmoother>(o);
+    }
+    smoothed_ = roverRaw;
+    smoother_->apply(smoothed_, nav.glonassChannels());
+  }
+  const ObsEpoch& rover = smoother_ ? smoothed_ : roverRaw;
   if (nav_ != &nav) {
     nav_ = &nav;
     spp_ = std::make_unique<SppSolver>(nav);
@@ -495,7 +512,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
       lastBase_ = base->time;
     }
     if (fullRtk) {
-      const RtkSolution rtk = rtk_->process(rover);
+      const RtkSolution rtk = rtk_->process(roverRaw);
       rep.rtkFixed = rtk.quality == SolutionQuality::Fix;
       baseAge = rtk.age;
     }
@@ -644,7 +661,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
     }
     const std::size_t nIndependent = rows.size();
     std::vector<DoubleDifference> phase;
-    if (rtk_ && !fullRtk) baseAge = rtk_->differences(rover, k.x_E);
+    if (rtk_ && !fullRtk) baseAge = rtk_->differences(roverRaw, k.x_E);
     if (baseAge && config_.usesDifferences() && *baseAge <= config_.maxBaseAge) {
       const DdEpoch& e = rtk_->measurements();
       // Base clock per system: mean base code OMC (clock + errors common to the base).

@@ -119,6 +119,10 @@ GnssFusionConfig parseGnssFusionConfig(std::string_view yaml, const std::string&
       });
     } else if (key == "code_sigma") {
       c.codeSigma = positive(v, f);
+    } else if (key == "carrier_smoothing") {
+      c.carrierSmoothing = rd.number(v, f, 0.0, 3600.0);
+    } else if (key == "smoothed_code_factor") {
+      c.smoothedCodeFactor = rd.number(v, f, 0.01, 1.0);
     } else if (key == "doppler_sigma") {
       c.dopplerSigma = positive(v, f);
     } else if (key == "clock_bias_random_walk") {
@@ -145,7 +149,8 @@ GnssFusionConfig parseGnssFusionConfig(std::string_view yaml, const std::string&
   };
   static const std::set<std::string> kKeys = {
       "mode", "lever_arm", "calibrate_lever_arm", "lever_arm_sigma", "min_rotation_rate", "systems",
-      "elevation_mask_deg", "ionosphere", "bands", "ephemeris_error_m", "precise_ephemeris_error_m", "code_sigma", "doppler_sigma",
+      "elevation_mask_deg", "ionosphere", "bands", "ephemeris_error_m", "precise_ephemeris_error_m", "code_sigma",
+      "carrier_smoothing", "smoothed_code_factor", "doppler_sigma",
       "clock_bias_random_walk", "clock_drift_random_walk", "row_gate", "epoch_gate", "frame_yaw_sigma_deg",
       "frame_min_speed", "outage_reset", "clock_ransac_threshold", "base_position", "max_base_age"};
   if (const YAML::Node section = root["gnss_fusion"]) {

@@ -16,6 +16,8 @@ TEST(GnssFusionConfig, ParsesAllKeys) {
       "  calibrate_lever_arm: true\n"
       "  systems: GE\n"
       "  code_sigma: 0.8\n"
+      "  carrier_smoothing: 60\n"
+      "  smoothed_code_factor: 0.5\n"
       "  ionosphere: broadcast\n"
       "  base_position: [1, 2, 3]\n"
       "  row_gate: 0.99\n"
@@ -41,6 +43,8 @@ TEST(GnssFusionConfig, ParsesAllKeys) {
   EXPECT_TRUE(c.useSystem(System::Galileo));
   EXPECT_FALSE(c.useSystem(System::BeiDou));
   EXPECT_DOUBLE_EQ(c.codeSigma, 0.8);
+  EXPECT_DOUBLE_EQ(c.carrierSmoothing, 60.0);
+  EXPECT_DOUBLE_EQ(c.smoothedCodeFactor, 0.5);
   EXPECT_DOUBLE_EQ(c.rowGate, 0.99);
   ASSERT_TRUE(c.basePosition);
   EXPECT_EQ(*c.basePosition, Eigen::Vector3d(1, 2, 3));
@@ -95,7 +99,8 @@ TEST(GnssFusionConfig, ErrorsNameFileLineAndField) {
     EXPECT_EQ(e.field(), "ionosphere");
   }
   for (const char* bad : {"  bands: {G: \"19\"}\n", "  bands: {X: \"12\"}\n", "  bands: \"12\"\n",
-                          "  ephemeris_error_m: {G: -1}\n"}) {
+                          "  ephemeris_error_m: {G: -1}\n", "  carrier_smoothing: -5\n",
+                          "  smoothed_code_factor: 2\n"}) {
     try {
       parseGnssFusionConfig(std::string("gnss_fusion:\n  mode: vio+dopp+psr\n") + bad, "b.yaml");
       FAIL() << "no error for " << bad;

@@ -101,6 +101,13 @@ TEST(SppCli, BadArgumentsAndBadFiles) {
   EXPECT_EQ(run("--elmask abc -o x.pos a b").code, 2);
   EXPECT_EQ(run("--systems GX -o x.pos a b").code, 2);
   EXPECT_EQ(run("--frobnicate -o x.pos a b").code, 2);
+  EXPECT_EQ(run("--smooth -1 -o x.pos a b").code, 2);
+  EXPECT_EQ(run("--smooth abc -o x.pos a b").code, 2);
+  // A clock product without an orbit product is a mistake, not something to ignore silently.
+  const CliRun clkOnly = run("-q -o " + tmp("c.pos") + " " + kData + "/gnss/nagoya_static_2024/rover.obs.gz " + kData +
+                             "/gnss/nagoya_static_2024/base.nav.gz " + tmp("only.clk"));
+  EXPECT_EQ(clkOnly.code, 2);
+  EXPECT_NE(clkOnly.err.find("clock files need an SP3 orbit file"), std::string::npos) << clkOnly.err;
   const CliRun missing = run("-o " + tmp("m.pos") + " /nonexistent.obs " + kData + "/gnss/nagoya_static_2024/base.nav.gz");
   EXPECT_EQ(missing.code, 1);
   EXPECT_NE(missing.err.find("/nonexistent.obs"), std::string::npos);
@@ -132,7 +139,35 @@ TEST(SppCli, BadArgumentsAndBadFiles) {
                         "/gnss/nagoya_static_2024/base.nav.gz");
   EXPECT_EQ(noeph.code, 3) << noeph.err;
   EXPECT_NE(noeph.err.find("no ephemeris"), std::string::npos) << noeph.err;
-  for (const char* n : {"m.pos", "s.pos", "cut.obs", "t.pos", "e.pos"}) std::filesystem::remove(tmp(n));
+  for (const char* n : {"m.pos", "s.pos", "cut.obs", "t.pos", "e.pos", "c.pos"}) std::filesystem::remove(tmp(n));
+}
+
+// --smooth: carrier-smoothed dual-frequency SPP on the Nagoya rover, against the same run on raw
+// codes. Measured: 3-D RMS 1.174 -> 0.782 m, up standard deviation 0.88 -> 0.27 m. The header
+// says so.
+TEST(SppCli, CarrierSmoothingOption) {
+  const std::string obs = kData + "/gnss/nagoya_static_2024/rover.obs.gz";
+  const std::string nav = kData + "/gnss/nagoya_static_2024/base.nav.gz";
+  const Eigen::Vector3d truth =
+      gvins::geodeticToEcef(gvins::geodeticFromDegrees(35.13469901, 136.97757549, 104.8626));
+  auto upStd = [&](const std::string& pos) {
+    gvins::AccuracyStatistics st(truth);
+    for (const auto& s : gvins::readPosFile(pos).solutions) st.addPosition(s.position);
+    return st.position().enu[2].stddev;
+  };
+  const std::string a = tmp("raw.pos"), b = tmp("smooth.pos");
+  const CliRun raw = run("-q --freq 2 --iono dual-frequency -o " + a + " " + obs + " " + nav);
+  const CliRun sm = run("-q --freq 2 --iono dual-frequency --smooth 100 -o " + b + " " + obs + " " + nav);
+  ASSERT_EQ(raw.code, 0) << raw.err;
+  ASSERT_EQ(sm.code, 0) << sm.err;
+  const double ra = upStd(a), sb = upStd(b);
+  std::printf("up standard deviation: raw %.3f m, smoothed %.3f m\n", ra, sb);
+  EXPECT_LT(sb, 0.4 * ra);
+  std::ifstream f(b);
+  const std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("carrier smoothing"), std::string::npos);
+  std::filesystem::remove(a);
+  std::filesystem::remove(b);
 }
 
 // Precise products among the inputs (told apart by name): an SP3 file holding the broadcast

@@ -31,6 +31,7 @@
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/fusion/gnss_fusion_config.hpp"
 #include "gvins/fusion/gnss_measurement_models.hpp"
+#include "gvins/gnss/carrier_smoothing.hpp"
 #include "gvins/gnss/rtk.hpp"
 #include "gvins/gnss/spp.hpp"
 #include "gvins/vio/estimator_backend.hpp"
@@ -123,6 +124,8 @@ class GnssFusion {
   std::unique_ptr<SppSolver> spp_;
   std::unique_ptr<RtkSolver> rtk_;
   std::optional<GpsTime> lastBase_;
+  std::unique_ptr<CarrierSmoother> smoother_;  // psr modes with carrierSmoothing > 0
+  ObsEpoch smoothed_;
 };
 
 extern template class GnssFusion<float>;
