@@ -17,7 +17,7 @@
 namespace {
 
 const char* kUsage =
-    "usage: gvins-orbit NAV... [ORBIT.sp3...] [CLOCK.clk...] --time \"YYYY-MM-DD HH:MM:SS[.ffffff]\"\n"
+    "usage: gvins-orbit NAV... [ORBIT.sp3...] [CLOCK.clk...] [ANT.atx] --time \"YYYY-MM-DD HH:MM:SS[.ffffff]\"\n"
     "                   [--gpst|--utc] [--compare [--duration S] [--step S]] [options]\n"
     "\n"
     "Prints the state of every satellite with a usable broadcast ephemeris at the given time\n"
@@ -31,12 +31,14 @@ const char* kUsage =
     "          several files are merged.\n"
     "ORBIT/CLOCK  precise products (SP3-c/d *.sp3, RINEX clock *.clk, plain or .gz; told apart by\n"
     "          name): where they cover a satellite its state comes from them.\n"
+    "ANT.atx   ANTEX file: satellite antenna offsets added to the products' centre-of-mass\n"
+    "          positions (IGS SP3); satellites without an entry keep their broadcast states.\n"
     "--compare broadcast minus precise instead of states (needs an SP3 file), one row per\n"
     "          satellite and epoch: gpst,sat,radial_m,along_m,cross_m,clock_m,sisre_m (orbit in the\n"
     "          precise state's radial/along/cross frame, clock as c*dt; SISRE after Montenbruck et\n"
     "          al. 2018 with the per-epoch mean clock difference of each system removed, which a\n"
-    "          receiver clock absorbs); RMS per system on stderr. No satellite antenna offsets are\n"
-    "          applied: IGS SP3 orbits are centres of mass, broadcast ones antenna phase centres.\n"
+    "          receiver clock absorbs); RMS per system on stderr. Give the ANTEX file with IGS SP3\n"
+    "          orbits (centres of mass; broadcast ones are antenna phase centres).\n"
     "--duration S, --step S   with --compare: epochs T, T+step, ... up to T+duration (default one\n"
     "          epoch; step 300 s).\n"
     "--time T  epoch, \"YYYY-MM-DD HH:MM:SS\" with optional fraction (also \"YYYY-MM-DDTHH:MM:SS\").\n"
@@ -65,7 +67,7 @@ bool parseTime(const char* text, gvins::CalendarTime& c) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<std::string> files, sp3Files, clockFiles;
+  std::vector<std::string> files, sp3Files, clockFiles, antennaFiles;
   const char* timeText = nullptr;
   bool utc = false, unhealthy = false, realtime = false, compare = false;
   double duration = 0.0, step = 300.0;
@@ -108,6 +110,7 @@ int main(int argc, char** argv) {
       switch (gvins::preciseFileKind(a)) {
         case gvins::PreciseFileKind::kOrbit: sp3Files.push_back(a); break;
         case gvins::PreciseFileKind::kClock: clockFiles.push_back(a); break;
+        case gvins::PreciseFileKind::kAntenna: antennaFiles.push_back(a); break;
         case gvins::PreciseFileKind::kOther: files.push_back(a); break;
       }
     }
@@ -153,6 +156,16 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  std::shared_ptr<gvins::AntexData> antennas;
+  if (!antennaFiles.empty()) {
+    try {
+      antennas = gvins::readAntennaFiles(antennaFiles);
+    } catch (const gvins::ParseError& e) {
+      std::fprintf(stderr, "gvins-orbit: %s\n", e.what());
+      return 1;
+    }
+  }
+
   gvins::EphemerisSelection policy;
   policy.allowUnhealthy = unhealthy;
   if (realtime) policy.futureTolerance = -1.0;
@@ -164,6 +177,9 @@ int main(int argc, char** argv) {
       int n = 0;
     };
     std::map<int, Acc> acc;
+    gvins::EphemerisStore preciseStore = store;  // the products with the antenna offsets, if any
+    preciseStore.setPrecise(precise);
+    if (antennas) preciseStore.setSatelliteAntennas(antennas);
     std::printf("gpst,sat,radial_m,along_m,cross_m,clock_m,sisre_m\n");
     int epochs = 0;
     for (double dt = 0.0; dt <= duration + 1e-9; dt += step) {
@@ -173,7 +189,7 @@ int main(int argc, char** argv) {
       int cnt[gvins::kNumSystems] = {};
       for (const gvins::SatId sat : store.satellites()) {
         const auto b = store.satelliteState(sat, te, policy);
-        const auto p = precise->satelliteState(sat, te);
+        const auto p = preciseStore.preciseState(sat, te);
         if (!b || !p) continue;
         const gvins::OrbitDifference d = gvins::orbitDifference(*b, *p);
         rows.emplace_back(sat, d);
@@ -209,6 +225,7 @@ int main(int argc, char** argv) {
     return acc.empty() ? 3 : 0;
   }
   if (precise) store.setPrecise(precise);
+  if (antennas) store.setSatelliteAntennas(antennas);
   int perSystem[gvins::kNumSystems] = {};
   std::printf("sat,x,y,z,vx,vy,vz,clock_s,drift_s_per_s\n");
   for (const gvins::SatId sat : store.satellites()) {

@@ -58,6 +58,8 @@ const char* kUsage =
     "  --sp3 F --clk F        precise orbit / clock products, repeatable (default: the *.sp3 and\n"
     "                         *.clk files in DATASET/gnss); they replace the broadcast orbits and\n"
     "                         clocks where they cover a satellite\n"
+    "  --atx F                ANTEX satellite antenna offsets for the products (IGS SP3 orbits are\n"
+    "                         centres of mass; default: *.atx in DATASET/gnss)\n"
     "  --broadcast            broadcast orbits and clocks only (ignore precise products)\n"
     "  --carrier-smoothing S  psr modes: Hatch window of the carrier-smoothed pseudoranges, s\n"
     "                         (default: gnss_fusion.carrier_smoothing, 100; 0 = raw codes)\n"
@@ -111,7 +113,7 @@ int main(int argc, char** argv) {
   bool useFloat = false, quiet = false, images = false, noEval = false, skipBad = false, skipMissing = false;
   std::optional<double> start, duration, maxGap;
   std::optional<std::string> gapPolicy, rover, base, nav;
-  std::vector<std::string> sp3Files, clockFiles;
+  std::vector<std::string> sp3Files, clockFiles, antennaFiles;
   bool broadcastOnly = false;
   std::optional<Eigen::Vector3d> basePos, leverArm;
   std::int64_t sensorToGpst = 0;
@@ -142,6 +144,7 @@ int main(int argc, char** argv) {
     else if (a == "--nav") nav = value();
     else if (a == "--sp3") sp3Files.push_back(value());
     else if (a == "--clk") clockFiles.push_back(value());
+    else if (a == "--atx") antennaFiles.push_back(value());
     else if (a == "--broadcast") broadcastOnly = true;
     else if (a == "--carrier-smoothing") {
       carrierSmoothing = toNumber(value(), a);
@@ -213,6 +216,7 @@ int main(int argc, char** argv) {
     if (nav) opt.navFile = *nav;
     opt.sp3Files = sp3Files;
     opt.clockFiles = clockFiles;
+    opt.antennaFiles = antennaFiles;
     opt.broadcastOnly = broadcastOnly;
     opt.basePosition = basePos;
     opt.sensorToGpst_ns = sensorToGpst;

@@ -29,6 +29,8 @@
 
 #include "gvins/ephemeris/ephemeris_store.hpp"
 
+#include "gvins/ephemeris/satellite_antenna.hpp"
+
 namespace gvins {
 namespace {
 
@@ -302,10 +304,21 @@ void EphemerisStore::setPrecise(std::shared_ptr<const PreciseEphemeris> precise)
   ++revision_;
 }
 
+void EphemerisStore::setSatelliteAntennas(std::shared_ptr<const AntexData> antex) {
+  antex_ = std::move(antex);
+  ++revision_;
+}
+
 std::optional<SatelliteState> EphemerisStore::preciseState(SatId sat, const GpsTime& t) const {
   if (!precise_ || !sat.valid()) return std::nullopt;
   auto st = precise_->satelliteState(sat, t);
-  if (st) st->precise = true;
+  if (!st) return st;
+  if (antex_) {
+    const auto offset = satelliteAntennaOffset(*antex_, sat, t, st->position);
+    if (!offset) return std::nullopt;  // centre of mass only: the broadcast record is better
+    st->position += *offset;
+  }
+  st->precise = true;
   return st;
 }
 

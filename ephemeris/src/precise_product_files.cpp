@@ -14,6 +14,7 @@ PreciseFileKind preciseFileKind(std::string_view path) {
   if (lower.size() > 3 && lower.ends_with(".gz")) lower.resize(lower.size() - 3);
   if (lower.ends_with(".sp3")) return PreciseFileKind::kOrbit;
   if (lower.ends_with(".clk") || lower.ends_with(".clk_30s")) return PreciseFileKind::kClock;
+  if (lower.ends_with(".atx")) return PreciseFileKind::kAntenna;
   return PreciseFileKind::kOther;
 }
 
@@ -23,6 +24,19 @@ std::shared_ptr<PreciseEphemeris> readPreciseProducts(const std::vector<std::str
   for (const std::string& f : orbitFiles) precise->add(readSp3(f));
   for (const std::string& f : clockFiles) precise->add(readRinexClock(f));
   return precise;
+}
+
+std::shared_ptr<AntexData> readAntennaFiles(const std::vector<std::string>& files) {
+  auto out = std::make_shared<AntexData>();
+  for (const std::string& f : files) {
+    AntexData d = readAntex(f);
+    if (out->antennas.empty()) {  // the first file's header
+      *out = std::move(d);
+      continue;
+    }
+    for (AntexAntenna& a : d.antennas) out->antennas.push_back(std::move(a));
+  }
+  return out;
 }
 
 }  // namespace gvins

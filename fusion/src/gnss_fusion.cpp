@@ -474,13 +474,17 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
     return rep;
   };
   if (config_.mode == GnssFusionMode::kVio) return finish();
-  // Undifferenced pseudoranges carrier-smoothed (every epoch, also before the VIO is ready, so
-  // that the arcs are long when the rows start); the RTK module keeps the raw epoch.
-  if (config_.carrierSmoothing > 0.0 && config_.usesPseudorange() && !config_.usesDifferences()) {
+  // Carrier-smoothed codes for the psr rows, and for the dpsr rows on both receivers (every epoch,
+  // also before the VIO is ready, so that the arcs are long when the rows start). Ddcp keeps the
+  // raw codes: its RTK filter estimates the ambiguities from phase minus code, which smoothing
+  // would correlate in time.
+  const bool smoothDifferences = config_.mode == GnssFusionMode::kDoppDpsr;
+  if (config_.carrierSmoothing > 0.0 && (config_.usesPseudorange() || smoothDifferences)) {
     if (!smoother_) {
       CarrierSmoothingOptions o;
       o.window = config_.carrierSmoothing;
       smoother_ = std::make_unique<CarrierSmoother>(o);
+      if (smoothDifferences) baseSmoother_ = std::make_unique<CarrierSmoother>(o);
     }
     smoothed_ = roverRaw;
     smoother_->apply(smoothed_, nav.glonassChannels());
@@ -508,7 +512,13 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
   std::optional<double> baseAge;
   if (rtk_) {
     if (base && (!lastBase_ || base->time > *lastBase_)) {
-      rtk_->addBaseEpoch(*base);
+      if (baseSmoother_) {
+        ObsEpoch b = *base;
+        baseSmoother_->apply(b, nav.glonassChannels());
+        rtk_->addBaseEpoch(b);
+      } else {
+        rtk_->addBaseEpoch(*base);
+      }
       lastBase_ = base->time;
     }
     if (fullRtk) {
@@ -661,7 +671,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
     }
     const std::size_t nIndependent = rows.size();
     std::vector<DoubleDifference> phase;
-    if (rtk_ && !fullRtk) baseAge = rtk_->differences(roverRaw, k.x_E);
+    if (rtk_ && !fullRtk) baseAge = rtk_->differences(rover, k.x_E);
     if (baseAge && config_.usesDifferences() && *baseAge <= config_.maxBaseAge) {
       const DdEpoch& e = rtk_->measurements();
       // Base clock per system: mean base code OMC (clock + errors common to the base).

@@ -68,18 +68,21 @@ class OutFile {
   std::ofstream f_;
 };
 
-// Precise products in a dataset's gnss folder (preciseFileKind: *.sp3, *.clk, also gzipped or
-// upper case), sorted by name (consecutive days).
-void findPreciseProducts(const fs::path& dir, std::vector<std::string>& sp3, std::vector<std::string>& clk) {
+// Precise products in a dataset's gnss folder (preciseFileKind: *.sp3, *.clk, *.atx, also gzipped
+// or upper case), sorted by name (consecutive days).
+void findPreciseProducts(const fs::path& dir, std::vector<std::string>& sp3, std::vector<std::string>& clk,
+                         std::vector<std::string>& atx) {
   std::error_code ec;
   for (const auto& e : fs::directory_iterator(dir, ec)) {
     if (!e.is_regular_file()) continue;
     const PreciseFileKind kind = preciseFileKind(e.path().string());
     if (kind == PreciseFileKind::kOrbit) sp3.push_back(e.path().string());
     else if (kind == PreciseFileKind::kClock) clk.push_back(e.path().string());
+    else if (kind == PreciseFileKind::kAntenna) atx.push_back(e.path().string());
   }
   std::sort(sp3.begin(), sp3.end());
   std::sort(clk.begin(), clk.end());
+  std::sort(atx.begin(), atx.end());
 }
 
 /// The navigation file of a gvins-sim gnss/ folder: the first regular file that is neither an
@@ -356,12 +359,13 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
     if (navPath.empty()) throw ParseError(gdir.string(), 0, "navigation", "no navigation file in the gnss folder (use --nav)");
     g.nav.add(readRinexNav(navPath));
     if (!opt.broadcastOnly) {
-      std::vector<std::string> sp3 = opt.sp3Files, clk = opt.clockFiles;
-      if (sp3.empty() && clk.empty()) findPreciseProducts(gdir, sp3, clk);
+      std::vector<std::string> sp3 = opt.sp3Files, clk = opt.clockFiles, atx = opt.antennaFiles;
+      if (sp3.empty() && clk.empty()) findPreciseProducts(gdir, sp3, clk, atx);
       if (!sp3.empty()) {
         auto precise = readPreciseProducts(sp3, clk);
         sum.preciseSatellites = precise->satellites().size();
         g.nav.setPrecise(std::move(precise));
+        if (!atx.empty()) g.nav.setSatelliteAntennas(readAntennaFiles(atx));
       } else if (!clk.empty()) {
         throw ParseError(clk.front(), 0, "precise clock", "clock files need an SP3 orbit file (use --sp3)");
       }

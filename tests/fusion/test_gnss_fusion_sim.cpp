@@ -397,7 +397,8 @@ TEST(GnssFusionSim, PseudorangeFusionWithPreciseProducts) {
   EXPECT_LT(precise.velRms, 0.1);
 }
 
-// Carrier-smoothed codes (Hatch, 100 s) in vio+dopp+psr with the precise products: the simulated
+// Carrier-smoothed codes (Hatch, 100 s, the default) in vio+dopp+psr with the precise products and
+// in vio+dopp+dpsr: the simulated
 // rover code multipath (0.2 m/sin(el), 5 s correlation; ×2.6–3 in the ionosphere-free pair) and
 // noise average out over the arcs.
 TEST(GnssFusionSim, CarrierSmoothedPseudoranges) {
@@ -414,6 +415,15 @@ TEST(GnssFusionSim, CarrierSmoothedPseudoranges) {
   EXPECT_GT(sm.psr.used, 5 * sm.epochs);
   EXPECT_LT(sm.posRms, 0.8 * raw.posRms);
   EXPECT_LT(sm.velRms, 0.1);
+  // Dpsr: rover and base codes smoothed; the single differences keep the rover's multipath and
+  // noise (the base's are small), which the smoothing averages. Measured 0.240 -> 0.085 m.
+  GnssFusionConfig dpsrRaw = mode(GnssFusionMode::kDoppDpsr);
+  dpsrRaw.carrierSmoothing = 0.0;
+  const RunResult dr = run<double>(dpsrRaw);
+  const RunResult ds = run<double>(mode(GnssFusionMode::kDoppDpsr));
+  std::fprintf(stderr, "dpsr: raw codes %.3f m, smoothed %.3f m\n", dr.posRms, ds.posRms);
+  EXPECT_GT(ds.dpsr.used, 5 * ds.epochs);
+  EXPECT_LT(ds.posRms, 0.5 * dr.posRms);
 }
 
 TEST(GnssFusionSim, ModesTable) {
@@ -426,15 +436,15 @@ TEST(GnssFusionSim, ModesTable) {
   const RunResult psr = run<double>(mode(GnssFusionMode::kDoppPsr));
   for (const auto& [m, x] : r) EXPECT_GT(x.tightAfter, 0.0) << toString(m);
   // Measured (seed 2024): gpsvel 0.44 m/s, dopp 0.049 m/s; psr 0.050 m/s vs 0.072 m/s without the
-  // integration to the measurement time (100 ms latency); dpsr 0.24 m 3-D; ddcp 1.4 cm (RTK fixed
-  // every epoch); float psr as double.
+  // integration to the measurement time (100 ms latency); dpsr 0.085 m 3-D (carrier-smoothed codes;
+  // 0.24 m raw); ddcp 1.4 cm (RTK fixed every epoch); float psr as double.
   EXPECT_LT(r[GnssFusionMode::kGpsVel].velRms, 0.6);
   EXPECT_LT(r[GnssFusionMode::kDopp].velRms, 0.08);
   EXPECT_LT(psr.velRms, 0.8 * r[GnssFusionMode::kDoppPsrNoInt].velRms);
   EXPECT_LT(r[GnssFusionMode::kDoppDpsr].posRms, 0.5);
   EXPECT_LT(r[GnssFusionMode::kDoppDdcp].posRms, 0.05);
   EXPECT_GT(r[GnssFusionMode::kDoppDdcp].ddcp.used, 10 * r[GnssFusionMode::kDoppDdcp].epochs);
-  EXPECT_LT(r[GnssFusionMode::kDoppDdcp].posRms, 0.2 * r[GnssFusionMode::kDoppDpsr].posRms);
+  EXPECT_LT(r[GnssFusionMode::kDoppDdcp].posRms, 0.25 * r[GnssFusionMode::kDoppDpsr].posRms);
   EXPECT_LT(f.horRms, 1.5);
   EXPECT_NEAR(f.horRms, psr.horRms, 0.2);
 }

@@ -11,6 +11,7 @@
 #include "gvins/ephemeris/glonass_ephemeris.hpp"
 #include "gvins/ephemeris/ionosphere_parameters.hpp"
 #include "gvins/ephemeris/kepler_ephemeris.hpp"
+#include "gvins/ephemeris/antex.hpp"
 #include "gvins/ephemeris/precise_ephemeris.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "gvins/ephemeris/satellite_state.hpp"
@@ -78,6 +79,14 @@ class EphemerisStore {
   const PreciseEphemeris* precise() const { return precise_.get(); }
   /// The precise state alone (std::nullopt without products or coverage).
   std::optional<SatelliteState> preciseState(SatId sat, const GpsTime& t) const;
+  /// Satellite antenna phase-centre offsets (ANTEX) for the precise products: SP3 positions are the
+  /// centre of mass (IGS), the ranges refer to the antenna phase centre, metres apart. With them
+  /// set, preciseState adds the offset of the reference ionosphere-free pair
+  /// (satellite_antenna.hpp), and satellites without a valid ANTEX entry fall back to their
+  /// broadcast records. Without them the product positions are taken as phase-centre positions
+  /// (right for gvins-sim products, metres off for IGS ones). Changes revision().
+  void setSatelliteAntennas(std::shared_ptr<const AntexData> antex);
+  const AntexData* satelliteAntennas() const { return antex_.get(); }
   /// Group delay (s) for a pseudorange on `code` from the record selected at t (0 if none).
   double groupDelay(SatId sat, ObsCode code, const GpsTime& t,
                     const EphemerisSelection& policy = {}) const;
@@ -108,6 +117,7 @@ class EphemerisStore {
   GlonassChannels channels_;
   std::optional<int> leapSeconds_;
   std::shared_ptr<const PreciseEphemeris> precise_;
+  std::shared_ptr<const AntexData> antex_;
   std::uint64_t revision_ = 0;
 };
 

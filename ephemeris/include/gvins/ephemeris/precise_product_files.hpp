@@ -1,5 +1,5 @@
 // Precise product files among a tool's inputs: told apart by name (as RTKLIB's tools do) and read
-// into one PreciseEphemeris.
+// into one PreciseEphemeris, and the ANTEX files that go with them.
 #pragma once
 
 #include <memory>
@@ -7,19 +7,25 @@
 #include <string_view>
 #include <vector>
 
+#include "gvins/ephemeris/antex.hpp"
 #include "gvins/ephemeris/precise_ephemeris.hpp"
 
 namespace gvins {
 
-enum class PreciseFileKind { kOrbit, kClock, kOther };
+enum class PreciseFileKind { kOrbit, kClock, kAntenna, kOther };
 
 /// By the file name, case-insensitive, a trailing ".gz" ignored: "*.sp3" (also the IGS long names
-/// "*_ORB.SP3") orbits, "*.clk" / "*.clk_30s" clocks, anything else kOther.
+/// "*_ORB.SP3") orbits, "*.clk" / "*.clk_30s" clocks, "*.atx" ANTEX antenna files, anything else
+/// kOther.
 PreciseFileKind preciseFileKind(std::string_view path);
 
 /// Reads the orbit files, then the clock files (which take precedence over SP3 clocks) into one
 /// PreciseEphemeris. Throws ParseError (file, line, field) for a malformed file.
 std::shared_ptr<PreciseEphemeris> readPreciseProducts(const std::vector<std::string>& orbitFiles,
                                                       const std::vector<std::string>& clockFiles);
+
+/// Reads ANTEX files into one AntexData (antennas in file order; for EphemerisStore::
+/// setSatelliteAntennas). Throws ParseError for a malformed file.
+std::shared_ptr<AntexData> readAntennaFiles(const std::vector<std::string>& files);
 
 }  // namespace gvins

@@ -124,7 +124,7 @@ class GnssFusion {
   std::unique_ptr<SppSolver> spp_;
   std::unique_ptr<RtkSolver> rtk_;
   std::optional<GpsTime> lastBase_;
-  std::unique_ptr<CarrierSmoother> smoother_;  // psr modes with carrierSmoothing > 0
+  std::unique_ptr<CarrierSmoother> smoother_, baseSmoother_;  // carrierSmoothing > 0: psr, dpsr
   ObsEpoch smoothed_;
 };
 

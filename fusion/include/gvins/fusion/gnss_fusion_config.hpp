@@ -19,7 +19,7 @@
 //     precise_ephemeris_error_m: {G: 0.05} # the same for satellites from precise products (SP3/clock;
 //                                         # default: the SPP's precise_ephemeris_error_m)
 //     code_sigma: 0.6                     # m at zenith; variance (a² + a²/sin²(el)) style
-//     carrier_smoothing: 100              # s, Hatch window of the psr codes (default; 0 = raw codes)
+//     carrier_smoothing: 100              # s, Hatch window of the psr/dpsr codes (default; 0 = raw)
 //     smoothed_code_factor: 1.0           # floor of the smoothed code's sigma / code_sigma
 //     doppler_sigma: 0.1                  # m/s at zenith
 //     clock_bias_random_walk: 0.1         # m/√s per constellation bias
@@ -95,9 +95,10 @@ struct GnssFusionConfig {
     return b;
   }
   double codeSigma = 0.6;
-  /// Carrier smoothing of the undifferenced pseudoranges (psr modes): Hatch window in s, 0 = raw
-  /// codes (CarrierSmoother). 100 s as in RTCA DO-229E; the ionosphere-free pair of smoothed codes
-  /// has no ionospheric divergence, a single-frequency one lags by about 2 T dI/dt.
+  /// Carrier smoothing of the pseudoranges (psr modes; dpsr: rover and base): Hatch window in s,
+  /// 0 = raw codes (CarrierSmoother); ddcp keeps raw codes. 100 s as in RTCA DO-229E; the
+  /// ionosphere-free pair of smoothed codes has no ionospheric divergence, a single-frequency one
+  /// lags by about 2 T dI/dt.
   double carrierSmoothing = 100.0;
   /// Floor of the smoothed code's sigma relative to codeSigma: the smoothing averages white noise
   /// by up to sqrt(2T/Δt − 1), but multipath correlated over tens of seconds much less.

@@ -123,6 +123,9 @@ struct ReplayOptions {
   /// gzipped) in <dataset>/gnss. Where they cover a satellite they replace its broadcast orbit and
   /// clock (EphemerisStore::setPrecise). broadcastOnly: use none.
   std::vector<std::string> sp3Files, clockFiles;
+  /// ANTEX files for the products' satellite antenna offsets (default: *.atx in DATASET/gnss when
+  /// the products come from there too).
+  std::vector<std::string> antennaFiles;
   bool broadcastOnly = false;
   std::optional<Eigen::Vector3d> basePosition;  ///< default: base.obs header position
   /// GPST (ns since the GPS epoch) = sensor stamp + this. 0 for gvins-sim datasets, whose sensor
