@@ -21,6 +21,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <ostream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -549,6 +550,75 @@ AntexData parseAntex(std::string_view text, const std::string& name) {
 AntexData readAntex(const std::string& path) {
   LineReader in(path, kMaxLineLength);
   return AntexReader(in).run();
+}
+
+
+namespace {
+
+/// One 80-column record: `body` padded (or cut) to 60 columns, then the label.
+void record(std::ostream& out, const std::string& body, const char* label) {
+  std::string b = body.substr(0, 60);
+  b.resize(60, ' ');
+  out << b << label << '\n';
+}
+
+std::string validityText(const GpsTime& t) {
+  const CalendarTime c = t.toCalendar();
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%6d%6d%6d%6d%6d%13.7f", c.year, c.month, c.day, c.hour, c.minute, c.second);
+  return buf;
+}
+
+void writeRow(std::ostream& out, const char* head, const std::vector<double>& values) {
+  out << head;
+  char buf[32];
+  for (double v : values) {
+    std::snprintf(buf, sizeof buf, "%8.2f", v * 1000.0);
+    out << buf;
+  }
+  out << '\n';
+}
+
+}  // namespace
+
+void writeAntex(std::ostream& out, const AntexData& data) {
+  char buf[128];
+  std::snprintf(buf, sizeof buf, "%8.1f%12s%c", data.version, "", data.system);
+  record(out, buf, "ANTEX VERSION / SYST");
+  std::snprintf(buf, sizeof buf, "%c%19s%-20s", data.pcvType, "", data.referenceAntenna.c_str());
+  record(out, buf, "PCV TYPE / REFANT");
+  for (const std::string& c : data.comments) record(out, c, "COMMENT");
+  record(out, "", "END OF HEADER");
+  for (const AntexAntenna& a : data.antennas) {
+    record(out, "", "START OF ANTENNA");
+    std::snprintf(buf, sizeof buf, "%-20.20s%-20.20s%-10.10s%-10.10s", a.type.c_str(), a.serial.c_str(), a.svn.c_str(),
+                  a.cospar.c_str());
+    record(out, buf, "TYPE / SERIAL NO");
+    std::snprintf(buf, sizeof buf, "  %6.1f", a.dazi);
+    record(out, buf, "DAZI");
+    std::snprintf(buf, sizeof buf, "  %6.1f%6.1f%6.1f", a.zen1, a.zen2, a.dzen);
+    record(out, buf, "ZEN1 / ZEN2 / DZEN");
+    std::snprintf(buf, sizeof buf, "%6zu", a.frequencies.size());
+    record(out, buf, "# OF FREQUENCIES");
+    if (a.validFrom) record(out, validityText(*a.validFrom), "VALID FROM");
+    if (a.validUntil) record(out, validityText(*a.validUntil), "VALID UNTIL");
+    if (!a.sinexCode.empty()) record(out, a.sinexCode, "SINEX CODE");
+    for (const AntexFrequency& f : a.frequencies) {
+      std::snprintf(buf, sizeof buf, "   %c%02d", systemLetter(f.system), f.band - '0');
+      const std::string code = buf;
+      record(out, code, "START OF FREQUENCY");
+      std::snprintf(buf, sizeof buf, "%10.2f%10.2f%10.2f", f.offset.x() * 1000.0, f.offset.y() * 1000.0,
+                    f.offset.z() * 1000.0);
+      record(out, buf, "NORTH / EAST / UP");
+      writeRow(out, "   NOAZI", f.noAzimuth);
+      for (std::size_t k = 0; k < f.byAzimuth.size(); ++k) {
+        std::snprintf(buf, sizeof buf, "%8.1f", static_cast<double>(k) * a.dazi);
+        writeRow(out, buf, f.byAzimuth[k]);
+      }
+      record(out, code, "END OF FREQUENCY");
+    }
+    record(out, "", "END OF ANTENNA");
+  }
 }
 
 }  // namespace gvins

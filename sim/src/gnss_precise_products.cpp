@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>
 
 #include "gvins/base/constants.hpp"
+#include "gvins/ephemeris/satellite_antenna.hpp"
 #include "gvins/sim/gnss_random.hpp"
 
 namespace gvins::sim {
@@ -54,7 +55,39 @@ GnssPreciseProducts makePreciseProducts(const GnssConstellation& constellation, 
     }
     errors.push_back(e);
   }
-  // Product state at t: truth plus the product error; the clock without the relativistic term.
+  GnssPreciseProducts out;
+  // Satellite antennas of centre-of-mass products: invented offsets on both reference frequencies
+  // (the second band's z up to 10 cm off the first's, as real ones differ).
+  if (config.centreOfMass) {
+    AntexData& a = out.antennas.emplace();
+    a.comments = {"gvins-sim: invented satellite antenna offsets of the simulated products"};
+    for (SatId sat : constellation.satellites()) {
+      GnssRandom rng(streamSeed(seed, {0xA7, static_cast<std::uint64_t>(satIndex(sat))}));
+      AntexAntenna ant;
+      ant.type = std::string("GVINS-SIM ") + std::string(systemName(sat.system));
+      ant.serial = sat.str();
+      ant.satellite = sat;
+      ant.svn = sat.str();
+      ant.zen1 = 0.0;
+      ant.zen2 = 14.0;
+      ant.dzen = 1.0;
+      ant.validFrom = first - 86400.0;
+      const Eigen::Vector3d pco(rng.uniform(-0.4, 0.4), rng.uniform(-0.01, 0.01), rng.uniform(0.5, 2.6));
+      const double dz = rng.uniform(-0.1, 0.1);
+      const auto [b1, b2] = referenceFrequencyPair(sat.system);
+      for (char b : {b1, b2}) {
+        AntexFrequency f;
+        f.system = sat.system;
+        f.band = b;
+        f.offset = pco + Eigen::Vector3d(0.0, 0.0, b == b2 ? dz : 0.0);
+        f.noAzimuth.assign(15, 0.0);
+        ant.frequencies.push_back(f);
+      }
+      a.antennas.push_back(std::move(ant));
+    }
+  }
+  // Product state at t: truth plus the product error; the clock without the relativistic term;
+  // the centre of mass c solves p = c + R(c) pco (a fixed point: R turns by ~1e-7 rad per metre).
   auto product = [&](std::size_t i, const GpsTime& t, Eigen::Vector3d& pos, double& clock) {
     const auto st = constellation.state(constellation.satellites()[i], t, margin + config.orbitInterval);
     if (!st) return false;
@@ -63,12 +96,19 @@ GnssPreciseProducts makePreciseProducts(const GnssConstellation& constellation, 
     const Eigen::Vector3d cHat = st->position.cross(st->velocity).normalized();
     const Eigen::Vector3d aHat = cHat.cross(rHat);
     pos = st->position + e[0] * rHat + e[1] * aHat + e[2] * cHat;
+    if (out.antennas) {
+      const Eigen::Vector3d apc = pos;
+      for (int k = 0; k < 3; ++k) {
+        const auto off = satelliteAntennaOffset(*out.antennas, constellation.satellites()[i], t, pos);
+        if (!off) break;
+        pos = apc - *off;
+      }
+    }
     const double relativistic = -2.0 * st->position.dot(st->velocity) / (c * c);
     clock = st->clock - relativistic + e[3] / c;
     return true;
   };
 
-  GnssPreciseProducts out;
   Sp3Data& o = out.orbits;
   o.version = 'd';
   o.timeSystem = "GPS";
@@ -125,8 +165,12 @@ std::vector<std::filesystem::path> writePreciseProducts(const GnssPreciseProduct
     if (!f) throw std::runtime_error("writing " + path.string() + " failed");
     return path;
   };
-  return {write("precise.sp3", [&](std::ostream& os) { writeSp3(os, products.orbits); }),
-          write("precise.clk", [&](std::ostream& os) { writeRinexClock(os, products.clocks); })};
+  std::vector<std::filesystem::path> files{
+      write("precise.sp3", [&](std::ostream& os) { writeSp3(os, products.orbits); }),
+      write("precise.clk", [&](std::ostream& os) { writeRinexClock(os, products.clocks); })};
+  if (products.antennas)
+    files.push_back(write("satellites.atx", [&](std::ostream& os) { writeAntex(os, *products.antennas); }));
+  return files;
 }
 
 }  // namespace gvins::sim

@@ -369,11 +369,13 @@ void apply(const Reader& r, const YAML::Node& g, const std::string& file, GnssSi
         }
       });
     } else if (k == "precise_products") {
-      r.map(v, full, {"write", "orbit_interval_s", "clock_interval_s", "sisre_m"},
+      r.map(v, full, {"write", "orbit_interval_s", "clock_interval_s", "sisre_m", "centre_of_mass"},
             [&](const std::string& pk, const std::string& pf, const YAML::Node& pv) {
               auto& p = c.preciseProducts;
               if (pk == "write") {
                 p.write = r.boolean(pv, pf);
+              } else if (pk == "centre_of_mass") {
+                p.centreOfMass = r.boolean(pv, pf);
               } else if (pk == "orbit_interval_s") {
                 p.orbitInterval = r.number(pv, pf, 1.0, 3600.0);
               } else if (pk == "clock_interval_s") {

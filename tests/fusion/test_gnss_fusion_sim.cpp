@@ -91,6 +91,7 @@ const Scenario& scenario() {
       precise->add(parseRinexClock(clk.str(), "precise.clk"));
       sc->navPrecise.add(nav);
       sc->navPrecise.setPrecise(std::move(precise));
+      if (products.antennas) sc->navPrecise.setSatelliteAntennas(std::make_shared<AntexData>(*products.antennas));
     }
     sc->basePosition = gen.basePosition();
     std::fprintf(stderr, "scenario: %.1f s flight, %zu IMU samples, %zu GNSS epochs\n", sc->traj->duration(),

@@ -24,6 +24,7 @@ const char* kFull = R"(gnss:
   code_noise_factor: {E5Q: 0.4}
   include_unhealthy: true
   satellite_errors: {blend_records: false, sisre_m: {G: 0.7, C: 1.2}}
+  precise_products: {orbit_interval_s: 900, sisre_m: {E: 0.04}, centre_of_mass: false}
   troposphere:
     relative_humidity: 0.6
     hydrostatic_scale_sigma: 0.02
@@ -78,6 +79,10 @@ TEST(GnssSimConfig, ReadsEveryKey) {
   EXPECT_TRUE(c.transmits(SatId(System::Gps, 4), {'1', 'C'}));
   EXPECT_FALSE(c.transmits(SatId(System::BeiDou, 30), {'7', 'I'}));  // default rule kept
   EXPECT_DOUBLE_EQ(c.cn0Offset(System::Gps, {'2', 'L'}), -3.5);
+  EXPECT_DOUBLE_EQ(c.preciseProducts.orbitInterval, 900.0);
+  EXPECT_DOUBLE_EQ(c.preciseProducts.sisre[systemIndex(System::Galileo)], 0.04);
+  EXPECT_FALSE(c.preciseProducts.centreOfMass);
+  EXPECT_TRUE(GnssPreciseProductsConfig{}.centreOfMass);
   EXPECT_DOUBLE_EQ(c.cn0Offset(System::Gps, {'2', 'W'}), -6.0);  // default kept
   EXPECT_DOUBLE_EQ(c.codeNoiseFactor(System::Galileo, {'5', 'Q'}), 0.4);
   EXPECT_TRUE(c.includeUnhealthy);
@@ -194,6 +199,7 @@ TEST(GnssSimConfig, MalformedInputNamesFileLineAndKey) {
       {"gnss:\n  signal_satellites: {G5Q: [40]}\n", 2, "gnss.signal_satellites.G5Q[0]"},
       {"gnss:\n  cn0_offset_db: {Q1C: 1}\n", 2, "gnss.cn0_offset_db.Q1C"},
       {"gnss:\n  satellite_errors: {sisre_m: {G: -1}}\n", 2, "gnss.satellite_errors.sisre_m.G"},
+      {"gnss:\n  precise_products: {centre_of_mass: maybe}\n", 2, "gnss.precise_products.centre_of_mass"},
       {"gnss:\n  troposphere:\n    residual: [{sigma_m: 0.01, covariance: matern}]\n", 3,
        "gnss.troposphere.residual[0].covariance"},
       {"gnss:\n  troposphere:\n    residual: [{sigma_tecu: 1}]\n", 3, "gnss.troposphere.residual[0].sigma_tecu"},

@@ -14,6 +14,8 @@
 
 #include "gvins/base/constants.hpp"
 #include "gvins/base/rinex_obs_reader.hpp"
+#include "gvins/ephemeris/antex.hpp"
+#include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/ephemeris/precise_ephemeris.hpp"
 #include "gvins/ephemeris/rinex_clock.hpp"
 #include "gvins/ephemeris/sp3.hpp"
@@ -137,7 +139,7 @@ std::unique_ptr<CircleTrajectory> GnssSimFlight::traj_;
 std::unique_ptr<GnssSimSummary> GnssSimFlight::summary_;
 
 TEST_F(GnssSimFlight, WritesTheDatasetFolder) {
-  for (const char* f : {"rover.obs", "base.obs", "base.rtcm3", "nav.rnx", "precise.sp3", "precise.clk", "truth/rover_antenna.csv", "truth/rover_clock.csv",
+  for (const char* f : {"rover.obs", "base.obs", "base.rtcm3", "nav.rnx", "precise.sp3", "precise.clk", "satellites.atx", "truth/rover_antenna.csv", "truth/rover_clock.csv",
                         "truth/base_clock.csv", "truth/ambiguities.csv", "truth/cycle_slips.csv", "truth/events.csv",
                         "truth/gnss_truth.yaml"}) {
     EXPECT_TRUE(fs::exists(gnss(f))) << f;
@@ -150,15 +152,21 @@ TEST_F(GnssSimFlight, WritesTheDatasetFolder) {
     EXPECT_GE(summary_->roverSatellites[systemIndex(s)], 3) << systemName(s);
 }
 
-// The precise products written with the dataset (precise.sp3, precise.clk) read back and
+// The precise products written with the dataset (precise.sp3, precise.clk, satellites.atx) read back and
 // interpolated give the true orbits and clocks of the simulation up to the configured product
 // errors (GnssPreciseProductsConfig::sisre, a few cm), where the broadcast records are off by the
 // broadcast SISRE; both measured as the range error seen from the rover (LOS orbit error minus
 // clock error) over the flight.
 TEST_F(GnssSimFlight, PreciseProductsGiveTheTrueOrbitsAndClocks) {
-  PreciseEphemeris precise;
-  precise.add(readSp3(gnss("precise.sp3").string()));
-  precise.add(readRinexClock(gnss("precise.clk").string()));
+  // Centre-of-mass orbits (as IGS ones) and the ANTEX file of their antenna offsets.
+  auto products = std::make_shared<PreciseEphemeris>();
+  products->add(readSp3(gnss("precise.sp3").string()));
+  products->add(readRinexClock(gnss("precise.clk").string()));
+  EphemerisStore centreOfMass, precise;
+  centreOfMass.setPrecise(products);
+  precise.setPrecise(products);
+  precise.setSatelliteAntennas(std::make_shared<AntexData>(readAntex(gnss("satellites.atx").string())));
+  double withoutAntex = 0.0;
   GnssEpochGenerator gen(flightConfig(), nagoyaNav(), *traj_, nagoyaFrame(), lever(), kSeed);
   const GnssConstellation& truth = gen.world().constellation();
   EphemerisStore store;
@@ -173,7 +181,9 @@ TEST_F(GnssSimFlight, PreciseProductsGiveTheTrueOrbitsAndClocks) {
       const GpsTime t = t0 + dt;
       if (!truth.covers(sat, t)) continue;  // a record ending in the run: the satellite sets
       const auto st = truth.state(sat, t);
-      const auto p = precise.satelliteState(sat, t);
+      const auto p = precise.preciseState(sat, t);
+      if (const auto m = centreOfMass.preciseState(sat, t); m && p)
+        withoutAntex = std::max(withoutAntex, (m->position - p->position).norm());
       ASSERT_TRUE(st.has_value());
       ASSERT_TRUE(p.has_value()) << sat.str() << " not covered by the products at +" << dt << " s";
       const Eigen::Vector3d u = (st->position - rx).normalized();
@@ -204,6 +214,10 @@ TEST_F(GnssSimFlight, PreciseProductsGiveTheTrueOrbitsAndClocks) {
     EXPECT_GT(brms, 5.0 * prms) << systemName(sys);
   }
   EXPECT_LT(maxPos, 0.5);
+  // The antenna offsets matter: the centre of mass is 0.5-2.6 m from the phase centre.
+  std::printf("largest centre-of-mass to phase-centre distance: %.3f m\n", withoutAntex);
+  EXPECT_GT(withoutAntex, 1.0);
+  EXPECT_LT(withoutAntex, 2.8);
 }
 
 TEST_F(GnssSimFlight, OurSppAndDopplerVelocityLandWithinTheSimulatedErrors) {

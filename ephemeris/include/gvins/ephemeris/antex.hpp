@@ -10,6 +10,7 @@
 // non-azimuth-dependent row (NOAZI) and, when DAZI > 0, one row per azimuth.
 #pragma once
 
+#include <iosfwd>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -78,5 +79,9 @@ struct AntexData {
 AntexData parseAntex(std::string_view text, const std::string& name);
 /// Reads an ANTEX file (plain or gzip).
 AntexData readAntex(const std::string& path);
+
+/// Writes ANTEX 1.4 (offsets and PCVs to 0.01 mm; validity times as given, GPST). What
+/// parseAntex reads back equals `data` to that rounding.
+void writeAntex(std::ostream& out, const AntexData& data);
 
 }  // namespace gvins

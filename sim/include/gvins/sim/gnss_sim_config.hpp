@@ -208,6 +208,11 @@ struct GnssPreciseProductsConfig {
   /// products' stated accuracy (orbits ~2.5 cm, clocks ~75 ps; igs.org/products) for GPS and the
   /// MGEX assessments for the others (Montenbruck et al. 2017, Adv. Space Res. 59(7)).
   std::array<double, kNumSystems> sisre{0.02, 0.04, 0.03, 0.06, 0.05, 0.1, 0.1};
+  /// Orbits as IGS products give them: satellite centres of mass, with the antenna phase-centre
+  /// offsets in gnss/satellites.atx (ANTEX). The offsets are invented per satellite within the
+  /// range of the real ones (z 0.5-2.6 m, x within ±0.4 m; e.g. igs20.atx); false: the orbits are
+  /// the phase-centre positions the ranges are simulated to, and no ANTEX file is written.
+  bool centreOfMass = true;
 };
 
 /// Satellites that transmit a signal (e.g. BeiDou B2I only from BDS-2 satellites C01-C18: BDS-3
