@@ -49,6 +49,7 @@ function(gvins_add_test)
   endif()
   add_executable(${A_NAME} ${A_SOURCES})
   target_link_libraries(${A_NAME} PRIVATE ${A_DEPS} GTest::gtest GTest::gtest_main)
+  target_include_directories(${A_NAME} PRIVATE ${PROJECT_SOURCE_DIR}/tests/support)
   target_compile_options(${A_NAME} PRIVATE ${GVINS_WARNINGS})
   target_compile_definitions(${A_NAME} PRIVATE
     GVINS_TEST_DATA="${PROJECT_SOURCE_DIR}/tests/data"

@@ -21,6 +21,7 @@
 #include "gvins/ephemeris/satellite_antenna.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "gvins/ephemeris/sp3.hpp"
+#include "nagoya_recording.hpp"
 
 namespace {
 
@@ -134,12 +135,7 @@ TEST(OrbitApp, CompareRecoversKnownOrbitAndClockOffsets) {
   const std::string nav = kData + "/gnss/nagoya_static_2024/base.nav.gz";
   gvins::EphemerisStore store;
   store.add(gvins::readRinexNav(nav));
-  gvins::CalendarTime c;
-  c.year = 2024;
-  c.month = 6;
-  c.day = 24;
-  c.hour = 8;
-  const gvins::GpsTime t0 = gvins::GpsTime::fromCalendar(c);
+  const gvins::GpsTime t0 = gvins::test::nagoyaTime(8, 0);
   gvins::Sp3Data d;
   d.interval = 300.0;
   for (gvins::SatId s : store.satellites())
@@ -204,12 +200,7 @@ TEST(OrbitApp, AntexMovesCentreOfMassProductsToThePhaseCentre) {
   const std::string nav = kData + "/gnss/nagoya_static_2024/base.nav.gz";
   gvins::EphemerisStore store;
   store.add(gvins::readRinexNav(nav));
-  gvins::CalendarTime c;
-  c.year = 2024;
-  c.month = 6;
-  c.day = 24;
-  c.hour = 8;
-  const gvins::GpsTime t0 = gvins::GpsTime::fromCalendar(c);
+  const gvins::GpsTime t0 = gvins::test::nagoyaTime(8, 0);
   std::vector<gvins::SatId> gps;
   for (gvins::SatId s : store.satellites())
     if (s.system == gvins::System::Gps) gps.push_back(s);

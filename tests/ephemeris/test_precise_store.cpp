@@ -14,6 +14,7 @@
 #include "gvins/ephemeris/precise_ephemeris.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "gvins/ephemeris/sp3.hpp"
+#include "nagoya_recording.hpp"
 
 using namespace gvins;
 
@@ -43,13 +44,7 @@ TEST(PreciseStore, PreciseStatesReplaceBroadcastWhereTheyCover) {
   EphemerisStore nav;
   nav.add(readRinexNav(kNagoya));
   const SatId g = SatId::parse("G05").value(), e = SatId::parse("E04").value();
-  CalendarTime c;
-  c.year = 2024;
-  c.month = 6;
-  c.day = 24;
-  c.hour = 8;
-  c.minute = 20;
-  const GpsTime t0 = GpsTime::fromCalendar(c);
+  const GpsTime t0 = gvins::test::nagoyaTime(8, 20);
   ASSERT_TRUE(nav.satelliteState(g, t0));
   ASSERT_TRUE(nav.satelliteState(e, t0));
   const Eigen::Vector3d offset(1.0, -2.0, 0.5);
@@ -94,12 +89,7 @@ TEST(PreciseStore, PreciseStatesReplaceBroadcastWhereTheyCover) {
 TEST(PreciseStore, BroadcastSampledAsSp3ReadsBack) {
   EphemerisStore nav;
   nav.add(readRinexNav(kNagoya));
-  CalendarTime c;
-  c.year = 2024;
-  c.month = 6;
-  c.day = 24;
-  c.hour = 8;
-  const GpsTime t0 = GpsTime::fromCalendar(c);
+  const GpsTime t0 = gvins::test::nagoyaTime(8, 0);
   const Sp3Data d = broadcastSp3(nav, t0, t0 + 3600.0, 300.0);
   EXPECT_EQ(d.satellites.size(), nav.satellites().size());
   EXPECT_EQ(d.epochs.size(), 13u);

@@ -17,6 +17,7 @@
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "gvins/ephemeris/satellite_antenna.hpp"
 #include "gvins/ephemeris/sun_position.hpp"
+#include "nagoya_recording.hpp"
 
 using namespace gvins;
 
@@ -133,13 +134,7 @@ TEST(SatelliteAntenna, CentreOfMassProductsComeBackToThePhaseCentre) {
   nav.add(readRinexNav(std::string(GVINS_TEST_DATA) + "/gnss/nagoya_static_2024/base.nav.gz"));
   plain = nav;
   const SatId g = SatId::parse("G05").value(), e = SatId::parse("E04").value(), other = SatId::parse("G13").value();
-  CalendarTime c;
-  c.year = 2024;
-  c.month = 6;
-  c.day = 24;
-  c.hour = 8;
-  c.minute = 20;
-  const GpsTime t0 = GpsTime::fromCalendar(c);
+  const GpsTime t0 = gvins::test::nagoyaTime(8, 20);
   auto antex = std::make_shared<AntexData>();
   antex->antennas.push_back(satelliteAntenna(g, '1', '2', {0.279, 0.0, 1.5}, {0.279, 0.0, 1.5}));
   antex->antennas.push_back(satelliteAntenna(e, '1', '5', {0.15, 0.01, 0.8}, {0.15, 0.01, 0.7}));

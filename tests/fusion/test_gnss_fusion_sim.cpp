@@ -27,6 +27,7 @@
 #include "gvins/sim/imu_simulator.hpp"
 #include "gvins/vio/so3.hpp"
 #include "imu_gnss_test_backend.hpp"
+#include "nagoya_recording.hpp"
 
 namespace gvins::fusion {
 namespace {
@@ -52,13 +53,7 @@ const Scenario& scenario() {
   static const std::unique_ptr<Scenario> s = [] {
     auto sc = std::make_unique<Scenario>();
     sc->frame.origin = geodeticFromDegrees(35.134707705, 136.977577939, 104.853);
-    CalendarTime c;
-    c.year = 2024;
-    c.month = 6;
-    c.day = 24;
-    c.hour = 8;
-    c.minute = 20;
-    sc->frame.startTime = GpsTime::fromCalendar(c);
+    sc->frame.startTime = gvins::test::nagoyaTime(8, 20);
     sim::FlightSpec f;
     f.pattern = sim::FlightPattern::FigureEight;
     f.length = 500.0;

@@ -14,6 +14,7 @@
 #include "gvins/ephemeris/sp3.hpp"
 #include "gvins/gnss/accuracy_statistics.hpp"
 #include "gvins/gnss/pos_reader.hpp"
+#include "nagoya_recording.hpp"
 
 namespace {
 const std::string kData = GVINS_TEST_DATA;
@@ -180,12 +181,7 @@ TEST(SppCli, PreciseProductsAmongTheInputs) {
   const std::string obs = kData + "/gnss/nagoya_static_2024/rover.obs.gz";
   EphemerisStore store;
   store.add(readRinexNav(nav));
-  CalendarTime c;
-  c.year = 2024;
-  c.month = 6;
-  c.day = 24;
-  c.hour = 8;
-  const GpsTime t0 = GpsTime::fromCalendar(c);
+  const GpsTime t0 = gvins::test::nagoyaTime(8, 0);
   std::vector<SatId> gps;
   for (SatId s : store.satellites())
     if (s.system == System::Gps) gps.push_back(s);

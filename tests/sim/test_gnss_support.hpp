@@ -13,6 +13,7 @@
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "gvins/sim/local_frame.hpp"
 #include "gvins/sim/trajectory.hpp"
+#include "nagoya_recording.hpp"
 
 namespace gvins::sim::testing {
 
@@ -28,13 +29,7 @@ inline const NavData& nagoyaNav() {
 inline LocalFrame nagoyaFrame(double secondsAfter0820 = 0.0) {
   LocalFrame f;
   f.origin = geodeticFromDegrees(35.134707705, 136.977577939, 104.853);
-  CalendarTime c;
-  c.year = 2024;
-  c.month = 6;
-  c.day = 24;
-  c.hour = 8;
-  c.minute = 20;
-  f.startTime = GpsTime::fromCalendar(c) + secondsAfter0820;
+  f.startTime = gvins::test::nagoyaTime(8, 20) + secondsAfter0820;
   return f;
 }
 
