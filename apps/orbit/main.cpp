@@ -111,6 +111,9 @@ int main(int argc, char** argv) {
         case gvins::PreciseFileKind::kOrbit: sp3Files.push_back(a); break;
         case gvins::PreciseFileKind::kClock: clockFiles.push_back(a); break;
         case gvins::PreciseFileKind::kAntenna: antennaFiles.push_back(a); break;
+        case gvins::PreciseFileKind::kBias:
+          std::fprintf(stderr, "gvins-orbit: note: %s: code biases do not change satellite states; not used\n", a.c_str());
+          break;
         case gvins::PreciseFileKind::kOther: files.push_back(a); break;
       }
     }

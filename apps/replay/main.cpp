@@ -60,6 +60,8 @@ const char* kUsage =
     "                         clocks where they cover a satellite\n"
     "  --atx F                ANTEX satellite antenna offsets for the products (IGS SP3 orbits are\n"
     "                         centres of mass; default: *.atx in DATASET/gnss)\n"
+    "  --bia F                Bias-SINEX code biases (OSB) for the products' clocks, repeatable\n"
+    "                         (default: *.bia / *.bsx in DATASET/gnss)\n"
     "  --broadcast            broadcast orbits and clocks only (ignore precise products)\n"
     "  --carrier-smoothing S  psr modes: Hatch window of the carrier-smoothed pseudoranges, s\n"
     "                         (default: gnss_fusion.carrier_smoothing, 100; 0 = raw codes)\n"
@@ -113,7 +115,7 @@ int main(int argc, char** argv) {
   bool useFloat = false, quiet = false, images = false, noEval = false, skipBad = false, skipMissing = false;
   std::optional<double> start, duration, maxGap;
   std::optional<std::string> gapPolicy, rover, base, nav;
-  std::vector<std::string> sp3Files, clockFiles, antennaFiles;
+  std::vector<std::string> sp3Files, clockFiles, antennaFiles, biasFiles;
   bool broadcastOnly = false;
   std::optional<Eigen::Vector3d> basePos, leverArm;
   std::int64_t sensorToGpst = 0;
@@ -145,6 +147,7 @@ int main(int argc, char** argv) {
     else if (a == "--sp3") sp3Files.push_back(value());
     else if (a == "--clk") clockFiles.push_back(value());
     else if (a == "--atx") antennaFiles.push_back(value());
+    else if (a == "--bia") biasFiles.push_back(value());
     else if (a == "--broadcast") broadcastOnly = true;
     else if (a == "--carrier-smoothing") {
       carrierSmoothing = toNumber(value(), a);
@@ -217,6 +220,7 @@ int main(int argc, char** argv) {
     opt.sp3Files = sp3Files;
     opt.clockFiles = clockFiles;
     opt.antennaFiles = antennaFiles;
+    opt.biasFiles = biasFiles;
     opt.broadcastOnly = broadcastOnly;
     opt.basePosition = basePos;
     opt.sensorToGpst_ns = sensorToGpst;

@@ -34,6 +34,7 @@ namespace {
 
 const char* kUsage =
     "usage: gvins-spp [options] -o OUT.pos OBS NAV [NAV...] [ORBIT.sp3...] [CLOCK.clk...] [ANT.atx]\n"
+    "                 [BIAS.bia...]\n"
     "       gvins-spp --score FILE.pos --truth X,Y,Z | --truth-llh LAT,LON,H\n"
     "\n"
     "Single point positioning from RINEX observations (2.10/2.11, 3.0x; plain or .gz) and\n"
@@ -41,7 +42,8 @@ const char* kUsage =
     "solved epoch, prints progress and a summary to stderr. Precise products among the inputs\n"
     "(SP3-c/d orbits *.sp3, RINEX clocks *.clk, plain or .gz; told apart by their names) replace\n"
     "the broadcast orbits and clocks where they cover a satellite; an ANTEX file (*.atx) moves\n"
-    "their centre-of-mass positions to the antenna phase centre (needed for IGS products).\n"
+    "their centre-of-mass positions to the antenna phase centre (needed for IGS products), and\n"
+    "Bias-SINEX code biases (*.bia, *.bsx: OSBs) replace the broadcast group delays with them.\n"
     "\n"
     "  -o FILE            output .pos file ('-' for stdout); required\n"
     "  --config F.yaml    options from the 'spp:' section of a YAML file (see docs); command-line\n"
@@ -265,16 +267,18 @@ int main(int argc, char** argv) {
   // Navigation data.
   EphemerisStore nav;
   try {
-    std::vector<std::string> orbits, clocks, antennas;
+    std::vector<std::string> orbits, clocks, antennas, biases;
     for (std::size_t i = 1; i < args.inputs.size(); ++i) {
       switch (preciseFileKind(args.inputs[i])) {
         case PreciseFileKind::kOrbit: orbits.push_back(args.inputs[i]); break;
         case PreciseFileKind::kClock: clocks.push_back(args.inputs[i]); break;
         case PreciseFileKind::kAntenna: antennas.push_back(args.inputs[i]); break;
+        case PreciseFileKind::kBias: biases.push_back(args.inputs[i]); break;
         case PreciseFileKind::kOther: nav.add(readRinexNav(args.inputs[i])); break;
       }
     }
     if (!antennas.empty()) nav.setSatelliteAntennas(readAntennaFiles(antennas));
+    if (!biases.empty()) nav.setCodeBiases(readCodeBiasFiles(biases));
     if (orbits.empty() && !clocks.empty()) {
       std::fprintf(stderr, "gvins-spp: error: clock files need an SP3 orbit file\n");
       return 2;

@@ -309,6 +309,19 @@ void EphemerisStore::setSatelliteAntennas(std::shared_ptr<const AntexData> antex
   ++revision_;
 }
 
+void EphemerisStore::setCodeBiases(std::shared_ptr<const BiasSinexData> biases) {
+  biases_ = std::move(biases);
+  ++revision_;
+}
+
+double EphemerisStore::codeDelay(const SatelliteState& state, SatId sat, ObsCode code, const GpsTime& t,
+                                 const EphemerisSelection& policy) const {
+  if (state.precise && biases_) {
+    if (const auto osb = biases_->codeOsb(sat, code, t)) return *osb;
+  }
+  return groupDelay(sat, code, t, policy);
+}
+
 std::optional<SatelliteState> EphemerisStore::preciseState(SatId sat, const GpsTime& t) const {
   if (!precise_ || !sat.valid()) return std::nullopt;
   auto st = precise_->satelliteState(sat, t);

@@ -15,6 +15,7 @@ PreciseFileKind preciseFileKind(std::string_view path) {
   if (lower.ends_with(".sp3")) return PreciseFileKind::kOrbit;
   if (lower.ends_with(".clk") || lower.ends_with(".clk_30s")) return PreciseFileKind::kClock;
   if (lower.ends_with(".atx")) return PreciseFileKind::kAntenna;
+  if (lower.ends_with(".bia") || lower.ends_with(".bsx")) return PreciseFileKind::kBias;
   return PreciseFileKind::kOther;
 }
 
@@ -35,6 +36,19 @@ std::shared_ptr<AntexData> readAntennaFiles(const std::vector<std::string>& file
       continue;
     }
     for (AntexAntenna& a : d.antennas) out->antennas.push_back(std::move(a));
+  }
+  return out;
+}
+
+std::shared_ptr<BiasSinexData> readCodeBiasFiles(const std::vector<std::string>& files) {
+  auto out = std::make_shared<BiasSinexData>();
+  for (const std::string& f : files) {
+    BiasSinexData d = readBiasSinex(f);
+    if (out->entries.empty()) {
+      *out = std::move(d);
+      continue;
+    }
+    for (BiasEntry& e : d.entries) out->entries.push_back(std::move(e));
   }
   return out;
 }

@@ -101,7 +101,7 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     m.clockBias = tx->state.clockBias;
     m.clockDrift = tx->state.clockDrift;
     m.precise = tx->state.precise;
-    m.groupDelay = nav.groupDelay(so.sat, s->code, tx->transmitTime);
+    m.groupDelay = nav.codeDelay(tx->state, so.sat, s->code, tx->transmitTime);
     m.wavelength = kC / *f;
     m.azel = azimuthElevation(g, x, m.position);
     if (m.azel.elevation < config_.elevationMaskDeg * constants::kDegToRad) continue;
@@ -142,7 +142,7 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
         if (!f2 || !(s2->pseudorange > 1e6 && s2->pseudorange < 1e8)) continue;
         const IonosphereFreeCoefficients c = ionosphereFreeCoefficients(*f, *f2);
         m.pseudorange = c.a1 * s->pseudorange + c.a2 * s2->pseudorange;
-        m.groupDelay = c.a1 * m.groupDelay + c.a2 * nav.groupDelay(so.sat, s2->code, tx->transmitTime);
+        m.groupDelay = c.a1 * m.groupDelay + c.a2 * nav.codeDelay(tx->state, so.sat, s2->code, tx->transmitTime);
         m.ionosphere = 0.0;
         m.ionosphereFree = true;
         m.code2 = s2->code;

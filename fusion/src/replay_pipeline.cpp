@@ -68,10 +68,10 @@ class OutFile {
   std::ofstream f_;
 };
 
-// Precise products in a dataset's gnss folder (preciseFileKind: *.sp3, *.clk, *.atx, also gzipped
+// Precise products in a dataset's gnss folder (preciseFileKind: *.sp3, *.clk, *.atx, *.bia, also gzipped
 // or upper case), sorted by name (consecutive days).
 void findPreciseProducts(const fs::path& dir, std::vector<std::string>& sp3, std::vector<std::string>& clk,
-                         std::vector<std::string>& atx) {
+                         std::vector<std::string>& atx, std::vector<std::string>& bia) {
   std::error_code ec;
   for (const auto& e : fs::directory_iterator(dir, ec)) {
     if (!e.is_regular_file()) continue;
@@ -79,7 +79,9 @@ void findPreciseProducts(const fs::path& dir, std::vector<std::string>& sp3, std
     if (kind == PreciseFileKind::kOrbit) sp3.push_back(e.path().string());
     else if (kind == PreciseFileKind::kClock) clk.push_back(e.path().string());
     else if (kind == PreciseFileKind::kAntenna) atx.push_back(e.path().string());
+    else if (kind == PreciseFileKind::kBias) bia.push_back(e.path().string());
   }
+  std::sort(bia.begin(), bia.end());
   std::sort(sp3.begin(), sp3.end());
   std::sort(clk.begin(), clk.end());
   std::sort(atx.begin(), atx.end());
@@ -359,13 +361,14 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
     if (navPath.empty()) throw ParseError(gdir.string(), 0, "navigation", "no navigation file in the gnss folder (use --nav)");
     g.nav.add(readRinexNav(navPath));
     if (!opt.broadcastOnly) {
-      std::vector<std::string> sp3 = opt.sp3Files, clk = opt.clockFiles, atx = opt.antennaFiles;
-      if (sp3.empty() && clk.empty()) findPreciseProducts(gdir, sp3, clk, atx);
+      std::vector<std::string> sp3 = opt.sp3Files, clk = opt.clockFiles, atx = opt.antennaFiles, bia = opt.biasFiles;
+      if (sp3.empty() && clk.empty()) findPreciseProducts(gdir, sp3, clk, atx, bia);
       if (!sp3.empty()) {
         auto precise = readPreciseProducts(sp3, clk);
         sum.preciseSatellites = precise->satellites().size();
         g.nav.setPrecise(std::move(precise));
         if (!atx.empty()) g.nav.setSatelliteAntennas(readAntennaFiles(atx));
+        if (!bia.empty()) g.nav.setCodeBiases(readCodeBiasFiles(bia));
       } else if (!clk.empty()) {
         throw ParseError(clk.front(), 0, "precise clock", "clock files need an SP3 orbit file (use --sp3)");
       }

@@ -189,7 +189,14 @@ bool SppSolver::gatherMeasurements(const ObsEpoch& epoch, SppSolution& sol, std:
       continue;
     }
     m.state = *st;
-    auto groupDelayOf = [&](ObsCode c) { return ge ? broadcastGroupDelay(*ge, c) : broadcastGroupDelay(*ke, c); };
+    // Code biases: the OSBs that go with precise clocks (EphemerisStore::setCodeBiases), else the
+    // broadcast group delays of the record.
+    auto groupDelayOf = [&](ObsCode c) {
+      if (st->precise && nav_.codeBiases()) {
+        if (const auto osb = nav_.codeBiases()->codeOsb(so.sat, c, ttx)) return *osb;
+      }
+      return ge ? broadcastGroupDelay(*ge, c) : broadcastGroupDelay(*ke, c);
+    };
     double gd = groupDelayOf(s1->code);
     if (m.ionosphereFree) gd = ifc.a1 * gd + ifc.a2 * groupDelayOf(s2->code);
     m.satClock = st->clockBias - gd;

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "gvins/base/constants.hpp"
+#include "gvins/ephemeris/bias_sinex.hpp"
 #include "gvins/ephemeris/broadcast_sp3.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/ephemeris/precise_ephemeris.hpp"
@@ -108,4 +109,34 @@ TEST(PreciseStore, BroadcastSampledAsSp3ReadsBack) {
   }
   EXPECT_GT(compared, 8);
   EXPECT_THROW(broadcastSp3(nav, t0, t0 - 1.0, 300.0), std::invalid_argument);
+}
+
+// codeDelay: the OSB of the code biases for a precise state that has one, the broadcast group
+// delay for a broadcast state or a signal without an OSB.
+TEST(PreciseStore, CodeDelayTakesTheOsbOnlyWithPreciseStates) {
+  EphemerisStore nav;
+  nav.add(readRinexNav(kNagoya));
+  const SatId g = SatId::parse("G05").value();
+  const GpsTime t = gvins::test::nagoyaTime(8, 50);
+  auto precise = std::make_shared<PreciseEphemeris>();
+  precise->add(broadcastSp3(nav, t - 3000.0, t + 3000.0, 300.0, {g}));
+  auto biases = std::make_shared<BiasSinexData>();
+  BiasEntry b;
+  b.satellite = g;
+  b.obs1 = ObsCode('1', 'C');
+  b.start = t - 600.0;
+  b.end = t + 600.0;
+  b.unit = "ns";
+  b.value = 4.5e-9;
+  biases->entries.push_back(b);
+  const double tgd = nav.groupDelay(g, ObsCode('1', 'C'), t);
+  const SatelliteState broadcast = *nav.satelliteState(g, t);
+  nav.setCodeBiases(biases);
+  EXPECT_DOUBLE_EQ(nav.codeDelay(broadcast, g, ObsCode('1', 'C'), t), tgd);
+  nav.setPrecise(precise);
+  const SatelliteState st = *nav.satelliteState(g, t);
+  ASSERT_TRUE(st.precise);
+  EXPECT_DOUBLE_EQ(nav.codeDelay(st, g, ObsCode('1', 'C'), t), 4.5e-9);
+  EXPECT_DOUBLE_EQ(nav.codeDelay(st, g, ObsCode('2', 'W'), t), nav.groupDelay(g, ObsCode('2', 'W'), t));
+  EXPECT_DOUBLE_EQ(nav.codeDelay(st, g, ObsCode('1', 'C'), t + 900.0), nav.groupDelay(g, ObsCode('1', 'C'), t + 900.0));
 }

@@ -12,6 +12,8 @@
 #include "gvins/base/geodetic.hpp"
 #include "gvins/base/local_frame.hpp"
 #include "gvins/base/rinex_obs_reader.hpp"
+#include "gvins/ephemeris/bias_sinex.hpp"
+#include "gvins/ephemeris/broadcast_sp3.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "gvins/gnss/accuracy_statistics.hpp"
 #include "gvins/gnss/carrier_smoothing.hpp"
@@ -380,6 +382,62 @@ TEST(Spp, DegenerateEpochsGiveStatusesNotCrashes) {
   EXPECT_TRUE(sj.valid());
   EXPECT_EQ(sj.satellites[0].use, SatelliteUse::NoSignal);
   EXPECT_LT((sj.position - o.position).norm(), 0.02);
+}
+
+// Code biases (Bias-SINEX OSBs) with precise clocks: the pseudoranges carry, on top of the
+// broadcast group delay, a bias of −3..+3 ns per GPS/Galileo satellite (what the broadcast group
+// delay misses, e.g. a C1C−C1W DCB). The products are the broadcast orbits and clocks as SP3, the
+// OSBs the broadcast group delay plus that bias: SPP then lands on the truth to millimetres; without
+// the OSBs the biases go into the position (metres); OSBs without precise states are not used.
+TEST(Spp, CodeBiasesGoWithPreciseClocks) {
+  SimOptions o;
+  o.position = kNagoyaRover;
+  // 08:50: the SP3 nodes (from the broadcast records, 08:00-10:00) surround it on both sides.
+  const GpsTime t = kNagoyaTime + 1680.0;
+  ObsEpoch e = simulate(nagoyaNav(), t, o);
+  auto bias = [](SatId s) { return ((s.prn * 5) % 7 - 3) * 1e-9; };  // s
+  auto biases = std::make_shared<BiasSinexData>();
+  for (SatObs& so : e.sats) {
+    if (so.sat.system != System::Gps && so.sat.system != System::Galileo) continue;
+    for (SignalObs& sig : so.signals) {
+      sig.pseudorange += kC * bias(so.sat);
+      BiasEntry b;
+      b.satellite = so.sat;
+      b.obs1 = sig.code;
+      b.start = t - 3600.0;
+      b.end = t + 3600.0;
+      b.unit = "ns";
+      b.value = nagoyaNav().groupDelay(so.sat, sig.code, t) + bias(so.sat);
+      biases->entries.push_back(b);
+    }
+  }
+  ASSERT_GT(biases->entries.size(), 10u);
+  auto precise = std::make_shared<PreciseEphemeris>();
+  precise->add(broadcastSp3(nagoyaNav(), t - 3000.0, t + 4200.0, 300.0));
+  SppConfig c = plainConfig();
+  c.systems = {true, false, true, false, false, false, false};  // GPS and Galileo
+  c.faultExclusion.enabled = false;
+  c.robust.enabled = false;
+  auto error = [&](bool withPrecise, bool withBiases) {
+    EphemerisStore nav = nagoyaNav();
+    if (withPrecise) nav.setPrecise(precise);
+    if (withBiases) nav.setCodeBiases(biases);
+    const SppSolution s = SppSolver(nav, c).solve(e);
+    EXPECT_TRUE(s.valid());
+    int precise = 0;
+    for (const SatObs& so : e.sats)
+      if (const auto st = nav.preciseState(so.sat, t)) precise += st->precise;
+    if (withPrecise) {
+      EXPECT_GT(precise, 14);  // every GPS and Galileo satellite
+    }
+    return (s.position - o.position).norm();
+  };
+  const double both = error(true, true), noBiases = error(true, false), noPrecise = error(false, true);
+  std::printf("SPP error: precise + OSB %.4f m, precise without OSB %.3f m, OSB without precise %.3f m\n", both,
+              noBiases, noPrecise);
+  EXPECT_LT(both, 0.01);
+  EXPECT_GT(noBiases, 0.3);
+  EXPECT_DOUBLE_EQ(noPrecise, error(false, false));  // the OSBs are ignored without precise states
 }
 
 // ---- real data ----------------------------------------------------------------------------------

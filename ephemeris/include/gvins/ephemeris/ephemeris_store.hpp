@@ -12,6 +12,7 @@
 #include "gvins/ephemeris/ionosphere_parameters.hpp"
 #include "gvins/ephemeris/kepler_ephemeris.hpp"
 #include "gvins/ephemeris/antex.hpp"
+#include "gvins/ephemeris/bias_sinex.hpp"
 #include "gvins/ephemeris/precise_ephemeris.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "gvins/ephemeris/satellite_state.hpp"
@@ -87,6 +88,14 @@ class EphemerisStore {
   /// (right for gvins-sim products, metres off for IGS ones). Changes revision().
   void setSatelliteAntennas(std::shared_ptr<const AntexData> antex);
   const AntexData* satelliteAntennas() const { return antex_.get(); }
+  /// Code biases (Bias-SINEX OSBs) that go with the precise clocks. Changes revision().
+  void setCodeBiases(std::shared_ptr<const BiasSinexData> biases);
+  const BiasSinexData* codeBiases() const { return biases_.get(); }
+  /// Delay (s) of the code `code` of `sat` against the clock of `state`: the code OSB of the
+  /// biases when the state is precise and they have one for the signal (IGS convention: the OSBs of
+  /// the clock's reference pair combine to zero), else the broadcast group delay (groupDelay()).
+  double codeDelay(const SatelliteState& state, SatId sat, ObsCode code, const GpsTime& t,
+                   const EphemerisSelection& policy = {}) const;
   /// Group delay (s) for a pseudorange on `code` from the record selected at t (0 if none).
   double groupDelay(SatId sat, ObsCode code, const GpsTime& t,
                     const EphemerisSelection& policy = {}) const;
@@ -118,6 +127,7 @@ class EphemerisStore {
   std::optional<int> leapSeconds_;
   std::shared_ptr<const PreciseEphemeris> precise_;
   std::shared_ptr<const AntexData> antex_;
+  std::shared_ptr<const BiasSinexData> biases_;
   std::uint64_t revision_ = 0;
 };
 

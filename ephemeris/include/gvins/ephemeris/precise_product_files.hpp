@@ -8,15 +8,16 @@
 #include <vector>
 
 #include "gvins/ephemeris/antex.hpp"
+#include "gvins/ephemeris/bias_sinex.hpp"
 #include "gvins/ephemeris/precise_ephemeris.hpp"
 
 namespace gvins {
 
-enum class PreciseFileKind { kOrbit, kClock, kAntenna, kOther };
+enum class PreciseFileKind { kOrbit, kClock, kAntenna, kBias, kOther };
 
 /// By the file name, case-insensitive, a trailing ".gz" ignored: "*.sp3" (also the IGS long names
-/// "*_ORB.SP3") orbits, "*.clk" / "*.clk_30s" clocks, "*.atx" ANTEX antenna files, anything else
-/// kOther.
+/// "*_ORB.SP3") orbits, "*.clk" / "*.clk_30s" clocks, "*.atx" ANTEX antenna files, "*.bia" /
+/// "*.bsx" Bias-SINEX code biases, anything else kOther.
 PreciseFileKind preciseFileKind(std::string_view path);
 
 /// Reads the orbit files, then the clock files (which take precedence over SP3 clocks) into one
@@ -27,5 +28,9 @@ std::shared_ptr<PreciseEphemeris> readPreciseProducts(const std::vector<std::str
 /// Reads ANTEX files into one AntexData (antennas in file order; for EphemerisStore::
 /// setSatelliteAntennas). Throws ParseError for a malformed file.
 std::shared_ptr<AntexData> readAntennaFiles(const std::vector<std::string>& files);
+
+/// Reads Bias-SINEX files into one BiasSinexData (entries in file order; for EphemerisStore::
+/// setCodeBiases). Throws ParseError for a malformed file.
+std::shared_ptr<BiasSinexData> readCodeBiasFiles(const std::vector<std::string>& files);
 
 }  // namespace gvins

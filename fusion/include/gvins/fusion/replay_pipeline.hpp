@@ -126,6 +126,8 @@ struct ReplayOptions {
   /// ANTEX files for the products' satellite antenna offsets (default: *.atx in DATASET/gnss when
   /// the products come from there too).
   std::vector<std::string> antennaFiles;
+  /// Bias-SINEX code biases for the products (default: *.bia / *.bsx in DATASET/gnss, as above).
+  std::vector<std::string> biasFiles;
   bool broadcastOnly = false;
   std::optional<Eigen::Vector3d> basePosition;  ///< default: base.obs header position
   /// GPST (ns since the GPS epoch) = sensor stamp + this. 0 for gvins-sim datasets, whose sensor
