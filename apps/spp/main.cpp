@@ -58,7 +58,8 @@ const char* kUsage =
     "                     own parameters for BeiDou)\n"
     "  --tropo MODEL      off | saastamoinen (default; Niell mapping)\n"
     "  --smooth S         carrier-smoothed pseudoranges, Hatch window S seconds (e.g. 100; default\n"
-    "                     0 = raw codes); with --freq 2 --iono dual-frequency free of divergence\n"
+    "                     the config's carrier_smoothing_s, 0 = raw codes); with --freq 2 --iono\n"
+    "                     dual-frequency free of divergence\n"
     "  --no-fde           no fault detection and exclusion\n"
     "  --no-velocity      no Doppler velocity (velocity columns are zeros)\n"
     "  --xyz              ECEF x/y/z columns instead of latitude/longitude/height\n"
@@ -82,7 +83,7 @@ struct Args {
   std::optional<double> elmask, snrmask;
   std::optional<int> freq;
   std::optional<std::string> iono, tropo;
-  double smooth = 0.0;
+  std::optional<double> smooth;
   bool noFde = false, noVelocity = false, xyz = false, strict = false, quiet = false;
   int timeDecimals = 3;
   std::optional<Eigen::Vector3d> truth;
@@ -138,7 +139,7 @@ Args parseArgs(int argc, char** argv) {
       a.tropo = value(i, o);
     } else if (o == "--smooth") {
       a.smooth = parseNumber(o, value(i, o));
-      if (a.smooth < 0.0 || a.smooth > 3600.0) usageError("--smooth must be within 0..3600 s");
+      if (*a.smooth < 0.0 || *a.smooth > 3600.0) usageError("--smooth must be within 0..3600 s");
     } else if (o == "--no-fde") {
       a.noFde = true;
     } else if (o == "--no-velocity") {
@@ -339,11 +340,12 @@ int main(int argc, char** argv) {
   std::snprintf(buf, sizeof buf, "%d", cfg.frequencies);
   popt.headerFields.emplace_back("freqs", buf);
   std::optional<CarrierSmoother> smoother;
-  if (args.smooth > 0.0) {
+  if (args.smooth) cfg.carrierSmoothing = *args.smooth;
+  if (cfg.carrierSmoothing > 0.0) {
     CarrierSmoothingOptions so;
-    so.window = args.smooth;
+    so.window = cfg.carrierSmoothing;
     smoother.emplace(so);
-    std::snprintf(buf, sizeof buf, "%.0f s", args.smooth);
+    std::snprintf(buf, sizeof buf, "%.0f s", cfg.carrierSmoothing);
     popt.headerFields.emplace_back("carrier smoothing", buf);
   }
 

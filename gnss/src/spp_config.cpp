@@ -31,7 +31,7 @@ void apply(const Reader& r, const YAML::Node& spp, SppConfig& c) {
       "systems", "elevation_mask_deg", "snr_mask_dbhz", "frequencies", "bands", "ionosphere", "troposphere",
       "relative_humidity", "meteo", "weighting", "ionosphere_model_error", "troposphere_zenith_error_m",
       "ephemeris_error_m", "ephemeris_alarm_accuracy_m", "precise_ephemeris_error_m", "fault_exclusion", "robust", "ionosphere_estimation", "max_gdop", "isb_prior_sigma_m", "isb_random_walk_m2ps", "qzss_gps_clock",
-      "max_iterations", "velocity", "allow_unhealthy"};
+      "max_iterations", "velocity", "carrier_smoothing_s", "allow_unhealthy"};
   r.map(spp, "spp", kKeys, [&](const std::string& k, const std::string& full, const YAML::Node& v) {
     if (k == "systems") {
       c.systems = r.systems(v, full);
@@ -143,6 +143,8 @@ void apply(const Reader& r, const YAML::Node& spp, SppConfig& c) {
       c.maxIterations = r.integer(v, full, 1, 100);
     } else if (k == "velocity") {
       c.velocity = r.boolean(v, full);
+    } else if (k == "carrier_smoothing_s") {
+      c.carrierSmoothing = r.number(v, full, 0.0, 3600.0);
     } else if (k == "allow_unhealthy") {
       c.ephemeris.allowUnhealthy = r.boolean(v, full);
     }

@@ -35,6 +35,7 @@ TEST(SppConfig, ParsesEveryKey) {
       "  qzss_gps_clock: false\n"
       "  max_iterations: 12\n"
       "  velocity: false\n"
+      "  carrier_smoothing_s: 60\n"
       "  allow_unhealthy: true\n";
   const SppConfig c = parseSppConfig(y, "all.yaml");
   EXPECT_TRUE(c.useSystem(System::Gps) && c.useSystem(System::Galileo) && c.useSystem(System::BeiDou));
@@ -63,6 +64,7 @@ TEST(SppConfig, ParsesEveryKey) {
   EXPECT_FALSE(c.qzssUsesGpsClock);
   EXPECT_EQ(c.maxIterations, 12);
   EXPECT_FALSE(c.velocity);
+  EXPECT_DOUBLE_EQ(c.carrierSmoothing, 60.0);
   EXPECT_TRUE(c.ephemeris.allowUnhealthy);
   // Missing keys keep the base values; an empty document is the defaults.
   EXPECT_EQ(parseSppConfig("", "e.yaml").frequencies, 1);
@@ -114,6 +116,7 @@ TEST(SppConfig, ErrorsNameFileLineAndKey) {
   expectError("spp:\n  bands: {X: \"1\"}\n", 2, "spp.bands.X", "unknown system");
   expectError("spp:\n  robust: {k0: 3, k1: 2}\n", 2, "spp.robust", "larger");
   expectError("spp:\n  velocity: maybe\n", 2, "spp.velocity", "wrong type");
+  expectError("spp:\n  carrier_smoothing_s: -1\n", 2, "spp.carrier_smoothing_s", "");
   expectError("spp: [1, 2\n", 2, "YAML", "");
   expectError("- a\n- b\n", 1, "", "map");
   expectError("spp:\n  weighting: 3\n", 2, "spp.weighting", "must be a map");

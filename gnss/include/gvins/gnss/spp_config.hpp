@@ -90,6 +90,10 @@ struct SppConfig {
   bool qzssUsesGpsClock = true;
   int maxIterations = 10;
   bool velocity = true;  ///< estimate velocity and clock drift from Doppler
+  /// Carrier smoothing window (s) applied to the epochs before solving (CarrierSmoother; 0 = raw
+  /// codes). SppSolver solves one epoch at a time; the caller that feeds it epochs in order (e.g.
+  /// gvins-spp) owns the smoother and reads this value.
+  double carrierSmoothing = 0.0;
   EphemerisSelection ephemeris;
 
   bool useSystem(System s) const { return systems[systemIndex(s)]; }
@@ -127,6 +131,7 @@ struct SppConfig {
 ///     qzss_gps_clock: true
 ///     max_iterations: 10
 ///     velocity: true
+///     carrier_smoothing_s: 0      # Hatch window of the codes, s (0 = raw; gvins-spp --smooth)
 ///     allow_unhealthy: false
 /// Why `bands` is not a valid band preference list for system s (as in SppConfig::bands), or an
 /// empty string when it is: every character a band of the system (GLONASS: also '1' and '2',
