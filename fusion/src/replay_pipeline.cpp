@@ -238,6 +238,8 @@ void ReplaySummary::writeMetrics(std::ostream& os) const {
   kv("gnss_epochs_updated", static_cast<double>(gnssEpochsUpdated));
   kv("gnss_epochs_fixed", static_cast<double>(gnssEpochsFixed));
   kv("precise_satellites", static_cast<double>(preciseSatellites));
+  kv("antex_satellite_antennas", static_cast<double>(antexAntennas));
+  kv("code_biases", static_cast<double>(codeBiases));
   kv("frame_init_s", frameInitSeconds);
   auto acc = [&](const std::string& p, const Accuracy& a) {
     kv((p + "position_rmse_m").c_str(), a.positionRmse);
@@ -294,8 +296,13 @@ void ReplaySummary::print(std::ostream& os) const {
                            std::to_string(gnssEpochsFixed) + " RTK fixed), " + std::to_string(gnssEpochsSkipped) +
                            " before VIO initialisation");
     row("GNSS [ms/epoch]", f("mean %.3f", gnssMsMean) + f(" (%.3f ms per frame)", gnssMsPerFrame));
-    row("orbits/clocks", preciseSatellites > 0 ? "precise products, " + std::to_string(preciseSatellites) + " satellites"
-                                               : std::string("broadcast"));
+    std::string products = "broadcast";
+    if (preciseSatellites > 0) {
+      products = "precise products, " + std::to_string(preciseSatellites) + " satellites";
+      if (antexAntennas > 0) products += ", ANTEX " + std::to_string(antexAntennas) + " satellite antennas";
+      if (codeBiases > 0) products += ", " + std::to_string(codeBiases) + " code biases";
+    }
+    row("orbits/clocks", products);
     if (std::isfinite(frameInitSeconds)) row("frame initialised", f("%.1f s after the first frame", frameInitSeconds));
   }
   if (leverArm) {
@@ -367,8 +374,16 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
         auto precise = readPreciseProducts(sp3, clk);
         sum.preciseSatellites = precise->satellites().size();
         g.nav.setPrecise(std::move(precise));
-        if (!atx.empty()) g.nav.setSatelliteAntennas(readAntennaFiles(atx));
-        if (!bia.empty()) g.nav.setCodeBiases(readCodeBiasFiles(bia));
+        if (!atx.empty()) {
+          auto antex = readAntennaFiles(atx);
+          for (const AntexAntenna& a : antex->antennas) sum.antexAntennas += a.isSatellite();
+          g.nav.setSatelliteAntennas(std::move(antex));
+        }
+        if (!bia.empty()) {
+          auto biases = readCodeBiasFiles(bia);
+          sum.codeBiases = biases->entries.size();
+          g.nav.setCodeBiases(std::move(biases));
+        }
       } else if (!clk.empty()) {
         throw ParseError(clk.front(), 0, "precise clock", "clock files need an SP3 orbit file (use --sp3)");
       }

@@ -18,6 +18,8 @@
 
 #include "gvins/base/parse_error.hpp"
 #include "gvins/base/rinex_obs_reader.hpp"
+#include "gvins/ephemeris/antex.hpp"
+#include "gvins/ephemeris/bias_sinex.hpp"
 #include "gvins/ephemeris/broadcast_sp3.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
@@ -388,6 +390,11 @@ TEST(Replay, PreciseProductsInTheGnssFolder) {
     const fs::path d = copyV101(sameDay ? "sp3_same" : "sp3_other");
     fs::create_directories(d / "gnss");
     writeText(d / "gnss" / "products.sp3", products(rover[0].time - 1800.0 + (sameDay ? 0.0 : 86400.0)));
+    // The ANTEX and Bias-SINEX files beside them are picked up too (fuzz seeds: valid files).
+    fs::copy_file(kData / "fuzz" / "antex" / "valid_satellites.atx", d / "gnss" / "igs.atx",
+                  fs::copy_options::overwrite_existing);
+    fs::copy_file(kData / "fuzz" / "bias_sinex" / "valid_gps_galileo.bia", d / "gnss" / "products.bia",
+                  fs::copy_options::overwrite_existing);
     StubEstimator est;
     StubGnss gnss;
     ReplayOptions o = quietOptions(d.parent_path() / ("out_" + d.filename().string()));
@@ -399,6 +406,9 @@ TEST(Replay, PreciseProductsInTheGnssFolder) {
     const ReplaySummary s = runReplay(d.string(), est, &gnss, o);
     const std::string err = ::testing::internal::GetCapturedStderr();
     EXPECT_EQ(s.preciseSatellites, nav.satellites().size());
+    EXPECT_EQ(s.antexAntennas, readAntex((kData / "fuzz" / "antex" / "valid_satellites.atx").string()).antennas.size());
+    EXPECT_EQ(s.codeBiases, readBiasSinex((kData / "fuzz" / "bias_sinex" / "valid_gps_galileo.bia").string()).entries.size());
+    EXPECT_GT(s.codeBiases, 0u);
     EXPECT_EQ(err.find("precise products cover") != std::string::npos, !sameDay) << err;
     o.broadcastOnly = true;
     EXPECT_EQ(runReplay(d.string(), est, &gnss, o).preciseSatellites, 0u);

@@ -156,6 +156,8 @@ struct ReplaySummary {
   std::size_t gnssEpochs = 0, gnssEpochsUpdated = 0, gnssEpochsFixed = 0, gnssEpochsSkipped = 0;
   /// Satellites with precise products loaded (0: broadcast orbits and clocks only).
   std::size_t preciseSatellites = 0;
+  std::size_t antexAntennas = 0;  ///< satellite antenna entries of the ANTEX files used with the products
+  std::size_t codeBiases = 0;     ///< entries of the Bias-SINEX files used with the products
   double realTimeFactor() const { return wallSeconds > 0.0 ? datasetSeconds / wallSeconds : 0.0; }
   double estimatorMsMedian = 0.0;
   double gnssMsPerFrame = 0.0;   ///< GNSS time summed over the run / processed frames
