@@ -6,6 +6,7 @@
 
 #include "gvins/base/rinex_obs_reader.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
+#include "gvins/gnss/carrier_smoothing.hpp"
 #include "gvins/gnss/spp.hpp"
 
 namespace {
@@ -40,6 +41,30 @@ BENCHMARK_CAPTURE(BM_SppEpoch, nagoya_42sats, kData + "/gnss/nagoya_static_2024/
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_SppEpoch, kamakura_20sats, kData + "/gnss/kamakura_static_2021/SEPT078M.21O.gz",
                   kData + "/gnss/kamakura_static_2021/SEPT078M.21P.gz")
+    ->Unit(benchmark::kMicrosecond);
+
+// Carrier smoothing (slip detection + Hatch update) of one epoch, all signals, in time order; the
+// file is replayed from its start (a fresh smoother) when it runs out.
+void BM_CarrierSmoothingEpoch(benchmark::State& st, const std::string& obs) {
+  gvins::RinexObsHeader header;
+  const std::vector<gvins::ObsEpoch> epochs = gvins::readRinexObs(obs, &header);
+  gvins::CarrierSmoother smoother;
+  std::size_t i = 0;
+  gvins::ObsEpoch e;
+  for (auto _ : st) {
+    st.PauseTiming();
+    e = epochs[i];
+    st.ResumeTiming();
+    smoother.apply(e, header.glonassChannels);
+    benchmark::DoNotOptimize(e);
+    if (++i == epochs.size()) {
+      i = 0;
+      smoother.reset();
+    }
+  }
+  st.counters["epochs/s"] = benchmark::Counter(static_cast<double>(st.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK_CAPTURE(BM_CarrierSmoothingEpoch, nagoya_42sats, kData + "/gnss/nagoya_static_2024/rover.obs.gz")
     ->Unit(benchmark::kMicrosecond);
 }  // namespace
 
