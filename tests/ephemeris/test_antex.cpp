@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "gvins/ephemeris/antex.hpp"
+#include "parse_error_cases.hpp"
 
 using namespace gvins;
 
@@ -405,13 +406,7 @@ std::string substituted(std::string text, const std::string& from, const std::st
 }
 std::string firstLines(std::size_t n) { return join(std::vector<std::string>(kBase.begin(), kBase.begin() + static_cast<long>(n))); }
 
-struct BadCase {
-  std::string name;
-  std::string text;
-  std::int64_t line;
-  std::string field;
-  std::string reason;  // a substring of the message
-};
+using gvins::test::BadCase;
 
 }  // namespace
 
@@ -519,38 +514,20 @@ TEST(Antex, MalformedInputs) {
       {"duplicate DAZI", inserted(7, {kBase[6]}), 8, "DAZI", "duplicate"},
   };
   ASSERT_GE(cases.size(), 20u);
-  for (const BadCase& c : cases) {
-    SCOPED_TRACE(c.name);
-    try {
-      parseAntex(c.text, "bad.atx");
-      ADD_FAILURE() << "no error for " << c.name;
-    } catch (const ParseError& e) {
-      EXPECT_EQ(e.file(), "bad.atx");
-      EXPECT_EQ(e.line(), c.line) << e.what();
-      EXPECT_EQ(e.field(), c.field) << e.what();
-      EXPECT_NE(std::string(e.what()).find(c.reason), std::string::npos) << e.what();
-    }
-  }
+  gvins::test::expectParseErrors(cases, "bad.atx", [](const std::string& t, const std::string& f) { parseAntex(t, f); });
 }
 
 TEST(Antex, ReadsGzipFileAndNamesMissingFiles) {
   const auto dir = std::filesystem::temp_directory_path();
-  const std::string plain = (dir / ("gvins_antex_" + std::to_string(::getpid()) + ".atx")).string();
-  const std::string gz = plain + ".gz";
-  {
-    std::ofstream out(plain, std::ios::binary);
-    out << kAtx;
-  }
-  ASSERT_EQ(std::system(("gzip -c '" + plain + "' > '" + gz + "'").c_str()), 0);
-  const AntexData a = readAntex(plain);
-  const AntexData b = readAntex(gz);
+  const gvins::test::PlainAndGzipFiles files("gvins_antex", ".atx", kAtx);
+  ASSERT_TRUE(files.ok());
+  const AntexData a = readAntex(files.plain());
+  const AntexData b = readAntex(files.gz());
   ASSERT_EQ(b.antennas.size(), 5u);
   EXPECT_EQ(b.antennas.size(), a.antennas.size());
   const AntexAntenna* r = b.receiver("GVI1000.00");
   ASSERT_NE(r, nullptr);
   EXPECT_NEAR(r->frequencies.at(0).byAzimuth.at(3).at(4), -0.00037, 1e-15);
-  std::remove(plain.c_str());
-  std::remove(gz.c_str());
 
   const std::string missing = (dir / "gvins_antex_does_not_exist.atx").string();
   try {

@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "gvins/ephemeris/bias_sinex.hpp"
+#include "parse_error_cases.hpp"
 
 using namespace gvins;
 
@@ -267,13 +268,7 @@ std::string osb(const char* prn, const char* obs1, const char* start, const char
   return replaced(6, bias(type, "G050", prn, "", obs1, obs2, start, end, unit, value, sigma));
 }
 
-struct BadCase {
-  std::string name;
-  std::string text;
-  std::int64_t line;
-  std::string field;
-  std::string reason;  // a substring of the message
-};
+using gvins::test::BadCase;
 
 }  // namespace
 
@@ -357,48 +352,20 @@ TEST(BiasSinex, MalformedInputs) {
       {"line too long", replaced(6, line6 + std::string(600, ' ')), 6, "", "longer than"},
   };
   ASSERT_GE(cases.size(), 20u);
-  for (const BadCase& c : cases) {
-    SCOPED_TRACE(c.name);
-    try {
-      parseBiasSinex(c.text, "bad.bia");
-      ADD_FAILURE() << "no error for " << c.name;
-    } catch (const ParseError& e) {
-      EXPECT_EQ(e.file(), "bad.bia");
-      EXPECT_EQ(e.line(), c.line) << e.what();
-      EXPECT_EQ(e.field(), c.field) << e.what();
-      EXPECT_NE(std::string(e.what()).find(c.reason), std::string::npos) << e.what();
-    }
-  }
+  gvins::test::expectParseErrors(cases, "bad.bia",
+                                 [](const std::string& t, const std::string& f) { parseBiasSinex(t, f); });
 }
 
 TEST(BiasSinex, ReadsGzipFileAndNamesMissingFiles) {
   const auto dir = std::filesystem::temp_directory_path();
-  const std::string plain = (dir / ("gvins_bias_sinex_" + std::to_string(::getpid()) + ".bia")).string();
-  const std::string gz = plain + ".gz";
-  {
-    std::ofstream out(plain, std::ios::binary);
-    out << join(kFile);
-  }
-  FILE* pipe = ::popen(("gzip -c '" + plain + "'").c_str(), "r");
-  ASSERT_NE(pipe, nullptr);
-  std::string compressed;
-  char buf[4096];
-  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, pipe)) > 0;) compressed.append(buf, n);
-  ASSERT_EQ(::pclose(pipe), 0);
-  ASSERT_GT(compressed.size(), 2u);
-  EXPECT_EQ(static_cast<unsigned char>(compressed[0]), 0x1fu);
-  {
-    std::ofstream out(gz, std::ios::binary);
-    out << compressed;
-  }
-  const BiasSinexData a = readBiasSinex(plain);
-  const BiasSinexData b = readBiasSinex(gz);
+  const gvins::test::PlainAndGzipFiles files("gvins_bias_sinex", ".bia", join(kFile));
+  ASSERT_TRUE(files.ok());
+  const BiasSinexData a = readBiasSinex(files.plain());
+  const BiasSinexData b = readBiasSinex(files.gz());
   EXPECT_EQ(a.entries.size(), 15u);
   ASSERT_EQ(b.entries.size(), a.entries.size());
   EXPECT_DOUBLE_EQ(b.codeOsb(kG05, k1C, gpst(10, 12)).value(), -3.2e-9);
   EXPECT_DOUBLE_EQ(b.codeDsb(kG12, k1W, k1C, gpst(9, 12)).value(), -0.65e-9);
-  std::remove(plain.c_str());
-  std::remove(gz.c_str());
 
   const std::string missing = (dir / "gvins_bias_sinex_does_not_exist.bia").string();
   try {
