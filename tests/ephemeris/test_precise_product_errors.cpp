@@ -7,6 +7,7 @@
 
 #include "gvins/ephemeris/rinex_clock.hpp"
 #include "gvins/ephemeris/sp3.hpp"
+#include "parse_error_cases.hpp"
 
 using namespace gvins;
 
@@ -75,33 +76,8 @@ const std::string kClk = join({
     "AS G16  2024 06 24 00 01  0.000000  1   -0.123456789012E-03",                      // 8
 });
 
-struct Case {
-  std::string name;
-  std::string text;
-  std::int64_t line;
-  std::string field;
-};
-
-template <class Parse>
-void expectErrors(const std::vector<Case>& cases, const std::string& file, Parse parse) {
-  for (const Case& c : cases) {
-    SCOPED_TRACE(c.name);
-    try {
-      parse(c.text, file);
-      ADD_FAILURE() << "no error for " << c.name;
-    } catch (const ParseError& e) {
-      EXPECT_EQ(e.file(), file);
-      EXPECT_EQ(e.line(), c.line) << e.what();
-      EXPECT_EQ(e.field(), c.field) << e.what();
-      const std::string what = e.what();
-      EXPECT_NE(what.find(file), std::string::npos) << what;
-      if (c.line > 0) {
-        EXPECT_NE(what.find(":" + std::to_string(c.line) + ":"), std::string::npos) << what;
-      }
-      EXPECT_NE(what.find(c.field), std::string::npos) << what;
-    }
-  }
-}
+using Case = gvins::test::BadCase;
+using gvins::test::expectParseErrors;
 
 }  // namespace
 
@@ -167,17 +143,17 @@ TEST(PreciseProductErrors, Sp3) {
       {"unknown record", edit(kSp3, 16, "Q junk"), 17, "record type"},
       {"missing EOF", edit(kSp3, 19, "<del>"), 19, "EOF"},
   };
-  expectErrors(cases, "bad.sp3", [](const std::string& t, const std::string& n) { parseSp3(t, n); });
+  expectParseErrors(cases, "bad.sp3", [](const std::string& t, const std::string& n) { parseSp3(t, n); });
   // A V record must follow its own P record.
   std::string v = edit(kSp3, 0, "#dV2024  6 24  0  0  0.00000000       2 ORBIT IGb20 FIT  IGS");
-  expectErrors({{"V of another satellite", edit(v, 16, "VR02  20298.880364 -18462.044804   1381.387685     -4.534317"),
+  expectParseErrors({{"V of another satellite", edit(v, 16, "VR02  20298.880364 -18462.044804   1381.387685     -4.534317"),
                  17, "V record"}},
                "bad.sp3", [](const std::string& t, const std::string& n) { parseSp3(t, n); });
   // SP3-c needs exactly five '+' lines.
   std::string c = edit(kSp3, 0, "#cP2024  6 24  0  0  0.00000000       2 ORBIT IGb20 FIT  IGS");
   c = edit(c, 6, "<del>");
   c = edit(c, 10, "<del>");
-  expectErrors({{"sp3-c with 4 + lines", c, 7, "+"}}, "bad.sp3",
+  expectParseErrors({{"sp3-c with 4 + lines", c, 7, "+"}}, "bad.sp3",
                [](const std::string& t, const std::string& n) { parseSp3(t, n); });
 }
 
@@ -215,10 +191,10 @@ TEST(PreciseProductErrors, RinexClock) {
       {"continuation cut at the end", join({lines(kClk)[0], lines(kClk)[3], lines(kClk)[5]}), 3, "data values"},
       {"duplicate record", edit(kClk, 7, "AS G16  2024 06 24 00 00 30.000000  1   -0.123456789012E-03"), 8, "epoch"},
   };
-  expectErrors(cases, "bad.clk", [](const std::string& t, const std::string& n) { parseRinexClock(t, n); });
+  expectParseErrors(cases, "bad.clk", [](const std::string& t, const std::string& n) { parseRinexClock(t, n); });
   // 3.04 layout: a record written with the old A4 name field.
   const std::string v304 = edit(kClk, 0, label("     3.04           C                   G", "RINEX VERSION / TYPE"));
-  expectErrors({{"A4 name in a 3.04 file", edit(v304, 4, "AS G16  2024 06 24 00 00 30.000000  1   -0.1E-03"), 5, "name"},
+  expectParseErrors({{"A4 name in a 3.04 file", edit(v304, 4, "AS G16  2024 06 24 00 00 30.000000  1   -0.1E-03"), 5, "name"},
                 {"3.04 ok but missing year", edit(v304, 4, "AS G16       "), 5, "epoch"}},
                "bad.clk", [](const std::string& t, const std::string& n) { parseRinexClock(t, n); });
 }

@@ -23,11 +23,11 @@ struct BadCase {
   std::string text;
   std::int64_t line;
   std::string field;
-  std::string reason;  ///< a substring of the message
+  std::string reason = {};  ///< a substring of the message (empty: not checked)
 };
 
-/// Every case must throw a ParseError naming `file`, the case's line and field and containing its
-/// reason; `parse(text, file)` is the parser under test.
+/// Every case must throw a ParseError naming `file`, the case's line and field (also in the
+/// message) and containing its reason; `parse(text, file)` is the parser under test.
 template <typename Parse>
 void expectParseErrors(const std::vector<BadCase>& cases, const std::string& file, Parse&& parse) {
   for (const BadCase& c : cases) {
@@ -39,7 +39,14 @@ void expectParseErrors(const std::vector<BadCase>& cases, const std::string& fil
       EXPECT_EQ(e.file(), file);
       EXPECT_EQ(e.line(), c.line) << e.what();
       EXPECT_EQ(e.field(), c.field) << e.what();
-      EXPECT_NE(std::string(e.what()).find(c.reason), std::string::npos) << e.what();
+      const std::string what = e.what();
+      EXPECT_NE(what.find(c.reason), std::string::npos) << what;
+      // The message itself names the place: "file:line: field ...".
+      EXPECT_NE(what.find(file), std::string::npos) << what;
+      if (c.line > 0) {
+        EXPECT_NE(what.find(":" + std::to_string(c.line) + ":"), std::string::npos) << what;
+      }
+      EXPECT_NE(what.find(c.field), std::string::npos) << what;
     }
   }
 }
