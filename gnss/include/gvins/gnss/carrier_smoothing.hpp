@@ -69,8 +69,8 @@ class CarrierSmoother {
  private:
   struct Signal {
     ObsCode code;
-    double smoothed = 0.0;  // m
-    double phase = 0.0;     // m (λ φ)
+    double smoothed = 0.0;  // m; in work_ (this epoch's inputs): the raw code
+    double phase = 0.0;     // m (λ φ of the carrying phase)
   };
   struct Arc {
     std::vector<Signal> signals;
