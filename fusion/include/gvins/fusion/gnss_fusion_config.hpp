@@ -8,7 +8,7 @@
 //     lever_arm_sigma: 0.2                # m, prior 1-sigma per axis when calibrated
 //     min_rotation_rate: 0.3              # rad/s: lever-arm Jacobian used by Doppler rows above it
 //     systems: GREJ                       # RINEX letters of the constellations used
-//     elevation_mask_deg: 10
+//     elevation_mask_deg: 15              # deg (RTKLIB's and gvins-spp's default too)
 //     ionosphere: dual-frequency          # psr rows: ionosphere-free code where a second band
 //                                         # exists (else broadcast), or broadcast (Klobuchar)
 //     bands: {G: "152"}                   # per system: bands tried in order for the second signal of
@@ -73,7 +73,7 @@ struct GnssFusionConfig {
   double leverArmSigma = 0.2;
   double minRotationRate = 0.3;
   std::array<bool, kNumSystems> systems{true, true, true, true, true, false, false};
-  double elevationMaskDeg = 10.0;
+  double elevationMaskDeg = 15.0;
   GnssIonosphere ionosphere = GnssIonosphere::kDualFrequency;
   /// Band order per system (index systemIndex): the ionosphere-free pair takes the first tracked
   /// band of this list other than the primary band. Default: the SPP's, except GPS/QZSS L5 before
