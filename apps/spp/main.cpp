@@ -312,6 +312,10 @@ int main(int argc, char** argv) {
 
   SppSolver solver(nav, cfg);
   solver.setGlonassChannels(hdr.glonassChannels);
+  // GLONASS channels for the carrier smoothing's wavelengths: the header's, else the navigation
+  // records' (as the solver does).
+  GlonassChannels channels = hdr.glonassChannels;
+  channels.mergeMissing(nav.glonassChannels());
   if (hdr.station.approxPosition) solver.setInitialPosition(*hdr.station.approxPosition);
 
   std::ofstream file;
@@ -374,7 +378,7 @@ int main(int argc, char** argv) {
       break;
     }
     ++epochs;
-    if (smoother) smoother->apply(epoch, hdr.glonassChannels);
+    if (smoother) smoother->apply(epoch, channels);
     const SppSolution sol = solver.solve(epoch);
     ++statusCount[sol.status];
     for (const auto& s : sol.satellites) ++useCount[static_cast<int>(s.use)];
