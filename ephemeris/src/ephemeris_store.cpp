@@ -314,11 +314,15 @@ void EphemerisStore::setCodeBiases(std::shared_ptr<const BiasSinexData> biases) 
   ++revision_;
 }
 
+std::optional<double> EphemerisStore::preciseCodeBias(const SatelliteState& state, SatId sat, ObsCode code,
+                                                      const GpsTime& t) const {
+  if (!state.precise || !biases_) return std::nullopt;
+  return biases_->codeOsb(sat, code, t);
+}
+
 double EphemerisStore::codeDelay(const SatelliteState& state, SatId sat, ObsCode code, const GpsTime& t,
                                  const EphemerisSelection& policy) const {
-  if (state.precise && biases_) {
-    if (const auto osb = biases_->codeOsb(sat, code, t)) return *osb;
-  }
+  if (const auto osb = preciseCodeBias(state, sat, code, t)) return *osb;
   return groupDelay(sat, code, t, policy);
 }
 

@@ -27,30 +27,32 @@ std::shared_ptr<PreciseEphemeris> readPreciseProducts(const std::vector<std::str
   return precise;
 }
 
-std::shared_ptr<AntexData> readAntennaFiles(const std::vector<std::string>& files) {
-  auto out = std::make_shared<AntexData>();
+namespace {
+
+/// Reads every file and appends its items (`items`) to the first file's data (whose header wins).
+template <typename Data, typename Item>
+std::shared_ptr<Data> readAndMerge(const std::vector<std::string>& files, Data (*read)(const std::string&),
+                                   std::vector<Item> Data::*items) {
+  auto out = std::make_shared<Data>();
   for (const std::string& f : files) {
-    AntexData d = readAntex(f);
-    if (out->antennas.empty()) {  // the first file's header
+    Data d = read(f);
+    if ((*out.*items).empty()) {
       *out = std::move(d);
       continue;
     }
-    for (AntexAntenna& a : d.antennas) out->antennas.push_back(std::move(a));
+    for (Item& x : d.*items) (*out.*items).push_back(std::move(x));
   }
   return out;
 }
 
+}  // namespace
+
+std::shared_ptr<AntexData> readAntennaFiles(const std::vector<std::string>& files) {
+  return readAndMerge(files, &readAntex, &AntexData::antennas);
+}
+
 std::shared_ptr<BiasSinexData> readCodeBiasFiles(const std::vector<std::string>& files) {
-  auto out = std::make_shared<BiasSinexData>();
-  for (const std::string& f : files) {
-    BiasSinexData d = readBiasSinex(f);
-    if (out->entries.empty()) {
-      *out = std::move(d);
-      continue;
-    }
-    for (BiasEntry& e : d.entries) out->entries.push_back(std::move(e));
-  }
-  return out;
+  return readAndMerge(files, &readBiasSinex, &BiasSinexData::entries);
 }
 
 }  // namespace gvins

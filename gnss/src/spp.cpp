@@ -189,12 +189,10 @@ bool SppSolver::gatherMeasurements(const ObsEpoch& epoch, SppSolution& sol, std:
       continue;
     }
     m.state = *st;
-    // Code biases: the OSBs that go with precise clocks (EphemerisStore::setCodeBiases), else the
-    // broadcast group delays of the record.
+    // Code biases: the OSBs that go with precise clocks (EphemerisStore::codeDelay's rule), else
+    // the broadcast group delays of the record selected above.
     auto groupDelayOf = [&](ObsCode c) {
-      if (st->precise && nav_.codeBiases()) {
-        if (const auto osb = nav_.codeBiases()->codeOsb(so.sat, c, ttx)) return *osb;
-      }
+      if (const auto osb = nav_.preciseCodeBias(*st, so.sat, c, ttx)) return *osb;
       return ge ? broadcastGroupDelay(*ge, c) : broadcastGroupDelay(*ke, c);
     };
     double gd = groupDelayOf(s1->code);

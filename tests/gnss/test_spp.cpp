@@ -424,11 +424,11 @@ TEST(Spp, CodeBiasesGoWithPreciseClocks) {
     if (withBiases) nav.setCodeBiases(biases);
     const SppSolution s = SppSolver(nav, c).solve(e);
     EXPECT_TRUE(s.valid());
-    int precise = 0;
+    int preciseStates = 0;
     for (const SatObs& so : e.sats)
-      if (const auto st = nav.preciseState(so.sat, t)) precise += st->precise;
+      if (const auto st = nav.preciseState(so.sat, t)) preciseStates += st->precise;
     if (withPrecise) {
-      EXPECT_GT(precise, 14);  // every GPS and Galileo satellite
+      EXPECT_GT(preciseStates, 14);  // every GPS and Galileo satellite
     }
     return (s.position - o.position).norm();
   };

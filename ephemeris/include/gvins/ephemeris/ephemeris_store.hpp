@@ -96,6 +96,10 @@ class EphemerisStore {
   /// the clock's reference pair combine to zero), else the broadcast group delay (groupDelay()).
   double codeDelay(const SatelliteState& state, SatId sat, ObsCode code, const GpsTime& t,
                    const EphemerisSelection& policy = {}) const;
+  /// The OSB part of codeDelay alone: the code OSB (s) when `state` is precise and the biases
+  /// have one for the signal, else nullopt (for callers that hold their broadcast record already).
+  std::optional<double> preciseCodeBias(const SatelliteState& state, SatId sat, ObsCode code,
+                                        const GpsTime& t) const;
   /// Group delay (s) for a pseudorange on `code` from the record selected at t (0 if none).
   double groupDelay(SatId sat, ObsCode code, const GpsTime& t,
                     const EphemerisSelection& policy = {}) const;
