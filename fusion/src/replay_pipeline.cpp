@@ -81,10 +81,10 @@ void findPreciseProducts(const fs::path& dir, std::vector<std::string>& sp3, std
     else if (kind == PreciseFileKind::kAntenna) atx.push_back(e.path().string());
     else if (kind == PreciseFileKind::kBias) bia.push_back(e.path().string());
   }
-  std::sort(bia.begin(), bia.end());
   std::sort(sp3.begin(), sp3.end());
   std::sort(clk.begin(), clk.end());
   std::sort(atx.begin(), atx.end());
+  std::sort(bia.begin(), bia.end());
 }
 
 /// The navigation file of a gvins-sim gnss/ folder: the first regular file that is neither an
@@ -368,8 +368,11 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
     if (navPath.empty()) throw ParseError(gdir.string(), 0, "navigation", "no navigation file in the gnss folder (use --nav)");
     g.nav.add(readRinexNav(navPath));
     if (!opt.broadcastOnly) {
-      std::vector<std::string> sp3 = opt.sp3Files, clk = opt.clockFiles, atx = opt.antennaFiles, bia = opt.biasFiles;
+      std::vector<std::string> sp3 = opt.sp3Files, clk = opt.clockFiles, atx, bia;
+      // The folder's files where none were given (an --atx / --bia file replaces the folder's).
       if (sp3.empty() && clk.empty()) findPreciseProducts(gdir, sp3, clk, atx, bia);
+      if (!opt.antennaFiles.empty()) atx = opt.antennaFiles;
+      if (!opt.biasFiles.empty()) bia = opt.biasFiles;
       if (!sp3.empty()) {
         auto precise = readPreciseProducts(sp3, clk);
         sum.preciseSatellites = precise->satellites().size();
