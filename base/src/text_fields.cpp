@@ -124,6 +124,12 @@ double parseDouble(std::string_view text, const TextLocation& where, std::string
   return *v;
 }
 
+double parseFiniteDouble(std::string_view text, const TextLocation& where, std::string_view field) {
+  const double v = parseDouble(text, where, field);
+  if (!std::isfinite(v)) throwParseError(where, field, "not a finite number '" + std::string(trim(text)) + "'");
+  return v;
+}
+
 double parseDoubleOr(std::string_view text, double blankValue, const TextLocation& where,
                      std::string_view field) {
   return parseOptionalDouble(text, where, field).value_or(blankValue);

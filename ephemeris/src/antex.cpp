@@ -103,12 +103,6 @@ bool tryNumber(std::string_view text, double& v) {
   return !text.empty() && text.size() < 64 && parseShortDecimal(text, v);
 }
 
-double number(std::string_view text, const TextLocation& where, std::string_view field) {
-  const double v = parseDouble(trim(text), where, field);
-  if (!std::isfinite(v)) throwParseError(where, field, "not a finite number '" + std::string(trim(text)) + "'");
-  return v;
-}
-
 std::string describe(std::string_view line) {
   line = trim(line);
   if (line.size() > 40) return "'" + std::string(line.substr(0, 40)) + "...'";
@@ -180,7 +174,7 @@ void AntexReader::numbers(std::string_view field, std::size_t n, std::size_t off
   const std::string_view body = column(line_, 0, 60);
   tokenize(body, tok_, n);
   if (tok_.size() == n) {
-    for (std::size_t k = 0; k < n; ++k) out[k] = number(tok_[k], here(), field);
+    for (std::size_t k = 0; k < n; ++k) out[k] = parseFiniteDouble(tok_[k], here(), field);
     return;
   }
   bool fixed = true;
@@ -195,7 +189,7 @@ void AntexReader::readHeader() {
   if (labelOf(line_) != kVersionLabel) {
     throwParseError(here(), kVersionLabel, "first line is not 'ANTEX VERSION / SYST' (not an ANTEX file?)");
   }
-  d_.version = number(column(line_, 0, 8), here(), kVersionLabel);
+  d_.version = parseFiniteDouble(column(line_, 0, 8), here(), kVersionLabel);
   if (d_.version < 1.0 || d_.version >= 2.0) {
     throwParseError(here(), kVersionLabel, "unsupported ANTEX version " + fmt(d_.version) + " (1.x expected)");
   }
@@ -258,7 +252,7 @@ GpsTime AntexReader::validity(std::string_view field) {
   c.day = whole(2, 1, 31);
   c.hour = whole(3, 0, 23);
   c.minute = whole(4, 0, 59);
-  c.second = number(tok_[5], here(), field);
+  c.second = parseFiniteDouble(tok_[5], here(), field);
   if (!isValidCalendar(c)) throwParseError(here(), field, "invalid date " + describe(body));
   return GpsTime::fromCalendar(c);
 }
@@ -279,7 +273,7 @@ std::string_view AntexReader::readRow(std::size_t n, std::string_view field) {
     throwParseError(here(), field, "expected " + std::to_string(n) + " values on the ZEN1..ZEN2/DZEN grid, found " + found);
   }
   // Blank-separated with the right count: a number the short form does not cover, or not a number.
-  for (std::size_t k = 0; k < n; ++k) row_[k] = number(tok_[k + 1], here(), field);
+  for (std::size_t k = 0; k < n; ++k) row_[k] = parseFiniteDouble(tok_[k + 1], here(), field);
   return tok_[0];
 }
 
@@ -332,7 +326,7 @@ void AntexReader::readFrequency(Pending& p, bool rms) {
                                                std::to_string(p.azimuthRows) + " azimuth rows (DAZI " + fmt(p.a.dazi) + ")");
     }
     const std::string_view lead = readRow(p.gridPoints, kAzimuthRow);
-    const double az = number(lead, here(), kAzimuthRow);
+    const double az = parseFiniteDouble(lead, here(), kAzimuthRow);
     if (std::abs(az - expected) > 0.05 + 1e-9) {
       throwParseError(here(), kAzimuthRow, "azimuth " + fmt(az) + " where " + fmt(expected) + " was expected (DAZI " +
                                                fmt(p.a.dazi) + ")");

@@ -99,12 +99,6 @@ void tokenize(std::string_view line, std::size_t from, std::vector<Token>& out, 
   }
 }
 
-double finiteNumber(std::string_view text, const TextLocation& where, std::string_view field) {
-  const double v = parseDouble(trim(text), where, field);
-  if (!std::isfinite(v)) throwParseError(where, field, "not a finite number '" + std::string(trim(text)) + "'");
-  return v;
-}
-
 // The product time scale (product_time_scale.hpp) of a TIME_SYSTEM value, or empty if unknown.
 std::string_view productScale(std::string_view ts) {
   if (ts == "G") return "GPS";
@@ -322,10 +316,10 @@ void BiasSinexReader::solutionLine() {
   e.unit = std::string(unit);
   const double scale = unit == "ns" ? kNsToS : 1.0;
   if (tok_.size() < 2) throwParseError(here(), kValue, "missing value");
-  e.value = finiteNumber(tok_[1].text, here(), kValue) * scale;
+  e.value = parseFiniteDouble(tok_[1].text, here(), kValue) * scale;
   std::size_t k = 2;
   if (k < tok_.size() && tok_[k].pos < kSlopeFrom) {
-    const double s = finiteNumber(tok_[k].text, here(), kStdDev);
+    const double s = parseFiniteDouble(tok_[k].text, here(), kStdDev);
     if (s < 0.0) throwParseError(here(), kStdDev, "negative standard deviation " + describe(tok_[k].text));
     e.sigma = s * scale;
     ++k;
@@ -333,7 +327,7 @@ void BiasSinexReader::solutionLine() {
   if (tok_.size() - k > 2) throwParseError(here(), kValue, "too many values after the unit");
   for (std::string_view field = kSlope; k < tok_.size(); ++k, field = kStdDev) {
     if (tok_[k].pos < kSlopeFrom) throwParseError(here(), field, "value " + describe(tok_[k].text) + " before column 105");
-    finiteNumber(tok_[k].text, here(), field);  // the slope is not kept
+    parseFiniteDouble(tok_[k].text, here(), field);  // the slope is not kept
   }
   d_.entries.push_back(std::move(e));
 }

@@ -46,12 +46,6 @@ std::size_t tokens(std::string_view text, std::string_view* out, std::size_t max
   return n;
 }
 
-double number(std::string_view text, const TextLocation& where, std::string_view field) {
-  const double v = parseDouble(text, where, field);
-  if (!std::isfinite(v)) throwParseError(where, field, "not a finite number '" + std::string(text) + "'");
-  return v;
-}
-
 int intToken(std::string_view text, const TextLocation& where, std::string_view field, long lo, long hi) {
   const long v = parseInt(text, where, field);
   if (v < lo || v > hi) throwParseError(where, field, "value " + std::to_string(v) + " out of range");
@@ -80,7 +74,7 @@ void ClockReader::readHeader() {
   if (!endsWithLabel(line_, "RINEX VERSION / TYPE")) {
     throwParseError(here(), "RINEX VERSION / TYPE", "first line is not 'RINEX VERSION / TYPE'");
   }
-  d_.version = number(trimmedColumn(line_, 0, 9), here(), "RINEX version");
+  d_.version = parseFiniteDouble(trimmedColumn(line_, 0, 9), here(), "RINEX version");
   if (d_.version < 2.0 || d_.version >= 4.0) {
     throwParseError(here(), "RINEX version", "unsupported clock RINEX version " + std::string(trimmedColumn(line_, 0, 9)));
   }
@@ -138,7 +132,7 @@ void ClockReader::readRecord() {
   c.minute = intToken(tok[4], here(), "epoch minute", 0, 59);
   // F10.6 seconds: finer digits are rounded away (the epochs compared and written are the ones the
   // format can hold).
-  c.second = std::round(number(tok[5], here(), "epoch second") * 1e6) * 1e-6;
+  c.second = std::round(parseFiniteDouble(tok[5], here(), "epoch second") * 1e6) * 1e-6;
   if (!isValidCalendar(c)) throwParseError(here(), "epoch", "invalid date/time");
   const int count = intToken(tok[6], here(), "number of data values", 1, kMaxValues);
   const std::size_t onFirst = static_cast<std::size_t>(std::min(count, 2));
@@ -147,7 +141,7 @@ void ClockReader::readRecord() {
                                                " on the first line");
   }
   double values[kMaxValues] = {};
-  for (std::size_t k = 0; k < onFirst; ++k) values[k] = number(tok[7 + k], here(), k == 0 ? "clock bias" : "bias sigma");
+  for (std::size_t k = 0; k < onFirst; ++k) values[k] = parseFiniteDouble(tok[7 + k], here(), k == 0 ? "clock bias" : "bias sigma");
   if (count > 2) {
     if (!in_.next(line_)) throwParseError(here(), "data values", "unexpected end of file in a continuation line");
     std::string_view more[5];
@@ -155,7 +149,7 @@ void ClockReader::readRecord() {
     if (m != static_cast<std::size_t>(count - 2)) {
       throwParseError(here(), "data values", std::to_string(count - 2) + " values expected on the continuation line");
     }
-    for (std::size_t k = 0; k < m; ++k) values[2 + k] = number(more[k], here(), "data values");
+    for (std::size_t k = 0; k < m; ++k) values[2 + k] = parseFiniteDouble(more[k], here(), "data values");
   }
   if (!sat) {
     ++d_.skippedRecords;

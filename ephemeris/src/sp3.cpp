@@ -38,12 +38,6 @@ constexpr std::size_t kMaxReserve = 4096;   // never pre-allocate more than this
 
 bool startsWith(std::string_view s, std::string_view p) { return s.substr(0, p.size()) == p; }
 
-double finiteNumber(std::string_view text, const TextLocation& where, std::string_view field) {
-  const double v = parseDouble(trim(text), where, field);
-  if (!std::isfinite(v)) throwParseError(where, field, "not a finite number '" + std::string(trim(text)) + "'");
-  return v;
-}
-
 int intField(std::string_view text, const TextLocation& where, std::string_view field, long lo, long hi) {
   const long v = parseInt(trim(text), where, field);
   if (v < lo || v > hi) {
@@ -73,7 +67,7 @@ CalendarTime parseCalendar(std::string_view text, const TextLocation& where, std
   c.minute = intField(tok[4], where, field, 0, 59);
   // F11.8 seconds: anything finer than the field's 1e-8 s is rounded away, so that the epochs
   // compared and written are the ones the format can hold.
-  c.second = std::round(finiteNumber(tok[5], where, field) * 1e8) * 1e-8;
+  c.second = std::round(parseFiniteDouble(tok[5], where, field) * 1e8) * 1e-8;
   if (!isValidCalendar(c)) throwParseError(where, field, "invalid date/time '" + std::string(trim(text)) + "'");
   return c;
 }
@@ -141,9 +135,9 @@ void Sp3Reader::readHeader() {
   need("##");
   if (!startsWith(line_, "##")) throwParseError(here(), "##", "expected the '##' line");
   intField(column(line_, 3, 4), here(), "GPS week", 0, 99999);
-  const double sow = finiteNumber(column(line_, 8, 15), here(), "seconds of week");
+  const double sow = parseFiniteDouble(column(line_, 8, 15), here(), "seconds of week");
   if (sow < 0.0 || sow >= kSecondsPerWeek) throwParseError(here(), "seconds of week", "out of range");
-  d_.interval = finiteNumber(column(line_, 24, 14), here(), "epoch interval");
+  d_.interval = parseFiniteDouble(column(line_, 24, 14), here(), "epoch interval");
   if (!(d_.interval > 0.0 && d_.interval < 1e5)) throwParseError(here(), "epoch interval", "must be in (0, 1e5) s (F14.8)");
   intField(column(line_, 39, 5), here(), "MJD", 0, 999999);
 
@@ -270,9 +264,9 @@ void Sp3Reader::readBody() {
       inEpoch.push_back(sat);
       Sp3Record r;
       r.sat = sat;
-      const double x = finiteNumber(column(line_, 4, 14), here(), "x");
-      const double y = finiteNumber(column(line_, 18, 14), here(), "y");
-      const double z = finiteNumber(column(line_, 32, 14), here(), "z");
+      const double x = parseFiniteDouble(column(line_, 4, 14), here(), "x");
+      const double y = parseFiniteDouble(column(line_, 18, 14), here(), "y");
+      const double z = parseFiniteDouble(column(line_, 32, 14), here(), "z");
       if (!(x == 0.0 && y == 0.0 && z == 0.0)) r.position = Eigen::Vector3d(x, y, z) * 1000.0;
       const auto clk = parseOptionalDouble(trimmedColumn(line_, 46, 14), here(), "clock");
       if (clk && !std::isfinite(*clk)) throwParseError(here(), "clock", "not a finite number");
@@ -289,9 +283,9 @@ void Sp3Reader::readBody() {
       if (!(sat == last->sat) || lastHasV) {
         throwParseError(here(), "V record", "velocity record of " + sat.str() + " does not follow its position record");
       }
-      const double vx = finiteNumber(column(line_, 4, 14), here(), "vx");
-      const double vy = finiteNumber(column(line_, 18, 14), here(), "vy");
-      const double vz = finiteNumber(column(line_, 32, 14), here(), "vz");
+      const double vx = parseFiniteDouble(column(line_, 4, 14), here(), "vx");
+      const double vy = parseFiniteDouble(column(line_, 18, 14), here(), "vy");
+      const double vz = parseFiniteDouble(column(line_, 32, 14), here(), "vz");
       last->velocity = (vx == 0.0 && vy == 0.0 && vz == 0.0) ? Eigen::Vector3d(Eigen::Vector3d::Constant(kNaN))
                                                              : Eigen::Vector3d(Eigen::Vector3d(vx, vy, vz) * 0.1);  // dm/s
       const auto rate = parseOptionalDouble(trimmedColumn(line_, 46, 14), here(), "clock rate");

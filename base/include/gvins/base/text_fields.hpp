@@ -36,6 +36,8 @@ std::optional<double> parseOptionalDouble(std::string_view text, const TextLocat
 bool parseShortDecimal(std::string_view text, double& v);
 /// As parseOptionalDouble but a blank field is an error too.
 double parseDouble(std::string_view text, const TextLocation& where, std::string_view field);
+/// As parseDouble, and NaN or infinity ("nan", "inf", overflow) is an error too.
+double parseFiniteDouble(std::string_view text, const TextLocation& where, std::string_view field);
 /// Blank means `blankValue`.
 double parseDoubleOr(std::string_view text, double blankValue, const TextLocation& where,
                      std::string_view field);
