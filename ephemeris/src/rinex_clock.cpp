@@ -141,7 +141,8 @@ void ClockReader::readRecord() {
                                                " on the first line");
   }
   double values[kMaxValues] = {};
-  for (std::size_t k = 0; k < onFirst; ++k) values[k] = parseFiniteDouble(tok[7 + k], here(), k == 0 ? "clock bias" : "bias sigma");
+  for (std::size_t k = 0; k < onFirst; ++k)
+    values[k] = parseFiniteDouble(tok[7 + k], here(), k == 0 ? "clock bias" : "bias sigma");
   if (count > 2) {
     if (!in_.next(line_)) throwParseError(here(), "data values", "unexpected end of file in a continuation line");
     std::string_view more[5];
