@@ -26,17 +26,6 @@ namespace {
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
 constexpr double kAu = 1.495978707e11;  // m (IAU 2012)
 
-GpsTime utc(int y, int mo, int d, int h, int mi, double s = 0.0) {
-  CalendarTime c;
-  c.year = y;
-  c.month = mo;
-  c.day = d;
-  c.hour = h;
-  c.minute = mi;
-  c.second = s;
-  return utcToGpst(c);
-}
-
 double declinationDeg(const Eigen::Vector3d& r) { return std::asin(r.z() / r.norm()) / kDeg; }
 
 }  // namespace
@@ -45,23 +34,23 @@ double declinationDeg(const Eigen::Vector3d& r) { return std::asin(r.z() / r.nor
 // Example 3-5: 1992-08-20 12:14 UT1 -> 152.578787810 deg (UT1 taken as UTC here, as the
 // function does).
 TEST(SunPosition, SiderealTimeOfAPublishedExample) {
-  EXPECT_NEAR(greenwichMeanSiderealTime(utc(1992, 8, 20, 12, 14)) / kDeg, 152.578787810, 1e-6);
+  EXPECT_NEAR(greenwichMeanSiderealTime(utcToGpst({1992, 8, 20, 12, 14, 0.0})) / kDeg, 152.578787810, 1e-6);
 }
 
 // June solstice 2024-06-20 20:51 UTC: declination = obliquity (23.4393 deg), the Sun ~1.0163 AU
 // away, and overhead at about 132.4 deg W (apparent noon: 12 h - 20.85 h + 1.5 min equation of
 // time, times 15 deg/h). March equinox 2024-03-20 03:06 UTC: declination 0 (it moves 0.017 deg/h).
 TEST(SunPosition, SolsticeAndEquinox) {
-  const Eigen::Vector3d s = sunPositionEcef(utc(2024, 6, 20, 20, 51));
+  const Eigen::Vector3d s = sunPositionEcef(utcToGpst({2024, 6, 20, 20, 51, 0.0}));
   EXPECT_NEAR(declinationDeg(s), 23.4393, 0.02);
   EXPECT_NEAR(s.norm() / kAu, 1.0163, 0.0005);
   EXPECT_NEAR(std::atan2(s.y(), s.x()) / kDeg, -132.4, 0.3);
-  const Eigen::Vector3d e = sunPositionEcef(utc(2024, 3, 20, 3, 6));
+  const Eigen::Vector3d e = sunPositionEcef(utcToGpst({2024, 3, 20, 3, 6, 0.0}));
   EXPECT_NEAR(declinationDeg(e), 0.0, 0.03);
   EXPECT_NEAR(e.norm() / kAu, 0.996, 0.001);
   // Twelve hours later the Sun stands over the opposite meridian (to the equation of time's
   // change, seconds).
-  const Eigen::Vector3d e12 = sunPositionEcef(utc(2024, 3, 20, 15, 6));
+  const Eigen::Vector3d e12 = sunPositionEcef(utcToGpst({2024, 3, 20, 15, 6, 0.0}));
   double dl = (std::atan2(e12.y(), e12.x()) - std::atan2(e.y(), e.x())) / kDeg;
   dl = std::remainder(dl, 360.0);
   EXPECT_NEAR(std::abs(dl), 180.0, 0.2);
@@ -70,7 +59,7 @@ TEST(SunPosition, SolsticeAndEquinox) {
 // Yaw steering: z to the Earth's centre, y perpendicular to the Sun direction, x on the Sun's
 // side, a proper rotation.
 TEST(SatelliteAttitude, YawSteeringAxesFollowTheirDefinition) {
-  const Eigen::Vector3d sun = sunPositionEcef(utc(2024, 6, 24, 8, 0));
+  const Eigen::Vector3d sun = sunPositionEcef(utcToGpst({2024, 6, 24, 8, 0, 0.0}));
   for (const Eigen::Vector3d& pos : {Eigen::Vector3d(15e6, -10e6, 18e6), Eigen::Vector3d(-26e6, 2e6, -1e6),
                                      Eigen::Vector3d(5e6, 25e6, 7e6)}) {
     const Eigen::Matrix3d R = yawSteeringAxes(pos, sun);
