@@ -180,7 +180,7 @@ int main(int argc, char** argv) {
       int n = 0;
     };
     std::map<int, Acc> acc;
-    gvins::EphemerisStore preciseStore = store;  // the products with the antenna offsets, if any
+    gvins::EphemerisStore preciseStore;  // the products with the antenna offsets, if any
     preciseStore.setPrecise(precise);
     if (antennas) preciseStore.setSatelliteAntennas(antennas);
     std::printf("gpst,sat,radial_m,along_m,cross_m,clock_m,sisre_m\n");
