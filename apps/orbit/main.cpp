@@ -67,7 +67,8 @@ bool parseTime(const char* text, gvins::CalendarTime& c) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<std::string> files, sp3Files, clockFiles, antennaFiles;
+  std::vector<std::string> files;
+  gvins::PreciseProductFiles products;
   const char* timeText = nullptr;
   bool utc = false, unhealthy = false, realtime = false, compare = false;
   double duration = 0.0, step = 300.0;
@@ -107,17 +108,14 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "gvins-orbit: unknown option '%s' (see --help)\n", a.c_str());
       return 2;
     } else {
-      switch (gvins::preciseFileKind(a)) {
-        case gvins::PreciseFileKind::kOrbit: sp3Files.push_back(a); break;
-        case gvins::PreciseFileKind::kClock: clockFiles.push_back(a); break;
-        case gvins::PreciseFileKind::kAntenna: antennaFiles.push_back(a); break;
-        case gvins::PreciseFileKind::kBias:
-          std::fprintf(stderr, "gvins-orbit: note: %s: code biases do not change satellite states; not used\n", a.c_str());
-          break;
-        case gvins::PreciseFileKind::kOther: files.push_back(a); break;
-      }
+      if (!products.add(a)) files.push_back(a);
     }
   }
+  for (const std::string& b : products.biases)
+    std::fprintf(stderr, "gvins-orbit: note: %s: code biases do not change satellite states; not used\n", b.c_str());
+  const std::vector<std::string>& sp3Files = products.orbits;
+  const std::vector<std::string>& clockFiles = products.clocks;
+  const std::vector<std::string>& antennaFiles = products.antennas;
   if (compare && sp3Files.empty()) {
     std::fprintf(stderr, "gvins-orbit: --compare needs a precise orbit file (*.sp3)\n");
     return 2;

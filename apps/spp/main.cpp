@@ -268,24 +268,18 @@ int main(int argc, char** argv) {
   // Navigation data.
   EphemerisStore nav;
   try {
-    std::vector<std::string> orbits, clocks, antennas, biases;
+    PreciseProductFiles products;
     for (std::size_t i = 1; i < args.inputs.size(); ++i) {
-      switch (preciseFileKind(args.inputs[i])) {
-        case PreciseFileKind::kOrbit: orbits.push_back(args.inputs[i]); break;
-        case PreciseFileKind::kClock: clocks.push_back(args.inputs[i]); break;
-        case PreciseFileKind::kAntenna: antennas.push_back(args.inputs[i]); break;
-        case PreciseFileKind::kBias: biases.push_back(args.inputs[i]); break;
-        case PreciseFileKind::kOther: nav.add(readRinexNav(args.inputs[i])); break;
-      }
+      if (!products.add(args.inputs[i])) nav.add(readRinexNav(args.inputs[i]));
     }
-    if (!antennas.empty()) nav.setSatelliteAntennas(readAntennaFiles(antennas));
-    if (!biases.empty()) nav.setCodeBiases(readCodeBiasFiles(biases));
-    if (orbits.empty() && !clocks.empty()) {
+    if (!products.antennas.empty()) nav.setSatelliteAntennas(readAntennaFiles(products.antennas));
+    if (!products.biases.empty()) nav.setCodeBiases(readCodeBiasFiles(products.biases));
+    if (products.orbits.empty() && !products.clocks.empty()) {
       std::fprintf(stderr, "gvins-spp: error: clock files need an SP3 orbit file\n");
       return 2;
     }
-    if (!orbits.empty()) {
-      auto precise = readPreciseProducts(orbits, clocks);
+    if (!products.orbits.empty()) {
+      auto precise = readPreciseProducts(products.orbits, products.clocks);
       if (!args.quiet) std::fprintf(stderr, "precise products: %zu satellites\n", precise->satellites().size());
       nav.setPrecise(std::move(precise));
     }

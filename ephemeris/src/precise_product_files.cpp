@@ -19,6 +19,17 @@ PreciseFileKind preciseFileKind(std::string_view path) {
   return PreciseFileKind::kOther;
 }
 
+bool PreciseProductFiles::add(const std::string& path) {
+  switch (preciseFileKind(path)) {
+    case PreciseFileKind::kOrbit: orbits.push_back(path); return true;
+    case PreciseFileKind::kClock: clocks.push_back(path); return true;
+    case PreciseFileKind::kAntenna: antennas.push_back(path); return true;
+    case PreciseFileKind::kBias: biases.push_back(path); return true;
+    case PreciseFileKind::kOther: return false;
+  }
+  return false;
+}
+
 std::shared_ptr<PreciseEphemeris> readPreciseProducts(const std::vector<std::string>& orbitFiles,
                                                       const std::vector<std::string>& clockFiles) {
   auto precise = std::make_shared<PreciseEphemeris>();

@@ -68,23 +68,16 @@ class OutFile {
   std::ofstream f_;
 };
 
-// Precise products in a dataset's gnss folder (preciseFileKind: *.sp3, *.clk, *.atx, *.bia, also gzipped
-// or upper case), sorted by name (consecutive days).
-void findPreciseProducts(const fs::path& dir, std::vector<std::string>& sp3, std::vector<std::string>& clk,
-                         std::vector<std::string>& atx, std::vector<std::string>& bia) {
+// Precise products in a dataset's gnss folder (preciseFileKind: *.sp3, *.clk, *.atx, *.bia, also
+// gzipped or upper case), each list sorted by name (consecutive days).
+PreciseProductFiles findPreciseProducts(const fs::path& dir) {
+  PreciseProductFiles p;
   std::error_code ec;
   for (const auto& e : fs::directory_iterator(dir, ec)) {
-    if (!e.is_regular_file()) continue;
-    const PreciseFileKind kind = preciseFileKind(e.path().string());
-    if (kind == PreciseFileKind::kOrbit) sp3.push_back(e.path().string());
-    else if (kind == PreciseFileKind::kClock) clk.push_back(e.path().string());
-    else if (kind == PreciseFileKind::kAntenna) atx.push_back(e.path().string());
-    else if (kind == PreciseFileKind::kBias) bia.push_back(e.path().string());
+    if (e.is_regular_file()) p.add(e.path().string());
   }
-  std::sort(sp3.begin(), sp3.end());
-  std::sort(clk.begin(), clk.end());
-  std::sort(atx.begin(), atx.end());
-  std::sort(bia.begin(), bia.end());
+  for (auto* list : {&p.orbits, &p.clocks, &p.antennas, &p.biases}) std::sort(list->begin(), list->end());
+  return p;
 }
 
 /// The navigation file of a gvins-sim gnss/ folder: the first regular file that is neither an
@@ -368,11 +361,13 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
     if (navPath.empty()) throw ParseError(gdir.string(), 0, "navigation", "no navigation file in the gnss folder (use --nav)");
     g.nav.add(readRinexNav(navPath));
     if (!opt.broadcastOnly) {
-      std::vector<std::string> sp3 = opt.sp3Files, clk = opt.clockFiles, atx, bia;
       // The folder's files where none were given (an --atx / --bia file replaces the folder's).
-      if (sp3.empty() && clk.empty()) findPreciseProducts(gdir, sp3, clk, atx, bia);
-      if (!opt.antennaFiles.empty()) atx = opt.antennaFiles;
-      if (!opt.biasFiles.empty()) bia = opt.biasFiles;
+      PreciseProductFiles found;
+      if (opt.sp3Files.empty() && opt.clockFiles.empty()) found = findPreciseProducts(gdir);
+      const std::vector<std::string>& sp3 = opt.sp3Files.empty() ? found.orbits : opt.sp3Files;
+      const std::vector<std::string>& clk = opt.clockFiles.empty() ? found.clocks : opt.clockFiles;
+      const std::vector<std::string>& atx = opt.antennaFiles.empty() ? found.antennas : opt.antennaFiles;
+      const std::vector<std::string>& bia = opt.biasFiles.empty() ? found.biases : opt.biasFiles;
       if (!sp3.empty()) {
         auto precise = readPreciseProducts(sp3, clk);
         sum.preciseSatellites = precise->satellites().size();

@@ -20,6 +20,14 @@ enum class PreciseFileKind { kOrbit, kClock, kAntenna, kBias, kOther };
 /// "*.bsx" Bias-SINEX code biases, anything else kOther.
 PreciseFileKind preciseFileKind(std::string_view path);
 
+/// Product files sorted by kind (preciseFileKind), in the order given.
+struct PreciseProductFiles {
+  std::vector<std::string> orbits, clocks, antennas, biases;
+  /// Files a tool was given: a product file goes into its list (true); anything else is left to
+  /// the caller (false).
+  bool add(const std::string& path);
+};
+
 /// Reads the orbit files, then the clock files (which take precedence over SP3 clocks) into one
 /// PreciseEphemeris. Throws ParseError (file, line, field) for a malformed file.
 std::shared_ptr<PreciseEphemeris> readPreciseProducts(const std::vector<std::string>& orbitFiles,
