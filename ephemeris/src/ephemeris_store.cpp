@@ -29,6 +29,7 @@
 
 #include "gvins/ephemeris/ephemeris_store.hpp"
 
+#include "gvins/base/constants.hpp"
 #include "gvins/ephemeris/satellite_antenna.hpp"
 
 namespace gvins {
@@ -323,7 +324,52 @@ std::optional<double> EphemerisStore::preciseCodeBias(const SatelliteState& stat
 double EphemerisStore::codeDelay(const SatelliteState& state, SatId sat, ObsCode code, const GpsTime& t,
                                  const EphemerisSelection& policy) const {
   if (const auto osb = preciseCodeBias(state, sat, code, t)) return *osb;
+  if (state.ssr)
+    if (const auto b = ssr_.codeBias(sat, code, t)) return -*b / constants::kSpeedOfLight;
   return groupDelay(sat, code, t, policy);
+}
+
+void EphemerisStore::addSsr(const SsrMessage& message) {
+  ssr_.add(message);
+  ++revision_;
+}
+
+void EphemerisStore::setSsrOptions(const SsrOptions& options) {
+  ssr_.setOptions(options);  // only the selection changes; what was received is kept
+  ++revision_;
+}
+
+std::optional<SatelliteState> EphemerisStore::ssrState(SatId sat, const GpsTime& t,
+                                                       const EphemerisSelection& policy) const {
+  if (ssr_.empty() || !sat.valid()) return std::nullopt;
+  const auto sel = ssr_.select(sat, t);
+  if (!sel) return std::nullopt;
+  const int iod = sel->orbit.issueOfData;
+  std::optional<SatelliteState> broadcast;
+  if (sat.system == System::Glonass) {
+    const GlonassEphemeris* best = nullptr;
+    for (const auto& g : glonassRecords(sat)) {
+      if (ssrIssueOfData(g) != iod || std::abs(t - g.toe) > validityHalfWindow(g)) continue;
+      if (!best || std::abs(t - g.toe) < std::abs(t - best->toe)) best = &g;
+    }
+    if (best) broadcast = glonassSatelliteState(*best, t);
+  } else {
+    const KeplerEphemeris* best = nullptr;
+    auto rank = [&](const KeplerEphemeris& e) {
+      if (sat.system != System::Galileo) return 0;
+      const bool inav = e.message == NavMessage::GalileoInav;
+      return inav == policy.preferGalileoInav ? 0 : 1;
+    };
+    for (const auto& e : keplerRecords(sat)) {
+      if (ssrIssueOfData(e) != iod || std::abs(t - e.toe) > validityHalfWindow(e)) continue;
+      if (!best || rank(e) < rank(*best) ||
+          (rank(e) == rank(*best) && std::abs(t - e.toe) < std::abs(t - best->toe)))
+        best = &e;
+    }
+    if (best) broadcast = keplerSatelliteState(*best, t);
+  }
+  if (!broadcast || (!broadcast->healthy && !policy.allowUnhealthy)) return std::nullopt;
+  return applySsr(*broadcast, *sel, t);
 }
 
 std::optional<SatelliteState> EphemerisStore::preciseState(SatId sat, const GpsTime& t) const {
@@ -342,6 +388,10 @@ std::optional<SatelliteState> EphemerisStore::preciseState(SatId sat, const GpsT
 std::optional<SatelliteState> EphemerisStore::satelliteState(SatId sat, const GpsTime& t,
                                                              const EphemerisSelection& policy) const {
   if (auto st = preciseState(sat, t)) return st;
+  if (!ssr_.empty()) {
+    if (auto st = ssrState(sat, t, policy)) return st;
+    if (ssr_.coversSystem(sat.system, t)) return std::nullopt;
+  }
   if (sat.system == System::Glonass) {
     if (const auto* g = selectGlonass(sat, t, policy)) return glonassSatelliteState(*g, t);
     return std::nullopt;

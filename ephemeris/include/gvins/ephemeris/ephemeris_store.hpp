@@ -16,6 +16,7 @@
 #include "gvins/ephemeris/precise_ephemeris.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "gvins/ephemeris/satellite_state.hpp"
+#include "gvins/ephemeris/ssr_corrections.hpp"
 
 namespace gvins {
 
@@ -93,13 +94,26 @@ class EphemerisStore {
   const BiasSinexData* codeBiases() const { return biases_.get(); }
   /// Delay (s) of the code `code` of `sat` against the clock of `state`: the code OSB of the
   /// biases when the state is precise and they have one for the signal (IGS convention: the OSBs of
-  /// the clock's reference pair combine to zero), else the broadcast group delay (groupDelay()).
+  /// the clock's reference pair combine to zero); for an SSR state the SSR code bias of the signal
+  /// (−bias/c: RTCM biases are added to the measurement); else the broadcast group delay
+  /// (groupDelay()).
   double codeDelay(const SatelliteState& state, SatId sat, ObsCode code, const GpsTime& t,
                    const EphemerisSelection& policy = {}) const;
   /// The OSB part of codeDelay alone: the code OSB (s) when `state` is precise and the biases
   /// have one for the signal, else nullopt (for callers that hold their broadcast record already).
   std::optional<double> preciseCodeBias(const SatelliteState& state, SatId sat, ObsCode code,
                                         const GpsTime& t) const;
+  /// SSR corrections (real-time streams; ssr_corrections.hpp). Where no precise products cover a
+  /// satellite, satelliteState corrects the broadcast record that the SSR orbit correction names;
+  /// satellites of a system the stream covers at t but without a valid correction of their own
+  /// get no state (their clocks would be in another datum). Changes revision().
+  void addSsr(const SsrMessage& message);
+  void setSsrOptions(const SsrOptions& options);
+  const SsrCorrections& ssr() const { return ssr_; }
+  /// The SSR-corrected state alone (std::nullopt without a valid correction or matching record).
+  std::optional<SatelliteState> ssrState(SatId sat, const GpsTime& t,
+                                         const EphemerisSelection& policy = {}) const;
+
   /// Group delay (s) for a pseudorange on `code` from the record selected at t (0 if none).
   double groupDelay(SatId sat, ObsCode code, const GpsTime& t,
                     const EphemerisSelection& policy = {}) const;
@@ -132,6 +146,7 @@ class EphemerisStore {
   std::shared_ptr<const PreciseEphemeris> precise_;
   std::shared_ptr<const AntexData> antex_;
   std::shared_ptr<const BiasSinexData> biases_;
+  SsrCorrections ssr_;
   std::uint64_t revision_ = 0;
 };
 

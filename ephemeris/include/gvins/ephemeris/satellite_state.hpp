@@ -25,6 +25,8 @@ struct SatelliteState {
   /// From precise products (SP3/RINEX clock; gvins/ephemeris/precise_ephemeris.hpp), not from a
   /// broadcast record.
   bool precise = false;
+  /// A broadcast state corrected by SSR (gvins/ephemeris/ssr_corrections.hpp).
+  bool ssr = false;
 };
 
 /// Keplerian orbit (IS-GPS-200 table 20-IV; Galileo OS SIS ICD 5.1.1; BeiDou GEO rotation per
