@@ -317,6 +317,10 @@ void EphemerisStore::setCodeBiases(std::shared_ptr<const BiasSinexData> biases) 
 
 std::optional<double> EphemerisStore::preciseCodeBias(const SatelliteState& state, SatId sat, ObsCode code,
                                                       const GpsTime& t) const {
+  if (state.ssr) {
+    if (const auto b = ssr_.codeBias(sat, code, t)) return -*b / constants::kSpeedOfLight;
+    return std::nullopt;
+  }
   if (!state.precise || !biases_) return std::nullopt;
   return biases_->codeOsb(sat, code, t);
 }
@@ -324,8 +328,6 @@ std::optional<double> EphemerisStore::preciseCodeBias(const SatelliteState& stat
 double EphemerisStore::codeDelay(const SatelliteState& state, SatId sat, ObsCode code, const GpsTime& t,
                                  const EphemerisSelection& policy) const {
   if (const auto osb = preciseCodeBias(state, sat, code, t)) return *osb;
-  if (state.ssr)
-    if (const auto b = ssr_.codeBias(sat, code, t)) return -*b / constants::kSpeedOfLight;
   return groupDelay(sat, code, t, policy);
 }
 

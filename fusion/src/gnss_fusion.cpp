@@ -119,8 +119,12 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     // ionosphere (Klobuchar corrects about half of the delay; IS-GPS-200N 20.3.3.5.2.5).
     // Broadcast orbit/clock error (SISRE) of the system: a bias per satellite, in the variance so
     // that systems with poorer broadcast products weigh less.
-    // Precise products (SP3/RINEX clock) where the store has them: centimetres instead.
-    const auto& ephemerisError = tx->state.precise ? config_.preciseEphemerisError : config_.ephemerisError;
+    // Precise products (SP3/RINEX clock) or SSR corrections where the store has them: centimetres
+    // instead.
+    // SSR-corrected states (real-time streams) count as precise: their orbit/clock error is that
+    // of real-time products, a few centimetres.
+    const auto& ephemerisError =
+        tx->state.precise || tx->state.ssr ? config_.preciseEphemerisError : config_.ephemerisError;
     const double ephemerisVariance = std::pow(ephemerisError[static_cast<std::size_t>(systemIndex(so.sat.system))], 2);
     // Carrier-smoothed code: noise and multipath averaged over the arc (CarrierSmoother), down
     // to `smoothed_code_factor` of the raw sigma.

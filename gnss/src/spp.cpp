@@ -183,14 +183,27 @@ bool SppSolver::gatherMeasurements(const ObsEpoch& epoch, SppSolution& sol, std:
         st = p;
       }
     }
+    // SSR corrections (real-time streams) where no products cover the satellite: the record the
+    // correction names, corrected; a satellite of a system the stream covers but without its own
+    // correction is left out (its broadcast clock is in another datum).
+    if (st && !st->precise && !nav_.ssr().empty()) {
+      if (auto c = nav_.ssrState(so.sat, ttx, cfg.ephemeris)) {
+        c->healthy = st->healthy;
+        st = c;
+      } else if (nav_.ssr().coversSystem(so.sat.system, ttx)) {
+        out.use = SatelliteUse::NoEphemeris;
+        continue;
+      }
+    }
     if (!st || (!st->healthy && !cfg.ephemeris.allowUnhealthy) || !st->position.allFinite() ||
         st->position.norm() < 1e7) {
       out.use = SatelliteUse::NoEphemeris;
       continue;
     }
     m.state = *st;
-    // Code biases: the OSBs that go with precise clocks (EphemerisStore::codeDelay's rule), else
-    // the broadcast group delays of the record selected above.
+    // Code biases: the OSBs that go with precise clocks or the SSR code biases that go with SSR
+    // clocks (EphemerisStore::codeDelay's rule), else the broadcast group delays of the record
+    // selected above.
     auto groupDelayOf = [&](ObsCode c) {
       if (const auto osb = nav_.preciseCodeBias(*st, so.sat, c, ttx)) return *osb;
       return ge ? broadcastGroupDelay(*ge, c) : broadcastGroupDelay(*ke, c);
@@ -343,9 +356,9 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
       }
       double var = cfg.weighting.codeVariance(m.sat.system, m.azel.elevation, m.snr) * m.noiseFactor * m.noiseFactor;
       var += ionoVar + tropoVar;
-      double eph = m.state.precise ? cfg.preciseEphemerisError[systemIndex(m.sat.system)]
+      double eph = m.state.precise || m.state.ssr ? cfg.preciseEphemerisError[systemIndex(m.sat.system)]
                                    : cfg.ephemerisError[systemIndex(m.sat.system)];
-      if (!m.state.precise && m.state.accuracy > cfg.ephemerisAlarmAccuracy && cfg.ephemerisAlarmAccuracy > 0.0) {
+      if (!m.state.precise && !m.state.ssr && m.state.accuracy > cfg.ephemerisAlarmAccuracy && cfg.ephemerisAlarmAccuracy > 0.0) {
         eph = std::max(eph, std::min(m.state.accuracy, 1000.0));
       }
       var += eph * eph;

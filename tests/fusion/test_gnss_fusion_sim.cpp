@@ -24,6 +24,7 @@
 #include "gvins/sim/flight_pattern.hpp"
 #include "gvins/sim/gnss_epoch_generator.hpp"
 #include "gvins/sim/gnss_precise_products.hpp"
+#include "gvins/sim/gnss_ssr_corrections.hpp"
 #include "gvins/sim/imu_simulator.hpp"
 #include "gvins/vio/so3.hpp"
 #include "imu_gnss_test_backend.hpp"
@@ -45,6 +46,7 @@ struct Scenario {
   EphemerisStore nav;
   /// The same records plus the simulator's precise products (SP3 + RINEX clock text, read back).
   EphemerisStore navPrecise;
+  EphemerisStore navSsr;  // broadcast records + SSR corrections derived from the products
   std::vector<sim::GnssSimEpoch> epochs;  // rover and base, in tag order
   Vector3d basePosition;
 };
@@ -88,6 +90,10 @@ const Scenario& scenario() {
       sc->navPrecise.setPrecise(std::move(precise));
       if (products.antennas) sc->navPrecise.setSatelliteAntennas(std::make_shared<AntexData>(*products.antennas));
     }
+    sc->navSsr.add(nav);
+    for (const SsrMessage& m : sim::makeSsrCorrections(sc->nav, sc->navPrecise, gen.world().start() - 30.0,
+                                                      gen.world().start() + gen.world().duration(), {}))
+      sc->navSsr.addSsr(m);
     sc->basePosition = gen.basePosition();
     std::fprintf(stderr, "scenario: %.1f s flight, %zu IMU samples, %zu GNSS epochs\n", sc->traj->duration(),
                  sc->imu.samples.size(), sc->epochs.size());
@@ -364,11 +370,14 @@ TEST(GnssFusionSim, PreciseProductsRemoveTheBroadcastOrbitClockError) {
     EXPECT_GT(n, 500);
     return std::sqrt(e2 / std::max(n, 1));
   };
-  int preciseB = 0, preciseP = 0;
+  int preciseB = 0, preciseP = 0, preciseS = 0;
   const double broadcast = orbitClockRms(sc.nav, preciseB);
   const double precise = orbitClockRms(sc.navPrecise, preciseP);
-  std::fprintf(stderr, "orbit/clock part of the code residual at truth: broadcast %.3f m, precise products %.3f m\n",
-               broadcast, precise);
+  const double ssr = orbitClockRms(sc.navSsr, preciseS);
+  std::fprintf(stderr,
+               "orbit/clock part of the code residual at truth: broadcast %.3f m, precise products %.3f m, "
+               "SSR %.3f m\n",
+               broadcast, precise, ssr);
   // Measured: broadcast 1.014 m, precise 0.053 m (all systems; GLONASS and BeiDou have the
   // largest errors in both).
   EXPECT_EQ(preciseB, 0);
@@ -376,6 +385,22 @@ TEST(GnssFusionSim, PreciseProductsRemoveTheBroadcastOrbitClockError) {
   EXPECT_GT(broadcast, 0.3);
   EXPECT_LT(precise, 0.08);
   EXPECT_LT(precise, 0.15 * broadcast);
+  // SSR corrections made from the same products (5 s updates, used up to 5 s late with their
+  // rates, 0.1 mm quantisation in the stream): the products' accuracy in real time.
+  EXPECT_EQ(preciseS, 0);  // SSR states are corrected broadcast states, not product states
+  EXPECT_LT(ssr, precise + 0.01);
+}
+
+// End to end: vio+dopp+psr with SSR corrections (real-time) against precise products (post).
+TEST(GnssFusionSim, PseudorangeFusionWithSsrCorrections) {
+  const Scenario& sc = scenario();
+  const RunResult precise = run<double>(mode(GnssFusionMode::kDoppPsr), {}, &sc.navPrecise);
+  const RunResult ssr = run<double>(mode(GnssFusionMode::kDoppPsr), {}, &sc.navSsr);
+  std::fprintf(stderr, "vio+dopp+psr: precise products %.3f m, SSR %.3f m (velocity %.4f / %.4f m/s)\n",
+               precise.posRms, ssr.posRms, precise.velRms, ssr.velRms);
+  ASSERT_GT(ssr.epochs, 100);
+  EXPECT_LT(std::abs(ssr.posRms - precise.posRms), 0.05);
+  EXPECT_LT(ssr.posRms, 0.6);
 }
 
 // End to end: vio+dopp+psr with the precise products against the broadcast records.

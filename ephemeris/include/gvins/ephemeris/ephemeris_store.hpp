@@ -99,8 +99,9 @@ class EphemerisStore {
   /// (groupDelay()).
   double codeDelay(const SatelliteState& state, SatId sat, ObsCode code, const GpsTime& t,
                    const EphemerisSelection& policy = {}) const;
-  /// The OSB part of codeDelay alone: the code OSB (s) when `state` is precise and the biases
-  /// have one for the signal, else nullopt (for callers that hold their broadcast record already).
+  /// The correction-service part of codeDelay alone: the code OSB (s) when `state` is precise and
+  /// the biases have one for the signal, −(SSR code bias)/c when `state` is SSR-corrected and the
+  /// stream has one, else nullopt (for callers that hold their broadcast record already).
   std::optional<double> preciseCodeBias(const SatelliteState& state, SatId sat, ObsCode code,
                                         const GpsTime& t) const;
   /// SSR corrections (real-time streams; ssr_corrections.hpp). Where no precise products cover a

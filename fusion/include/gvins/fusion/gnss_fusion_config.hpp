@@ -84,7 +84,7 @@ struct GnssFusionConfig {
   /// the SPP's error budget (SppConfig::ephemerisError: GPS 0.6, GLONASS 5 with its FDMA code
   /// biases, Galileo 0.3, BeiDou 1.0, QZSS 0.6 m).
   std::array<double, kNumSystems> ephemerisError = SppConfig{}.ephemerisError;
-  /// The same for satellites whose orbit and clock come from precise products
+  /// The same for satellites whose orbit and clock come from precise products or SSR corrections
   /// (SppConfig::preciseEphemerisError: GPS/Galileo 5 cm; GLONASS 5 m for its FDMA code biases).
   std::array<double, kNumSystems> preciseEphemerisError = SppConfig{}.preciseEphemerisError;
 
