@@ -2,18 +2,24 @@
 // navigation file: definitions of RTCM 10403.3 3.5.12.3 (radial/along/cross frame, reference time
 // epoch + update interval / 2, δC added to the broadcast clock), selection as a real-time receiver
 // would see the stream, issue-of-data matching, code-bias sign, and an end-to-end check that
-// corrections computed from "precise" states (the broadcast orbit moved by a known offset) give
-// those states back.
+// corrections made from products (ssrFromProducts; the broadcast orbit moved by a known offset)
+// give the products' states back.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <memory>
 #include <string>
 
 #include <Eigen/Geometry>
 
 #include "gvins/base/constants.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
+#include "gvins/ephemeris/broadcast_sp3.hpp"
+#include "gvins/ephemeris/precise_ephemeris.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
+#include "gvins/ephemeris/sp3.hpp"
+#include "gvins/ephemeris/ssr_from_products.hpp"
 #include "gvins/ephemeris/ssr_corrections.hpp"
 #include "nagoya_recording.hpp"
 
@@ -231,56 +237,57 @@ TEST(SsrCorrections, CodeBiasesAreAddedToTheMeasurementSoTheDelayIsTheirNegative
   EXPECT_DOUBLE_EQ(nav.codeDelay(plain, g, c1c, t0 + 1.0), tgd);
 }
 
-TEST(SsrCorrections, CorrectionsComputedFromPreciseStatesGiveThemBack) {
-  // A correction server's view: "precise" = broadcast orbit moved by a fixed ECEF offset and
-  // clock shifted; it sends δO (and its rate) in the RAC frame of the broadcast state every 5 s
-  // with udi 5 s. A receiver applying them up to 5 s after each epoch gets the precise state
-  // back to the size of the second-order terms (mm).
+TEST(SsrCorrections, CorrectionsMadeFromProductsGiveTheProductStatesBack) {
+  // A correction service's view (ssrFromProducts): "products" = the broadcast orbits moved by a
+  // fixed ECEF offset and clocks shifted by 0.8 m, as SP3/clock data with 300 s nodes; it sends
+  // combined corrections every 5 s (udi 5 s). A receiver applying each one until the next (up to
+  // 7.5 s after the reference time, by its rates) gets the products' states back.
   EphemerisStore nav;
   nav.add(readRinexNav(kNagoya));
   const GpsTime t0 = gvins::test::nagoyaTime(8, 20);
   const Eigen::Vector3d offset(1.5, -0.7, 2.0);
-  const double clockOffset = 0.8 / kC;
-  EphemerisStore rx;
-  rx.add(readRinexNav(kNagoya));
   std::vector<SatId> sats;
-  for (const char* id : {"G05", "G13", "E04", "J03", "C23"}) {
+  for (const char* id : {"G05", "G13", "E04", "J03", "C23", "R07"}) {
     const SatId sat = SatId::parse(id).value();
     if (nav.satelliteState(sat, t0)) sats.push_back(sat);
   }
-  ASSERT_GE(sats.size(), 3u);
-  auto racAt = [&](SatId sat, const GpsTime& t) {
-    const SatelliteState b = *nav.satelliteState(sat, t);
-    const Eigen::Vector3d ea = b.velocity.normalized();
-    const Eigen::Vector3d ec = b.position.cross(b.velocity).normalized();
-    Eigen::Matrix3d m;
-    m.col(0) = ea.cross(ec);
-    m.col(1) = ea;
-    m.col(2) = ec;
-    return Eigen::Vector3d(m.transpose() * (-offset));  // X_brdc − X_precise in RAC
-  };
-  for (double k = 0; k <= 60.0; k += 5.0) {
-    const GpsTime epoch = t0 + k;
-    const GpsTime ref = epoch + 2.5;
-    for (SatId sat : sats) {
-      const int iod = nav.selectKepler(sat, ref)->iode;
-      const Eigen::Vector3d rate = (racAt(sat, ref + 0.5) - racAt(sat, ref - 0.5));
-      rx.addSsr(combined(sat, epoch, iod, racAt(sat, ref), rate, {clockOffset * kC, 0, 0}));
+  ASSERT_GE(sats.size(), 4u);
+  Sp3Data sp3 = broadcastSp3(nav, t0 - 1800.0, t0 + 1800.0, 300.0, sats);
+  for (Sp3Epoch& ep : sp3.epochs)
+    for (Sp3Record& r : ep.records) {
+      r.position += offset;
+      r.clock += 0.8 / kC;
     }
-  }
-  double worst = 0.0;
+  auto precise = std::make_shared<PreciseEphemeris>();
+  precise->add(sp3);
+  EphemerisStore products;
+  products.add(readRinexNav(kNagoya));
+  products.setPrecise(precise);
+  SsrServiceConfig service;
+  const std::vector<SsrMessage> messages = ssrFromProducts(nav, products, t0 - 10.0, t0 + 70.0, service);
+  ASSERT_GE(messages.size(), 16u);  // every 5 s, one message per system with satellites
+  EXPECT_EQ(messages.front().header.kind, SsrKind::kCombined);
+  EXPECT_DOUBLE_EQ(messages.front().header.updateInterval, 5.0);
+  EphemerisStore rx;
+  rx.add(readRinexNav(kNagoya));
+  for (const SsrMessage& m : messages) rx.addSsr(m);
+  double worst = 0.0, worstClock = 0.0;
   for (double dt = 0.0; dt < 60.0; dt += 0.7) {
     const GpsTime t = t0 + dt;
     for (SatId sat : sats) {
-      const SatelliteState b = *nav.satelliteState(sat, t);
+      const auto p = products.preciseState(sat, t);
       const auto s = rx.satelliteState(sat, t);
-      ASSERT_TRUE(s) << sat.str() << " at +" << dt;
-      worst = std::max(worst, (s->position - (b.position + offset)).norm());
-      EXPECT_NEAR((s->clockBias - b.clockBias) * kC, 0.8, 1e-6);
+      ASSERT_TRUE(p && s) << sat.str() << " at +" << dt;
+      EXPECT_TRUE(s->ssr);
+      worst = std::max(worst, (s->position - p->position).norm());
+      worstClock = std::max(worstClock, std::abs(s->clockBias - p->clockBias) * kC);
     }
   }
-  EXPECT_LT(worst, 2e-3);
-  EXPECT_GT(worst, 0.0);
+  // Measured: 1e-5 m position, 1e-8 m clock (second-order terms of the rates' linear
+  // extrapolation over <= 7.5 s).
+  EXPECT_LT(worst, 1e-4);
+  EXPECT_LT(worstClock, 1e-4);
+  std::printf("SSR from products: worst position %.2e m, clock %.2e m\n", worst, worstClock);
 }
 
 TEST(SsrCorrections, UraIndexFollowsDf389) {

@@ -20,11 +20,11 @@
 #include "gvins/ephemeris/rinex_clock.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "gvins/ephemeris/sp3.hpp"
+#include "gvins/ephemeris/ssr_from_products.hpp"
 #include "gvins/fusion/gnss_fusion.hpp"
 #include "gvins/sim/flight_pattern.hpp"
 #include "gvins/sim/gnss_epoch_generator.hpp"
 #include "gvins/sim/gnss_precise_products.hpp"
-#include "gvins/sim/gnss_ssr_corrections.hpp"
 #include "gvins/sim/imu_simulator.hpp"
 #include "gvins/vio/so3.hpp"
 #include "imu_gnss_test_backend.hpp"
@@ -91,8 +91,8 @@ const Scenario& scenario() {
       if (products.antennas) sc->navPrecise.setSatelliteAntennas(std::make_shared<AntexData>(*products.antennas));
     }
     sc->navSsr.add(nav);
-    for (const SsrMessage& m : sim::makeSsrCorrections(sc->nav, sc->navPrecise, gen.world().start() - 30.0,
-                                                      gen.world().start() + gen.world().duration(), {}))
+    for (const SsrMessage& m : ssrFromProducts(sc->nav, sc->navPrecise, gen.world().start() - 30.0,
+                                               gen.world().start() + gen.world().duration(), {}))
       sc->navSsr.addSsr(m);
     sc->basePosition = gen.basePosition();
     std::fprintf(stderr, "scenario: %.1f s flight, %zu IMU samples, %zu GNSS epochs\n", sc->traj->duration(),

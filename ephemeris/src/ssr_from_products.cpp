@@ -1,4 +1,4 @@
-#include "gvins/sim/gnss_ssr_corrections.hpp"
+#include "gvins/ephemeris/ssr_from_products.hpp"
 
 #include <cmath>
 #include <optional>
@@ -7,7 +7,7 @@
 
 #include "gvins/base/constants.hpp"
 
-namespace gvins::sim {
+namespace gvins {
 
 namespace {
 
@@ -62,8 +62,8 @@ Eigen::Vector3d racDifference(const SatelliteState& b, const SatelliteState& p) 
 
 }  // namespace
 
-std::vector<SsrMessage> makeSsrCorrections(const EphemerisStore& broadcast, const EphemerisStore& products,
-                                           const GpsTime& start, const GpsTime& end, const GnssSsrConfig& config) {
+std::vector<SsrMessage> ssrFromProducts(const EphemerisStore& broadcast, const EphemerisStore& products,
+                                        const GpsTime& start, const GpsTime& end, const SsrServiceConfig& config) {
   std::vector<SsrMessage> out;
   if (!(config.interval > 0.0)) return out;
   const std::vector<SatId> sats = broadcast.satellites();
@@ -109,4 +109,4 @@ std::vector<SsrMessage> makeSsrCorrections(const EphemerisStore& broadcast, cons
   return out;
 }
 
-}  // namespace gvins::sim
+}  // namespace gvins
