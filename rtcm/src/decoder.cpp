@@ -6,6 +6,7 @@
 #include "decoder_state.hpp"
 #include "gvins/base/parse_error.hpp"
 #include "gvins/rtcm/message_types.hpp"
+#include "ssr_layout.hpp"
 
 namespace gvins::rtcm {
 namespace {
@@ -252,6 +253,8 @@ void Decoder::decodeMessage(std::span<const std::uint8_t> payload, std::int64_t 
       decodeGalileoEphemeris(s, r, type == 1046);
     } else if (type == 1230) {
       decodeGlonassBiases(s, r);
+    } else if (ssr::messageKind(type)) {
+      decodeSsr(s, r, type);
     } else if (const auto k = msmKind(type)) {
       decodeMsm(s, r, k->system, k->msm);
     }

@@ -116,5 +116,7 @@ void decodeGlonassEphemeris(Decoder::State& s, BitReader& r);
 void decodeBeidouEphemeris(Decoder::State& s, BitReader& r);
 void decodeQzssEphemeris(Decoder::State& s, BitReader& r);
 void decodeGalileoEphemeris(Decoder::State& s, BitReader& r, bool inav);
+/// SSR messages 1057-1068, 1240-1251, 1258-1263 (decode_ssr.cpp).
+void decodeSsr(Decoder::State& s, BitReader& r, int type);
 
 }  // namespace gvins::rtcm

@@ -1,5 +1,7 @@
 #include "gvins/rtcm/message_types.hpp"
 
+#include "ssr_layout.hpp"
+
 namespace gvins::rtcm {
 
 std::optional<MsmKind> msmKind(int type) {
@@ -36,6 +38,8 @@ bool isDecodedType(int type) {
     default:
       break;
   }
+  // SSR of GPS, GLONASS, Galileo, QZSS and BeiDou (SBAS 1252-1257 not decoded).
+  if (ssr::messageKind(type)) return true;
   const auto k = msmKind(type);
   return k && k->system != System::Navic;
 }

@@ -34,6 +34,7 @@ struct Decoded {
   std::vector<AntennaDescriptor> antennas;
   std::vector<ReceiverDescriptor> receivers;
   std::vector<GlonassCodePhaseBiases> biases;
+  std::vector<SsrMessage> ssr;
 };
 
 Decoded decodeAll(Decoder& dec, const std::vector<std::uint8_t>& d, std::size_t chunk = 4096) {
@@ -49,7 +50,8 @@ Decoded decodeAll(Decoder& dec, const std::vector<std::uint8_t>& d, std::size_t 
             else if constexpr (std::is_same_v<T, StationPosition>) out.stations.push_back(v);
             else if constexpr (std::is_same_v<T, AntennaDescriptor>) out.antennas.push_back(v);
             else if constexpr (std::is_same_v<T, ReceiverDescriptor>) out.receivers.push_back(v);
-            else out.biases.push_back(v);
+            else if constexpr (std::is_same_v<T, GlonassCodePhaseBiases>) out.biases.push_back(v);
+            else out.ssr.push_back(v);
           },
           *it);
     }

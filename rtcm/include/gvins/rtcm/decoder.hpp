@@ -1,5 +1,5 @@
-// Streaming RTCM 3 decoder: bytes in (any chunk size), observation epochs, ephemerides and station
-// descriptions out.
+// Streaming RTCM 3 decoder: bytes in (any chunk size), observation epochs, ephemerides, SSR
+// corrections and station descriptions out.
 //
 // Observations. Legacy messages 1001-1004 (GPS, SBAS), 1009-1012 (GLONASS) and MSM1-MSM7 of GPS,
 // GLONASS, Galileo, SBAS, QZSS and BeiDou become gvins::ObsEpoch in GPST with RINEX 3 signal
@@ -12,10 +12,20 @@
 // gap), and at its first observation in a running stream (not in the stream's first epoch,
 // where only a zero lock time is flagged). Legacy phase-range rollovers of +-1500 cycles (RTCM 10403.3, DF012 note) are undone.
 //
+// Ephemerides and SSR. 1019 (GPS), 1020 (GLONASS), 1042 (BeiDou), 1044 (QZSS), 1045/1046
+// (Galileo F/NAV, I/NAV) become gvins::KeplerEphemeris / gvins::GlonassEphemeris; 1230 the GLONASS
+// code-phase biases. The SSR messages of RTCM 10403.3 section 3.5.12 (orbit, clock, code bias,
+// combined orbit and clock, URA, high-rate clock) of GPS 1057-1062, GLONASS 1063-1068, Galileo
+// 1240-1245, QZSS 1246-1251 and BeiDou 1258-1263 become one gvins::SsrMessage each (no merging of
+// multiple messages), with the epoch time resolved to GPST like the observation times and
+// code-bias signal identifiers mapped to RINEX codes (reserved identifiers are skipped and counted
+// in DecoderStats::unknownBiasSignals). SBAS SSR (1252-1257), phase biases (1265-1270), VTEC
+// (1264) and IGS SSR (4076) are not decoded.
+//
 // Time. Times of week (GPS, Galileo, QZSS, SBAS; BeiDou BDT = GPST - 14 s), GLONASS times of day
 // (Moscow time) and truncated week numbers are resolved to the instant nearest a reference time.
-// The reference is DecoderOptions::referenceTime, then follows the decoded epochs (so week
-// rollovers are crossed naturally). Without an option the host clock is used until the stream
+// The reference is DecoderOptions::referenceTime, then follows the decoded observation and SSR
+// epochs (so week rollovers are crossed naturally). Without an option the host clock is used until the stream
 // gives an absolute time: a Galileo (12-bit GST week) or BeiDou (13-bit BDT week) ephemeris, or a
 // GLONASS 1020 with its four-year interval N4 and day NT; epochs decoded before that carry the
 // host-clock week.
@@ -29,7 +39,8 @@
 // message comes first in its epoch, the BeiDou-only epoch it opened (read as BDT) is retimed when
 // the other systems' messages arrive exactly 14 s earlier. Once seen, GPST stamping is assumed for
 // BeiDou messages that have no epoch of another system to compare with (until a BeiDou time
-// matches as BDT again), so the order of messages within an epoch does not matter.
+// matches as BDT again), so the order of messages within an epoch does not matter. BeiDou SSR
+// epoch times (DF465) are always read as BDT.
 //
 // Errors. Frames with bad CRCs are skipped by the framer and counted. A frame with a good CRC but
 // impossible content (too short for its satellite/cell counts, out-of-range fields) is skipped and
@@ -52,6 +63,7 @@
 #include "gvins/base/observation.hpp"
 #include "gvins/ephemeris/glonass_ephemeris.hpp"
 #include "gvins/ephemeris/kepler_ephemeris.hpp"
+#include "gvins/ephemeris/ssr_message.hpp"
 #include "gvins/rtcm/framer.hpp"
 #include "gvins/rtcm/messages.hpp"
 
@@ -73,7 +85,7 @@ struct DecoderOptions {
 
 /// What the decoder delivers.
 using Decoded = std::variant<ObsEpoch, StationPosition, AntennaDescriptor, ReceiverDescriptor,
-                             KeplerEphemeris, GlonassEphemeris, GlonassCodePhaseBiases>;
+                             KeplerEphemeris, GlonassEphemeris, GlonassCodePhaseBiases, SsrMessage>;
 
 /// A malformed message (good CRC, bad content).
 struct DecodeIssue {
@@ -99,6 +111,9 @@ struct DecoderStats {
                                          ///< dropped: whole milliseconds of the range unknown
                                          ///< (no recent full range of the satellite)
   std::int64_t ephemerides = 0;          ///< ephemeris records delivered
+  std::int64_t ssrMessages = 0;          ///< SSR messages delivered
+  std::int64_t unknownBiasSignals = 0;   ///< SSR code biases of reserved signal identifiers
+                                         ///< (skipped)
   std::optional<GpsTime> firstEpoch, lastEpoch;
   std::vector<DecodeIssue> issues;       ///< the first DecoderOptions::maxIssues malformed frames
 };

@@ -1,7 +1,7 @@
-// RTCM 3 encoder: station position (1005/1006), MSM4/MSM7 observations of every system and the
-// broadcast ephemeris messages (1019, 1020, 1042, 1044, 1045, 1046). Used by the simulator's
-// base-station stream and by the round-trip tests; each function returns complete frames
-// (preamble, length, payload, CRC-24Q).
+// RTCM 3 encoder: station position (1005/1006), MSM4/MSM7 observations of every system, the
+// broadcast ephemeris messages (1019, 1020, 1042, 1044, 1045, 1046) and the SSR corrections
+// (1057-1068, 1240-1251, 1258-1263). Used by the simulator's base-station stream and by the
+// round-trip tests; each function returns complete frames (preamble, length, payload, CRC-24Q).
 //
 // MSM. One message per system and epoch (split by satellites if the 64-cell or 1023-byte limits
 // would be exceeded); the multiple-message bit is set on every message of the epoch but the last.
@@ -24,6 +24,7 @@
 #include "gvins/base/observation.hpp"
 #include "gvins/ephemeris/glonass_ephemeris.hpp"
 #include "gvins/ephemeris/kepler_ephemeris.hpp"
+#include "gvins/ephemeris/ssr_message.hpp"
 #include "gvins/rtcm/messages.hpp"
 
 namespace gvins::rtcm {
@@ -50,6 +51,16 @@ class Encoder {
   std::vector<std::uint8_t> ephemeris(const KeplerEphemeris& e) const;
   /// 1020. The four-year interval N4 and day NT are sent, so a decoder learns the absolute date.
   std::vector<std::uint8_t> ephemeris(const GlonassEphemeris& g) const;
+
+  /// One SSR message (RTCM 10403.3, 3.5.12) in one frame: the message number follows from
+  /// m.header.system and m.header.kind (GPS, GLONASS, Galileo, QZSS, BeiDou; header.messageType
+  /// is checked if set). Values are rounded to their field's resolution; the epoch must be a
+  /// whole second and the update interval one of the DF391 values. Splitting into several
+  /// messages (DF388) is the caller's: at most 63 satellites and 1023 bytes. Throws
+  /// std::invalid_argument naming the field ("DF365 delta radial: ...") if a value does not fit
+  /// its field, a satellite is of another system, the kind's correction is missing or a code
+  /// bias signal has no identifier.
+  std::vector<std::uint8_t> ssr(const SsrMessage& m) const;
 
   /// Wraps a payload (at most 1023 bytes) in a frame.
   static std::vector<std::uint8_t> frame(std::span<const std::uint8_t> payload);
