@@ -63,6 +63,10 @@ const char* kUsage =
     "  --bia F                Bias-SINEX code biases (OSB) for the products' clocks, repeatable\n"
     "                         (default: *.bia / *.bsx in DATASET/gnss)\n"
     "  --broadcast            broadcast orbits and clocks only (ignore precise products)\n"
+    "  --ssr F                SSR corrections from a recorded RTCM 3 stream (e.g. DATASET/gnss/\n"
+    "                         ssr.rtcm3 of gvins-sim, a caster's SSR mountpoint saved to a file),\n"
+    "                         repeatable; used where no precise products cover a satellite (with\n"
+    "                         --broadcast: for all)\n"
     "  --carrier-smoothing S  psr modes: Hatch window of the carrier-smoothed pseudoranges, s\n"
     "                         (default: gnss_fusion.carrier_smoothing, 100; 0 = raw codes)\n"
     "  --base-position X,Y,Z  base antenna ECEF (default: base.obs header)\n"
@@ -117,6 +121,7 @@ int main(int argc, char** argv) {
   std::optional<std::string> gapPolicy, rover, base, nav;
   std::vector<std::string> sp3Files, clockFiles, antennaFiles, biasFiles;
   bool broadcastOnly = false;
+  std::vector<std::string> ssrFiles;
   std::optional<Eigen::Vector3d> basePos, leverArm;
   std::int64_t sensorToGpst = 0;
   for (int i = 1; i < argc; ++i) {
@@ -149,6 +154,7 @@ int main(int argc, char** argv) {
     else if (a == "--atx") antennaFiles.push_back(value());
     else if (a == "--bia") biasFiles.push_back(value());
     else if (a == "--broadcast") broadcastOnly = true;
+    else if (a == "--ssr") ssrFiles.push_back(value());
     else if (a == "--carrier-smoothing") {
       carrierSmoothing = toNumber(value(), a);
       if (!(*carrierSmoothing >= 0.0 && *carrierSmoothing <= 3600.0)) usageError("--carrier-smoothing must be within 0..3600 s");
@@ -222,6 +228,7 @@ int main(int argc, char** argv) {
     opt.antennaFiles = antennaFiles;
     opt.biasFiles = biasFiles;
     opt.broadcastOnly = broadcastOnly;
+    opt.ssrFiles = ssrFiles;
     opt.basePosition = basePos;
     opt.sensorToGpst_ns = sensorToGpst;
 

@@ -29,6 +29,7 @@
 #include "gvins/gnss/pos_writer.hpp"
 #include "gvins/gnss/spp.hpp"
 #include "gvins/gnss/spp_config.hpp"
+#include "gvins/rtcm/ssr_file.hpp"
 
 namespace {
 
@@ -57,6 +58,9 @@ const char* kUsage =
     "  --iono MODEL       off | broadcast | dual-frequency (default broadcast: Klobuchar, BeiDou's\n"
     "                     own parameters for BeiDou)\n"
     "  --tropo MODEL      off | saastamoinen (default; Niell mapping)\n"
+    "  --ssr F            SSR orbit/clock/code-bias corrections from a recorded RTCM 3 stream\n"
+    "                     (repeatable): they correct the broadcast records where no precise\n"
+    "                     products cover a satellite\n"
     "  --smooth S         carrier-smoothed pseudoranges, Hatch window S seconds (e.g. 100; default\n"
     "                     the config's carrier_smoothing_s, 0 = raw codes); with --freq 2 --iono\n"
     "                     dual-frequency free of divergence\n"
@@ -84,6 +88,7 @@ struct Args {
   std::optional<int> freq;
   std::optional<std::string> iono, tropo;
   std::optional<double> smooth;
+  std::vector<std::string> ssr;
   bool noFde = false, noVelocity = false, xyz = false, strict = false, quiet = false;
   int timeDecimals = 3;
   std::optional<Eigen::Vector3d> truth;
@@ -140,6 +145,8 @@ Args parseArgs(int argc, char** argv) {
     } else if (o == "--smooth") {
       a.smooth = parseNumber(o, value(i, o));
       if (*a.smooth < 0.0 || *a.smooth > 3600.0) usageError("--smooth must be within 0..3600 s");
+    } else if (o == "--ssr") {
+      a.ssr.push_back(value(i, o));
     } else if (o == "--no-fde") {
       a.noFde = true;
     } else if (o == "--no-velocity") {
@@ -303,6 +310,30 @@ int main(int argc, char** argv) {
     return 1;
   }
   const RinexObsHeader& hdr = obs->header();
+  // SSR corrections: their times of week resolve against the first observation epoch.
+  if (!args.ssr.empty()) {
+    GpsTime first;
+    {
+      RinexObsReader peek(args.inputs[0], ropt);
+      ObsEpoch e;
+      if (peek.next(e)) first = e.time;
+    }
+    try {
+      std::size_t n = 0;
+      for (const std::string& f : args.ssr) {
+        const rtcm::SsrFile ssr = rtcm::readSsrFile(f, first);
+        for (const SsrMessage& m : ssr.messages) nav.addSsr(m);
+        n += ssr.messages.size();
+        if (ssr.stats.malformed > 0 && !args.quiet)
+          std::fprintf(stderr, "%s: %lld malformed RTCM frames skipped\n", f.c_str(),
+                       static_cast<long long>(ssr.stats.malformed));
+      }
+      if (!args.quiet) std::fprintf(stderr, "SSR corrections: %zu messages\n", n);
+    } catch (const ParseError& e) {
+      printError(e);
+      return 1;
+    }
+  }
 
   SppSolver solver(nav, cfg);
   solver.setGlonassChannels(hdr.glonassChannels);

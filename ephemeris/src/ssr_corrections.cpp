@@ -17,7 +17,17 @@ std::optional<double> ssrUraMetres(int uraIndex) {
   return (std::pow(3.0, cls) * (1.0 + val / 4.0) - 1.0) * 1e-3;
 }
 
-int ssrIssueOfData(const KeplerEphemeris& eph) { return eph.iode; }
+int ssrIssueOfData(const KeplerEphemeris& eph) {
+  // BeiDou: DF470 "toe modulo", (toe mod 8192) / 8 with toe in BDT seconds of the week (the BDS
+  // ephemerides have no issue-of-data field of their own; the broadcast AODE is not used).
+  if (eph.sat.system == System::BeiDou) return (static_cast<int>(std::lround(eph.toeSeconds)) % 8192) / 8;
+  return eph.iode;
+}
+
+int ssrBeidouIod(const KeplerEphemeris& eph) {
+  // DF471 "BDS IOD": (toe / 720) mod 240.
+  return (static_cast<int>(std::lround(eph.toeSeconds)) / 720) % 240;
+}
 int ssrIssueOfData(const GlonassEphemeris& eph) { return eph.iode; }
 
 namespace {

@@ -93,6 +93,7 @@ std::vector<SsrMessage> ssrFromProducts(const EphemerisStore& broadcast, const E
         s.sat = sat;
         SsrOrbitCorrection o;
         o.issueOfData = rec->issueOfData;
+        if (rec->kepler && sat.system == System::BeiDou) o.iodCrc = ssrBeidouIod(*rec->kepler);
         o.rac = racDifference(b0, *p0);
         o.racRate = racDifference(rec->at(ref + 0.5), *pp) - racDifference(rec->at(ref - 0.5), *pm);
         s.orbit = o;

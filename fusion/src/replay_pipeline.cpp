@@ -30,6 +30,7 @@
 #include "gvins/fusion/replay_feature_tracks.hpp"
 #include "gvins/gnss/base_reader.hpp"
 #include "gvins/gnss/pos_writer.hpp"
+#include "gvins/rtcm/ssr_file.hpp"
 #include "gvins/vio/camera_model.hpp"
 #include "gvins/vio/euroc_dataset.hpp"
 #include "gvins/vio/frontend_thread.hpp"
@@ -233,6 +234,7 @@ void ReplaySummary::writeMetrics(std::ostream& os) const {
   kv("precise_satellites", static_cast<double>(preciseSatellites));
   kv("antex_satellite_antennas", static_cast<double>(antexAntennas));
   kv("code_biases", static_cast<double>(codeBiases));
+  kv("ssr_messages", static_cast<double>(ssrMessages));
   kv("frame_init_s", frameInitSeconds);
   auto acc = [&](const std::string& p, const Accuracy& a) {
     kv((p + "position_rmse_m").c_str(), a.positionRmse);
@@ -295,6 +297,8 @@ void ReplaySummary::print(std::ostream& os) const {
       if (antexAntennas > 0) products += ", ANTEX " + std::to_string(antexAntennas) + " satellite antennas";
       if (codeBiases > 0) products += ", " + std::to_string(codeBiases) + " code biases";
     }
+    if (ssrMessages > 0) products += std::string(preciseSatellites > 0 ? "; where they do not cover: " : " + ") +
+                                     "SSR corrections (" + std::to_string(ssrMessages) + " messages)";
     row("orbits/clocks", products);
     if (std::isfinite(frameInitSeconds)) row("frame initialised", f("%.1f s after the first frame", frameInitSeconds));
   }
@@ -390,6 +394,17 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
     ro.skipBadEpochs = true;
     g.rover = std::make_unique<RinexObsReader>(roverPath, ro);
     g.haveRover = g.rover->next(g.nextRover);
+    // SSR corrections of recorded correction streams; their times of week resolve against the rover.
+    for (const std::string& f : opt.ssrFiles) {
+      const rtcm::SsrFile ssr = rtcm::readSsrFile(f, g.haveRover ? g.nextRover.time : GpsTime{});
+      for (const SsrMessage& m : ssr.messages) g.nav.addSsr(m);
+      sum.ssrMessages += ssr.messages.size();
+      if (ssr.messages.empty())
+        std::fprintf(stderr, "[gvins-replay] warning: %s holds no SSR message\n", f.c_str());
+      if (ssr.stats.malformed > 0)
+        std::fprintf(stderr, "[gvins-replay] warning: %s: %lld malformed RTCM frames skipped\n", f.c_str(),
+                     static_cast<long long>(ssr.stats.malformed));
+    }
     // Products of another day than the observations: every state would silently be broadcast.
     if (const PreciseEphemeris* p = g.nav.precise(); p && g.haveRover) {
       const auto [first, last] = p->span();

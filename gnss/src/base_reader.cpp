@@ -65,6 +65,7 @@ class RtcmBase final : public BaseReader {
         if (nav_) {
           if (auto* k = std::get_if<KeplerEphemeris>(&*d)) nav_->add(*k);
           else if (auto* g = std::get_if<GlonassEphemeris>(&*d)) nav_->add(*g);
+          else if (auto* s = std::get_if<SsrMessage>(&*d)) nav_->addSsr(*s);  // SSR mixed into the stream
         }
       }
       if (done_) return false;

@@ -11,6 +11,9 @@
 
 #include "gvins/base/constants.hpp"
 #include "gvins/base/rinex_obs_writer.hpp"
+#include "gvins/ephemeris/precise_ephemeris.hpp"
+#include "gvins/ephemeris/ssr_from_products.hpp"
+#include "gvins/rtcm/ssr_file.hpp"
 #include "gvins/sim/gnss_epoch_generator.hpp"
 #include "gvins/sim/gnss_precise_products.hpp"
 #include "gvins/sim/gnss_rtcm_stream.hpp"
@@ -213,6 +216,24 @@ GnssSimSummary GnssSimulator::run(const NavData& nav, const Trajectory& trajecto
                                                              world.start() + world.duration(), seed);
     for (const auto& p : writePreciseProducts(products, dir)) sum.files.push_back(p);
     sum.preciseSatellites = products.orbits.satellites.size();
+    if (config_.preciseProducts.ssrInterval > 0.0) {
+      // The real-time counterpart: SSR corrections from these products for the broadcast records.
+      EphemerisStore productStore;
+      auto precise = std::make_shared<PreciseEphemeris>();
+      precise->add(products.orbits);
+      precise->add(products.clocks);
+      productStore.setPrecise(std::move(precise));
+      if (products.antennas) productStore.setSatelliteAntennas(std::make_shared<AntexData>(*products.antennas));
+      SsrServiceConfig service;
+      service.interval = config_.preciseProducts.ssrInterval;
+      const std::vector<SsrMessage> ssr =
+          ssrFromProducts(world.store(), productStore, world.start(), world.start() + world.duration(), service);
+      const std::vector<std::uint8_t> bytes = rtcm::encodeSsrFrames(ssr);
+      std::ofstream f = openOut("ssr.rtcm3");
+      f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+      if (!f) throw std::runtime_error("writing ssr.rtcm3 failed");
+      sum.ssrMessages = static_cast<std::int64_t>(ssr.size());
+    }
   }
   // Constants of the run.
   {
@@ -294,6 +315,7 @@ void GnssSimSummary::print(std::ostream& os) const {
   }
   if (preciseSatellites > 0)
     os << "  precise products: precise.sp3, precise.clk (" << preciseSatellites << " satellites)\n";
+  if (ssrMessages > 0) os << "  SSR corrections:  ssr.rtcm3 (" << ssrMessages << " combined orbit/clock messages)\n";
 }
 
 }  // namespace gvins::sim

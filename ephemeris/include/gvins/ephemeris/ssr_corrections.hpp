@@ -99,10 +99,12 @@ class SsrCorrections {
 std::optional<SatelliteState> applySsr(const SatelliteState& broadcast, const SsrSelection& ssr,
                                        const GpsTime& t);
 
-/// The issue of data that SSR orbit corrections use to name a broadcast record: GPS/QZSS IODE,
-/// Galileo IODnav, BeiDou the record's AODE/IODE field (the sim and RTCM 1042 decoding store the
-/// same value there), GLONASS the tb index.
+/// The issue of data that SSR orbit corrections use to name a broadcast record
+/// (SsrOrbitCorrection::issueOfData): GPS/QZSS IODE, Galileo IODnav, GLONASS the tb index, BeiDou
+/// DF470 = (toe mod 8192) / 8 (toe in BDT seconds of the week).
 int ssrIssueOfData(const KeplerEphemeris& eph);
 int ssrIssueOfData(const GlonassEphemeris& eph);
+/// BeiDou DF471 (SsrOrbitCorrection::iodCrc): (toe / 720) mod 240.
+int ssrBeidouIod(const KeplerEphemeris& eph);
 
 }  // namespace gvins

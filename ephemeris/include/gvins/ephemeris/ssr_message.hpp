@@ -50,11 +50,11 @@ struct SsrHeader {
 /// broadcast orbit (along = velocity direction, cross = r x v, radial = along x cross). The
 /// corrected antenna phase centre is X_broadcast - [e_r e_a e_c] (rac + racRate (t - t0)).
 struct SsrOrbitCorrection {
-  /// Issue of data of the broadcast record the correction refers to: GPS/QZSS IODE (8 bits),
-  /// GLONASS IOD (8 bits, = the record's tb index), Galileo IODnav (10 bits), BeiDou IOD
-  /// (10 bits), SBAS IODN (9 bits).
+  /// Issue of data of the broadcast record the correction refers to: GPS/QZSS IODE (DF071/DF434,
+  /// 8 bits), GLONASS IOD (DF392, 8 bits, = the record's tb index), Galileo IODnav (DF459, 10 bits),
+  /// BeiDou toe modulo (DF470, 10 bits: (toe mod 8192) / 8).
   int issueOfData = 0;
-  int iodCrc = 0;  ///< BeiDou and SBAS: 24-bit CRC of the broadcast record (0 if unused)
+  int iodCrc = 0;  ///< BeiDou: BDS IOD (DF471, 8 bits: (toe / 720) mod 240); 0 for other systems
   Eigen::Vector3d rac = Eigen::Vector3d::Zero();      ///< m (DF365/DF366/DF367)
   Eigen::Vector3d racRate = Eigen::Vector3d::Zero();  ///< m/s (DF368/DF369/DF370)
 };

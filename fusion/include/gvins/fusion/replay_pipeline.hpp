@@ -129,6 +129,10 @@ struct ReplayOptions {
   /// Bias-SINEX code biases for the products (default: *.bia / *.bsx in DATASET/gnss, as above).
   std::vector<std::string> biasFiles;
   bool broadcastOnly = false;
+  /// Recorded RTCM 3 streams of SSR corrections (gvins/rtcm/ssr_file.hpp; e.g. a gvins-sim
+  /// dataset's gnss/ssr.rtcm3): they correct the broadcast records where no precise products
+  /// cover a satellite (with broadcastOnly: everywhere). Not read from the folder by default.
+  std::vector<std::string> ssrFiles;
   std::optional<Eigen::Vector3d> basePosition;  ///< default: base.obs header position
   /// GPST (ns since the GPS epoch) = sensor stamp + this. 0 for gvins-sim datasets, whose sensor
   /// stamps are GPST; set it to replay GNSS files against a recording stamped on another clock.
@@ -158,6 +162,7 @@ struct ReplaySummary {
   std::size_t preciseSatellites = 0;
   std::size_t antexAntennas = 0;  ///< satellite antenna entries of the ANTEX files used with the products
   std::size_t codeBiases = 0;     ///< entries of the Bias-SINEX files used with the products
+  std::size_t ssrMessages = 0;    ///< SSR messages read from the ReplayOptions::ssrFiles
   double realTimeFactor() const { return wallSeconds > 0.0 ? datasetSeconds / wallSeconds : 0.0; }
   double estimatorMsMedian = 0.0;
   double gnssMsPerFrame = 0.0;   ///< GNSS time summed over the run / processed frames

@@ -23,8 +23,8 @@ class BaseReader {
   virtual ~BaseReader() = default;
 
   /// Opens `path`. `referenceTime` resolves the times of week of an RTCM stream (use the rover's
-  /// first epoch). Ephemerides an RTCM stream carries are added to `nav` (if not null) as they are
-  /// decoded. Throws ParseError for unreadable files or a malformed RINEX header;
+  /// first epoch). Ephemerides and SSR corrections an RTCM stream carries are added to `nav` (if
+  /// not null) as they are decoded. Throws ParseError for unreadable files or a malformed RINEX header;
   /// `skipBadEpochs` as in RinexObsReaderOptions.
   static std::unique_ptr<BaseReader> open(const std::string& path, const GpsTime& referenceTime,
                                           EphemerisStore* nav, bool skipBadEpochs = true);

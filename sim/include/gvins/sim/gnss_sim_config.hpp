@@ -213,6 +213,11 @@ struct GnssPreciseProductsConfig {
   /// range of the real ones (z 0.5-2.6 m, x within ±0.4 m; e.g. igs20.atx); false: the orbits are
   /// the phase-centre positions the ranges are simulated to, and no ANTEX file is written.
   bool centreOfMass = true;
+  /// Also write gnss/ssr.rtcm3: SSR corrections (RTCM 1060/1066/1243/1249/1261, combined orbit and
+  /// clock) every ssrInterval seconds that turn the broadcast records into these products' states
+  /// (gvins/ephemeris/ssr_from_products.hpp). One of the RTCM update intervals (1, 2, 5, 10, 15,
+  /// 30, 60 s ...); 0: no SSR stream.
+  double ssrInterval = 5.0;
 };
 
 /// Satellites that transmit a signal (e.g. BeiDou B2I only from BDS-2 satellites C01-C18: BDS-3

@@ -50,6 +50,7 @@ struct GnssSimSummary {
   std::vector<std::filesystem::path> files;
   /// Satellites in the precise products (0: none written).
   std::size_t preciseSatellites = 0;
+  std::int64_t ssrMessages = 0;  ///< SSR messages in gnss/ssr.rtcm3 (before splitting into frames)
 
   /// A short table for the tool's output.
   void print(std::ostream& os) const;
