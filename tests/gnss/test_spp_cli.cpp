@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <sstream>
 
 #include "gvins/base/geodetic.hpp"
@@ -12,6 +13,8 @@
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "gvins/ephemeris/sp3.hpp"
+#include "gvins/ephemeris/ssr_from_products.hpp"
+#include "gvins/rtcm/ssr_file.hpp"
 #include "gvins/gnss/accuracy_statistics.hpp"
 #include "gvins/gnss/pos_reader.hpp"
 #include "nagoya_recording.hpp"
@@ -218,4 +221,78 @@ TEST(SppCli, PreciseProductsAmongTheInputs) {
   EXPECT_EQ(bad.code, 1);
   EXPECT_NE(bad.err.find(broken), std::string::npos) << bad.err;
   for (const std::string& f : {sp3, broken, a, b, cfg}) std::filesystem::remove(f);
+}
+
+// --ssr: a recorded stream of SSR corrections made by the test (ssrFromProducts, as a correction
+// service would: combined orbit/clock messages every 5 s) from "products" that are the broadcast
+// GPS orbits moved by a fixed ECEF offset with clocks 0.8 m late. Applied to the broadcast
+// records, the whole GPS constellation moves by the offset and every clock by the same amount, so
+// the GPS-only solution moves by exactly the offset (the receiver clock absorbs the clock shift).
+// A missing --ssr file stops the tool with its name.
+TEST(SppCli, SsrCorrectionsFromARecordedStream) {
+  using namespace gvins;
+  const std::string nav = kData + "/gnss/nagoya_static_2024/base.nav.gz";
+  const std::string obs = kData + "/gnss/nagoya_static_2024/rover.obs.gz";
+  EphemerisStore store;
+  store.add(readRinexNav(nav));
+  const GpsTime t0 = gvins::test::nagoyaTime(8, 20);  // observations 08:20-08:25
+  std::vector<SatId> gps;
+  for (SatId s : store.satellites())
+    if (s.system == System::Gps) gps.push_back(s);
+  const Eigen::Vector3d offset(1.5, -0.7, 2.0);
+  const double clockShift = 0.8;  // m
+  // 30 s nodes: the GPS records of the file are valid from 08:00, and a correction for the first
+  // epoch (08:19:55, reference time 08:19:57.5) needs the interpolation window around it.
+  Sp3Data sp3 = broadcastSp3(store, t0 - 1200.0, t0 + 1200.0, 30.0, gps);
+  for (Sp3Epoch& ep : sp3.epochs)
+    for (Sp3Record& r : ep.records) {
+      r.position += offset;
+      r.clock += clockShift / 299792458.0;
+    }
+  auto precise = std::make_shared<PreciseEphemeris>();
+  precise->add(sp3);
+  EphemerisStore products;
+  products.setPrecise(precise);
+  const std::vector<SsrMessage> messages = ssrFromProducts(store, products, t0 - 10.0, t0 + 320.0, SsrServiceConfig{});
+  ASSERT_GE(messages.size(), 60u);
+  const std::string ssr = tmp("g.rtcm3");
+  {
+    const std::vector<std::uint8_t> bytes = rtcm::encodeSsrFrames(messages);
+    std::ofstream f(ssr, std::ios::binary);
+    f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  }
+  // The broadcast error budget for the SSR-corrected states too: the same weights.
+  const std::string cfg = tmp("ssr.yaml");
+  std::ofstream(cfg) << "spp:\n  precise_ephemeris_error_m: {G: 0.6}\n";
+  const std::string a = tmp("bc.pos"), b = tmp("ssr.pos");
+  const CliRun plain = run("-q --config " + cfg + " --systems G -o " + a + " " + obs + " " + nav);
+  const CliRun corrected = run("--config " + cfg + " --systems G --ssr " + ssr + " -o " + b + " " + obs + " " + nav);
+  ASSERT_EQ(plain.code, 0) << plain.err;
+  ASSERT_EQ(corrected.code, 0) << corrected.err;
+  EXPECT_NE(corrected.err.find("SSR corrections: " + std::to_string(messages.size()) + " messages"), std::string::npos)
+      << corrected.err;
+  const PosFile fa = readPosFile(a), fb = readPosFile(b);
+  ASSERT_EQ(fa.solutions.size(), 301u);
+  ASSERT_EQ(fb.solutions.size(), fa.solutions.size());
+  double worst = 0.0;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < fa.solutions.size(); ++i) {
+    const PositionSolution& x = fa.solutions[i];
+    const PositionSolution& y = fb.solutions[i];
+    EXPECT_EQ(x.time, y.time);
+    EXPECT_EQ(x.numSatellites, y.numSatellites) << x.time.toString(1);
+    const Eigen::Vector3d shift = y.position - x.position;
+    worst = std::max(worst, (shift - offset).norm());
+    mean += shift / static_cast<double>(fa.solutions.size());
+  }
+  std::printf("--ssr: mean solution shift %.4f %.4f %.4f m (products moved by %.1f %.1f %.1f m), worst deviation %.4f m\n",
+              mean.x(), mean.y(), mean.z(), offset.x(), offset.y(), offset.z(), worst);
+  EXPECT_LT(worst, 0.005);  // SP3 interpolation, 0.1-0.4 mm RTCM resolution, pos-file rounding
+
+  const std::string missingFile = tmp("missing.rtcm3");
+  const CliRun missing = run("-q --ssr " + missingFile + " -o " + tmp("m.pos") + " " + obs + " " + nav);
+  EXPECT_EQ(missing.code, 1);
+  EXPECT_NE(missing.err.find(missingFile), std::string::npos) << missing.err;
+  EXPECT_FALSE(std::filesystem::exists(tmp("m.pos")));
+  for (const std::string& f : {ssr, cfg, a, b}) std::filesystem::remove(f);
 }

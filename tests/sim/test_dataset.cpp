@@ -7,7 +7,10 @@
 //   integrated by vio's ImuPropagator (gravity from dataset.yaml) reproduces the written truth;
 // - dataset.yaml states the time convention, the frame origin and the calibration that the
 //   sensor.yaml files hold;
-// - the same scenario and seed give byte-identical files for any number of threads.
+// - the same scenario and seed give byte-identical files for any number of threads;
+// - gnss/ssr.rtcm3 (precise_products.ssr_interval_s, default 5 s) decodes to combined orbit/clock
+//   corrections every 5 s over the GNSS span which, applied to nav.rnx, give the states of
+//   precise.sp3/.clk with satellites.atx; ssr_interval_s: 0 writes no such file.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -25,6 +28,12 @@
 #include <opencv2/calib3d.hpp>
 #include <yaml-cpp/yaml.h>
 
+#include "gvins/base/constants.hpp"
+#include "gvins/base/rinex_obs_reader.hpp"
+#include "gvins/ephemeris/ephemeris_store.hpp"
+#include "gvins/ephemeris/precise_product_files.hpp"
+#include "gvins/ephemeris/rinex_nav.hpp"
+#include "gvins/rtcm/ssr_file.hpp"
 #include "gvins/sim/dataset_generator.hpp"
 #include "gvins/sim/scenario.hpp"
 #include "gvins/vio/euroc_csv.hpp"
@@ -350,6 +359,118 @@ TEST(SimDataset, SameSeedSameBytesForAnyThreadCount) {
   EXPECT_EQ(ta.size(), tc.size());
   EXPECT_NE(ta.at("mav0/imu0/data.csv"), tc.at("mav0/imu0/data.csv"));
   EXPECT_NE(ta.at("gnss/rover.obs"), tc.at("gnss/rover.obs"));
+}
+
+/// A short GNSS flight (about 25 s, rover 1 Hz, no base, feature tracks only); `precise` is the
+/// body of gnss.precise_products.
+std::string shortGnssFlight(const std::string& precise) {
+  return "name: ssr_test\n"
+         "trajectory: {pattern: circle, height_m: 30, length_m: 120, speed_mps: 6, laps: 1,\n"
+         "             takeoff_landing: false, hover_start_s: 2, hover_end_s: 2, wobble_deg: 0.5}\n"
+         "cameras: {output: features}\n"
+         "gnss: {rover: {rate_hz: 1}, base: {enabled: false}" +
+         (precise.empty() ? std::string() : ", precise_products: {" + precise + "}") + "}\n";
+}
+
+TEST(SimDataset, SsrStreamGivesThePreciseProductStates) {
+  TempDir dir("ssr");
+  generate(shortGnssFlight(""), dir.path(), 11);
+  const fs::path g = dir.path() / "gnss";
+  ASSERT_TRUE(fs::exists(g / "ssr.rtcm3"));
+  for (const char* f : {"nav.rnx", "precise.sp3", "precise.clk", "satellites.atx"}) ASSERT_TRUE(fs::exists(g / f)) << f;
+
+  // The rover's span.
+  GpsTime first, last;
+  {
+    RinexObsReader rover((g / "rover.obs").string());
+    ObsEpoch e;
+    ASSERT_TRUE(rover.next(e));
+    first = last = e.time;
+    while (rover.next(e)) last = e.time;
+  }
+  ASSERT_GT(last - first, 20.0);
+
+  const rtcm::SsrFile ssr = rtcm::readSsrFile((g / "ssr.rtcm3").string(), first);
+  EXPECT_EQ(ssr.stats.malformed, 0);
+  EXPECT_EQ(ssr.stats.framing.crcFailures, 0);
+  EXPECT_EQ(ssr.stats.framing.skippedBytes, 0);
+  ASSERT_FALSE(ssr.messages.empty());
+  // Combined orbit/clock messages every 5 s (udi 5 s), one per system (split into parts with
+  // DF388 where it has more than a frame holds) at every epoch, from the rover's first epoch (a
+  // multiple of 5 s) to within 5 s of its last.
+  std::map<double, std::set<int>> typesAt;  // s after the first epoch -> message numbers
+  for (const SsrMessage& m : ssr.messages) {
+    EXPECT_EQ(m.header.kind, SsrKind::kCombined);
+    EXPECT_EQ(m.header.updateInterval, 5.0);
+    EXPECT_FALSE(m.satellites.empty());
+    typesAt[m.header.epoch - first].insert(m.header.messageType);
+  }
+  const std::set<int> allSystems = {1060, 1066, 1243, 1249, 1261};  // G R E J C
+  double expected = 0.0;
+  for (const auto& [dt, types] : typesAt) {
+    EXPECT_NEAR(dt, expected, 1e-9);
+    EXPECT_EQ(types, allSystems) << "at +" << dt << " s";
+    expected += 5.0;
+  }
+  EXPECT_NEAR(typesAt.begin()->first, 0.0, 1e-9);
+  EXPECT_GE(typesAt.rbegin()->first, (last - first) - 5.0);
+  EXPECT_LE(typesAt.rbegin()->first, last - first);
+
+  // The receiver's view: broadcast records of nav.rnx + the SSR stream, against the dataset's
+  // products as gvins-replay loads them (SP3 + clock, ANTEX phase-centre offsets).
+  EphemerisStore rx;
+  rx.add(readRinexNav((g / "nav.rnx").string()));
+  for (const SsrMessage& m : ssr.messages) rx.addSsr(m);
+  EphemerisStore products;
+  products.setPrecise(readPreciseProducts({(g / "precise.sp3").string()}, {(g / "precise.clk").string()}));
+  products.setSatelliteAntennas(readAntennaFiles({(g / "satellites.atx").string()}));
+  const std::vector<SatId> sats = products.precise()->satellites();
+  double worstPos = 0.0, worstClock = 0.0;
+  int compared = 0, times = 0, productOnly = 0;
+  for (double dt = 0.2; dt < last - first; dt += 2.9) {
+    const GpsTime t = first + dt;
+    ++times;
+    int here = 0;
+    for (SatId sat : sats) {
+      const auto p = products.preciseState(sat, t);
+      const auto s = rx.ssrState(sat, t);
+      if (p && !s) {
+        // Only satellites without a broadcast record that a real-time receiver holds at the SSR
+        // epoch and still at t (the bundled file's BeiDou records transmitted after the run, a
+        // Galileo record whose validity ends at the start) lack corrections.
+        EphemerisSelection realTime;
+        realTime.futureTolerance = -1.0;
+        auto heldAt = [&](const GpsTime& x) {
+          return sat.system == System::Glonass ? rx.selectGlonass(sat, x, realTime) != nullptr
+                                               : rx.selectKepler(sat, x, realTime) != nullptr;
+        };
+        const bool held = heldAt(first + 5.0 * std::floor(dt / 5.0)) && heldAt(t);
+        EXPECT_FALSE(held) << sat.str() << " at +" << dt << " s: products and a broadcast record, but no SSR state";
+        ++productOnly;
+      }
+      if (!p || !s) continue;
+      EXPECT_TRUE(s->ssr);
+      const double dp = (s->position - p->position).norm();
+      const double dc = std::abs(s->clockBias - p->clockBias) * constants::kSpeedOfLight;
+      EXPECT_LT(dp, 0.01) << sat.str() << " at +" << dt << " s";
+      EXPECT_LT(dc, 0.01) << sat.str() << " at +" << dt << " s";
+      worstPos = std::max(worstPos, dp);
+      worstClock = std::max(worstClock, dc);
+      ++here;
+    }
+    EXPECT_GE(here, 30) << "at +" << dt << " s";
+    compared += here;
+  }
+  std::printf("ssr.rtcm3: %zu messages, %zu epochs; SSR vs products: %d states at %d times (%d with products only), "
+              "worst position %.4f m, clock %.4f m\n",
+              ssr.messages.size(), typesAt.size(), compared, times, productOnly, worstPos, worstClock);
+  EXPECT_GE(times, 8);
+
+  // ssr_interval_s: 0: the products, but no SSR stream.
+  TempDir none("ssr_none");
+  generate(shortGnssFlight("ssr_interval_s: 0"), none.path(), 11);
+  EXPECT_TRUE(fs::exists(none.path() / "gnss" / "precise.sp3"));
+  EXPECT_FALSE(fs::exists(none.path() / "gnss" / "ssr.rtcm3"));
 }
 
 }  // namespace

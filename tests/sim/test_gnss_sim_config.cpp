@@ -231,6 +231,56 @@ TEST(GnssSimConfig, MalformedInputNamesFileLineAndKey) {
   }
 }
 
+// gnss.precise_products.ssr_interval_s: 0 (no gnss/ssr.rtcm3) or one of the RTCM DF391 update
+// intervals, default 5 s; anything else names the key and the line of the value.
+TEST(GnssSimConfig, SsrIntervalIsZeroOrAnRtcmUpdateInterval) {
+  EXPECT_DOUBLE_EQ(GnssPreciseProductsConfig{}.ssrInterval, 5.0);
+  EXPECT_DOUBLE_EQ(parseGnssSimConfigText("gnss:\n  rover: {rate_hz: 5}\n", "d.yaml").preciseProducts.ssrInterval, 5.0);
+  EXPECT_DOUBLE_EQ(parseGnssSimConfigText(kFull, "f.yaml").preciseProducts.ssrInterval, 5.0);
+  for (double v : {0.0, 1.0, 5.0, 60.0, 10800.0}) {
+    const std::string y = "gnss:\n  precise_products: {ssr_interval_s: " + std::to_string(v) + "}\n";
+    EXPECT_DOUBLE_EQ(parseGnssSimConfigText(y, "ok.yaml").preciseProducts.ssrInterval, v) << y;
+  }
+  // Other keys of the section are kept alongside.
+  const GnssSimConfig c =
+      parseGnssSimConfigText("gnss:\n  precise_products: {ssr_interval_s: 60, orbit_interval_s: 900}\n", "ok.yaml");
+  EXPECT_DOUBLE_EQ(c.preciseProducts.ssrInterval, 60.0);
+  EXPECT_DOUBLE_EQ(c.preciseProducts.orbitInterval, 900.0);
+
+  const BadCase cases[] = {
+      {"gnss:\n  precise_products: {ssr_interval_s: 3}\n", 2, "gnss.precise_products.ssr_interval_s"},
+      {"gnss:\n  precise_products: {ssr_interval_s: -1}\n", 2, "gnss.precise_products.ssr_interval_s"},
+      {"gnss:\n  precise_products: {ssr_interval_s: often}\n", 2, "gnss.precise_products.ssr_interval_s"},
+      {"gnss:\n  precise_products: {ssr_interval_s: 2.5}\n", 2, "gnss.precise_products.ssr_interval_s"},
+      {"gnss:\n  precise_products: {ssr_interval_s: 20000}\n", 2, "gnss.precise_products.ssr_interval_s"},
+      {"gnss:\n  precise_products: {ssr_interval_s: .nan}\n", 2, "gnss.precise_products.ssr_interval_s"},
+      {"gnss:\n  precise_products: {ssr_interval_s: [5]}\n", 2, "gnss.precise_products.ssr_interval_s"},
+      // Block style: the line of the value.
+      {"gnss:\n  rover: {rate_hz: 5}\n  precise_products:\n    write: true\n    ssr_interval_s: 3\n", 5,
+       "gnss.precise_products.ssr_interval_s"},
+      {"gnss:\n  precise_products: {ssr_intervall_s: 5}\n", 2, "gnss.precise_products.ssr_intervall_s"},
+  };
+  for (const BadCase& b : cases) {
+    try {
+      parseGnssSimConfigText(b.yaml, "bad.yaml");
+      ADD_FAILURE() << "accepted:\n" << b.yaml;
+    } catch (const ParseError& e) {
+      EXPECT_EQ(e.file(), "bad.yaml") << b.yaml;
+      EXPECT_EQ(e.line(), b.line) << b.yaml << "\n" << e.what();
+      EXPECT_EQ(e.field(), b.key) << b.yaml << "\n" << e.what();
+      EXPECT_NE(e.reason().find(b.key), std::string::npos) << e.what();
+    }
+  }
+  // Not an update interval: the message lists the allowed ones.
+  try {
+    parseGnssSimConfigText("gnss:\n  precise_products: {ssr_interval_s: 3}\n", "bad.yaml");
+    ADD_FAILURE() << "3 s accepted";
+  } catch (const ParseError& e) {
+    EXPECT_NE(e.reason().find("1, 2, 5, 10"), std::string::npos) << e.what();
+    EXPECT_NE(e.reason().find("0 or"), std::string::npos) << e.what();
+  }
+}
+
 TEST(GnssSimConfig, RandomlyDamagedScenariosThrowOnlyParseErrors) {
   // Byte flips, truncations and insertions of YAML punctuation into the full scenario: every
   // result is either a valid configuration or a ParseError; nothing else escapes.
