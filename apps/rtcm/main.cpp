@@ -23,6 +23,10 @@ constexpr const char* kUsage =
     "      records an NTRIP stream byte for byte; URL = ntrip://user:pass@host[:port]/MOUNT\n"
     "      (port 2101 by default); --frames stops right after the N-th frame, --duration after\n"
     "      S seconds; --timeout (default 10 s connect, 15 s data) gives up on a silent caster\n"
+    "  from-products NAV... SP3... [CLK...] [ATX...] -o FILE [--interval S]\n"
+    "      an SSR correction stream (combined orbit/clock 1060/1066/1243/1249/1261 every S s,\n"
+    "      default 5) that turns the broadcast records of NAV into the products' states, over the\n"
+    "      products' span; for testing real-time (SSR) processing: gvins-replay/gvins-spp --ssr\n"
     "exit status: 0 ok, 1 error (file, decoding, NTRIP), 2 usage\n";
 
 }  // namespace
@@ -39,6 +43,7 @@ int main(int argc, char** argv) {
     if (cmd == "info") return runInfo(args);
     if (cmd == "to-rinex") return runToRinex(args);
     if (cmd == "ntrip") return runNtrip(args);
+    if (cmd == "from-products") return runFromProducts(args);
     throw UsageError("unknown command '" + cmd + "'");
   } catch (const UsageError& e) {
     std::cerr << "gvins-rtcm: " << e.what() << "\n" << kUsage;
