@@ -20,6 +20,7 @@
 #include "gvins/rtcm/encoder.hpp"
 #include "gvins/rtcm/ssr_file.hpp"
 #include "independent_frame_scan.hpp"
+#include "ssr_field_checks.hpp"
 
 namespace gvins::rtcm {
 namespace {
@@ -103,43 +104,6 @@ Decoded decodeAll(const std::vector<std::uint8_t>& bytes) {
   return out;
 }
 
-void expectQuantized(double got, double want, double lsb, const char* what) {
-  EXPECT_LE(std::abs(got - want), 0.5 * lsb * (1 + 1e-9) + 1e-12) << what << ": got " << got << ", sent " << want;
-}
-
-/// Same satellites and values to half an LSB of their fields (RTCM 10403.3 DF365-DF378, DF383).
-void expectSameSatellites(const std::vector<SsrSatellite>& got, const std::vector<SsrSatellite>& sent) {
-  ASSERT_EQ(got.size(), sent.size());
-  for (std::size_t i = 0; i < got.size(); ++i) {
-    const SsrSatellite& a = got[i];
-    const SsrSatellite& b = sent[i];
-    SCOPED_TRACE(b.sat.str());
-    EXPECT_EQ(a.sat, b.sat);
-    ASSERT_EQ(a.orbit.has_value(), b.orbit.has_value());
-    ASSERT_EQ(a.clock.has_value(), b.clock.has_value());
-    if (b.orbit) {
-      EXPECT_EQ(a.orbit->issueOfData, b.orbit->issueOfData);
-      EXPECT_EQ(a.orbit->iodCrc, b.orbit->iodCrc);
-      expectQuantized(a.orbit->rac.x(), b.orbit->rac.x(), 1e-4, "DF365");
-      expectQuantized(a.orbit->rac.y(), b.orbit->rac.y(), 4e-4, "DF366");
-      expectQuantized(a.orbit->rac.z(), b.orbit->rac.z(), 4e-4, "DF367");
-      expectQuantized(a.orbit->racRate.x(), b.orbit->racRate.x(), 1e-6, "DF368");
-      expectQuantized(a.orbit->racRate.y(), b.orbit->racRate.y(), 4e-6, "DF369");
-      expectQuantized(a.orbit->racRate.z(), b.orbit->racRate.z(), 4e-6, "DF370");
-    }
-    if (b.clock) {
-      expectQuantized(a.clock->c0, b.clock->c0, 1e-4, "DF376");
-      expectQuantized(a.clock->c1, b.clock->c1, 1e-6, "DF377");
-      expectQuantized(a.clock->c2, b.clock->c2, 2e-8, "DF378");
-    }
-    ASSERT_EQ(a.codeBiases.size(), b.codeBiases.size());
-    for (std::size_t k = 0; k < a.codeBiases.size(); ++k) {
-      EXPECT_EQ(a.codeBiases[k].first, b.codeBiases[k].first);
-      expectQuantized(a.codeBiases[k].second, b.codeBiases[k].second, 0.01, "DF383");
-    }
-  }
-}
-
 void expectSameHeader(const SsrHeader& got, const SsrHeader& sent) {
   EXPECT_EQ(got.system, sent.system);
   EXPECT_EQ(got.kind, sent.kind);
@@ -194,7 +158,7 @@ TEST(SsrFile, BeidouCombinedOfSixtySatellitesSplitsIntoThreeMessages) {
   }
   std::printf("60 BeiDou satellites: parts of %zu, %zu, %zu satellites, %zu bytes\n", got.ssr[0].satellites.size(),
               got.ssr[1].satellites.size(), got.ssr[2].satellites.size(), bytes.size());
-  expectSameSatellites(all, m.satellites);
+  gvins::test::expectSameSatellites(all, m.satellites);
 }
 
 TEST(SsrFile, CodeBiasMessagesWithManyBiasesPerSatelliteSplitToo) {
@@ -225,7 +189,7 @@ TEST(SsrFile, CodeBiasMessagesWithManyBiasesPerSatelliteSplitToo) {
   }
   std::printf("63 BeiDou satellites x 16 code biases: %lld frames, %zu bytes\n", static_cast<long long>(scan.frames),
               bytes.size());
-  expectSameSatellites(all, m.satellites);
+  gvins::test::expectSameSatellites(all, m.satellites);
 }
 
 TEST(SsrFile, EmptyMessageGivesOneFrameAndOrderIsKept) {
@@ -305,7 +269,7 @@ TEST(SsrFile, ReadBackInOrderThroughChunkBoundariesSkippingOtherMessages) {
       expectSameHeader(got.messages[j].header, m.header);
       all.insert(all.end(), got.messages[j].satellites.begin(), got.messages[j].satellites.end());
     } while (got.messages[j++].header.multipleMessage);
-    expectSameSatellites(all, m.satellites);
+    gvins::test::expectSameSatellites(all, m.satellites);
   }
   EXPECT_EQ(j, got.messages.size());
 }
@@ -369,7 +333,7 @@ TEST(SsrFile, DamagedFramesAreSkippedAndCounted) {
   for (int i = 0; i < 4; ++i) {
     SCOPED_TRACE(i);
     expectSameHeader(got.messages[i].header, sent[kept[i]].header);
-    expectSameSatellites(got.messages[i].satellites, sent[kept[i]].satellites);
+    gvins::test::expectSameSatellites(got.messages[i].satellites, sent[kept[i]].satellites);
   }
   const testing::ScanResult scan = testing::independentScan(bytes);
   EXPECT_GE(got.stats.framing.crcFailures, 1);
