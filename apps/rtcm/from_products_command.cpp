@@ -4,7 +4,6 @@
 // the broadcast records a receiver holds into the products' states (gvins/ephemeris/
 // ssr_from_products.hpp). For testing a real-time (SSR) processing chain against the products
 // it is made from, e.g. `gvins-replay D --broadcast --ssr FILE` against `gvins-replay D`.
-#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -32,8 +31,7 @@ int runFromProducts(const std::vector<std::string>& args) {
       const std::string v = args[++i];
       char* end = nullptr;
       interval = std::strtod(v.c_str(), &end);
-      const double allowed[] = {1, 2, 5, 10, 15, 30, 60, 120, 240, 300, 600, 900, 1800, 3600, 7200, 10800};
-      if (end == v.c_str() || *end != '\0' || std::find(std::begin(allowed), std::end(allowed), interval) == std::end(allowed))
+      if (end == v.c_str() || *end != '\0' || !isSsrUpdateInterval(interval))
         throw UsageError("--interval must be an RTCM SSR update interval (1, 2, 5, 10, 15, 30, 60, ... 10800 s), not '" +
                          v + "'");
     } else if (!args[i].empty() && args[i][0] == '-') {

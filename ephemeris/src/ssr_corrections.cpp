@@ -129,25 +129,31 @@ std::optional<double> SsrCorrections::codeBias(SatId sat, ObsCode code, const Gp
   return std::nullopt;
 }
 
-std::optional<SatelliteState> applySsr(const SatelliteState& broadcast, const SsrSelection& ssr,
-                                       const GpsTime& t) {
+std::optional<Eigen::Matrix3d> ssrOrbitFrame(const SatelliteState& broadcast) {
   const Eigen::Vector3d& r = broadcast.position;
   const Eigen::Vector3d& v = broadcast.velocity;
   const Eigen::Vector3d rxv = r.cross(v);
   if (v.norm() < 1e-3 || rxv.norm() < 1e-3) return std::nullopt;
   const Eigen::Vector3d ea = v.normalized();
   const Eigen::Vector3d ec = rxv.normalized();
-  const Eigen::Vector3d er = ea.cross(ec);
   Eigen::Matrix3d rac;
-  rac.col(0) = er;
+  rac.col(0) = ea.cross(ec);
   rac.col(1) = ea;
   rac.col(2) = ec;
+  return rac;
+}
+
+std::optional<SatelliteState> applySsr(const SatelliteState& broadcast, const SsrSelection& ssr,
+                                       const GpsTime& t) {
+  const auto frame = ssrOrbitFrame(broadcast);
+  if (!frame) return std::nullopt;
+  const Eigen::Matrix3d& rac = *frame;
   // Reference time t0 = SSR epoch + half the update interval (RTCM 10403.3, 3.5.12.3).
   const double dtOrbit = t - (ssr.orbitHeader.epoch + 0.5 * ssr.orbitHeader.updateInterval);
   const double dtClock = t - (ssr.clockHeader.epoch + 0.5 * ssr.clockHeader.updateInterval);
   SatelliteState out = broadcast;
-  out.position = r - rac * (ssr.orbit.rac + ssr.orbit.racRate * dtOrbit);
-  out.velocity = v - rac * ssr.orbit.racRate;
+  out.position = broadcast.position - rac * (ssr.orbit.rac + ssr.orbit.racRate * dtOrbit);
+  out.velocity = broadcast.velocity - rac * ssr.orbit.racRate;
   double dc = ssr.clock.c0 + ssr.clock.c1 * dtClock + ssr.clock.c2 * dtClock * dtClock;
   if (ssr.highRateClock) dc += *ssr.highRateClock;
   out.clockBias = broadcast.clockBias + dc / constants::kSpeedOfLight;

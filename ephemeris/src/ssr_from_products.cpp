@@ -49,15 +49,11 @@ std::optional<Broadcast> heldRecord(const EphemerisStore& nav, SatId sat, const 
 }
 
 // broadcast − precise in the radial / along / cross frame of the broadcast state (the quantity an
-// SSR orbit correction carries; applySsr subtracts it again).
-Eigen::Vector3d racDifference(const SatelliteState& b, const SatelliteState& p) {
-  const Eigen::Vector3d ea = b.velocity.normalized();
-  const Eigen::Vector3d ec = b.position.cross(b.velocity).normalized();
-  Eigen::Matrix3d m;
-  m.col(0) = ea.cross(ec);
-  m.col(1) = ea;
-  m.col(2) = ec;
-  return m.transpose() * (b.position - p.position);
+// SSR orbit correction carries; applySsr subtracts it again); nullopt for a degenerate velocity.
+std::optional<Eigen::Vector3d> racDifference(const SatelliteState& b, const SatelliteState& p) {
+  const auto frame = ssrOrbitFrame(b);
+  if (!frame) return std::nullopt;
+  return Eigen::Vector3d(frame->transpose() * (b.position - p.position));
 }
 
 }  // namespace
@@ -88,19 +84,20 @@ std::vector<SsrMessage> ssrFromProducts(const EphemerisStore& broadcast, const E
         const auto pm = products.preciseState(sat, ref - 0.5);
         const auto pp = products.preciseState(sat, ref + 0.5);
         if (!p0 || !pm || !pp) continue;
-        const SatelliteState b0 = rec->at(ref);
+        const SatelliteState b0 = rec->at(ref), bm = rec->at(ref - 0.5), bp = rec->at(ref + 0.5);
+        const auto d0 = racDifference(b0, *p0), dm = racDifference(bm, *pm), dp = racDifference(bp, *pp);
+        if (!d0 || !dm || !dp) continue;
         SsrSatellite s;
         s.sat = sat;
         SsrOrbitCorrection o;
         o.issueOfData = rec->issueOfData;
         if (rec->kepler && sat.system == System::BeiDou) o.iodCrc = ssrBeidouIod(*rec->kepler);
-        o.rac = racDifference(b0, *p0);
-        o.racRate = racDifference(rec->at(ref + 0.5), *pp) - racDifference(rec->at(ref - 0.5), *pm);
+        o.rac = *d0;
+        o.racRate = *dp - *dm;
         s.orbit = o;
         SsrClockCorrection c;
         c.c0 = (p0->clockBias - b0.clockBias) * constants::kSpeedOfLight;
-        c.c1 = ((pp->clockBias - rec->at(ref + 0.5).clockBias) - (pm->clockBias - rec->at(ref - 0.5).clockBias)) *
-               constants::kSpeedOfLight;
+        c.c1 = ((pp->clockBias - bp.clockBias) - (pm->clockBias - bm.clockBias)) * constants::kSpeedOfLight;
         s.clock = c;
         m.satellites.push_back(std::move(s));
       }

@@ -79,7 +79,7 @@ void decodeSsr(Decoder::State& s, BitReader& r, int type) {
   h.system = L.system;
   h.kind = kind;
   h.epoch = readEpoch(s, r, L);
-  h.updateInterval = ssr::kUpdateIntervals[r.u(4, "DF391 SSR update interval")];
+  h.updateInterval = kSsrUpdateIntervals[r.u(4, "DF391 SSR update interval")];
   h.multipleMessage = r.flag("DF388 multiple message indicator");
   if (ssr::hasOrbit(kind)) h.regionalDatum = r.flag("DF375 satellite reference datum");
   h.iodSsr = static_cast<int>(r.u(4, "DF413 IOD SSR"));

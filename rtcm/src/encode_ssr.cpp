@@ -71,8 +71,8 @@ void writeEpoch(BitWriter& w, const SystemLayout& L, const GpsTime& epoch) {
 }
 
 std::uint64_t updateIntervalIndex(double seconds) {
-  for (std::size_t i = 0; i < ssr::kUpdateIntervals.size(); ++i) {
-    if (std::abs(ssr::kUpdateIntervals[i] - seconds) < 1e-9) return i;
+  for (std::size_t i = 0; i < kSsrUpdateIntervals.size(); ++i) {
+    if (std::abs(kSsrUpdateIntervals[i] - seconds) < 1e-9) return i;
   }
   fail("DF391 SSR update interval",
        num(seconds) + " s is not one of 1, 2, 5, 10, 15, 30, 60, 120, 240, 300, 600, 900, 1800, 3600, 7200, 10800");

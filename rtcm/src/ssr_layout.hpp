@@ -105,10 +105,6 @@ inline int messageNumber(System system, SsrKind kind) {
 inline bool hasOrbit(SsrKind k) { return k == SsrKind::kOrbit || k == SsrKind::kCombined; }
 inline bool hasClock(SsrKind k) { return k == SsrKind::kClock || k == SsrKind::kCombined; }
 
-/// DF391 SSR update interval, seconds, by its 4-bit index.
-inline constexpr std::array<double, 16> kUpdateIntervals{1,   2,   5,   10,   15,   30,   60,   120,
-                                                         240, 300, 600, 900, 1800, 3600, 7200, 10800};
-
 // Field sizes in bits.
 inline constexpr int kOrbitBits = 22 + 20 + 20 + 21 + 19 + 19;  // DF365-DF370
 inline constexpr int kClockBits = 22 + 21 + 27;                  // DF376-DF378

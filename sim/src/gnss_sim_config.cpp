@@ -8,6 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "gvins/base/parse_error.hpp"
+#include "gvins/ephemeris/ssr_message.hpp"
 #include "gvins/rtcm/msm_signals.hpp"
 
 namespace gvins::sim {
@@ -382,13 +383,12 @@ void apply(const Reader& r, const YAML::Node& g, const std::string& file, GnssSi
                 p.clockInterval = r.number(pv, pf, 1.0, 3600.0);
               } else if (pk == "ssr_interval_s") {
                 // DF391 update intervals (RTCM 10403.3), 0 = no SSR stream.
-                const double v = r.number(pv, pf, 0.0, 10800.0);
-                const double allowed[] = {0, 1, 2, 5, 10, 15, 30, 60, 120, 240, 300, 600, 900, 1800, 3600, 7200, 10800};
-                if (std::find(std::begin(allowed), std::end(allowed), v) == std::end(allowed))
+                const double interval = r.number(pv, pf, 0.0, 10800.0);
+                if (interval != 0.0 && !isSsrUpdateInterval(interval))
                   r.fail(pv, pf,
                          "'" + pf + "' must be 0 or an RTCM SSR update interval (1, 2, 5, 10, 15, 30, 60, 120, 240, "
                          "300, 600, 900, 1800, 3600, 7200 or 10800 s)");
-                p.ssrInterval = v;
+                p.ssrInterval = interval;
               } else {
                 r.perSystem(pv, pf, [&](System s, const std::string& xf, const YAML::Node& xv) {
                   p.sisre[systemIndex(s)] = r.number(xv, xf, 0.0, 100.0);

@@ -228,9 +228,9 @@ GnssSimSummary GnssSimulator::run(const NavData& nav, const Trajectory& trajecto
       service.interval = config_.preciseProducts.ssrInterval;
       const std::vector<SsrMessage> ssr =
           ssrFromProducts(world.store(), productStore, world.start(), world.start() + world.duration(), service);
-      const std::vector<std::uint8_t> bytes = rtcm::encodeSsrFrames(ssr);
+      const std::vector<std::uint8_t> ssrBytes = rtcm::encodeSsrFrames(ssr);
       std::ofstream f = openOut("ssr.rtcm3");
-      f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+      f.write(reinterpret_cast<const char*>(ssrBytes.data()), static_cast<std::streamsize>(ssrBytes.size()));
       if (!f) throw std::runtime_error("writing ssr.rtcm3 failed");
       sum.ssrMessages = static_cast<std::int64_t>(ssr.size());
     }

@@ -49,7 +49,7 @@ const Stream& stream() {
     d.finish();
     while (auto m = d.poll()) {
       if (auto* k = std::get_if<KeplerEphemeris>(&*m)) out.nav.add(*k);
-      else if (auto* s = std::get_if<SsrMessage>(&*m)) out.ssr.push_back(*s);
+      else if (auto* msg = std::get_if<SsrMessage>(&*m)) out.ssr.push_back(*msg);
     }
     EXPECT_EQ(d.stats().malformed, 0);
     return out;

@@ -18,6 +18,8 @@
 #include <optional>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "gvins/base/gnss_time.hpp"
 #include "gvins/base/satellite.hpp"
 #include "gvins/base/signal.hpp"
@@ -92,6 +94,11 @@ class SsrCorrections {
   std::array<std::vector<GpsTime>, kNumSystems> orbitEpochs_;  // sorted, per system
   std::size_t count_ = 0;
 };
+
+/// The radial / along-track / cross-track frame of SSR orbit corrections as columns
+/// [e_r e_a e_c] (ECEF): e_a = v/|v|, e_c = r × v/|r × v|, e_r = e_a × e_c, from a broadcast
+/// state's position and velocity. nullopt if the velocity is degenerate.
+std::optional<Eigen::Matrix3d> ssrOrbitFrame(const SatelliteState& broadcast);
 
 /// Applies a selection to the broadcast state of the record the orbit correction refers to (see
 /// the file comment). The result has ssr = true; accuracy from the URA when given. nullopt if the

@@ -5,6 +5,8 @@
 // applies them to broadcast satellite states.
 #pragma once
 
+#include <algorithm>
+#include <array>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -26,6 +28,14 @@ enum class SsrKind {
   kUra,            ///< 1061/1067/1244/1250/1256/1262
   kHighRateClock,  ///< 1062/1068/1245/1251/1257/1263
 };
+
+/// The SSR update intervals of DF391 (RTCM 10403.3), seconds, by their 4-bit index.
+inline constexpr std::array<double, 16> kSsrUpdateIntervals{1,   2,   5,   10,   15,   30,   60,   120,
+                                                            240, 300, 600, 900, 1800, 3600, 7200, 10800};
+/// True if `seconds` is one of kSsrUpdateIntervals.
+inline bool isSsrUpdateInterval(double seconds) {
+  return std::find(kSsrUpdateIntervals.begin(), kSsrUpdateIntervals.end(), seconds) != kSsrUpdateIntervals.end();
+}
 
 /// Message header (RTCM 10403.3 tables 3.5-73 ... 3.5-78).
 struct SsrHeader {
