@@ -28,7 +28,7 @@ std::int64_t toNs(const GpsTime& t) {
 
 System clockSystemOf(System s) { return s == System::Qzss ? System::Gps : s; }
 
-enum RowType : int { kPsr, kDopp, kDpsr, kDdcp, kVel, kFrame };
+enum RowType : int { kPsr, kDopp, kDpsr, kDdcp, kVel, kFrame, kPhase };
 
 GnssTypeCount& countOf(GnssEpochReport& r, int type) {
   switch (type) {
@@ -37,6 +37,7 @@ GnssTypeCount& countOf(GnssEpochReport& r, int type) {
     case kDpsr: return r.dpsr;
     case kDdcp: return r.ddcp;
     case kVel: return r.vel;
+    case kPhase: return r.phase;
     default: return r.frame;
   }
 }
@@ -105,7 +106,9 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     m.wavelength = kC / *f;
     m.azel = azimuthElevation(g, x, m.position);
     if (m.azel.elevation < config_.elevationMaskDeg * constants::kDegToRad) continue;
-    m.troposphere = slantTroposphereDelay(g, m.azel.elevation, rover.time).slant;
+    const TroposphereDelay tropo = slantTroposphereDelay(g, m.azel.elevation, rover.time);
+    m.troposphere = tropo.slant;
+    m.mapWet = tropo.mapWet;
     m.shapiro = shapiroDelay(m.position, x);
     if (so.sat.system == System::BeiDou && iono.beidou) {
       m.ionosphere = beidouKlobucharDelayB1I(*iono.beidou, g, m.azel, rover.time) *
@@ -154,6 +157,17 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
         m.ifA2 = c.a2;
         m.codeVariance = std::pow(config_.codeSigma * c.noiseFactor() * smoothingFactor, 2) *
                              (0.5 + 0.5 / (sinEl * sinEl)) + ephemerisVariance;
+        // vio+dopp+ppp: the ionosphere-free phase of the same bands (the phase of another
+        // tracking mode on a band only shifts the float ambiguity).
+        if (config_.mode == GnssFusionMode::kDoppPpp) {
+          const SignalObs* p1 = so.bestOnBand(band, SignalObs::kPhase);
+          const SignalObs* p2 = so.bestOnBand(b2, SignalObs::kPhase);
+          if (p1 && p2 && p1->carrierPhase != 0.0 && p2->carrierPhase != 0.0) {
+            m.hasCarrier = true;
+            m.carrierRange = c.a1 * (kC / *f) * p1->carrierPhase + c.a2 * (kC / *f2) * p2->carrierPhase;
+            m.phaseVariance = std::pow(config_.phaseSigma * c.noiseFactor(), 2) * (0.5 + 0.5 / (sinEl * sinEl));
+          }
+        }
         break;
       }
     }
@@ -320,10 +334,47 @@ void GnssFusion<Scalar>::propagateClocks(vio::EstimatorBackend<Scalar>& est, con
 }
 
 template <typename Scalar>
+std::map<SatId, double> GnssFusion<Scalar>::ambiguities(const vio::EstimatorBackend<Scalar>& est) const {
+  std::map<SatId, double> out;
+  for (const auto& [sat, a] : ambiguities_) out[sat] = static_cast<double>(est.estimate(a.id).vector[0]);
+  return out;
+}
+
+template <typename Scalar>
+std::optional<double> GnssFusion<Scalar>::zenithWetDelay(const vio::EstimatorBackend<Scalar>& est) const {
+  if (!zwdBlock_.valid()) return std::nullopt;
+  return static_cast<double>(est.estimate(zwdBlock_).vector[0]);
+}
+
+template <typename Scalar>
+void GnssFusion<Scalar>::propagateZwd(vio::EstimatorBackend<Scalar>& est, const GpsTime& t) {
+  const double dt = t - zwdTime_;
+  if (!zwdBlock_.valid() || dt <= 0.0) return;
+  using Mat = typename sri::Propagation<Scalar>::Matrix;
+  sri::Propagation<Scalar> step;
+  step.addNewBlock(sri::BlockSpec::vector("gnss_zwd", 1), est.estimate(zwdBlock_));
+  step.setTransition(zwdBlock_, Mat::Identity(1, 1));
+  step.setNoiseCovariance(Mat::Constant(1, 1, static_cast<Scalar>(config_.zwdRandomWalk * config_.zwdRandomWalk * dt)));
+  step.marginalizeAfter(zwdBlock_);
+  zwdBlock_ = est.propagate(step, vio::ClientBlockRegion::kParameters).at(0);
+  zwdTime_ = t;
+}
+
+template <typename Scalar>
+void GnssFusion<Scalar>::dropAmbiguity(vio::EstimatorBackend<Scalar>& est, SatId sat) {
+  const auto it = ambiguities_.find(sat);
+  if (it == ambiguities_.end()) return;
+  const sri::BlockId id = it->second.id;
+  if (est.contains(id)) est.marginalize(std::span<const sri::BlockId>(&id, 1));
+  ambiguities_.erase(it);
+}
+
+template <typename Scalar>
 vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scalar>& est, std::vector<GnssRow>& rows,
                                                      const Eigen::MatrixXd& noise,
                                                      const Eigen::Matrix<double, 9, 9>& intCov,
-                                                     std::vector<bool>& accepted, bool gate) {
+                                                     std::vector<bool>& accepted, bool gate,
+                                                     const std::vector<sri::BlockId>& ambiguities) {
   const vio::ImuBlocks ib = est.newestImuBlocks();
   const int nc = clockBlock_.valid() ? static_cast<int>(clockSystems_.size()) + 1 : 0;
   accepted.assign(rows.size(), false);
@@ -343,6 +394,10 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
   if (leverBlock_.valid()) addBlock(leverBlock_, 3);
   const int clockAt = nc > 0 ? dim : -1;
   if (nc > 0) addBlock(clockBlock_, nc);
+  const int zwdAt = zwdBlock_.valid() ? dim : -1;
+  if (zwdBlock_.valid()) addBlock(zwdBlock_, 1);
+  const int ambiguityAt = dim;
+  for (const sri::BlockId& id : ambiguities) addBlock(id, 1);
   auto rowVector = [&](const GnssRow& r, auto&& h) {
     h.setZero();
     h.template head<15>() = r.H_imu;
@@ -352,6 +407,8 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
       if (r.clockBias >= 0) h[clockAt + r.clockBias] = 1.0;
       h[clockAt + nc - 1] = r.H_drift;
     }
+    if (zwdAt >= 0) h[zwdAt] = r.H_tropo;
+    if (r.ambiguity >= 0) h[ambiguityAt + r.ambiguity] = 1.0;
   };
 
   // Row gate: each row alone against the joint marginal covariance P of those blocks (cheap at
@@ -483,7 +540,14 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
   // raw codes: its RTK filter estimates the ambiguities from phase minus code, which smoothing
   // would correlate in time.
   const bool smoothDifferences = config_.mode == GnssFusionMode::kDoppDpsr;
-  if (config_.carrierSmoothing > 0.0 && (config_.usesPseudorange() || smoothDifferences)) {
+  const bool ppp = config_.mode == GnssFusionMode::kDoppPpp;
+  if (ppp) {
+    // Arcs of the float ambiguities (every epoch, also before the VIO is ready); raw codes.
+    if (!arcs_) arcs_ = std::make_unique<CarrierSmoother>();
+    arcSmoothed_ = roverRaw;
+    arcs_->apply(arcSmoothed_, nav.glonassChannels());
+  }
+  if (!ppp && config_.carrierSmoothing > 0.0 && (config_.usesPseudorange() || smoothDifferences)) {
     if (!smoother_) {
       CarrierSmoothingOptions o;
       o.window = config_.carrierSmoothing;
@@ -544,7 +608,13 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
       est.marginalize(std::span<const sri::BlockId>(&id, 1));
       clockBlock_ = {};
     }
+    if (zwdBlock_.valid()) {
+      const sri::BlockId id = zwdBlock_;
+      est.marginalize(std::span<const sri::BlockId>(&id, 1));
+      zwdBlock_ = {};
+    }
     if (rtk_) rtk_->reset();
+    while (!ambiguities_.empty()) dropAmbiguity(est, ambiguities_.begin()->first);
     rep.reset = true;
     lastUpdate_.reset();
   }
@@ -637,6 +707,17 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
       for (SatelliteModel& m : models) m.clock = clockIndex(m.sat);
     }
     if (clockBlock_.valid()) propagateClocks(est, tMeas);
+    if (clockBlock_.valid() && config_.zwdState()) {
+      if (!zwdBlock_.valid()) {
+        Eigen::Matrix<Scalar, Eigen::Dynamic, 1> z = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>::Zero(1);
+        zwdBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_zwd", 1), sri::BlockEstimate<Scalar>::fromVector(z),
+                                 sri::Prior<Scalar>::stdDev(1, static_cast<Scalar>(config_.zwdSigma)));
+        zwdTime_ = tMeas;
+      }
+      propagateZwd(est, tMeas);
+      const double zwd = static_cast<double>(est.estimate(zwdBlock_).vector[0]);
+      for (SatelliteModel& m : models) m.troposphere += m.mapWet * zwd;
+    }
     Eigen::VectorXd clk;
     if (clockBlock_.valid()) clk = est.estimate(clockBlock_).vector.template cast<double>();
     const int n = static_cast<int>(clockSystems_.size());
@@ -671,6 +752,66 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
         rows.push_back(r);
         types.push_back(kVel);
         diag.push_back(0.0);
+      }
+    }
+    // vio+dopp+ppp: ionosphere-free phase rows, one float ambiguity state per satellite arc.
+    std::vector<sri::BlockId> ambBlocks;
+    std::vector<SatId> ambSats;
+    if (ppp && clockBlock_.valid()) {
+      // Satellites with a state first, then the others highest first (max_ambiguities).
+      std::vector<const SatelliteModel*> order;
+      for (const SatelliteModel& m : models) order.push_back(&m);
+      std::stable_sort(order.begin(), order.end(), [&](const SatelliteModel* a, const SatelliteModel* b) {
+        const bool ha = ambiguities_.count(a->sat) > 0, hb = ambiguities_.count(b->sat) > 0;
+        if (ha != hb) return ha;
+        return a->azel.elevation > b->azel.elevation;
+      });
+      for (const SatelliteModel* mp : order) {
+        const SatelliteModel& m = *mp;
+        if (!m.hasCarrier || m.clock < 0 || arcs_->samples(m.sat) == 0) continue;
+        const GpsTime start = rover.time - arcs_->arcLength(m.sat);
+        auto it = ambiguities_.find(m.sat);
+        if (it != ambiguities_.end() && std::abs(it->second.arcStart - start) > 1e-3) {
+          dropAmbiguity(est, m.sat);  // new arc: cycle slip, gap or signal change
+          it = ambiguities_.end();
+        }
+        if (it == ambiguities_.end()) {
+          if (config_.maxAmbiguities > 0 && static_cast<int>(ambiguities_.size()) >= config_.maxAmbiguities) continue;
+          // Centred on phase minus code (code model: + c·group delay), which differ by the
+          // ambiguity plus the code error. The arc may be older than the state (epochs before
+          // the VIO or the clocks were ready, a restart after rejections): its carrier-smoothed
+          // code carries those epochs' codes, weighted as the code rows are (each epoch as one
+          // measurement: σ/sqrt(n)); a new arc starts from the raw code with a loose prior.
+          Eigen::Matrix<Scalar, Eigen::Dynamic, 1> x(1);
+          double code = m.pseudorange, sigma = config_.ambiguitySigma;
+          const SatObs* so = nullptr;
+          for (const SatObs& o : arcSmoothed_.sats)
+            if (o.sat == m.sat) so = &o;
+          const SignalObs* s1 = so ? so->find(m.code) : nullptr;
+          const SignalObs* s2 = so ? so->find(m.code2) : nullptr;
+          if (arcs_->samples(m.sat) > 1 && s1 && s2 && s1->hasCode() && s2->hasCode()) {
+            code = m.ifA1 * s1->pseudorange + m.ifA2 * s2->pseudorange;
+            sigma = std::sqrt(m.codeVariance) * arcs_->noiseFactor(m.sat);
+          }
+          x[0] = static_cast<Scalar>(m.carrierRange - (code - kC * m.groupDelay));
+          Ambiguity a;
+          // In front of the state: visual rows never reach those columns, and a state that ends
+          // with its arc is cheap to marginalize there.
+          a.id = est.addBlock(sri::BlockSpec::vector("gnss_ambiguity", 1), sri::BlockEstimate<Scalar>::fromVector(x),
+                              sri::Prior<Scalar>::stdDev(1, static_cast<Scalar>(sigma)), vio::ClientBlockRegion::kFront);
+          a.arcStart = start;
+          it = ambiguities_.emplace(m.sat, a).first;
+        }
+        it->second.lastRow = rover.time;
+        const double nAmb = static_cast<double>(est.estimate(it->second.id).vector[0]);
+        GnssRow r = carrierPhaseRow(m, k, clk[m.clock], nAmb);
+        r.H_lever.setZero();
+        r.ambiguity = static_cast<int>(ambBlocks.size());
+        ambBlocks.push_back(it->second.id);
+        ambSats.push_back(m.sat);
+        rows.push_back(r);
+        types.push_back(kPhase);
+        diag.push_back(r.variance);
       }
     }
     const std::size_t nIndependent = rows.size();
@@ -721,15 +862,30 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
     }
     if (!rows.empty()) {
       std::vector<bool> acc;
-      const auto u = apply(est, rows, noise, k.integrationCovariance, acc, true);
+      const auto u = apply(est, rows, noise, k.integrationCovariance, acc, true, ambBlocks);
       rep.chi2 = static_cast<double>(u.chi2);
       rep.dof = u.dof;
       rep.updated = u.applied;
       for (std::size_t i = 0; i < rows.size(); ++i) {
         GnssTypeCount& c = countOf(rep, types[i]);
         (acc[i] ? c.used : c.rejected)++;
+        if (types[i] != kPhase) continue;
+        // A phase row gated out again and again: the ambiguity no longer fits (undetected slip,
+        // broadcast orbit/clock change); it restarts from phase minus code.
+        const SatId sat = ambSats[static_cast<std::size_t>(rows[i].ambiguity)];
+        Ambiguity& a = ambiguities_.at(sat);
+        a.rejections = acc[i] ? 0 : a.rejections + 1;
+        if (a.rejections >= config_.ambiguityResetRejections) dropAmbiguity(est, sat);
       }
     }
+    // Ambiguities of satellites without a phase row for a while (set, masked, lost).
+    for (auto it = ambiguities_.begin(); it != ambiguities_.end();) {
+      const SatId sat = it->first;
+      const bool stale = rover.time - it->second.lastRow > 10.0;
+      ++it;
+      if (stale) dropAmbiguity(est, sat);
+    }
+    rep.ambiguities = static_cast<int>(ambiguities_.size());
   }
   if (rep.updated) lastUpdate_ = rover.time;
   if (buildState(est, t_ns, s)) {

@@ -25,6 +25,7 @@ constexpr ModeName kModes[] = {
     {GnssFusionMode::kDoppDpsr, "vio+dopp+dpsr"},
     {GnssFusionMode::kDoppDdcp, "vio+dopp+ddcp"},
     {GnssFusionMode::kDoppPsrNoInt, "vio+dopp+psr-nointegration"},
+    {GnssFusionMode::kDoppPpp, "vio+dopp+ppp"},
 };
 
 }  // namespace
@@ -47,7 +48,7 @@ bool GnssFusionConfig::usesDoppler() const {
   return mode != GnssFusionMode::kVio && mode != GnssFusionMode::kGpsVel;
 }
 bool GnssFusionConfig::usesPseudorange() const {
-  return mode == GnssFusionMode::kDoppPsr || mode == GnssFusionMode::kDoppPsrNoInt;
+  return mode == GnssFusionMode::kDoppPsr || mode == GnssFusionMode::kDoppPsrNoInt || mode == GnssFusionMode::kDoppPpp;
 }
 bool GnssFusionConfig::usesDifferences() const {
   return mode == GnssFusionMode::kDoppDpsr || mode == GnssFusionMode::kDoppDdcp;
@@ -83,7 +84,7 @@ GnssFusionConfig parseGnssFusionConfig(std::string_view yaml, const std::string&
         rd.fail(v, f,
                 "unknown mode '" + s +
                     "' (vio, vio+gpsvel, vio+dopp, vio+dopp+psr, vio+dopp+dpsr, vio+dopp+ddcp, "
-                    "vio+dopp+psr-nointegration)");
+                    "vio+dopp+psr-nointegration, vio+dopp+ppp)");
       }
       c.mode = *m;
     } else if (key == "lever_arm") {
@@ -123,6 +124,20 @@ GnssFusionConfig parseGnssFusionConfig(std::string_view yaml, const std::string&
       c.carrierSmoothing = rd.number(v, f, 0.0, 3600.0);
     } else if (key == "smoothed_code_factor") {
       c.smoothedCodeFactor = rd.number(v, f, 0.01, 1.0);
+    } else if (key == "phase_sigma") {
+      c.phaseSigma = positive(v, f);
+    } else if (key == "ambiguity_sigma") {
+      c.ambiguitySigma = positive(v, f);
+    } else if (key == "ambiguity_reset_rejections") {
+      c.ambiguityResetRejections = static_cast<int>(rd.number(v, f, 1.0, 1000.0));
+    } else if (key == "max_ambiguities") {
+      c.maxAmbiguities = static_cast<int>(rd.number(v, f, 0.0, 1000.0));
+    } else if (key == "estimate_zwd") {
+      c.estimateZwd = rd.boolean(v, f);
+    } else if (key == "zwd_sigma") {
+      c.zwdSigma = positive(v, f);
+    } else if (key == "zwd_random_walk") {
+      c.zwdRandomWalk = positive(v, f);
     } else if (key == "doppler_sigma") {
       c.dopplerSigma = positive(v, f);
     } else if (key == "clock_bias_random_walk") {
@@ -150,7 +165,8 @@ GnssFusionConfig parseGnssFusionConfig(std::string_view yaml, const std::string&
   static const std::set<std::string> kKeys = {
       "mode", "lever_arm", "calibrate_lever_arm", "lever_arm_sigma", "min_rotation_rate", "systems",
       "elevation_mask_deg", "ionosphere", "bands", "ephemeris_error_m", "precise_ephemeris_error_m", "code_sigma",
-      "carrier_smoothing", "smoothed_code_factor", "doppler_sigma",
+      "carrier_smoothing", "smoothed_code_factor", "phase_sigma", "ambiguity_sigma", "ambiguity_reset_rejections", "max_ambiguities", "estimate_zwd", "zwd_sigma", "zwd_random_walk",
+      "doppler_sigma",
       "clock_bias_random_walk", "clock_drift_random_walk", "row_gate", "epoch_gate", "frame_yaw_sigma_deg",
       "frame_min_speed", "outage_reset", "clock_ransac_threshold", "base_position", "max_base_age"};
   if (const YAML::Node section = root["gnss_fusion"]) {

@@ -101,6 +101,21 @@ GnssRow pseudorangeRow(const SatelliteModel& m, const AntennaKinematics& k, doub
   r.residual = m.pseudorange - h;
   r.variance = m.codeVariance;
   r.clockBias = m.clock;
+  r.H_tropo = m.mapWet;
+  r.sat = m.sat;
+  return r;
+}
+
+GnssRow carrierPhaseRow(const SatelliteModel& m, const AntennaKinematics& k, double clockBiasMeters,
+                        double ambiguityMeters) {
+  Vector3d g;
+  const double rho = geometricRange(m.position, k.x_E, &g);
+  const double h = rho + clockBiasMeters - kC * m.clockBias + m.troposphere + m.shapiro + ambiguityMeters;
+  GnssRow r = chainRow(k, g.transpose() * k.R_EN, RowVector3d::Zero());
+  r.residual = m.carrierRange - h;
+  r.variance = m.phaseVariance;
+  r.clockBias = m.clock;
+  r.H_tropo = m.mapWet;
   r.sat = m.sat;
   return r;
 }

@@ -454,7 +454,8 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
     ecefFile->out() << "# gps_week,tow [s],x [m],y [m],z [m],vx [m/s],vy [m/s],vz [m/s],rtk_fixed  (GNSS antenna, ECEF)\n";
     epochFile = std::make_unique<OutFile>(out / "gnss_epochs.csv");
     epochFile->out() << "# gps_week,tow [s],stage,psr_used,psr_rejected,dopp_used,dopp_rejected,dpsr_used,dpsr_rejected,"
-                        "ddcp_used,ddcp_rejected,vel_used,vel_rejected,updated,rtk_fixed,reset,chi2,dof,gnss_ms\n";
+                        "ddcp_used,ddcp_rejected,vel_used,vel_rejected,updated,rtk_fixed,reset,chi2,dof,gnss_ms,"
+                        "phase_used,phase_rejected,ambiguities\n";
   }
   std::vector<vio::TumPose> poses;
   std::vector<vio::TrajectorySample> localTrack;  // poses with the estimated velocity
@@ -633,10 +634,10 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
           if (o.rtkFixed) ++sum.gnssEpochsFixed;
           const GpsTime& t = g.nextRover.time;
           char b[400];
-          std::snprintf(b, sizeof b, "%d,%.3f,%s,%d,%d,%d,%d,%d,%d,%d,%d,%d,%d,%d,%d,%d,%.3f,%d,%.3f\n", t.week(), t.tow(),
+          std::snprintf(b, sizeof b, "%d,%.3f,%s,%d,%d,%d,%d,%d,%d,%d,%d,%d,%d,%d,%d,%d,%.3f,%d,%.3f,%d,%d,%d\n", t.week(), t.tow(),
                         o.stage.c_str(), o.psrUsed, o.psrRejected, o.doppUsed, o.doppRejected, o.dpsrUsed, o.dpsrRejected,
                         o.ddcpUsed, o.ddcpRejected, o.velUsed, o.velRejected, o.updated ? 1 : 0, o.rtkFixed ? 1 : 0,
-                        o.reset ? 1 : 0, o.chi2, o.dof, ms);
+                        o.reset ? 1 : 0, o.chi2, o.dof, ms, o.phaseUsed, o.phaseRejected, o.ambiguities);
           epochFile->out() << b;
           if (o.antennaEcef) {
             PositionSolution ps;
@@ -645,7 +646,7 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
             ps.positionCovariance = o.antennaCovarianceEcef;
             ps.quality = o.rtkFixed ? SolutionQuality::Fix
                                     : ((o.dpsrUsed + o.ddcpUsed) > 0 ? SolutionQuality::Float : SolutionQuality::Single);
-            ps.numSatellites = std::max({o.psrUsed, o.doppUsed, o.dpsrUsed, o.ddcpUsed});
+            ps.numSatellites = std::max({o.psrUsed, o.doppUsed, o.dpsrUsed, o.ddcpUsed, o.phaseUsed});
             ps.velocity = o.antennaVelocityEcef;
             posWriter->write(ps);
             const Eigen::Vector3d v = o.antennaVelocityEcef ? *o.antennaVelocityEcef : Eigen::Vector3d::Zero();

@@ -51,9 +51,36 @@ TEST(GnssFusionConfig, ParsesAllKeys) {
   EXPECT_TRUE(c.usesDifferences());
 }
 
+TEST(GnssFusionConfig, FloatPppKeys) {
+  const GnssFusionConfig c = parseGnssFusionConfig(
+      "gnss_fusion:\n"
+      "  mode: vio+dopp+ppp\n"
+      "  phase_sigma: 0.004\n"
+      "  ambiguity_sigma: 20\n"
+      "  ambiguity_reset_rejections: 5\n"
+      "  zwd_sigma: 0.08\n"
+      "  zwd_random_walk: 0.0001\n");
+  EXPECT_EQ(c.mode, GnssFusionMode::kDoppPpp);
+  EXPECT_TRUE(c.usesPseudorange());
+  EXPECT_FALSE(c.usesDifferences());
+  EXPECT_TRUE(c.integration());
+  EXPECT_DOUBLE_EQ(c.phaseSigma, 0.004);
+  EXPECT_DOUBLE_EQ(c.ambiguitySigma, 20.0);
+  EXPECT_EQ(c.ambiguityResetRejections, 5);
+  EXPECT_DOUBLE_EQ(c.zwdSigma, 0.08);
+  EXPECT_DOUBLE_EQ(c.zwdRandomWalk, 1e-4);
+  // The wet delay state: on by default in vio+dopp+ppp only; estimate_zwd switches it for the
+  // other pseudorange modes (never for modes without undifferenced codes).
+  EXPECT_TRUE(c.zwdState());
+  EXPECT_FALSE(parseGnssFusionConfig("gnss_fusion:\n  mode: vio+dopp+ppp\n  estimate_zwd: false\n").zwdState());
+  EXPECT_FALSE(parseGnssFusionConfig("gnss_fusion:\n  mode: vio+dopp+psr\n").zwdState());
+  EXPECT_TRUE(parseGnssFusionConfig("gnss_fusion:\n  mode: vio+dopp+psr\n  estimate_zwd: true\n").zwdState());
+  EXPECT_FALSE(parseGnssFusionConfig("gnss_fusion:\n  mode: vio+dopp+dpsr\n  estimate_zwd: true\n").zwdState());
+}
+
 TEST(GnssFusionConfig, ModeNamesRoundTrip) {
   for (const char* n : {"vio", "vio+gpsvel", "vio+dopp", "vio+dopp+psr", "vio+dopp+dpsr", "vio+dopp+ddcp",
-                        "vio+dopp+psr-nointegration"}) {
+                        "vio+dopp+psr-nointegration", "vio+dopp+ppp"}) {
     const auto m = gnssFusionModeFromString(n);
     ASSERT_TRUE(m) << n;
     EXPECT_STREQ(toString(*m), n);
@@ -100,7 +127,8 @@ TEST(GnssFusionConfig, ErrorsNameFileLineAndField) {
   }
   for (const char* bad : {"  bands: {G: \"19\"}\n", "  bands: {X: \"12\"}\n", "  bands: \"12\"\n",
                           "  ephemeris_error_m: {G: -1}\n", "  carrier_smoothing: -5\n",
-                          "  smoothed_code_factor: 2\n"}) {
+                          "  smoothed_code_factor: 2\n", "  phase_sigma: 0\n", "  ambiguity_sigma: -1\n",
+                          "  ambiguity_reset_rejections: 0\n", "  estimate_zwd: maybe\n", "  zwd_sigma: -0.1\n"}) {
     try {
       parseGnssFusionConfig(std::string("gnss_fusion:\n  mode: vio+dopp+psr\n") + bad, "b.yaml");
       FAIL() << "no error for " << bad;

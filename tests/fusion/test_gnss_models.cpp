@@ -129,6 +129,44 @@ TEST_P(GnssModelJacobians, Pseudorange) {
   EXPECT_NEAR(r.H_frame.tail<3>().norm(), 1.0, 1e-4);
 }
 
+// Undifferenced carrier phase (vio+dopp+ppp): the geometry of the code row without group delay
+// and ionosphere, +1 on the clock bias and on the float ambiguity, the wet mapping function on the
+// zenith wet delay state (also in the code row).
+TEST_P(GnssModelJacobians, CarrierPhaseWithAmbiguityAndWetDelay) {
+  Fixture fx(GetParam());
+  SatelliteModel m = satellite(antennaKinematics(fx.s).x_E);
+  m.ionosphere = 0.0;
+  m.ionosphereFree = true;
+  m.mapWet = 3.7;
+  m.hasCarrier = true;
+  m.carrierRange = m.pseudorange + 0.8 - constants::kSpeedOfLight * m.groupDelay;  // ambiguity 0.8 m
+  m.phaseVariance = 1e-4;
+  checkRow([&](const GnssStateValues& s) { return carrierPhaseRow(m, antennaKinematics(s), 100.0, 0.5); }, fx.s, 1e-4,
+           "phase");
+  const AntennaKinematics k = antennaKinematics(fx.s);
+  const GnssRow r = carrierPhaseRow(m, k, 100.0, 0.5);
+  const GnssRow code = pseudorangeRow(m, k, 100.0);
+  EXPECT_EQ(r.clockBias, 1);
+  EXPECT_EQ(r.ambiguity, -1);  // set by the fusion
+  EXPECT_DOUBLE_EQ(r.variance, 1e-4);
+  // Same geometry as the code; the residual differs by the ambiguity (0.8 true − 0.5 assumed).
+  EXPECT_NEAR((r.H_imu - code.H_imu).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((r.H_frame - code.H_frame).norm(), 0.0, 1e-12);
+  EXPECT_NEAR(r.residual - code.residual, 0.3, 1e-6);
+  EXPECT_NEAR(carrierPhaseRow(m, k, 100.0, 0.6).residual, r.residual - 0.1, 1e-6);
+  EXPECT_NEAR(carrierPhaseRow(m, k, 101.0, 0.5).residual, r.residual - 1.0, 1e-6);
+  // Zenith wet delay z enters as T + m_w z (the fusion adds m_w ẑ to the modelled delay).
+  for (auto row : {+[](const SatelliteModel& x, const AntennaKinematics& kk) { return carrierPhaseRow(x, kk, 100.0, 0.5); },
+                   +[](const SatelliteModel& x, const AntennaKinematics& kk) { return pseudorangeRow(x, kk, 100.0); }}) {
+    const double dz = 0.1;  // the delay is linear in z; a larger step keeps the 2e7 m rounding small
+    SatelliteModel mp = m, mm = m;
+    mp.troposphere += m.mapWet * dz;
+    mm.troposphere -= m.mapWet * dz;
+    EXPECT_NEAR(row(m, k).H_tropo, -(row(mp, k).residual - row(mm, k).residual) / (2 * dz), 1e-6 / dz);
+    EXPECT_DOUBLE_EQ(row(m, k).H_tropo, 3.7);
+  }
+}
+
 TEST_P(GnssModelJacobians, DopplerIncludingLeverArmRotation) {
   Fixture fx(GetParam());
   const SatelliteModel m = satellite(antennaKinematics(fx.s).x_E);

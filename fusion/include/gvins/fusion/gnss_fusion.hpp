@@ -20,6 +20,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -56,6 +57,8 @@ struct GnssEpochReport {
   std::int64_t t_ns = 0;        ///< measurement time used (tag − receiver clock)
   GnssFusionStage stage = GnssFusionStage::kWaitingVio;
   GnssTypeCount psr, dopp, dpsr, ddcp, vel, frame;
+  GnssTypeCount phase;          ///< undifferenced carrier phase (vio+dopp+ppp)
+  int ambiguities = 0;          ///< float ambiguity states after the epoch (vio+dopp+ppp)
   bool updated = false;         ///< at least one update applied
   bool clocksInitialized = false;  ///< this epoch
   bool reset = false;           ///< outage reset this epoch
@@ -99,6 +102,10 @@ class GnssFusion {
                                               const Eigen::Vector3d& x) const;
   /// Clock system index of a satellite (QZSS shares GPS's clock), or -1 if not estimated.
   int clockIndex(SatId sat) const;
+  /// Zenith wet delay residual estimate (m), when estimated.
+  std::optional<double> zenithWetDelay(const vio::EstimatorBackend<Scalar>& est) const;
+  /// Float ambiguity estimates (m) of the satellites with an ambiguity state (vio+dopp+ppp).
+  std::map<SatId, double> ambiguities(const vio::EstimatorBackend<Scalar>& est) const;
 
  private:
   struct Pending;
@@ -108,15 +115,22 @@ class GnssFusion {
   bool initClocks(vio::EstimatorBackend<Scalar>& est, const std::vector<SatelliteModel>& models,
                   const AntennaKinematics& k, const GpsTime& t);
   void propagateClocks(vio::EstimatorBackend<Scalar>& est, const GpsTime& t);
+  /// Random walk of the zenith wet delay state to time t.
+  void propagateZwd(vio::EstimatorBackend<Scalar>& est, const GpsTime& t);
   /// Gates rows one by one, stacks the accepted ones and applies them; returns the update.
+  /// `ambiguities`: the blocks that rows' `ambiguity` indices refer to.
   vio::BackendUpdate<Scalar> apply(vio::EstimatorBackend<Scalar>& est, std::vector<GnssRow>& rows,
                                    const Eigen::MatrixXd& noise, const Eigen::Matrix<double, 9, 9>& intCov,
-                                   std::vector<bool>& accepted, bool gate);
+                                   std::vector<bool>& accepted, bool gate,
+                                   const std::vector<sri::BlockId>& ambiguities = {});
+  /// vio+dopp+ppp: marginalizes the ambiguity state of `sat` (arc ended, slipped or rejected).
+  void dropAmbiguity(vio::EstimatorBackend<Scalar>& est, SatId sat);
 
   GnssFusionConfig config_;
   GnssFusionStage stage_ = GnssFusionStage::kWaitingVio;
   GnssAnchor anchor_;
-  sri::BlockId frameBlock_, leverBlock_, clockBlock_;
+  sri::BlockId frameBlock_, leverBlock_, clockBlock_, zwdBlock_;
+  GpsTime zwdTime_;
   std::vector<System> clockSystems_;
   GpsTime clockTime_;
   std::optional<GpsTime> lastUpdate_;
@@ -126,6 +140,17 @@ class GnssFusion {
   std::optional<GpsTime> lastBase_;
   std::unique_ptr<CarrierSmoother> smoother_, baseSmoother_;  // carrierSmoothing > 0: psr, dpsr
   ObsEpoch smoothed_;
+  // vio+dopp+ppp: one float ambiguity state per satellite arc; the arcs (cycle slips, gaps, signal
+  // changes, code-carrier jumps) are those of a CarrierSmoother run on a copy of the rover epochs.
+  struct Ambiguity {
+    sri::BlockId id;
+    GpsTime arcStart;   ///< start of the carrier arc the state belongs to
+    GpsTime lastRow;    ///< last epoch with a phase row
+    int rejections = 0; ///< consecutive gated-out phase rows
+  };
+  std::unique_ptr<CarrierSmoother> arcs_;
+  ObsEpoch arcSmoothed_;  // the rover epoch with the arcs' carrier-smoothed codes
+  std::map<SatId, Ambiguity> ambiguities_;
 };
 
 extern template class GnssFusion<float>;

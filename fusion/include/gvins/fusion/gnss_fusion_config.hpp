@@ -2,7 +2,7 @@
 //
 //   gnss_fusion:
 //     mode: vio+dopp+psr        # vio | vio+gpsvel | vio+dopp | vio+dopp+psr | vio+dopp+dpsr |
-//                               # vio+dopp+ddcp | vio+dopp+psr-nointegration
+//                               # vio+dopp+ddcp | vio+dopp+psr-nointegration | vio+dopp+ppp
 //     lever_arm: [0.0, 0.0, 0.1]          # ^I p_r, m (initial value)
 //     calibrate_lever_arm: true
 //     lever_arm_sigma: 0.2                # m, prior 1-sigma per axis when calibrated
@@ -19,8 +19,16 @@
 //     precise_ephemeris_error_m: {G: 0.05} # the same for satellites from precise products (SP3/clock;
 //                                         # default: the SPP's precise_ephemeris_error_m)
 //     code_sigma: 0.6                     # m at zenith; variance (a² + a²/sin²(el)) style
-//     carrier_smoothing: 100              # s, Hatch window of the psr/dpsr codes (default; 0 = raw)
+//     carrier_smoothing: 100              # s, Hatch window of the psr/dpsr codes (default; 0 = raw;
+//                                         # vio+dopp+ppp and ddcp use raw codes)
 //     smoothed_code_factor: 1.0           # floor of the smoothed code's sigma / code_sigma
+//     phase_sigma: 0.003                  # m at zenith, one band (vio+dopp+ppp; ×2.6–3 for the pair)
+//     ambiguity_sigma: 30                 # m, prior 1-sigma of a new float ambiguity (vio+dopp+ppp)
+//     ambiguity_reset_rejections: 3       # consecutive gated-out phase rows that restart an ambiguity
+//     max_ambiguities: 0                  # ambiguity states at most, highest satellites first (0: all)
+//     estimate_zwd: true                  # zenith wet delay residual as a state (default: vio+dopp+ppp only)
+//     zwd_sigma: 0.05                     # m, its prior 1-sigma (about the model's zenith wet delay)
+//     zwd_random_walk: 0.0002             # m/√s
 //     doppler_sigma: 0.1                  # m/s at zenith
 //     clock_bias_random_walk: 0.1         # m/√s per constellation bias
 //     clock_drift_random_walk: 0.5        # m/s/√s
@@ -55,6 +63,9 @@ enum class GnssFusionMode : std::uint8_t {
   kDoppDpsr,      ///< Doppler + single-differenced pseudorange
   kDoppDdcp,      ///< Doppler + SD pseudorange + double-differenced carrier phase (fixed)
   kDoppPsrNoInt,  ///< as kDoppPsr without IMU integration to the measurement time (ablation)
+  /// Doppler + raw ionosphere-free pseudorange + undifferenced ionosphere-free carrier phase with
+  /// one float ambiguity state per satellite arc: float PPP with precise products or SSR.
+  kDoppPpp,
 };
 const char* toString(GnssFusionMode m);
 std::optional<GnssFusionMode> gnssFusionModeFromString(std::string_view s);
@@ -103,6 +114,25 @@ struct GnssFusionConfig {
   /// Floor of the smoothed code's sigma relative to codeSigma: the smoothing averages white noise
   /// by up to sqrt(2T/Δt − 1), but multipath correlated over tens of seconds much less.
   double smoothedCodeFactor = 1.0;
+  /// vio+dopp+ppp: carrier-phase sigma at zenith for one band (m), weighted like the code and
+  /// multiplied by the ionosphere-free pair's noise factor.
+  double phaseSigma = 0.003;
+  /// vio+dopp+ppp: prior sigma of a new ambiguity state (m), centred on phase minus code.
+  double ambiguitySigma = 30.0;
+  /// vio+dopp+ppp: after this many consecutive epochs with the satellite's phase row gated out,
+  /// its ambiguity is marginalized and restarted (an undetected slip, a broadcast orbit change).
+  int ambiguityResetRejections = 3;
+  /// vio+dopp+ppp: at most this many ambiguity states (each is a state column that every visual
+  /// update also carries); satellites above the mask are taken highest first, and a satellite
+  /// keeps its state while it has one. 0: no limit.
+  int maxAmbiguities = 0;
+  /// Zenith wet delay residual (about the Saastamoinen/Niell model) as a random-walk state,
+  /// ∂T/∂ZWD = the wet mapping function. Unset: estimated in vio+dopp+ppp only, where the float
+  /// ambiguities let an unmodelled ZWD change with the satellites' elevations map into height.
+  std::optional<bool> estimateZwd;
+  double zwdSigma = 0.05;
+  double zwdRandomWalk = 2e-4;
+  bool zwdState() const { return estimateZwd.value_or(mode == GnssFusionMode::kDoppPpp) && usesPseudorange(); }
   double dopplerSigma = 0.1;
   double clockBiasRandomWalk = 0.1;
   double clockDriftRandomWalk = 0.5;

@@ -79,6 +79,8 @@ struct GnssRow {
   Eigen::Matrix<double, 1, 3> H_lever = Eigen::Matrix<double, 1, 3>::Zero();
   Eigen::Matrix<double, 1, 9> H_earlier = Eigen::Matrix<double, 1, 9>::Zero();
   int clockBias = -1;       ///< index of the clock-bias entry touched (coefficient +1), -1: none
+  int ambiguity = -1;       ///< index of the float-ambiguity block touched (coefficient +1), -1: none
+  double H_tropo = 0.0;     ///< coefficient of the zenith wet delay residual (wet mapping function)
   double H_drift = 0.0;     ///< coefficient of the clock drift entry
   SatId sat;
 };
@@ -96,7 +98,8 @@ struct SatelliteModel {
   double clockBias = 0.0;   ///< s, with relativity, without group delay
   double clockDrift = 0.0;  ///< s/s
   double groupDelay = 0.0;  ///< s, broadcast for this code
-  double troposphere = 0.0; ///< m, modelled slant delay at the rover
+  double troposphere = 0.0; ///< m, modelled slant delay at the rover (plus m_w · the ZWD state, if any)
+  double mapWet = 0.0;      ///< wet mapping function at the satellite's elevation (∂T/∂ZWD)
   double shapiro = 0.0;     ///< m, relativistic (Shapiro) delay, gnss::shapiroDelay
   double ionosphere = 0.0;  ///< m, modelled code delay (Klobuchar) on this frequency; 0 if ionosphere-free
   bool ionosphereFree = false;  ///< pseudorange and group delay are a dual-frequency ionosphere-free pair:
@@ -108,12 +111,23 @@ struct SatelliteModel {
   double pseudorange = 0.0; ///< m
   bool hasDoppler = false;
   double rangeRate = 0.0;   ///< m/s, −λ·D
+  /// Ionosphere-free carrier phase a1·λ1·φ1 + a2·λ2·φ2 (m) of the pair's bands, when both phases
+  /// exist (vio+dopp+ppp); it equals the code's model minus group delays plus an ambiguity.
+  bool hasCarrier = false;
+  double carrierRange = 0.0;
+  double phaseVariance = 0.0;  ///< m²
   double codeVariance = 0.0;     ///< m²
   double dopplerVariance = 0.0;  ///< (m/s)²
 };
 
 /// Pseudorange (paper eq. zp): h = ρ(x_E) + Sagnac + c·dt_r,sys − c(dt_s − gd) + T + I + Shapiro.
 GnssRow pseudorangeRow(const SatelliteModel& m, const AntennaKinematics& k, double clockBiasMeters);
+/// Undifferenced ionosphere-free carrier phase with a float ambiguity N (m; it absorbs the
+/// integer ambiguities, phase biases and any constant part of the orbit/clock error):
+/// h = ρ(x_E) + Sagnac + c·dt_r,sys − c·dt_s + T + Shapiro + N (no group delay, no ionosphere).
+/// The row's `ambiguity` is left −1 for the caller to set.
+GnssRow carrierPhaseRow(const SatelliteModel& m, const AntennaKinematics& k, double clockBiasMeters,
+                        double ambiguityMeters);
 /// Doppler as a range rate (paper eq. zd, times −λ): h = e·(v_s − u_E) + Sagnac rate + c·ḋt_r − c·ḋt_s.
 GnssRow dopplerRow(const SatelliteModel& m, const AntennaKinematics& k, double clockDriftMps);
 /// Single-differenced pseudorange vs the base (paper eq. z_dp). `sd` from the gnss layer's

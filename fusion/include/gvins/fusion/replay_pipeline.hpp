@@ -79,6 +79,7 @@ struct ReplayGnssOutcome {
   int psrUsed = 0, psrRejected = 0, doppUsed = 0, doppRejected = 0;
   int dpsrUsed = 0, dpsrRejected = 0, ddcpUsed = 0, ddcpRejected = 0;
   int velUsed = 0, velRejected = 0;
+  int phaseUsed = 0, phaseRejected = 0, ambiguities = 0;  ///< vio+dopp+ppp
   bool updated = false, rtkFixed = false, reset = false;
   double chi2 = 0.0;
   int dof = 0;
