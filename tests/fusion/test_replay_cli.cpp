@@ -15,6 +15,8 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <vector>
+#include <algorithm>
 
 #include "gvins/sim/dataset_generator.hpp"
 #include "gvins/sim/scenario.hpp"
@@ -125,6 +127,54 @@ TEST(ReplayCli, BroadcastWithTheSsrStreamIsAsGoodAsTheProducts) {
   const CliRun bad = replay("missing", "--mode vio+dopp+psr --broadcast --ssr " + missing);
   EXPECT_EQ(bad.code, 1) << bad.err;
   EXPECT_NE(bad.err.find(missing), std::string::npos) << bad.err;
+}
+
+// Float PPP as a user runs it, in post-processing (the folder's products) and in real time
+// (broadcast records + the SSR stream): the carrier-phase rows are used on (nearly) every
+// satellite, gnss_epochs.csv counts them, and the antenna velocity is better than with the
+// carrier-smoothed psr rows of the same products.
+TEST(ReplayCli, FloatPppWithProductsAndWithTheSsrStream) {
+  const fs::path ssr = dataset() / "gnss" / "ssr.rtcm3";
+  const CliRun psr = replay("ppp_psr", "--mode vio+dopp+psr");
+  const CliRun ppp = replay("ppp", "--mode vio+dopp+ppp");
+  const CliRun rt = replay("ppp_ssr", "--mode vio+dopp+ppp --broadcast --ssr " + ssr.string());
+  for (const CliRun* r : {&psr, &ppp, &rt}) {
+    ASSERT_EQ(r->code, 0) << r->err;
+    ASSERT_TRUE(r->metrics.count("global_position_rmse_m") && r->metrics.count("global_velocity_rmse_mps")) << r->err;
+  }
+  // Phase rows and ambiguity states from gnss_epochs.csv (columns 20-22).
+  long used = 0, rejected = 0, tight = 0, maxAmbiguities = 0;
+  {
+    std::ifstream in(scratch() / "ppp" / "gnss_epochs.csv");
+    std::string line;
+    while (std::getline(in, line)) {
+      if (line.empty() || line[0] == '#') continue;
+      std::vector<std::string> c;
+      std::stringstream ls(line);
+      for (std::string f; std::getline(ls, f, ',');) c.push_back(f);
+      ASSERT_EQ(c.size(), 22u) << line;
+      if (c[2] != "tight") continue;
+      ++tight;
+      used += std::stol(c[19]);
+      rejected += std::stol(c[20]);
+      maxAmbiguities = std::max(maxAmbiguities, std::stol(c[21]));
+    }
+  }
+  const double vPsr = psr.metrics.at("global_velocity_rmse_mps"), vPpp = ppp.metrics.at("global_velocity_rmse_mps");
+  const double vRt = rt.metrics.at("global_velocity_rmse_mps");
+  std::printf("float PPP: %ld tight epochs, %ld phase rows used, %ld rejected, up to %ld ambiguities; position %.3f m "
+              "(SSR %.3f m, psr %.3f m), antenna velocity %.4f m/s (SSR %.4f, psr %.4f)\n",
+              tight, used, rejected, maxAmbiguities, ppp.metrics.at("global_position_rmse_m"),
+              rt.metrics.at("global_position_rmse_m"), psr.metrics.at("global_position_rmse_m"), vPpp, vRt, vPsr);
+  ASSERT_GT(tight, 100);
+  EXPECT_GT(used, 8 * tight);
+  EXPECT_LT(rejected, used / 50);
+  EXPECT_GE(maxAmbiguities, 8);
+  EXPECT_LT(vPpp, 0.8 * vPsr);
+  EXPECT_LT(vRt, 0.8 * vPsr);
+  EXPECT_LT(ppp.metrics.at("global_position_rmse_m"), 1.0);
+  EXPECT_NEAR(rt.metrics.at("global_position_rmse_m"), ppp.metrics.at("global_position_rmse_m"), 0.1);
+  EXPECT_GT(rt.metrics.at("ssr_messages"), 0.0);
 }
 
 }  // namespace
