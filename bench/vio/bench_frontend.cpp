@@ -103,9 +103,9 @@ const Clip& rendered() {
     opt.seed = 7;
     std::fprintf(stderr, "rendering a 5 s stereo flight into %s ...\n", dir.c_str());
     gvins::sim::generateDataset(sc, dir, opt);
-    Clip c = loadClip("rendered", dir.string(), frames, 40);
+    Clip clip = loadClip("rendered", dir.string(), frames, 40);
     fs::remove_all(dir);
-    return c;
+    return clip;
   }();
   return c;
 }

@@ -9,9 +9,12 @@
 
 #include "gvins/base/constants.hpp"
 #include "gvins/base/local_frame.hpp"
+#include "gvins/ephemeris/satellite_antenna.hpp"
+#include "gvins/ephemeris/sun_position.hpp"
 #include "gvins/fusion/gnss_clock_init.hpp"
 #include "gvins/gnss/ionosphere_free.hpp"
 #include "gvins/gnss/klobuchar.hpp"
+#include "gvins/gnss/phase_windup.hpp"
 #include "gvins/gnss/sagnac.hpp"
 #include "gvins/gnss/troposphere.hpp"
 #include "gvins/gnss/zero_difference.hpp"
@@ -82,6 +85,16 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
   const Geodetic g = ecefToGeodetic(x);
   const IonosphereParameters& iono = nav.ionosphere();
   const double fL1 = *carrierFrequency(System::Gps, '1');
+  // Phase wind-up (vio+dopp+ppp): the Sun for the satellites' yaw steering (once per epoch), the
+  // receiver antenna level with x north, y west (its heading is common to all satellites).
+  std::optional<Eigen::Vector3d> sun;
+  Eigen::Matrix3d levelAxes;
+  {
+    const double sl = std::sin(g.lat), cl = std::cos(g.lat), so = std::sin(g.lon), co = std::cos(g.lon);
+    levelAxes.col(0) = Eigen::Vector3d(-sl * co, -sl * so, cl);
+    levelAxes.col(1) = -Eigen::Vector3d(-so, co, 0.0);
+    levelAxes.col(2) = Eigen::Vector3d(cl * co, cl * so, sl);
+  }
   for (const SatObs& so : rover.sats) {
     if (!so.sat.valid() || !config_.useSystem(so.sat.system)) continue;
     const char band = primaryBand(so.sat.system);
@@ -166,6 +179,11 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
             m.hasCarrier = true;
             m.carrierRange = c.a1 * (kC / *f) * p1->carrierPhase + c.a2 * (kC / *f2) * p2->carrierPhase;
             m.phaseVariance = std::pow(config_.phaseSigma * c.noiseFactor(), 2) * (0.5 + 0.5 / (sinEl * sinEl));
+            m.windupWavelength = c.a1 * (kC / *f) + c.a2 * (kC / *f2);
+            if (config_.phaseWindup) {
+              if (!sun) sun = sunPositionEcef(rover.time);
+              m.windup = phaseWindupCycles(m.position, x, yawSteeringAxes(m.position, *sun), levelAxes);
+            }
           }
         }
         break;
@@ -804,7 +822,14 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
         }
         it->second.lastRow = rover.time;
         const double nAmb = static_cast<double>(est.estimate(it->second.id).vector[0]);
-        GnssRow r = carrierPhaseRow(m, k, clk[m.clock], nAmb);
+        SatelliteModel mc = m;
+        if (config_.phaseWindup) {
+          double w = m.windup;
+          if (it->second.windup) w += std::round(*it->second.windup - w);
+          it->second.windup = w;
+          mc.carrierRange -= m.windupWavelength * w;
+        }
+        GnssRow r = carrierPhaseRow(mc, k, clk[m.clock], nAmb);
         r.H_lever.setZero();
         r.ambiguity = static_cast<int>(ambBlocks.size());
         ambBlocks.push_back(it->second.id);

@@ -12,6 +12,7 @@ GnssAntennaMotion trajectoryAntennaMotion(const Trajectory& trajectory, const Lo
     GnssAntennaState a;
     a.position = origin + rEW * s.pointPosition(leverArmBody);
     a.velocity = rEW * s.pointVelocity(leverArmBody);
+    a.axes = rEW * s.R_WB;  // antenna along the body axes, z up
     return a;
   };
 }

@@ -4,6 +4,9 @@
 #include <cmath>
 
 #include "gvins/base/constants.hpp"
+#include "gvins/ephemeris/satellite_antenna.hpp"
+#include "gvins/ephemeris/sun_position.hpp"
+#include "gvins/gnss/phase_windup.hpp"
 #include "gvins/gnss/sagnac.hpp"
 #include "gvins/sim/gnss_atmosphere.hpp"
 
@@ -200,6 +203,20 @@ void GnssReceiverSim::produce(const GpsTime& tag, const GpsTime& t, GnssSimEpoch
 
   const GnssConstellation& con = world_.constellation();
   const GnssAtmosphere& atm = world_.atmosphere();
+  // Phase wind-up: Sun for the satellites' yaw steering; the antenna's axes (level x north, y west
+  // when the motion gives none).
+  Eigen::Vector3d sun = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d rxAxes = rx.axes;
+  if (cfg_.phaseWindup) {
+    sun = sunPositionEcef(t);
+    if (rxAxes.isZero(0.0)) {
+      const double sl = std::sin(rxGeo.lat), cl = std::cos(rxGeo.lat), so = std::sin(rxGeo.lon), co = std::cos(rxGeo.lon);
+      const Eigen::Vector3d north(-sl * co, -sl * so, cl), east(-so, co, 0.0), up(cl * co, cl * so, sl);
+      rxAxes.col(0) = north;
+      rxAxes.col(1) = -east;
+      rxAxes.col(2) = up;
+    }
+  }
   for (SatTrack& st : sats_) {
     const SatId sat = st.sat;
     Geometry g;
@@ -284,6 +301,10 @@ void GnssReceiverSim::produce(const GpsTime& tag, const GpsTime& t, GnssSimEpoch
     satTruth.ionosphereModelL1 = atmo.ionosphereModelL1;
     satTruth.ionosphereL1Rate = ionoRate;
     satTruth.nlosBias = st.nlos ? st.nlosBias : 0.0;
+    if (cfg_.phaseWindup) {
+      st.windup = phaseWindupCycles(g.satRx, rx.position, yawSteeringAxes(g.satRx, sun), rxAxes, st.windup);
+      satTruth.windup = *st.windup;
+    }
 
     SatObs satObs;
     satObs.sat = sat;
@@ -339,7 +360,8 @@ void GnssReceiverSim::produce(const GpsTime& tag, const GpsTime& t, GnssSimEpoch
       const double common = g.range + satTruth.shapiro + clockTerm - kC * g.sat.clock + atmo.troposphere + satTruth.nlosBias;
       const double code = common + sgt.interFrequencyBias + kC * sgt.groupDelay + sgt.ionosphere + sgt.multipathCode +
                           sgt.codeNoise;
-      const double phaseNoN = (common - sgt.ionosphere + sgt.multipathPhase + sgt.phaseNoise) / lambda;
+      const double phaseNoN =
+          (common - sgt.ionosphere + sgt.multipathPhase + sgt.phaseNoise) / lambda + satTruth.windup;
 
       bool lli = false;
       if (!sg.active) {

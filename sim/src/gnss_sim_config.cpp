@@ -314,7 +314,7 @@ const std::set<std::string> kReceiverKeys = {"rate_hz", "elevation_mask_deg", "c
 void apply(const Reader& r, const YAML::Node& g, const std::string& file, GnssSimConfig& c) {
   static const std::set<std::string> kKeys = {
       "navigation", "systems",     "signals",     "signal_satellites", "cn0_offset_db", "code_noise_factor",
-      "include_unhealthy", "satellite_errors", "precise_products", "troposphere", "ionosphere", "shapiro", "rover", "base",
+      "include_unhealthy", "satellite_errors", "precise_products", "troposphere", "ionosphere", "shapiro", "phase_windup", "rover", "base",
       "rtcm",       "error_terms"};
   r.map(g, "gnss", kKeys, [&](const std::string& k, const std::string& full, const YAML::Node& v) {
     if (k == "navigation") {
@@ -416,6 +416,8 @@ void apply(const Reader& r, const YAML::Node& g, const std::string& file, GnssSi
             });
     } else if (k == "shapiro") {
       c.shapiroDelay = r.boolean(v, full);
+    } else if (k == "phase_windup") {
+      c.phaseWindup = r.boolean(v, full);
     } else if (k == "rover") {
       r.map(v, full, kReceiverKeys, [&](const std::string& rk, const std::string& rf, const YAML::Node& rv) {
         applyReceiver(r, rk, rf, rv, c.rover);

@@ -27,10 +27,10 @@ const char* kClockHeader =
 const char* kErrorHeader =
     "# every term of every measurement (m unless stated): P = range + shapiro + rx_clock + ifb - sat_clock + group_delay"
     " + tropo + iono + mp_code + nlos + code_noise; L*lambda = range + shapiro + rx_clock - sat_clock + tropo - iono"
-    " + mp_phase + nlos + phase_noise + N*lambda\n"
+    " + mp_phase + nlos + phase_noise + (N + windup)*lambda\n"
     "tag_ns,sat,signal,elevation_deg,azimuth_deg,cn0_dbhz,range,range_rate_mps,shapiro,rx_clock,ifb,sat_clock,"
     "sat_clock_error,orbit_error_los,group_delay,tropo,tropo_model,iono,iono_model,mp_code,mp_phase,nlos,code_noise,"
-    "phase_noise,doppler_noise_mps,ambiguity_cycles,wavelength,arc_start,lli\n";
+    "phase_noise,doppler_noise_mps,ambiguity_cycles,wavelength,arc_start,lli,windup_cycles\n";
 
 void writeClock(std::string& b, const GnssSimEpoch& e) {
   const auto& t = e.truth;
@@ -54,10 +54,10 @@ void writeErrors(std::string& b, const GnssSimEpoch& e) {
               g.cn0, s.range, s.rangeRate, s.shapiro, c * t.systemClockBias[systemIndex(s.sat.system)],
               g.interFrequencyBias, c * s.satClock, c * s.clockError, orbitLos, c * g.groupDelay);
       const double ionoModel = s.ionosphereModelL1 * g.ionosphere / std::max(s.ionosphereL1, 1e-12);
-      appendf(b, "%.4f,%.4f,%.4f,%.4f,%.4f,%.5f,%.4f,%.4f,%.5f,%.5f,%lld,%.9f,%d,%d\n", s.troposphere,
+      appendf(b, "%.4f,%.4f,%.4f,%.4f,%.4f,%.5f,%.4f,%.4f,%.5f,%.5f,%lld,%.9f,%d,%d,%.6f\n", s.troposphere,
               s.troposphereModel, g.ionosphere, ionoModel, g.multipathCode, g.multipathPhase, s.nlosBias, g.codeNoise,
               g.phaseNoise, g.dopplerNoise, static_cast<long long>(g.ambiguity), g.wavelength, g.arcStart ? 1 : 0,
-              g.lossOfLock ? 1 : 0);
+              g.lossOfLock ? 1 : 0, s.windup);
     }
   }
 }

@@ -59,7 +59,9 @@ TEST(GnssFusionConfig, FloatPppKeys) {
       "  ambiguity_sigma: 20\n"
       "  ambiguity_reset_rejections: 5\n"
       "  zwd_sigma: 0.08\n"
-      "  zwd_random_walk: 0.0001\n");
+      "  zwd_random_walk: 0.0001\n"
+      "  phase_windup: false\n"
+      "  max_ambiguities: 25\n");
   EXPECT_EQ(c.mode, GnssFusionMode::kDoppPpp);
   EXPECT_TRUE(c.usesPseudorange());
   EXPECT_FALSE(c.usesDifferences());
@@ -69,6 +71,9 @@ TEST(GnssFusionConfig, FloatPppKeys) {
   EXPECT_EQ(c.ambiguityResetRejections, 5);
   EXPECT_DOUBLE_EQ(c.zwdSigma, 0.08);
   EXPECT_DOUBLE_EQ(c.zwdRandomWalk, 1e-4);
+  EXPECT_FALSE(c.phaseWindup);
+  EXPECT_TRUE(GnssFusionConfig{}.phaseWindup);
+  EXPECT_EQ(c.maxAmbiguities, 25);
   // The wet delay state: on by default in vio+dopp+ppp only; estimate_zwd switches it for the
   // other pseudorange modes (never for modes without undifferenced codes).
   EXPECT_TRUE(c.zwdState());
@@ -128,7 +133,8 @@ TEST(GnssFusionConfig, ErrorsNameFileLineAndField) {
   for (const char* bad : {"  bands: {G: \"19\"}\n", "  bands: {X: \"12\"}\n", "  bands: \"12\"\n",
                           "  ephemeris_error_m: {G: -1}\n", "  carrier_smoothing: -5\n",
                           "  smoothed_code_factor: 2\n", "  phase_sigma: 0\n", "  ambiguity_sigma: -1\n",
-                          "  ambiguity_reset_rejections: 0\n", "  estimate_zwd: maybe\n", "  zwd_sigma: -0.1\n"}) {
+                          "  ambiguity_reset_rejections: 0\n", "  estimate_zwd: maybe\n", "  zwd_sigma: -0.1\n",
+                          "  phase_windup: 2\n", "  max_ambiguities: -1\n"}) {
     try {
       parseGnssFusionConfig(std::string("gnss_fusion:\n  mode: vio+dopp+psr\n") + bad, "b.yaml");
       FAIL() << "no error for " << bad;

@@ -38,6 +38,7 @@ const char* kFull = R"(gnss:
       - {sigma_tecu: 2, correlation_km: 800, covariance: gaussian, speed_mps: 40}
       - {sigma_tecu: 0.3, correlation_km: 100, covariance: exponential, speed_mps: 120}
   shapiro: false
+  phase_windup: false
   rover:
     rate_hz: 5
     elevation_mask_deg: 12
@@ -99,6 +100,8 @@ TEST(GnssSimConfig, ReadsEveryKey) {
   EXPECT_DOUBLE_EQ(c.ionosphere.residual[1].speed, 120.0);
   EXPECT_DOUBLE_EQ(c.ionosphere.shellHeight, 400e3);
   EXPECT_FALSE(c.shapiroDelay);
+  EXPECT_FALSE(c.phaseWindup);
+  EXPECT_TRUE(GnssSimConfig{}.phaseWindup);
   const GnssReceiverConfig& r = c.rover;
   EXPECT_DOUBLE_EQ(r.rate, 5.0);
   EXPECT_DOUBLE_EQ(r.elevationMaskDeg, 12.0);

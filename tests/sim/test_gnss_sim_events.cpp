@@ -204,7 +204,9 @@ TEST(GnssSimEvents, CycleSlipsJumpTheAmbiguityAndAreFlaggedAsConfigured) {
         const GnssSignalTruth& g = e.truth.sats[i].signals[j];
         const auto key = std::make_pair(e.truth.sats[i].sat, g.code.str());
         const auto it = last.find(key);
-        if (it != last.end() && it->second.second + 1 == k && !g.arcStart) EXPECT_EQ(g.ambiguity, it->second.first);
+        if (it != last.end() && it->second.second + 1 == k && !g.arcStart) {
+          EXPECT_EQ(g.ambiguity, it->second.first);
+        }
         if (it != last.end() && it->second.second + 1 == k && g.arcStart) {
           // A slip of a continuously tracked signal: recorded with its size and flag.
           const auto s = std::find_if(r.slips.begin(), r.slips.end(), [&](const GnssSlipEvent& x) {
@@ -313,7 +315,9 @@ TEST(GnssSimEvents, SignalsElevationMaskAndReportedClock) {
         EXPECT_NEAR(std::fmod(f - 1602e6, 562.5e3), 0.0, 1e-3);
         EXPECT_EQ(codes, (std::set<std::string>{"1C", "2C"}));
       }
-      if (so.sat.system == System::Gps) EXPECT_EQ(codes, (std::set<std::string>{"1C", "2W", "5Q"}));
+      if (so.sat.system == System::Gps) {
+        EXPECT_EQ(codes, (std::set<std::string>{"1C", "2W", "5Q"}));
+      }
     }
   }
   EXPECT_GT(seen.size(), 25u);

@@ -129,11 +129,13 @@ TEST(GnssSimModel, PseudorangeMinusGeometryAndModelsEqualsSimulatedErrors) {
         const double errors = (st.troposphere - st.troposphereModel) + (g.ionosphere - ionoModel * std::pow(1575.42e6 / f, 2)) +
                               shapiro + g.interFrequencyBias + g.multipathCode + st.nlosBias + g.codeNoise;
         EXPECT_NEAR(o.pseudorange - modelled, errors, 5e-4) << st.sat.str() << " " << o.code.str();
-        // Carrier phase: the same terms with the ionosphere advancing, plus N whole cycles.
+        // Carrier phase: the same terms with the ionosphere advancing, plus N whole cycles and the
+        // wind-up (cycles, the same on every frequency).
         const double phaseModelled = rho + rxClock - kC * bs->clockBias + tropoModel - ionoModel * std::pow(1575.42e6 / f, 2);
         const double phaseErrors = (st.troposphere - st.troposphereModel) - (g.ionosphere - ionoModel * std::pow(1575.42e6 / f, 2)) +
                                    shapiro + g.multipathPhase + st.nlosBias + g.phaseNoise;
-        EXPECT_NEAR((o.carrierPhase - static_cast<double>(g.ambiguity)) * lambda - phaseModelled, phaseErrors, 5e-4)
+        EXPECT_NEAR((o.carrierPhase - static_cast<double>(g.ambiguity) - st.windup) * lambda - phaseModelled, phaseErrors,
+                    5e-4)
             << st.sat.str() << " " << o.code.str();
         // Errors of a plausible size.
         EXPECT_LT(std::abs(g.codeNoise), 6.0 * g.codeSigma + 1e-12);

@@ -147,6 +147,7 @@ class GnssFusion {
     GpsTime arcStart;   ///< start of the carrier arc the state belongs to
     GpsTime lastRow;    ///< last epoch with a phase row
     int rejections = 0; ///< consecutive gated-out phase rows
+    std::optional<double> windup;  ///< cycles, continued over the arc
   };
   std::unique_ptr<CarrierSmoother> arcs_;
   ObsEpoch arcSmoothed_;  // the rover epoch with the arcs' carrier-smoothed codes

@@ -26,6 +26,7 @@
 //     ambiguity_sigma: 30                 # m, prior 1-sigma of a new float ambiguity (vio+dopp+ppp)
 //     ambiguity_reset_rejections: 3       # consecutive gated-out phase rows that restart an ambiguity
 //     max_ambiguities: 0                  # ambiguity states at most, highest satellites first (0: all)
+//     phase_windup: true                  # correct the phases for wind-up (vio+dopp+ppp)
 //     estimate_zwd: true                  # zenith wet delay residual as a state (default: vio+dopp+ppp only)
 //     zwd_sigma: 0.05                     # m, its prior 1-sigma (about the model's zenith wet delay)
 //     zwd_random_walk: 0.0002             # m/√s
@@ -126,6 +127,11 @@ struct GnssFusionConfig {
   /// update also carries); satellites above the mask are taken highest first, and a satellite
   /// keeps its state while it has one. 0: no limit.
   int maxAmbiguities = 0;
+  /// vio+dopp+ppp: phase wind-up correction (Wu et al. 1993; satellites in nominal yaw steering,
+  /// the receiver antenna taken level with x north: a vehicle's heading turns wind every
+  /// satellite up alike, which the clock absorbs, and its tilts change the differences by
+  /// millimetres; tests/gnss/test_phase_windup.cpp).
+  bool phaseWindup = true;
   /// Zenith wet delay residual (about the Saastamoinen/Niell model) as a random-walk state,
   /// ∂T/∂ZWD = the wet mapping function. Unset: estimated in vio+dopp+ppp only, where the float
   /// ambiguities let an unmodelled ZWD change with the satellites' elevations map into height.

@@ -116,6 +116,11 @@ struct SatelliteModel {
   bool hasCarrier = false;
   double carrierRange = 0.0;
   double phaseVariance = 0.0;  ///< m²
+  /// Phase wind-up (gvins/gnss/phase_windup.hpp) in cycles, in [−0.5, 0.5] (the caller continues it
+  /// over the arc), and the metres per cycle of the combination, a1 λ1 + a2 λ2; the observed
+  /// phase contains + windupWavelength · windup.
+  double windup = 0.0;
+  double windupWavelength = 0.0;
   double codeVariance = 0.0;     ///< m²
   double dopplerVariance = 0.0;  ///< (m/s)²
 };

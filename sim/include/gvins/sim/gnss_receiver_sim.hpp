@@ -27,6 +27,9 @@ namespace gvins::sim {
 struct GnssAntennaState {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< m
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  ///< m/s
+  /// Antenna axes (columns x, y, boresight z in ECEF) for the phase wind-up; zero: level, x north,
+  /// y west.
+  Eigen::Matrix3d axes = Eigen::Matrix3d::Zero();
 };
 using GnssAntennaMotion = std::function<GnssAntennaState(const GpsTime& gpst)>;
 
@@ -76,6 +79,7 @@ class GnssReceiverSim {
     GpsTime nlosEnd;
     double nlosBias = 0.0;
     int nlosEvent = -1;
+    std::optional<double> windup;  // cycles, continued while the satellite is in view
     GnssRandom rng;
     std::vector<SignalTrack> signals;
   };

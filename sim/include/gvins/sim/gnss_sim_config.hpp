@@ -264,6 +264,12 @@ struct GnssSimConfig {
   GnssIonosphereConfig ionosphere;
   /// Shapiro (relativistic) signal delay, ~2 cm (IERS Conventions 2010, eq. 11.17).
   bool shapiroDelay = true;
+  /// Carrier-phase wind-up (gvins/gnss/phase_windup.hpp, Wu et al. 1993): satellites in nominal
+  /// yaw steering, the rover antenna along the body axes (z the boresight), the base level (x
+  /// north, y west). Added to every phase (the same cycles on every frequency); the Doppler is
+  /// left without its rate (common to all satellites under a yaw turn, which the clock drift
+  /// takes).
+  bool phaseWindup = true;
   GnssReceiverConfig rover = defaultRover();
   GnssBaseConfig base = defaultBase();
   GnssRtcmConfig rtcm;

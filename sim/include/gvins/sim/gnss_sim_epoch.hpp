@@ -63,6 +63,7 @@ struct GnssSatelliteTruth {
   double range = 0.0;              ///< rho, m (Sagnac included)
   double rangeRate = 0.0;          ///< d rho / dt, m/s
   double shapiro = 0.0;            ///< m
+  double windup = 0.0;             ///< carrier-phase wind-up, cycles (every frequency)
   AzEl azel;
   double troposphere = 0.0, troposphereModel = 0.0;  ///< slant, m
   double troposphereRate = 0.0;                      ///< m/s
