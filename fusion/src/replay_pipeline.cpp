@@ -235,6 +235,9 @@ void ReplaySummary::writeMetrics(std::ostream& os) const {
   kv("antex_satellite_antennas", static_cast<double>(antexAntennas));
   kv("code_biases", static_cast<double>(codeBiases));
   kv("ssr_messages", static_cast<double>(ssrMessages));
+  kv("phase_rows_used", static_cast<double>(phaseRowsUsed));
+  kv("phase_rows_rejected", static_cast<double>(phaseRowsRejected));
+  kv("ambiguity_states_max", static_cast<double>(ambiguityStatesMax));
   kv("frame_init_s", frameInitSeconds);
   auto acc = [&](const std::string& p, const Accuracy& a) {
     kv((p + "position_rmse_m").c_str(), a.positionRmse);
@@ -300,6 +303,9 @@ void ReplaySummary::print(std::ostream& os) const {
     if (ssrMessages > 0) products += std::string(preciseSatellites > 0 ? "; where they do not cover: " : " + ") +
                                      "SSR corrections (" + std::to_string(ssrMessages) + " messages)";
     row("orbits/clocks", products);
+    if (phaseRowsUsed + phaseRowsRejected > 0)
+      row("carrier phase (PPP)", std::to_string(phaseRowsUsed) + " rows used, " + std::to_string(phaseRowsRejected) +
+                                     " gated out; up to " + std::to_string(ambiguityStatesMax) + " ambiguity states");
     if (std::isfinite(frameInitSeconds)) row("frame initialised", f("%.1f s after the first frame", frameInitSeconds));
   }
   if (leverArm) {
@@ -631,6 +637,9 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
           ++gnssCount;
           ++sum.gnssEpochs;
           if (o.updated) ++sum.gnssEpochsUpdated;
+          sum.phaseRowsUsed += static_cast<std::size_t>(o.phaseUsed);
+          sum.phaseRowsRejected += static_cast<std::size_t>(o.phaseRejected);
+          sum.ambiguityStatesMax = std::max(sum.ambiguityStatesMax, static_cast<std::size_t>(o.ambiguities));
           if (o.rtkFixed) ++sum.gnssEpochsFixed;
           const GpsTime& t = g.nextRover.time;
           char b[400];

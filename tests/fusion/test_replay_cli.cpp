@@ -175,6 +175,11 @@ TEST(ReplayCli, FloatPppWithProductsAndWithTheSsrStream) {
   EXPECT_LT(ppp.metrics.at("global_position_rmse_m"), 1.0);
   EXPECT_NEAR(rt.metrics.at("global_position_rmse_m"), ppp.metrics.at("global_position_rmse_m"), 0.1);
   EXPECT_GT(rt.metrics.at("ssr_messages"), 0.0);
+  // The summary's totals (metrics.csv) are the sums of the per-epoch file.
+  EXPECT_EQ(ppp.metrics.at("phase_rows_used"), static_cast<double>(used));
+  EXPECT_EQ(ppp.metrics.at("phase_rows_rejected"), static_cast<double>(rejected));
+  EXPECT_EQ(ppp.metrics.at("ambiguity_states_max"), static_cast<double>(maxAmbiguities));
+  EXPECT_EQ(psr.metrics.at("phase_rows_used"), 0.0);
 }
 
 }  // namespace

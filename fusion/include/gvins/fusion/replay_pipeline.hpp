@@ -164,6 +164,8 @@ struct ReplaySummary {
   std::size_t antexAntennas = 0;  ///< satellite antenna entries of the ANTEX files used with the products
   std::size_t codeBiases = 0;     ///< entries of the Bias-SINEX files used with the products
   std::size_t ssrMessages = 0;    ///< SSR messages read from the ReplayOptions::ssrFiles
+  /// vio+dopp+ppp: carrier-phase rows used / gated out over the run, most ambiguity states at once.
+  std::size_t phaseRowsUsed = 0, phaseRowsRejected = 0, ambiguityStatesMax = 0;
   double realTimeFactor() const { return wallSeconds > 0.0 ? datasetSeconds / wallSeconds : 0.0; }
   double estimatorMsMedian = 0.0;
   double gnssMsPerFrame = 0.0;   ///< GNSS time summed over the run / processed frames
