@@ -142,6 +142,7 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     const auto& ephemerisError =
         tx->state.precise || tx->state.ssr ? config_.preciseEphemerisError : config_.ephemerisError;
     const double ephemerisVariance = std::pow(ephemerisError[static_cast<std::size_t>(systemIndex(so.sat.system))], 2);
+    m.ephemerisVariance = ephemerisVariance;
     // Carrier-smoothed code: noise and multipath averaged over the arc (CarrierSmoother), down
     // to `smoothed_code_factor` of the raw sigma.
     const double smoothingFactor =
@@ -799,7 +800,8 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
           // ambiguity plus the code error. The arc may be older than the state (epochs before
           // the VIO or the clocks were ready, a restart after rejections): its carrier-smoothed
           // code carries those epochs' codes, weighted as the code rows are (each epoch as one
-          // measurement: σ/sqrt(n)); a new arc starts from the raw code with a loose prior.
+          // measurement: σ/sqrt(n)) except for the orbit/clock error, a bias per satellite that no
+          // averaging reduces; a new arc starts from the raw code with a loose prior.
           Eigen::Matrix<Scalar, Eigen::Dynamic, 1> x(1);
           double code = m.pseudorange, sigma = config_.ambiguitySigma;
           const SatObs* so = nullptr;
@@ -809,7 +811,8 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
           const SignalObs* s2 = so ? so->find(m.code2) : nullptr;
           if (arcs_->samples(m.sat) > 1 && s1 && s2 && s1->hasCode() && s2->hasCode()) {
             code = m.ifA1 * s1->pseudorange + m.ifA2 * s2->pseudorange;
-            sigma = std::sqrt(m.codeVariance) * arcs_->noiseFactor(m.sat);
+            const double nf = arcs_->noiseFactor(m.sat);
+            sigma = std::sqrt((m.codeVariance - m.ephemerisVariance) * nf * nf + m.ephemerisVariance);
           }
           x[0] = static_cast<Scalar>(m.carrierRange - (code - kC * m.groupDelay));
           Ambiguity a;

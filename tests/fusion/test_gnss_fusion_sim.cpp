@@ -534,6 +534,9 @@ TEST(GnssFusionSim, FloatPppWithPreciseProducts) {
   const RunResult psr = run<double>(mode(GnssFusionMode::kDoppPsr), {}, &sc.navPrecise);
   const RunResult ppp = run<double>(mode(GnssFusionMode::kDoppPpp), {}, &sc.navPrecise);
   const RunResult pppFloat = run<float>(mode(GnssFusionMode::kDoppPpp), {}, &sc.navPrecise);
+  // Broadcast records only: the orbit/clock errors are biases per satellite that the ambiguities
+  // take; the phase rows must still pass the gates (a new ambiguity's prior keeps the bias).
+  const RunResult pppBroadcast = run<double>(mode(GnssFusionMode::kDoppPpp));
   std::fprintf(stderr,
                "precise products: psr (smoothed) 3-D %.3f m vel %.4f m/s; ppp %.3f m vel %.4f m/s (float %.3f m, "
                "%.4f m/s); phase rows %d used, %d rejected; %zu ambiguities, ZWD %.3f m\n",
@@ -547,6 +550,11 @@ TEST(GnssFusionSim, FloatPppWithPreciseProducts) {
   EXPECT_LT(ppp.posRms, 0.6);
   EXPECT_LT(pppFloat.posRms, 0.6);
   EXPECT_NEAR(pppFloat.velRms, ppp.velRms, 0.3 * ppp.velRms);
+  std::fprintf(stderr, "broadcast only: ppp %.3f m, %.4f m/s; phase rows %d used, %d rejected\n", pppBroadcast.posRms,
+               pppBroadcast.velRms, pppBroadcast.phase.used, pppBroadcast.phase.rejected);
+  EXPECT_GT(pppBroadcast.phase.used, 5 * pppBroadcast.epochs);
+  EXPECT_LT(pppBroadcast.phase.rejected, pppBroadcast.phase.used / 50);
+  EXPECT_LT(pppBroadcast.velRms, 0.7 * psr.velRms);
   // Ambiguities against the simulator's (GPS L1/L5: a1 λ1 N1 + a2 λ2 N2), differenced between
   // satellites so that the receiver clock (which shares the common part) drops out: what is left
   // is the position and troposphere error along the lines of sight, decimetres; a wrong

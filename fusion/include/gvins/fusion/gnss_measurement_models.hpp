@@ -122,6 +122,7 @@ struct SatelliteModel {
   double windup = 0.0;
   double windupWavelength = 0.0;
   double codeVariance = 0.0;     ///< m²
+  double ephemerisVariance = 0.0;  ///< m², the orbit/clock part of codeVariance (a bias per satellite)
   double dopplerVariance = 0.0;  ///< (m/s)²
 };
 
