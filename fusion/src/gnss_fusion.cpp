@@ -88,13 +88,7 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
   // Phase wind-up (vio+dopp+ppp): the Sun for the satellites' yaw steering (once per epoch), the
   // receiver antenna level with x north, y west (its heading is common to all satellites).
   std::optional<Eigen::Vector3d> sun;
-  Eigen::Matrix3d levelAxes;
-  {
-    const double sl = std::sin(g.lat), cl = std::cos(g.lat), so = std::sin(g.lon), co = std::cos(g.lon);
-    levelAxes.col(0) = Eigen::Vector3d(-sl * co, -sl * so, cl);
-    levelAxes.col(1) = -Eigen::Vector3d(-so, co, 0.0);
-    levelAxes.col(2) = Eigen::Vector3d(cl * co, cl * so, sl);
-  }
+  const Eigen::Matrix3d levelAxes = levelAntennaAxes(g.lat, g.lon);
   for (const SatObs& so : rover.sats) {
     if (!so.sat.valid() || !config_.useSystem(so.sat.system)) continue;
     const char band = primaryBand(so.sat.system);

@@ -22,4 +22,13 @@ double phaseWindupCycles(const Eigen::Vector3d& satellite, const Eigen::Vector3d
   return w;
 }
 
+Eigen::Matrix3d levelAntennaAxes(double latitude, double longitude) {
+  const double sl = std::sin(latitude), cl = std::cos(latitude), so = std::sin(longitude), co = std::cos(longitude);
+  Eigen::Matrix3d a;
+  a.col(0) = Eigen::Vector3d(-sl * co, -sl * so, cl);  // north
+  a.col(1) = Eigen::Vector3d(so, -co, 0.0);            // west
+  a.col(2) = Eigen::Vector3d(cl * co, cl * so, sl);    // up
+  return a;
+}
+
 }  // namespace gvins

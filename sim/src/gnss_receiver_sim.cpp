@@ -209,13 +209,7 @@ void GnssReceiverSim::produce(const GpsTime& tag, const GpsTime& t, GnssSimEpoch
   Eigen::Matrix3d rxAxes = rx.axes;
   if (cfg_.phaseWindup) {
     sun = sunPositionEcef(t);
-    if (rxAxes.isZero(0.0)) {
-      const double sl = std::sin(rxGeo.lat), cl = std::cos(rxGeo.lat), so = std::sin(rxGeo.lon), co = std::cos(rxGeo.lon);
-      const Eigen::Vector3d north(-sl * co, -sl * so, cl), east(-so, co, 0.0), up(cl * co, cl * so, sl);
-      rxAxes.col(0) = north;
-      rxAxes.col(1) = -east;
-      rxAxes.col(2) = up;
-    }
+    if (rxAxes.isZero(0.0)) rxAxes = levelAntennaAxes(rxGeo.lat, rxGeo.lon);
   }
   for (SatTrack& st : sats_) {
     const SatId sat = st.sat;

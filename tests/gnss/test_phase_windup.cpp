@@ -94,6 +94,16 @@ TEST(PhaseWindup, YawIsCommonToAllSatellitesTiltIsNot) {
   EXPECT_LT(std::abs(lr - l0), 0.06);  // 20° = 0.056 cycles of rotation at most
 }
 
+TEST(PhaseWindup, LevelAntennaAxesAreNorthWestUp) {
+  const Geometry g = geometry(45.0, 0.0);
+  const Geodetic p = geodeticFromDegrees(35.1347, 136.9776, 105.0);
+  const Eigen::Matrix3d a = levelAntennaAxes(p.lat, p.lon);
+  EXPECT_NEAR((a.col(0) - g.enu.col(1)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((a.col(1) + g.enu.col(0)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((a.col(2) - g.enu.col(2)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR(a.determinant(), 1.0, 1e-12);
+}
+
 TEST(PhaseWindup, ContinuesPreviousValueAcrossWholeCycles) {
   const Geometry g = geometry(40.0, 200.0);
   const Eigen::Matrix3d axes = vehicleAxes(g, 1.0);

@@ -32,4 +32,8 @@ double phaseWindupCycles(const Eigen::Vector3d& satellite, const Eigen::Vector3d
                          const Eigen::Matrix3d& satelliteAxes, const Eigen::Matrix3d& receiverAxes,
                          std::optional<double> previous = std::nullopt);
 
+/// Axes of a level antenna at geodetic latitude/longitude (rad): x north, y west, z up (the
+/// receiver axes of RTKLIB's PPP wind-up; a vehicle's heading only adds a common term).
+Eigen::Matrix3d levelAntennaAxes(double latitude, double longitude);
+
 }  // namespace gvins
