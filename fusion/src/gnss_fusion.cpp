@@ -109,6 +109,7 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     m.clockBias = tx->state.clockBias;
     m.clockDrift = tx->state.clockDrift;
     m.precise = tx->state.precise;
+    m.ssr = tx->state.ssr;
     m.groupDelay = nav.codeDelay(tx->state, so.sat, s->code, tx->transmitTime);
     m.wavelength = kC / *f;
     m.azel = azimuthElevation(g, x, m.position);
@@ -374,6 +375,34 @@ void GnssFusion<Scalar>::propagateZwd(vio::EstimatorBackend<Scalar>& est, const 
 }
 
 template <typename Scalar>
+void GnssFusion<Scalar>::propagateAmbiguities(vio::EstimatorBackend<Scalar>& est, const std::vector<SatId>& broadcast,
+                                              const GpsTime& t) {
+  const double dt = ambiguityTime_ ? t - *ambiguityTime_ : 0.0;
+  ambiguityTime_ = t;
+  const double q = config_.broadcastAmbiguityRandomWalk;
+  if (!(dt > 0.0) || !(q > 0.0)) return;
+  std::vector<SatId> sats;
+  for (const SatId& s : broadcast)
+    if (ambiguities_.count(s)) sats.push_back(s);
+  if (sats.empty()) return;
+  using Mat = typename sri::Propagation<Scalar>::Matrix;
+  const auto n = static_cast<Eigen::Index>(sats.size());
+  sri::Propagation<Scalar> step;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const sri::BlockId old = ambiguities_.at(sats[static_cast<std::size_t>(i)]).id;
+    step.addNewBlock(sri::BlockSpec::vector("gnss_ambiguity", 1), est.estimate(old));
+    Mat phi = Mat::Zero(n, 1);
+    phi(i, 0) = Scalar(1);
+    step.setTransition(old, phi);
+    step.marginalizeAfter(old);
+  }
+  step.setNoiseCovariance(Mat::Identity(n, n) * static_cast<Scalar>(q * q * dt));
+  const std::vector<sri::BlockId> ids = est.propagate(step, vio::ClientBlockRegion::kFront);
+  for (Eigen::Index i = 0; i < n; ++i)
+    ambiguities_.at(sats[static_cast<std::size_t>(i)]).id = ids.at(static_cast<std::size_t>(i));
+}
+
+template <typename Scalar>
 void GnssFusion<Scalar>::dropAmbiguity(vio::EstimatorBackend<Scalar>& est, SatId sat) {
   const auto it = ambiguities_.find(sat);
   if (it == ambiguities_.end()) return;
@@ -628,6 +657,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
     }
     if (rtk_) rtk_->reset();
     while (!ambiguities_.empty()) dropAmbiguity(est, ambiguities_.begin()->first);
+    ambiguityTime_.reset();
     rep.reset = true;
     lastUpdate_.reset();
   }
@@ -771,6 +801,11 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
     std::vector<sri::BlockId> ambBlocks;
     std::vector<SatId> ambSats;
     if (ppp && clockBlock_.valid()) {
+      // Ambiguities of satellites on broadcast orbits and clocks follow their drifting errors.
+      std::vector<SatId> broadcast;
+      for (const SatelliteModel& m : models)
+        if (!m.precise && !m.ssr) broadcast.push_back(m.sat);
+      propagateAmbiguities(est, broadcast, tMeas);
       // Satellites with a state first, then the others highest first (max_ambiguities).
       std::vector<const SatelliteModel*> order;
       for (const SatelliteModel& m : models) order.push_back(&m);

@@ -415,7 +415,7 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
     // the millimetre phase rows cannot absorb (docs/gnss_fusion.md, "Float PPP").
     if (opt.modeName == "vio+dopp+ppp" && !g.nav.precise() && opt.ssrFiles.empty()) {
       std::fprintf(stderr, "[gvins-replay] warning: vio+dopp+ppp without precise products or an SSR stream: the "
-                           "broadcast orbit/clock errors limit it (simulated flights: 0.97 m against 0.58 m with "
+                           "broadcast orbit/clock errors limit it (simulated flights: 0.70 m against 0.58 m with "
                            "vio+dopp+psr)\n");
     }
     // Products of another day than the observations: every state would silently be broadcast.

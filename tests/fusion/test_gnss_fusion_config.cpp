@@ -61,7 +61,8 @@ TEST(GnssFusionConfig, FloatPppKeys) {
       "  zwd_sigma: 0.08\n"
       "  zwd_random_walk: 0.0001\n"
       "  phase_windup: false\n"
-      "  max_ambiguities: 25\n");
+      "  max_ambiguities: 25\n"
+      "  broadcast_ambiguity_random_walk: 0.01\n");
   EXPECT_EQ(c.mode, GnssFusionMode::kDoppPpp);
   EXPECT_TRUE(c.usesPseudorange());
   EXPECT_FALSE(c.usesDifferences());
@@ -74,6 +75,7 @@ TEST(GnssFusionConfig, FloatPppKeys) {
   EXPECT_FALSE(c.phaseWindup);
   EXPECT_TRUE(GnssFusionConfig{}.phaseWindup);
   EXPECT_EQ(c.maxAmbiguities, 25);
+  EXPECT_DOUBLE_EQ(c.broadcastAmbiguityRandomWalk, 0.01);
   // The wet delay state: on by default in vio+dopp+ppp only; estimate_zwd switches it for the
   // other pseudorange modes (never for modes without undifferenced codes).
   EXPECT_TRUE(c.zwdState());
@@ -134,7 +136,8 @@ TEST(GnssFusionConfig, ErrorsNameFileLineAndField) {
                           "  ephemeris_error_m: {G: -1}\n", "  carrier_smoothing: -5\n",
                           "  smoothed_code_factor: 2\n", "  phase_sigma: 0\n", "  ambiguity_sigma: -1\n",
                           "  ambiguity_reset_rejections: 0\n", "  estimate_zwd: maybe\n", "  zwd_sigma: -0.1\n",
-                          "  phase_windup: 2\n", "  max_ambiguities: -1\n"}) {
+                          "  phase_windup: 2\n", "  max_ambiguities: -1\n",
+                          "  broadcast_ambiguity_random_walk: -1\n"}) {
     try {
       parseGnssFusionConfig(std::string("gnss_fusion:\n  mode: vio+dopp+psr\n") + bad, "b.yaml");
       FAIL() << "no error for " << bad;

@@ -527,7 +527,8 @@ TEST(GnssFusionSim, PhaseResidualsAtTruthWithWindup) {
 // delay state. Against the carrier-smoothed psr rows: the phases halve the velocity error, and the
 // ambiguities match the simulator's integers. Measured (seed 2024, phases with wind-up): psr
 // 0.296 m / 0.050 m/s, ppp 0.363 m / 0.027 m/s, float 0.365 m / 0.027 m/s, broadcast only
-// 1.137 m / 0.027 m/s, ambiguities 0.20 m RMS between GPS satellites;
+// 0.955 m / 0.028 m/s (ambiguity random walk; 1.137 m without), ambiguities 0.20 m RMS between
+// GPS satellites;
 // on this 90 s flight the float ambiguities have not converged, so the position is still that of
 // the averaged codes (docs/gnss_fusion.md, "Float PPP").
 TEST(GnssFusionSim, FloatPppWithPreciseProducts) {

@@ -152,6 +152,9 @@ class GnssFusion {
   std::unique_ptr<CarrierSmoother> arcs_;
   ObsEpoch arcSmoothed_;  // the rover epoch with the arcs' carrier-smoothed codes
   std::map<SatId, Ambiguity> ambiguities_;
+  std::optional<GpsTime> ambiguityTime_;  // last random-walk step of the broadcast satellites' states
+  /// Random walk of the ambiguity states of the satellites in `broadcast` to time t (one step).
+  void propagateAmbiguities(vio::EstimatorBackend<Scalar>& est, const std::vector<SatId>& broadcast, const GpsTime& t);
 };
 
 extern template class GnssFusion<float>;

@@ -27,6 +27,7 @@
 //     ambiguity_reset_rejections: 3       # consecutive gated-out phase rows that restart an ambiguity
 //     max_ambiguities: 0                  # ambiguity states at most, highest satellites first (0: all)
 //     phase_windup: true                  # correct the phases for wind-up (vio+dopp+ppp)
+//     broadcast_ambiguity_random_walk: 0.005  # m/√s on ambiguities of broadcast-orbit satellites
 //     estimate_zwd: true                  # zenith wet delay residual as a state (default: vio+dopp+ppp only)
 //     zwd_sigma: 0.05                     # m, its prior 1-sigma (about the model's zenith wet delay)
 //     zwd_random_walk: 0.0002             # m/√s
@@ -132,6 +133,10 @@ struct GnssFusionConfig {
   /// satellite up alike, which the clock absorbs, and its tilts change the differences by
   /// millimetres; tests/gnss/test_phase_windup.cpp).
   bool phaseWindup = true;
+  /// vio+dopp+ppp: random walk (m/√s) of the ambiguity states of satellites on broadcast orbits
+  /// and clocks (no products, no SSR), whose errors drift by centimetres per minute as the true
+  /// orbit departs from the record; 0: constant ambiguities.
+  double broadcastAmbiguityRandomWalk = 0.005;
   /// Zenith wet delay residual (about the Saastamoinen/Niell model) as a random-walk state,
   /// ∂T/∂ZWD = the wet mapping function. Unset: estimated in vio+dopp+ppp only, where the float
   /// ambiguities let an unmodelled ZWD change with the satellites' elevations map into height.

@@ -107,6 +107,7 @@ struct SatelliteModel {
   double ifA1 = 1.0, ifA2 = 0.0;  ///< P = a1·P(code) + a2·P(code2)
   double wavelength = 0.0;  ///< m
   bool precise = false;     ///< orbit and clock from precise products (SP3/RINEX clock)
+  bool ssr = false;         ///< orbit and clock corrected by SSR
   AzEl azel;
   double pseudorange = 0.0; ///< m
   bool hasDoppler = false;
