@@ -31,6 +31,13 @@ std::int64_t toNs(const GpsTime& t) {
 
 System clockSystemOf(System s) { return s == System::Qzss ? System::Gps : s; }
 
+/// Marginalizes a client block that is in the state and forgets its id.
+template <typename Scalar>
+void marginalizeBlock(vio::EstimatorBackend<Scalar>& est, sri::BlockId& id) {
+  if (id.valid() && est.contains(id)) est.marginalize(std::span<const sri::BlockId>(&id, 1));
+  id = {};
+}
+
 enum RowType : int { kPsr, kDopp, kDpsr, kDdcp, kVel, kFrame, kPhase };
 
 GnssTypeCount& countOf(GnssEpochReport& r, int type) {
@@ -406,8 +413,7 @@ template <typename Scalar>
 void GnssFusion<Scalar>::dropAmbiguity(vio::EstimatorBackend<Scalar>& est, SatId sat) {
   const auto it = ambiguities_.find(sat);
   if (it == ambiguities_.end()) return;
-  const sri::BlockId id = it->second.id;
-  if (est.contains(id)) est.marginalize(std::span<const sri::BlockId>(&id, 1));
+  marginalizeBlock(est, it->second.id);
   ambiguities_.erase(it);
 }
 
@@ -645,16 +651,8 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
 
   // Outage: clocks and ambiguities start again.
   if (lastUpdate_ && rover.time - *lastUpdate_ > config_.outageReset && stage_ == GnssFusionStage::kTight) {
-    if (clockBlock_.valid()) {
-      const sri::BlockId id = clockBlock_;
-      est.marginalize(std::span<const sri::BlockId>(&id, 1));
-      clockBlock_ = {};
-    }
-    if (zwdBlock_.valid()) {
-      const sri::BlockId id = zwdBlock_;
-      est.marginalize(std::span<const sri::BlockId>(&id, 1));
-      zwdBlock_ = {};
-    }
+    marginalizeBlock(est, clockBlock_);
+    marginalizeBlock(est, zwdBlock_);
     if (rtk_) rtk_->reset();
     while (!ambiguities_.empty()) dropAmbiguity(est, ambiguities_.begin()->first);
     ambiguityTime_.reset();
@@ -833,9 +831,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
           // averaging reduces; a new arc starts from the raw code with a loose prior.
           Eigen::Matrix<Scalar, Eigen::Dynamic, 1> x(1);
           double code = m.pseudorange, sigma = config_.ambiguitySigma;
-          const SatObs* so = nullptr;
-          for (const SatObs& o : arcSmoothed_.sats)
-            if (o.sat == m.sat) so = &o;
+          const SatObs* so = arcSmoothed_.find(m.sat);
           const SignalObs* s1 = so ? so->find(m.code) : nullptr;
           const SignalObs* s2 = so ? so->find(m.code2) : nullptr;
           if (arcs_->samples(m.sat) > 1 && s1 && s2 && s1->hasCode() && s2->hasCode()) {
@@ -856,8 +852,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
         const double nAmb = static_cast<double>(est.estimate(it->second.id).vector[0]);
         SatelliteModel mc = m;
         if (config_.phaseWindup) {
-          double w = m.windup;
-          if (it->second.windup) w += std::round(*it->second.windup - w);
+          const double w = continueWindup(m.windup, it->second.windup);
           it->second.windup = w;
           mc.carrierRange -= m.windupWavelength * w;
         }

@@ -18,8 +18,11 @@ double phaseWindupCycles(const Eigen::Vector3d& satellite, const Eigen::Vector3d
   const double c = std::clamp(ds.dot(dr) / (ds.norm() * dr.norm()), -1.0, 1.0);
   double w = std::acos(c) / (2.0 * std::acos(-1.0));
   if (k.dot(ds.cross(dr)) < 0.0) w = -w;
-  if (previous) w += std::round(*previous - w);
-  return w;
+  return continueWindup(w, previous);
+}
+
+double continueWindup(double cycles, std::optional<double> previous) {
+  return previous ? cycles + std::round(*previous - cycles) : cycles;
 }
 
 Eigen::Matrix3d levelAntennaAxes(double latitude, double longitude) {

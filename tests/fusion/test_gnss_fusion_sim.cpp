@@ -23,6 +23,7 @@
 #include "gvins/ephemeris/sp3.hpp"
 #include "gvins/ephemeris/ssr_from_products.hpp"
 #include "gvins/fusion/gnss_fusion.hpp"
+#include "gvins/gnss/phase_windup.hpp"
 #include "gvins/sim/flight_pattern.hpp"
 #include "gvins/sim/gnss_epoch_generator.hpp"
 #include "gvins/sim/gnss_precise_products.hpp"
@@ -491,8 +492,8 @@ TEST(GnssFusionSim, PhaseResidualsAtTruthWithWindup) {
         }
         ASSERT_TRUE(g1 && g2) << m.sat.str();
         SatelliteModel mc = m;
-        double w = m.windup;
-        if (previous.count(m.sat)) w += std::round(previous[m.sat] - w);
+        const auto prev = previous.find(m.sat);
+        const double w = continueWindup(m.windup, prev == previous.end() ? std::nullopt : std::optional(prev->second));
         previous[m.sat] = w;
         if (windup) mc.carrierRange -= m.windupWavelength * w;
         const double n1 = m.ifA1 * g1->wavelength * static_cast<double>(g1->ambiguity) +

@@ -12,7 +12,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <string>
@@ -23,6 +22,7 @@
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "gvins/fusion/gnss_fusion.hpp"
 #include "gvins/gnss/carrier_smoothing.hpp"
+#include "gvins/gnss/phase_windup.hpp"
 
 namespace gvins::fusion {
 namespace {
@@ -79,13 +79,6 @@ Decomposition decompose(const std::map<std::string, std::vector<Sample>>& arcs, 
     }
   }
   d.rms = std::sqrt(s2 / static_cast<double>(d.samples));
-  if (std::getenv("GVINS_DEBUG_ARCS")) {
-    for (const auto& [id, v] : arcs) {
-      double q = 0.0;
-      for (const Sample& x : v) q += std::pow(value(x) - a[id] - b[x.system][static_cast<std::size_t>(x.epoch)], 2);
-      std::fprintf(stderr, "%s %s %zu %.4f\n", usePhase ? "phase" : "code", id.c_str(), v.size(), std::sqrt(q / v.size()));
-    }
-  }
   return d;
 }
 
@@ -121,8 +114,8 @@ TEST(GnssPhaseRealData, IonosphereFreePhaseModelOnTheNagoyaRover) {
       s.epoch = epoch;
       s.system = static_cast<int>(systemIndex(m.sat.system == System::Qzss ? System::Gps : m.sat.system));
       s.phase = carrierPhaseRow(m, k, 0.0, 0.0).residual;
-      double w = m.windup;
-      if (windup.count(id)) w += std::round(windup[id] - w);
+      const auto prev = windup.find(id);
+      const double w = continueWindup(m.windup, prev == windup.end() ? std::nullopt : std::optional(prev->second));
       windup[id] = w;
       SatelliteModel mc = m;
       mc.carrierRange -= m.windupWavelength * w;

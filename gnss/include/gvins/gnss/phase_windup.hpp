@@ -32,6 +32,10 @@ double phaseWindupCycles(const Eigen::Vector3d& satellite, const Eigen::Vector3d
                          const Eigen::Matrix3d& satelliteAxes, const Eigen::Matrix3d& receiverAxes,
                          std::optional<double> previous = std::nullopt);
 
+/// A wind-up value (cycles) shifted by whole cycles to within half a cycle of `previous` (the last
+/// value of the same arc); unchanged without one.
+double continueWindup(double cycles, std::optional<double> previous);
+
 /// Axes of a level antenna at geodetic latitude/longitude (rad): x north, y west, z up (the
 /// receiver axes of RTKLIB's PPP wind-up; a vehicle's heading only adds a common term).
 Eigen::Matrix3d levelAntennaAxes(double latitude, double longitude);
