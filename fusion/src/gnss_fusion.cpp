@@ -111,6 +111,7 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     m.sat = so.sat;
     m.code = s->code;
     m.clock = clockIndex(so.sat);
+    m.transmitTime = tx->transmitTime;
     m.position = tx->state.position;
     m.velocity = tx->state.velocity;
     m.clockBias = tx->state.clockBias;
@@ -851,6 +852,18 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
         it->second.lastRow = rover.time;
         const double nAmb = static_cast<double>(est.estimate(it->second.id).vector[0]);
         SatelliteModel mc = m;
+        if (config_.broadcastRecordChanges && !m.precise && !m.ssr) {
+          // Selected at the uncorrected transmit time, as satelliteAtTransmit selects.
+          Ambiguity& a = it->second;
+          if (auto rec = selectedBroadcastRecord(nav, m.sat, rover.time - m.pseudorange / kC)) {
+            if (a.record && !sameBroadcastRecord(*a.record, *rec)) {
+              a.recordShift += broadcastRecordRangeChange(*a.record, *rec, m.transmitTime, k.x_E);
+              ++rep.recordChanges;
+            }
+            a.record = std::move(rec);
+          }
+          mc.carrierRange += a.recordShift;
+        }
         if (config_.phaseWindup) {
           const double w = continueWindup(m.windup, it->second.windup);
           it->second.windup = w;

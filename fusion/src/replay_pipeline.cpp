@@ -238,6 +238,7 @@ void ReplaySummary::writeMetrics(std::ostream& os) const {
   kv("phase_rows_used", static_cast<double>(phaseRowsUsed));
   kv("phase_rows_rejected", static_cast<double>(phaseRowsRejected));
   kv("ambiguity_states_max", static_cast<double>(ambiguityStatesMax));
+  kv("broadcast_record_changes", static_cast<double>(recordChanges));
   kv("frame_init_s", frameInitSeconds);
   auto acc = [&](const std::string& p, const Accuracy& a) {
     kv((p + "position_rmse_m").c_str(), a.positionRmse);
@@ -305,7 +306,8 @@ void ReplaySummary::print(std::ostream& os) const {
     row("orbits/clocks", products);
     if (phaseRowsUsed + phaseRowsRejected > 0)
       row("carrier phase (PPP)", std::to_string(phaseRowsUsed) + " rows used, " + std::to_string(phaseRowsRejected) +
-                                     " gated out; up to " + std::to_string(ambiguityStatesMax) + " ambiguity states");
+                                     " gated out; up to " + std::to_string(ambiguityStatesMax) + " ambiguity states" +
+                                     (recordChanges > 0 ? "; " + std::to_string(recordChanges) + " broadcast record changes carried over" : ""));
     if (std::isfinite(frameInitSeconds)) row("frame initialised", f("%.1f s after the first frame", frameInitSeconds));
   }
   if (leverArm) {
@@ -647,6 +649,7 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
           sum.phaseRowsUsed += static_cast<std::size_t>(o.phaseUsed);
           sum.phaseRowsRejected += static_cast<std::size_t>(o.phaseRejected);
           sum.ambiguityStatesMax = std::max(sum.ambiguityStatesMax, static_cast<std::size_t>(o.ambiguities));
+          sum.recordChanges += static_cast<std::size_t>(o.recordChanges);
           if (o.rtkFixed) ++sum.gnssEpochsFixed;
           const GpsTime& t = g.nextRover.time;
           char b[400];

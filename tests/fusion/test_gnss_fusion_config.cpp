@@ -62,7 +62,8 @@ TEST(GnssFusionConfig, FloatPppKeys) {
       "  zwd_random_walk: 0.0001\n"
       "  phase_windup: false\n"
       "  max_ambiguities: 25\n"
-      "  broadcast_ambiguity_random_walk: 0.01\n");
+      "  broadcast_ambiguity_random_walk: 0.01\n"
+      "  broadcast_record_changes: false\n");
   EXPECT_EQ(c.mode, GnssFusionMode::kDoppPpp);
   EXPECT_TRUE(c.usesPseudorange());
   EXPECT_FALSE(c.usesDifferences());
@@ -76,6 +77,8 @@ TEST(GnssFusionConfig, FloatPppKeys) {
   EXPECT_TRUE(GnssFusionConfig{}.phaseWindup);
   EXPECT_EQ(c.maxAmbiguities, 25);
   EXPECT_DOUBLE_EQ(c.broadcastAmbiguityRandomWalk, 0.01);
+  EXPECT_FALSE(c.broadcastRecordChanges);
+  EXPECT_TRUE(GnssFusionConfig{}.broadcastRecordChanges);
   // The wet delay state: on by default in vio+dopp+ppp only; estimate_zwd switches it for the
   // other pseudorange modes (never for modes without undifferenced codes).
   EXPECT_TRUE(c.zwdState());
@@ -137,7 +140,7 @@ TEST(GnssFusionConfig, ErrorsNameFileLineAndField) {
                           "  smoothed_code_factor: 2\n", "  phase_sigma: 0\n", "  ambiguity_sigma: -1\n",
                           "  ambiguity_reset_rejections: 0\n", "  estimate_zwd: maybe\n", "  zwd_sigma: -0.1\n",
                           "  phase_windup: 2\n", "  max_ambiguities: -1\n",
-                          "  broadcast_ambiguity_random_walk: -1\n"}) {
+                          "  broadcast_ambiguity_random_walk: -1\n", "  broadcast_record_changes: 3\n"}) {
     try {
       parseGnssFusionConfig(std::string("gnss_fusion:\n  mode: vio+dopp+psr\n") + bad, "b.yaml");
       FAIL() << "no error for " << bad;

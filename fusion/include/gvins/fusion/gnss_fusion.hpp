@@ -32,6 +32,7 @@
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/fusion/gnss_fusion_config.hpp"
 #include "gvins/fusion/gnss_measurement_models.hpp"
+#include "gvins/gnss/broadcast_record_change.hpp"
 #include "gvins/gnss/carrier_smoothing.hpp"
 #include "gvins/gnss/rtk.hpp"
 #include "gvins/gnss/spp.hpp"
@@ -59,6 +60,7 @@ struct GnssEpochReport {
   GnssTypeCount psr, dopp, dpsr, ddcp, vel, frame;
   GnssTypeCount phase;          ///< undifferenced carrier phase (vio+dopp+ppp)
   int ambiguities = 0;          ///< float ambiguity states after the epoch (vio+dopp+ppp)
+  int recordChanges = 0;        ///< broadcast record changes carried over to ambiguities (vio+dopp+ppp)
   bool updated = false;         ///< at least one update applied
   bool clocksInitialized = false;  ///< this epoch
   bool reset = false;           ///< outage reset this epoch
@@ -148,6 +150,10 @@ class GnssFusion {
     GpsTime lastRow;    ///< last epoch with a phase row
     int rejections = 0; ///< consecutive gated-out phase rows
     std::optional<double> windup;  ///< cycles, continued over the arc
+    /// Broadcast satellites: the record of the last phase row and the sum of the modelled-range
+    /// jumps of the record changes since the state started (m, added to the phase).
+    std::optional<BroadcastRecord> record;
+    double recordShift = 0.0;
   };
   std::unique_ptr<CarrierSmoother> arcs_;
   ObsEpoch arcSmoothed_;  // the rover epoch with the arcs' carrier-smoothed codes

@@ -28,6 +28,7 @@
 //     max_ambiguities: 0                  # ambiguity states at most, highest satellites first (0: all)
 //     phase_windup: true                  # correct the phases for wind-up (vio+dopp+ppp)
 //     broadcast_ambiguity_random_walk: 0.005  # m/√s on ambiguities of broadcast-orbit satellites
+//     broadcast_record_changes: true      # carry the modelled-range jump of a new broadcast record over
 //     estimate_zwd: true                  # zenith wet delay residual as a state (default: vio+dopp+ppp only)
 //     zwd_sigma: 0.05                     # m, its prior 1-sigma (about the model's zenith wet delay)
 //     zwd_random_walk: 0.0002             # m/√s
@@ -137,6 +138,11 @@ struct GnssFusionConfig {
   /// and clocks (no products, no SSR), whose errors drift by centimetres per minute as the true
   /// orbit departs from the record; 0: constant ambiguities.
   double broadcastAmbiguityRandomWalk = 0.005;
+  /// vio+dopp+ppp: when a satellite on broadcast orbits and clocks switches to another record, the
+  /// jump of its modelled range ρ − c·dt_s (both records at the same transmit time;
+  /// gvins/gnss/broadcast_record_change.hpp) is added to its phase, so that its ambiguity state
+  /// keeps fitting instead of being off by the difference of the records' errors.
+  bool broadcastRecordChanges = true;
   /// Zenith wet delay residual (about the Saastamoinen/Niell model) as a random-walk state,
   /// ∂T/∂ZWD = the wet mapping function. Unset: estimated in vio+dopp+ppp only, where the float
   /// ambiguities let an unmodelled ZWD change with the satellites' elevations map into height.

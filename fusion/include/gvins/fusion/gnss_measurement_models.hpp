@@ -93,6 +93,7 @@ struct SatelliteModel {
   SatId sat;
   ObsCode code;
   int clock = -1;  ///< index of the receiver clock (system) this satellite uses
+  GpsTime transmitTime;  ///< GPST of transmission
   Eigen::Vector3d position = Eigen::Vector3d::Zero();  ///< ECEF of the transmit time
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
   double clockBias = 0.0;   ///< s, with relativity, without group delay

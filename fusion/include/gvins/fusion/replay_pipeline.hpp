@@ -80,6 +80,7 @@ struct ReplayGnssOutcome {
   int dpsrUsed = 0, dpsrRejected = 0, ddcpUsed = 0, ddcpRejected = 0;
   int velUsed = 0, velRejected = 0;
   int phaseUsed = 0, phaseRejected = 0, ambiguities = 0;  ///< vio+dopp+ppp
+  int recordChanges = 0;  ///< vio+dopp+ppp: broadcast record changes carried over to ambiguities
   bool updated = false, rtkFixed = false, reset = false;
   double chi2 = 0.0;
   int dof = 0;
@@ -166,6 +167,7 @@ struct ReplaySummary {
   std::size_t ssrMessages = 0;    ///< SSR messages read from the ReplayOptions::ssrFiles
   /// vio+dopp+ppp: carrier-phase rows used / gated out over the run, most ambiguity states at once.
   std::size_t phaseRowsUsed = 0, phaseRowsRejected = 0, ambiguityStatesMax = 0;
+  std::size_t recordChanges = 0;  ///< broadcast record changes carried over to ambiguities
   double realTimeFactor() const { return wallSeconds > 0.0 ? datasetSeconds / wallSeconds : 0.0; }
   double estimatorMsMedian = 0.0;
   double gnssMsPerFrame = 0.0;   ///< GNSS time summed over the run / processed frames

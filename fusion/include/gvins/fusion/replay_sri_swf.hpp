@@ -50,6 +50,7 @@ class GnssFusionReplayClient final : public ReplayGnss {
     o.ddcpUsed = r.ddcp.used, o.ddcpRejected = r.ddcp.rejected;
     o.velUsed = r.vel.used, o.velRejected = r.vel.rejected;
     o.phaseUsed = r.phase.used, o.phaseRejected = r.phase.rejected, o.ambiguities = r.ambiguities;
+    o.recordChanges = r.recordChanges;
     o.updated = r.updated, o.rtkFixed = r.rtkFixed, o.reset = r.reset;
     o.chi2 = r.chi2, o.dof = r.dof;
     o.antennaEcef = r.antennaEcef;
