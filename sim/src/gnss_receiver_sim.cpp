@@ -21,6 +21,8 @@ constexpr double kC = constants::kSpeedOfLight;
 constexpr double kGmEarth = 3.986004418e14;
 // Step of the finite differences that give the atmosphere's rates for the Doppler, s.
 constexpr double kRateStep = 1.0;
+// Half-interval of the central difference of the phase wind-up for the Doppler, s.
+constexpr double kWindupStep = 0.05;
 
 std::string systemLetters(const std::array<bool, kNumSystems>& s) {
   std::string out;
@@ -207,9 +209,19 @@ void GnssReceiverSim::produce(const GpsTime& tag, const GpsTime& t, GnssSimEpoch
   // when the motion gives none).
   Eigen::Vector3d sun = Eigen::Vector3d::Zero();
   Eigen::Matrix3d rxAxes = rx.axes;
+  // The antenna ±kWindupStep around t, for the wind-up rate in the Doppler (central difference).
+  GnssAntennaState rxBefore, rxAfter;
   if (cfg_.phaseWindup) {
     sun = sunPositionEcef(t);
     if (rxAxes.isZero(0.0)) rxAxes = levelAntennaAxes(rxGeo.lat, rxGeo.lon);
+    rxBefore = motion_(t - kWindupStep);
+    rxAfter = motion_(t + kWindupStep);
+    for (GnssAntennaState* a : {&rxBefore, &rxAfter}) {
+      if (a->axes.isZero(0.0)) {
+        const Geodetic ga = ecefToGeodetic(a->position);
+        a->axes = levelAntennaAxes(ga.lat, ga.lon);
+      }
+    }
   }
   for (SatTrack& st : sats_) {
     const SatId sat = st.sat;
@@ -295,9 +307,17 @@ void GnssReceiverSim::produce(const GpsTime& tag, const GpsTime& t, GnssSimEpoch
     satTruth.ionosphereModelL1 = atmo.ionosphereModelL1;
     satTruth.ionosphereL1Rate = ionoRate;
     satTruth.nlosBias = st.nlos ? st.nlosBias : 0.0;
+    double windupRate = 0.0;  // cycles per second of true time
     if (cfg_.phaseWindup) {
-      st.windup = phaseWindupCycles(g.satRx, rx.position, yawSteeringAxes(g.satRx, sun), rxAxes, st.windup);
+      const Eigen::Matrix3d satAxes = yawSteeringAxes(g.satRx, sun);
+      st.windup = phaseWindupCycles(g.satRx, rx.position, satAxes, rxAxes, st.windup);
       satTruth.windup = *st.windup;
+      // d/dt of the wind-up over ±kWindupStep of the antenna's motion and the satellite's (its
+      // yaw-steering axes change far more slowly than a vehicle turns; held).
+      const Eigen::Vector3d ds = g.sat.velocity * kWindupStep;
+      const double w0 = phaseWindupCycles(g.satRx - ds, rxBefore.position, satAxes, rxBefore.axes, st.windup);
+      const double w1 = phaseWindupCycles(g.satRx + ds, rxAfter.position, satAxes, rxAfter.axes, st.windup);
+      windupRate = (w1 - w0) / (2.0 * kWindupStep);
     }
 
     SatObs satObs;
@@ -386,7 +406,9 @@ void GnssReceiverSim::produce(const GpsTime& tag, const GpsTime& t, GnssSimEpoch
 
       // Doppler: -(d/dt of the phase range) / lambda per unit of receiver time.
       const double phaseRangeRate = g.rangeRate + clockRate - kC * g.sat.clockDrift + tropoRate - ionoRate * ionoScale;
-      const double doppler = -(phaseRangeRate / (1.0 + clock_.drift()) + sgt.dopplerNoise) / lambda;
+      // The phase also carries the wind-up (cycles): its rate enters as −ẇ.
+      const double doppler =
+          -(phaseRangeRate / (1.0 + clock_.drift()) + sgt.dopplerNoise) / lambda - windupRate / (1.0 + clock_.drift());
 
       SignalObs so;
       so.code = sg.code;

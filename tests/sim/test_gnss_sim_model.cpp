@@ -4,6 +4,8 @@
 // equal the simulated error terms; ambiguities are integers; Doppler agrees with the phase rate.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include <cmath>
 #include <map>
 
@@ -199,7 +201,8 @@ double dopplerVersusPhaseRate(const std::vector<GnssSimEpoch>& epochs, int* pair
 
 TEST(GnssSimModel, DopplerIsTheRateOfTheCarrierPhase) {
   // Static antenna: the phase-rate over 0.2 s equals the mean Doppler to the curvature of the
-  // range (1e-5 m/s); a moving one (8 m/s on an 80 m circle, 0.8 m/s^2): to its jerk.
+  // range (1e-5 m/s); a moving one (8 m/s on an 80 m circle, 0.8 m/s^2, the antenna turning
+  // with the body): to its jerk, with the phase wind-up's rate in the Doppler.
   for (const double speed : {0.0, 8.0}) {
     GnssSimConfig cfg = quietConfig();
     cfg.rover.rate = 5.0;
@@ -210,8 +213,11 @@ TEST(GnssSimModel, DopplerIsTheRateOfTheCarrierPhase) {
     while (auto e = gen.next()) epochs.push_back(std::move(*e));
     int pairs = 0;
     const double worst = dopplerVersusPhaseRate(epochs, &pairs);
+    std::fprintf(stderr, "speed %.0f m/s: Doppler against the phase rate, worst %.2e m/s (%d pairs)\n", speed, worst, pairs);
     EXPECT_GT(pairs, 3000);
-    EXPECT_LT(worst, speed == 0.0 ? 2e-4 : 5e-3) << "speed " << speed;
+    // Measured: 1.4e-4 static; moving 1.2e-3 (4.3e-3 before the Doppler carried the wind-up
+    // rate: the body turns at 0.1 rad/s, 0.016 cycles/s of wind-up on every satellite).
+    EXPECT_LT(worst, speed == 0.0 ? 2e-4 : 2e-3) << "speed " << speed;
     // The clock drift is in every Doppler: c * drift is tens of m/s for a 0.1 ppm oscillator.
     EXPECT_GT(std::abs(epochs.front().truth.clockDrift), 1e-10);
   }
