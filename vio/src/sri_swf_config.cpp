@@ -49,6 +49,8 @@ void SriSwfConfig::validate() const {
   req(init_motion_frames >= 3, "init.motion_frames must be >= 3");
   req(init_mono_motion_frames >= 5, "init.mono_motion_frames must be >= 5");
   req(init_mono_max_scale_sigma > 0 && std::isfinite(init_mono_max_scale_sigma), "init.mono_max_scale_sigma must be > 0");
+  req(init_mono_max_gyro_bias > 0 && std::isfinite(init_mono_max_gyro_bias), "init.mono_max_gyro_bias must be > 0");
+  req(init_mono_accel_error >= 0 && std::isfinite(init_mono_accel_error), "init.mono_accel_error must be >= 0");
   req(init_position_sigma > 0 && init_yaw_sigma > 0 && init_tilt_sigma > 0 && init_velocity_sigma > 0 &&
           init_gyro_bias_sigma > 0 && init_accel_bias_sigma > 0,
       "init sigmas must be positive");
@@ -133,6 +135,9 @@ SriSwfConfig parseRoot(const YAML::Node& root, const Ctx& c) {
       {"mono_in_motion", b(cfg.init_mono_in_motion, "init.mono_in_motion")},
       {"mono_motion_frames", i(cfg.init_mono_motion_frames, "init.mono_motion_frames")},
       {"mono_max_scale_sigma", d(cfg.init_mono_max_scale_sigma, "init.mono_max_scale_sigma")},
+      {"mono_gyro_bias", b(cfg.init_mono_gyro_bias, "init.mono_gyro_bias")},
+      {"mono_max_gyro_bias", d(cfg.init_mono_max_gyro_bias, "init.mono_max_gyro_bias")},
+      {"mono_accel_error", d(cfg.init_mono_accel_error, "init.mono_accel_error")},
       {"position_sigma", d(cfg.init_position_sigma, "init.position_sigma")},
       {"yaw_sigma", d(cfg.init_yaw_sigma, "init.yaw_sigma")},
       {"tilt_sigma", d(cfg.init_tilt_sigma, "init.tilt_sigma")},

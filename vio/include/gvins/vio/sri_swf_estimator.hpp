@@ -85,15 +85,25 @@ struct SriSwfConfig {
   double static_max_gyro_std = 0.02;   ///< rad/s
   double static_max_parallax = 1.0;    ///< px, median feature displacement over the window
   bool init_in_motion = true;          ///< linear visual-inertial alignment (stereo; mono see below)
-  /// Mono rigs: also try the mono in-motion alignment (experimental, off: it needs strong
-  /// acceleration within init_mono_motion_frames and assumes zero gyro bias; measured in
-  /// docs/vio_estimator.md). Without it a mono rig initialises at a standstill.
-  bool init_mono_in_motion = false;
+  /// Mono rigs: also try the mono in-motion alignment (gyro bias from the window's epipolar
+  /// constraints, scale/velocity/gravity, an excitation test against accelerometer errors;
+  /// measured in docs/vio_estimator.md). The static test is tried first; off: a mono rig
+  /// initialises at a standstill only.
+  bool init_mono_in_motion = true;
   int init_motion_frames = 10;         ///< frames used by the stereo in-motion alignment
   int init_mono_motion_frames = 20;    ///< frames used by the mono in-motion alignment (≥ 5)
   /// Mono in-motion alignment: largest relative 1-σ of the metric scale (from the fit's residuals
   /// with the gravity direction free) that is accepted; below it the motion lacked acceleration.
   double init_mono_max_scale_sigma = 0.05;
+  /// Mono in-motion alignment: estimate the gyro bias first from the epipolar constraints of the
+  /// window (its rotations come from the gyro), and start the state with it; a result above
+  /// init_mono_max_gyro_bias (rad/s) is discarded as degenerate.
+  bool init_mono_gyro_bias = true;
+  double init_mono_max_gyro_bias = 0.1;
+  /// Mono in-motion alignment, excitation test: a constant accelerometer error of this size (m/s²;
+  /// bias plus the tilt left by a wrong gravity direction) along any body axis must not move the
+  /// scale by more than init_mono_max_scale_sigma; 0: no test.
+  double init_mono_accel_error = 0.1;
   double init_position_sigma = 1e-3;   ///< m (gauge: the VIO frame is defined by the start)
   double init_yaw_sigma = 1e-3;        ///< rad (gauge)
   double init_tilt_sigma = 0.02;       ///< rad, roll/pitch
@@ -167,7 +177,7 @@ struct SriSwfConfig {
 ///   min_baseline_ratio, chi2_probability, max_msckf_per_frame, reanchor_sigma, position_random_walk,
 ///   attitude_random_walk,
 ///   init: {window, static_max_accel_std, static_max_gyro_std, static_max_parallax, in_motion,
-///          motion_frames, mono_in_motion, mono_motion_frames, mono_max_scale_sigma, position_sigma, yaw_sigma, tilt_sigma, velocity_sigma,
+///          motion_frames, mono_in_motion, mono_motion_frames, mono_max_scale_sigma, mono_gyro_bias, mono_max_gyro_bias, mono_accel_error, position_sigma, yaw_sigma, tilt_sigma, velocity_sigma,
 ///          gyro_bias_sigma, accel_bias_sigma}, zero_velocity_update, zero_velocity_sigma,
 ///   first_estimate_jacobians, first_estimate_delay, calibrate_extrinsics, extrinsic_rotation_sigma, extrinsic_translation_sigma,
 ///   time_offset, calibrate_time_offset, time_offset_sigma, precision: double | float, float_householder,
