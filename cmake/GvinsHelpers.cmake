@@ -81,6 +81,7 @@ function(gvins_add_fuzzer)
   endif()
   target_link_libraries(${A_NAME} PRIVATE ${A_DEPS})
   target_compile_options(${A_NAME} PRIVATE ${GVINS_WARNINGS})
+  target_compile_definitions(${A_NAME} PRIVATE GVINS_TEST_DATA="${PROJECT_SOURCE_DIR}/tests/data")
   set_target_properties(${A_NAME} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/fuzz)
 endfunction()
 
