@@ -853,16 +853,9 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
         const double nAmb = static_cast<double>(est.estimate(it->second.id).vector[0]);
         SatelliteModel mc = m;
         if (config_.broadcastRecordChanges && !m.precise && !m.ssr) {
-          // Selected at the uncorrected transmit time, as satelliteAtTransmit selects.
-          Ambiguity& a = it->second;
-          if (auto rec = selectedBroadcastRecord(nav, m.sat, rover.time - m.pseudorange / kC)) {
-            if (a.record && !sameBroadcastRecord(*a.record, *rec)) {
-              a.recordShift += broadcastRecordRangeChange(*a.record, *rec, m.transmitTime, k.x_E);
-              ++rep.recordChanges;
-            }
-            a.record = std::move(rec);
-          }
-          mc.carrierRange += a.recordShift;
+          BroadcastRecordContinuity& r = it->second.records;
+          if (r.update(nav, m.sat, rover.time - m.pseudorange / kC, m.transmitTime, k.x_E).changed) ++rep.recordChanges;
+          mc.carrierRange += r.shift();
         }
         if (config_.phaseWindup) {
           const double w = continueWindup(m.windup, it->second.windup);

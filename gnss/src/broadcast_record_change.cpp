@@ -49,4 +49,22 @@ double broadcastRecordRangeChange(const BroadcastRecord& from, const BroadcastRe
   return modelledRange(to, t, receiver) - modelledRange(from, t, receiver);
 }
 
+BroadcastRecordContinuity::Step BroadcastRecordContinuity::update(const EphemerisStore& nav, SatId sat,
+                                                                  const GpsTime& selectTime, const GpsTime& transmitTime,
+                                                                  const Eigen::Vector3d& receiver) {
+  Step step;
+  std::optional<BroadcastRecord> rec = selectedBroadcastRecord(nav, sat, selectTime);
+  if (!rec) return step;
+  step.found = true;
+  if (!record_) {
+    record_ = std::move(rec);
+  } else if (!sameBroadcastRecord(*record_, *rec)) {
+    step.changed = true;
+    step.jump = broadcastRecordRangeChange(*record_, *rec, transmitTime, receiver);
+    shift_ += step.jump;
+    record_ = std::move(rec);
+  }
+  return step;
+}
+
 }  // namespace gvins

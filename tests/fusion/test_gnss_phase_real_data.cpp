@@ -107,11 +107,7 @@ Collected collect(const std::vector<ObsEpoch>& rover, const EphemerisStore& nav,
   CarrierSmoother arcs;
   Collected out;
   std::map<std::string, double> windup;  // continued per arc, as the fusion does
-  struct RecordTrack {
-    BroadcastRecord record;
-    double shift = 0.0;
-  };
-  std::map<std::string, RecordTrack> records;  // per arc, as the fusion does
+  std::map<std::string, BroadcastRecordContinuity> records;  // per arc, as the fusion does
   int epoch = 0;
   for (const ObsEpoch& e : rover) {
     ObsEpoch copy = e;
@@ -132,22 +128,17 @@ Collected collect(const std::vector<ObsEpoch>& rover, const EphemerisStore& nav,
       s.phaseWindup = carrierPhaseRow(mc, k, 0.0, 0.0).residual;
       s.code = pseudorangeRow(m, k, 0.0).residual;
       // Broadcast record changes carried over to the phase (GnssFusionConfig::broadcastRecordChanges).
-      s.phaseRecord = s.phase;
-      if (auto rec = selectedBroadcastRecord(nav, m.sat, e.time - m.pseudorange / constants::kSpeedOfLight)) {
-        auto [rt, first] = records.try_emplace(id, RecordTrack{*rec, 0.0});
-        if (!first && !sameBroadcastRecord(rt->second.record, *rec)) {
-          const double jump = broadcastRecordRangeChange(rt->second.record, *rec, m.transmitTime, truth);
-          rt->second.shift += jump;
-          rt->second.record = *rec;
-          out.changedArcs[id] += jump;
-          ++out.recordChanges;
-        }
-        mc = m;
-        mc.carrierRange += rt->second.shift;
-        s.phaseRecord = carrierPhaseRow(mc, k, 0.0, 0.0).residual;
-      } else {
-        ADD_FAILURE() << "no broadcast record for " << m.sat.str();
+      BroadcastRecordContinuity& rc = records[id];
+      const BroadcastRecordContinuity::Step step =
+          rc.update(nav, m.sat, e.time - m.pseudorange / constants::kSpeedOfLight, m.transmitTime, truth);
+      if (!step.found) ADD_FAILURE() << "no broadcast record for " << m.sat.str();
+      if (step.changed) {
+        out.changedArcs[id] += step.jump;
+        ++out.recordChanges;
       }
+      mc = m;
+      mc.carrierRange += rc.shift();
+      s.phaseRecord = carrierPhaseRow(mc, k, 0.0, 0.0).residual;
       out.series[id].push_back(s);
     }
     ++epoch;

@@ -564,6 +564,11 @@ struct SriSwfEstimator<Scalar>::Impl {
       auto rotations = [&](const Eigen::Vector3d& b, std::vector<Eigen::Matrix3d>& out) {
         for (int j = 0; j < M; ++j) out[static_cast<std::size_t>(j)] = integs[static_cast<std::size_t>(j)].gammaFor(b);
       };
+      // Normal of the plane of the pair's two rays (zero when they are parallel).
+      auto planeNormal = [](const Eigen::Matrix3d& R0j, const std::pair<Eigen::Vector3d, Eigen::Vector3d>& p) {
+        const Eigen::Vector3d n = p.first.cross(R0j * p.second);
+        return n.norm() > 1e-9 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::Zero();
+      };
       // Residuals d_j · n̂ of frames j ≥ M/2 (the longer baselines) with ≥ 20 shared features.
       auto residuals = [&](const std::vector<Eigen::Matrix3d>& R, const std::vector<Eigen::Vector3d>& d,
                            std::vector<double>& e) {
@@ -571,21 +576,18 @@ struct SriSwfEstimator<Scalar>::Impl {
         for (int j = M / 2; j < M; ++j) {
           const auto& pj = pairs[static_cast<std::size_t>(j)];
           if (pj.size() < 20) continue;
-          for (const auto& [a, r] : pj) {
-            const Eigen::Vector3d n = a.cross(R[static_cast<std::size_t>(j)] * r);
-            e.push_back(n.norm() > 1e-9 ? d[static_cast<std::size_t>(j)].dot(n) / n.norm() : 0.0);
-          }
+          for (const auto& p : pj) e.push_back(d[static_cast<std::size_t>(j)].dot(planeNormal(R[static_cast<std::size_t>(j)], p)));
         }
       };
       std::vector<Eigen::Vector3d> d(static_cast<std::size_t>(M), Eigen::Vector3d::Zero());
       bool ok = true;
-      for (int it = 0; it < 6 && ok; ++it) {
+      for (int it = 0; it < 6; ++it) {
         rotations(bg, Rb);
         for (int j = M / 2; j < M; ++j) {
           Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
-          for (const auto& [a, r] : pairs[static_cast<std::size_t>(j)]) {
-            const Eigen::Vector3d n = a.cross(Rb[static_cast<std::size_t>(j)] * r);
-            if (n.norm() > 1e-9) S += n.normalized() * n.normalized().transpose();
+          for (const auto& p : pairs[static_cast<std::size_t>(j)]) {
+            const Eigen::Vector3d n = planeNormal(Rb[static_cast<std::size_t>(j)], p);
+            S += n * n.transpose();
           }
           d[static_cast<std::size_t>(j)] = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(S).eigenvectors().col(0);
         }
@@ -690,7 +692,9 @@ struct SriSwfEstimator<Scalar>::Impl {
     }
     // 3. s c̄_j − v₀ Δt_j − ½ g Δt_j² = α_j + (R_0j − I) p_IC; x = [s; v₀; g] or, with g = G·dir
     // + T δ, [s; v₀; δ]. Returns the 1-σ of s from the fit residuals.
-    auto solve = [&](const Eigen::Vector3d& g0, const Eigen::MatrixXd& T, Eigen::Matrix<double, 7, 1>& x) {
+    // da: a constant acceleration error added to every α_j (the excitation test below).
+    auto solve = [&](const Eigen::Vector3d& g0, const Eigen::MatrixXd& T, Eigen::Matrix<double, 7, 1>& x,
+                     const Eigen::Vector3d& da) {
       const int nx = 4 + static_cast<int>(T.cols());
       Eigen::MatrixXd A = Eigen::MatrixXd::Zero(nx, nx);
       Eigen::VectorXd b = Eigen::VectorXd::Zero(nx);
@@ -700,7 +704,7 @@ struct SriSwfEstimator<Scalar>::Impl {
         J.col(0) = cbar[static_cast<std::size_t>(j)];
         J.block(0, 1, 3, 3) = -dt * Eigen::Matrix3d::Identity();
         J.rightCols(nx - 4) = -0.5 * dt * dt * T;
-        const Eigen::Vector3d y = alpha[static_cast<std::size_t>(j)] +
+        const Eigen::Vector3d y = alpha[static_cast<std::size_t>(j)] + 0.5 * dt * dt * da +
                                   (R0[static_cast<std::size_t>(j)] - Eigen::Matrix3d::Identity()) * e0.p_IC +
                                   0.5 * dt * dt * g0;
         A += J.transpose() * J;
@@ -713,7 +717,7 @@ struct SriSwfEstimator<Scalar>::Impl {
       for (int j = 0; j < M; ++j) {
         const double dt = dts[static_cast<std::size_t>(j)];
         const Eigen::Vector3d e = x(0) * cbar[static_cast<std::size_t>(j)] - dt * x.segment(1, 3) -
-                                  0.5 * dt * dt * x.tail(3) - alpha[static_cast<std::size_t>(j)] -
+                                  0.5 * dt * dt * x.tail(3) - (alpha[static_cast<std::size_t>(j)] + 0.5 * dt * dt * da) -
                                   (R0[static_cast<std::size_t>(j)] - Eigen::Matrix3d::Identity()) * e0.p_IC;
         rss += e.squaredNorm();
       }
@@ -721,8 +725,8 @@ struct SriSwfEstimator<Scalar>::Impl {
       return std::sqrt(std::max(0.0, var * A.inverse()(0, 0)));
     };
     // Linear solve with |g| free, then |g| fixed and its direction refined; false if implausible.
-    auto align = [&](Eigen::Matrix<double, 7, 1>& x, double& sSigma) {
-      solve(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity(), x);
+    auto align = [&](Eigen::Matrix<double, 7, 1>& x, double& sSigma, const Eigen::Vector3d& da) {
+      solve(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity(), x, da);
       if (!(x(0) > 0.0) || std::abs(x.tail(3).norm() - cfg.gravity) > 1.0) return false;
       Eigen::Vector3d gdir = x.tail(3).normalized();
       sSigma = 0.0;  // of the last refinement, i.e. with the gravity direction free
@@ -730,34 +734,28 @@ struct SriSwfEstimator<Scalar>::Impl {
         Eigen::Matrix<double, 3, 2> T;
         const Eigen::Vector3d e1 = gdir.unitOrthogonal();
         T << e1, gdir.cross(e1);
-        sSigma = solve(cfg.gravity * gdir, T, x);
+        sSigma = solve(cfg.gravity * gdir, T, x, da);
         gdir = x.tail(3).normalized();
       }
-      solve(cfg.gravity * gdir, Eigen::MatrixXd(3, 0), x);
+      solve(cfg.gravity * gdir, Eigen::MatrixXd(3, 0), x, da);
       return x(0) > 0.0;
     };
     Eigen::Matrix<double, 7, 1> x;
     double sSigma = 0.0;
-    if (!align(x, sSigma) || sSigma > cfg.init_mono_max_scale_sigma * x(0)) return false;
+    if (!align(x, sSigma, Eigen::Vector3d::Zero()) || sSigma > cfg.init_mono_max_scale_sigma * x(0)) return false;
     // Excitation: the scale a constant accelerometer error of init_mono_accel_error (bias, and the
     // tilt that a wrong gravity direction leaves) along each body axis would give. The fit's own
     // residuals cannot show such a systematic error; with weak acceleration it moves the scale
     // by tens of percent while the residuals stay small.
     double sensitivity = 0.0;
     if (cfg.init_mono_accel_error > 0.0) {
-      const std::vector<Eigen::Vector3d> alpha0 = alpha;
       for (int k = 0; k < 3 && sensitivity <= cfg.init_mono_max_scale_sigma; ++k) {
-        for (int j = 0; j < M; ++j) {
-          const double dt = dts[static_cast<std::size_t>(j)];
-          alpha[static_cast<std::size_t>(j)] =
-              alpha0[static_cast<std::size_t>(j)] + 0.5 * dt * dt * cfg.init_mono_accel_error * Eigen::Vector3d::Unit(k);
-        }
         Eigen::Matrix<double, 7, 1> xk;
         double sk = 0.0;
-        sensitivity = align(xk, sk) ? std::max(sensitivity, std::abs(xk(0) - x(0)) / x(0))
-                                    : std::numeric_limits<double>::infinity();
+        sensitivity = align(xk, sk, cfg.init_mono_accel_error * Eigen::Vector3d::Unit(k))
+                          ? std::max(sensitivity, std::abs(xk(0) - x(0)) / x(0))
+                          : std::numeric_limits<double>::infinity();
       }
-      alpha = alpha0;
     }
     if (sensitivity > cfg.init_mono_max_scale_sigma) return false;
     const Eigen::Vector3d gb = x.tail(3);

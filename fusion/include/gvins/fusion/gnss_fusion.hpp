@@ -150,10 +150,9 @@ class GnssFusion {
     GpsTime lastRow;    ///< last epoch with a phase row
     int rejections = 0; ///< consecutive gated-out phase rows
     std::optional<double> windup;  ///< cycles, continued over the arc
-    /// Broadcast satellites: the record of the last phase row and the sum of the modelled-range
-    /// jumps of the record changes since the state started (m, added to the phase).
-    std::optional<BroadcastRecord> record;
-    double recordShift = 0.0;
+    /// Broadcast satellites: the record of the last phase row and the jumps of the record changes
+    /// since the state started (added to the phase).
+    BroadcastRecordContinuity records;
   };
   std::unique_ptr<CarrierSmoother> arcs_;
   ObsEpoch arcSmoothed_;  // the rover epoch with the arcs' carrier-smoothed codes

@@ -35,4 +35,27 @@ bool sameBroadcastRecord(const BroadcastRecord& a, const BroadcastRecord& b);
 double broadcastRecordRangeChange(const BroadcastRecord& from, const BroadcastRecord& to, const GpsTime& t,
                                   const Eigen::Vector3d& receiver);
 
+/// The broadcast record one carrier-phase arc of a satellite uses, followed epoch by epoch, and the
+/// sum of the modelled-range jumps of its record changes: the metres to add to the arc's phase so
+/// that one ambiguity keeps fitting across them.
+class BroadcastRecordContinuity {
+ public:
+  struct Step {
+    bool found = false;    ///< `nav` has a record for the satellite
+    bool changed = false;  ///< it differs from the previous epoch's
+    double jump = 0.0;     ///< m, added to shift() (0 without a change)
+  };
+  /// Follows the record `nav` selects for `sat` at `selectTime` (the uncorrected transmit time
+  /// t_rx − P/c, where satelliteAtTransmit selects); a change adds its jump at `transmitTime` for
+  /// a receiver at `receiver`. Without a record nothing changes.
+  Step update(const EphemerisStore& nav, SatId sat, const GpsTime& selectTime, const GpsTime& transmitTime,
+              const Eigen::Vector3d& receiver);
+  /// m, to add to the arc's phase.
+  double shift() const { return shift_; }
+
+ private:
+  std::optional<BroadcastRecord> record_;
+  double shift_ = 0.0;
+};
+
 }  // namespace gvins
