@@ -5,41 +5,13 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace gvins::sri {
 
 namespace {
-
-/// Householder reflector H = I − τ v vᵀ, v = [1; x̃], with H [α; x] = [β; 0] (the convention of
-/// LAPACK's xLARFG), for a contiguous x[0..n). On return alpha = β and x = x̃. The norm is
-/// scaled when the squares could under- or overflow.
-template <typename Scalar>
-Scalar makeReflectorRaw(Scalar& alpha, Scalar* x, int n) {
-  Scalar ss = 0;
-  for (int i = 0; i < n; ++i) ss += x[i] * x[i];
-  if (ss == Scalar(0)) return Scalar(0);
-  Scalar norm;
-  // Unscaled unless the squares may have lost precision to underflow or overflowed.
-  constexpr Scalar kSmall = std::numeric_limits<Scalar>::min() / std::numeric_limits<Scalar>::epsilon();
-  constexpr Scalar kBig = std::numeric_limits<Scalar>::max() / Scalar(4);
-  if (ss > kSmall && ss < kBig && alpha * alpha < kBig) {
-    norm = std::sqrt(alpha * alpha + ss);
-  } else {
-    Scalar xmax = std::abs(alpha);
-    for (int i = 0; i < n; ++i) xmax = std::max(xmax, std::abs(x[i]));
-    const Scalar inv = Scalar(1) / xmax;
-    Scalar sc = (alpha * inv) * (alpha * inv);
-    for (int i = 0; i < n; ++i) sc += (x[i] * inv) * (x[i] * inv);
-    norm = xmax * std::sqrt(sc);
-  }
-  const Scalar beta = alpha >= Scalar(0) ? -norm : norm;
-  const Scalar tau = (beta - alpha) / beta;
-  const Scalar scale = Scalar(1) / (alpha - beta);
-  for (int i = 0; i < n; ++i) x[i] *= scale;
-  alpha = beta;
-  return tau;
-}
 
 /// Givens rotation [c s; −s c] with −s·a + c·b = 0 and c·a + s·b = ρ = hypot(a, b) ≥ 0 for
 /// b ≠ 0 (Golub & Van Loan, Algorithm 5.1.3, scaled against overflow).
@@ -90,11 +62,31 @@ struct Simd;
       return v;                                                                        \
     }                                                                                  \
     GVINS_SRI_INLINE static void store(Scalar* p, type v) { std::memcpy(p, &v, sizeof(v)); } \
-    GVINS_SRI_INLINE static type broadcast(Scalar s) { return type{} + s; }            \
+    /* {s, s, ...}: one broadcast instruction (`type{} + s` keeps an add, since 0 + (-0) */ \
+    /* is +0; a lane-by-lane loop becomes a chain of inserts for float). */              \
+    GVINS_SRI_INLINE static type broadcast(Scalar s) {                                \
+      return splat(s, std::make_integer_sequence<int, kLanes>{});                      \
+    }                                                                                  \
+    template <int... I>                                                                \
+    GVINS_SRI_INLINE static type splat(Scalar s, std::integer_sequence<int, I...>) {  \
+      return type{((void)I, s)...};                                                    \
+    }                                                                                  \
   };
 GVINS_SRI_SIMD(16)
 GVINS_SRI_SIMD(32)
 #undef GVINS_SRI_SIMD
+/// Vector of *p in every lane, as a shuffle of lane 0 (GCC 12 builds {s, s, …} from a loaded
+/// float with a chain of vinsertps; the shuffle becomes one vbroadcastss/sd in AVX2 code).
+template <typename Scalar, int B, int... I>
+GVINS_SRI_INLINE typename Simd<Scalar, B>::type loadBroadcastImpl(const Scalar* p, std::integer_sequence<int, I...>) {
+  typename Simd<Scalar, B>::type v{};
+  v[0] = *p;
+  return __builtin_shufflevector(v, v, ((void)I, 0)...);
+}
+template <typename Scalar, int B>
+GVINS_SRI_INLINE typename Simd<Scalar, B>::type loadBroadcast(const Scalar* p) {
+  return loadBroadcastImpl<Scalar, B>(p, std::make_integer_sequence<int, Simd<Scalar, B>::kLanes>{});
+}
 #else
 #define GVINS_SRI_INLINE inline
 #define GVINS_SRI_LAMBDA_INLINE
@@ -106,6 +98,65 @@ template <typename Scalar, int B>
 GVINS_SRI_INLINE void putBroadcast(Scalar* b, int k, Scalar v) {
   constexpr int L = B / static_cast<int>(sizeof(Scalar));
   for (int l = 0; l < L; ++l) b[k * L + l] = v;
+}
+
+/// Σ a[i]·b[i] over n entries with SIMD partial sums (four vectors): the plain loop is one
+/// dependent scalar add per entry (the compiler may not reassociate it), which made the
+/// reflector norms and panel dot products of householderImpl latency-bound.
+template <typename Scalar, int B>
+GVINS_SRI_INLINE Scalar dotSimd(const Scalar* a, const Scalar* b, int n) {
+  int i = 0;
+  Scalar s = 0;
+#ifdef GVINS_SRI_VECTOR_EXT
+  using V = Simd<Scalar, B>;
+  using Vec = typename V::type;
+  constexpr int L = V::kLanes;
+  if (n >= 4 * L) {
+    Vec s0 = V::broadcast(Scalar(0));
+    Vec s1 = s0;
+    Vec s2 = s0;
+    Vec s3 = s0;
+    for (; i + 4 * L <= n; i += 4 * L) {
+      s0 += V::load(a + i) * V::load(b + i);
+      s1 += V::load(a + i + L) * V::load(b + i + L);
+      s2 += V::load(a + i + 2 * L) * V::load(b + i + 2 * L);
+      s3 += V::load(a + i + 3 * L) * V::load(b + i + 3 * L);
+    }
+    s0 = (s0 + s1) + (s2 + s3);
+    for (int l = 0; l < L; ++l) s += s0[l];
+  }
+#endif
+  for (; i < n; ++i) s += a[i] * b[i];
+  return s;
+}
+
+/// Householder reflector H = I − τ v vᵀ, v = [1; x̃], with H [α; x] = [β; 0] (the convention of
+/// LAPACK's xLARFG), for a contiguous x[0..n). On return alpha = β and x = x̃. The norm is
+/// scaled when the squares could under- or overflow.
+template <typename Scalar, int B>
+GVINS_SRI_INLINE Scalar makeReflectorRaw(Scalar& alpha, Scalar* x, int n) {
+  const Scalar ss = dotSimd<Scalar, B>(x, x, n);
+  if (ss == Scalar(0)) return Scalar(0);
+  Scalar norm;
+  // Unscaled unless the squares may have lost precision to underflow or overflowed.
+  constexpr Scalar kSmall = std::numeric_limits<Scalar>::min() / std::numeric_limits<Scalar>::epsilon();
+  constexpr Scalar kBig = std::numeric_limits<Scalar>::max() / Scalar(4);
+  if (ss > kSmall && ss < kBig && alpha * alpha < kBig) {
+    norm = std::sqrt(alpha * alpha + ss);
+  } else {
+    Scalar xmax = std::abs(alpha);
+    for (int i = 0; i < n; ++i) xmax = std::max(xmax, std::abs(x[i]));
+    const Scalar inv = Scalar(1) / xmax;
+    Scalar sc = (alpha * inv) * (alpha * inv);
+    for (int i = 0; i < n; ++i) sc += (x[i] * inv) * (x[i] * inv);
+    norm = xmax * std::sqrt(sc);
+  }
+  const Scalar beta = alpha >= Scalar(0) ? -norm : norm;
+  const Scalar tau = (beta - alpha) / beta;
+  const Scalar scale = Scalar(1) / (alpha - beta);
+  for (int i = 0; i < n; ++i) x[i] *= scale;
+  alpha = beta;
+  return tau;
 }
 
 /// Qᵀ = I − V Tᵀ Vᵀ of P reflectors (V = [I_P; V_W]) applied to the columns [t0, len) of the P
@@ -136,14 +187,64 @@ GVINS_SRI_INLINE void applyReflectorsScalar(Scalar* const* x, Scalar* w0, std::p
   }
 }
 
+/// applyReflectorsScalar for a few trailing columns (fewer than two SIMD vectors, or the
+/// right-hand side): rows outer, so that the P·(len − t0) sums are independent instead of P
+/// chains of a dependent additions each (the column-outer loop was latency-bound).
+template <typename Scalar, int P>
+GVINS_SRI_INLINE void applyReflectorsTail(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a, int t0, int len,
+                                          const Scalar* v, const Scalar* T) {
+  constexpr int kMax = 16;
+  const int nc = len - t0;
+  if (nc <= 0) return;
+  if (nc > kMax) return applyReflectorsScalar<Scalar, P>(x, w0, ws, a, t0, len, v, T);
+  Scalar zr[P][kMax];
+  for (int p = 0; p < P; ++p) {
+    for (int c = 0; c < nc; ++c) zr[p][c] = x[p][t0 + c];
+  }
+  for (int i = 0; i < a; ++i) {
+    const Scalar* wi = w0 + i * ws + t0;
+    for (int p = 0; p < P; ++p) {
+      const Scalar vp = v[p * a + i];
+      for (int c = 0; c < nc; ++c) zr[p][c] += vp * wi[c];
+    }
+  }
+  for (int c = 0; c < nc; ++c) {
+    for (int p = P - 1; p >= 0; --p) {
+      Scalar acc = T[p * P + p] * zr[p][c];
+      for (int q = 0; q < p; ++q) acc += T[p * P + q] * zr[q][c];
+      zr[p][c] = acc;
+    }
+  }
+  for (int p = 0; p < P; ++p) {
+    for (int c = 0; c < nc; ++c) x[p][t0 + c] -= zr[p][c];
+  }
+  for (int i = 0; i < a; ++i) {
+    Scalar* wi = w0 + i * ws + t0;
+    for (int c = 0; c < nc; ++c) {
+      Scalar acc = 0;
+      for (int p = 0; p < P; ++p) acc += v[p * a + i] * zr[p][c];
+      wi[c] -= acc;
+    }
+  }
+}
+
 #ifdef GVINS_SRI_VECTOR_EXT
 /// One chunk of NV SIMD vectors (columns t0 .. t0 + NV·lanes) of applyReflectors.
 template <typename Scalar, int B, int P, int NV>
 GVINS_SRI_INLINE void applyReflectorsChunk(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a,
-                                           int t0, const Scalar* vv, const Scalar* T) {
+                                           int t0, const Scalar* v, const Scalar* vv, const Scalar* T) {
   using V = Simd<Scalar, B>;
   using Vec = typename V::type;
   constexpr int L = V::kLanes;
+  // V_W(i, p) as a full vector: AVX2 broadcasts it from v with one load; SSE2 has no broadcast
+  // load and reads the pre-broadcast table vv.
+  auto vcoef = [&](int i, int p) GVINS_SRI_LAMBDA_INLINE {
+    if constexpr (B >= 32) {
+      return loadBroadcast<Scalar, B>(v + p * a + i);
+    } else {
+      return V::load(vv + (i * P + p) * L);
+    }
+  };
   Vec z[P][NV];
   for (int p = 0; p < P; ++p) {
     for (int u = 0; u < NV; ++u) z[p][u] = V::load(x[p] + t0 + u * L);
@@ -153,16 +254,16 @@ GVINS_SRI_INLINE void applyReflectorsChunk(Scalar* const* x, Scalar* w0, std::pt
     Vec wr[NV];
     for (int u = 0; u < NV; ++u) wr[u] = V::load(wi + u * L);
     for (int p = 0; p < P; ++p) {
-      const Vec vp = V::load(vv + (i * P + p) * L);
+      const Vec vp = vcoef(i, p);
       for (int u = 0; u < NV; ++u) z[p][u] += vp * wr[u];
     }
   }
   for (int p = P - 1; p >= 0; --p) {  // Z ← Tᵀ Z (Tᵀ lower triangular)
-    const Vec tpp = V::broadcast(T[p * P + p]);
+    const Vec tpp = loadBroadcast<Scalar, B>(T + p * P + p);
     Vec acc[NV];
     for (int u = 0; u < NV; ++u) acc[u] = tpp * z[p][u];
     for (int q = 0; q < p; ++q) {
-      const Vec tq = V::broadcast(T[p * P + q]);
+      const Vec tq = loadBroadcast<Scalar, B>(T + p * P + q);
       for (int u = 0; u < NV; ++u) acc[u] += tq * z[q][u];
     }
     for (int u = 0; u < NV; ++u) z[p][u] = acc[u];
@@ -175,7 +276,7 @@ GVINS_SRI_INLINE void applyReflectorsChunk(Scalar* const* x, Scalar* w0, std::pt
     Vec wr[NV];
     for (int u = 0; u < NV; ++u) wr[u] = V::load(wi + u * L);
     for (int p = 0; p < P; ++p) {
-      const Vec vp = V::load(vv + (i * P + p) * L);
+      const Vec vp = vcoef(i, p);
       for (int u = 0; u < NV; ++u) wr[u] -= vp * z[p][u];
     }
     for (int u = 0; u < NV; ++u) V::store(wi + u * L, wr[u]);
@@ -183,9 +284,10 @@ GVINS_SRI_INLINE void applyReflectorsChunk(Scalar* const* x, Scalar* w0, std::pt
 }
 #endif
 
-/// As applyReflectorsScalar on [0, len), register-blocked: per chunk of 2 SIMD vectors the P
-/// rows of Z stay in registers while the rows of W stream through twice. vb holds V_W(i, p)
-/// broadcast to full vectors at vb[i·P + p] (SSE2 has no cheap broadcast from memory).
+/// As applyReflectorsScalar on [0, len), register-blocked: per chunk of 3 (AVX2) or 2 (SSE2)
+/// SIMD vectors the P rows of Z stay in registers while the rows of W stream through twice.
+/// vv holds V_W(i, p) broadcast to full vectors at vv[i·P + p] for SSE2, which has no broadcast
+/// load (AVX2 broadcasts from v: the table of 4·a·lanes entries no longer crowds W out of L1).
 template <typename Scalar, int B, int P>
 GVINS_SRI_INLINE void applyReflectors(Scalar* const* x, Scalar* w0, std::ptrdiff_t ws, int a, int len,
                                       const Scalar* v, [[maybe_unused]] const Scalar* vv,
@@ -193,14 +295,17 @@ GVINS_SRI_INLINE void applyReflectors(Scalar* const* x, Scalar* w0, std::ptrdiff
   int t0 = 0;
 #ifdef GVINS_SRI_VECTOR_EXT
   constexpr int L = Simd<Scalar, B>::kLanes;
-  for (; t0 + 2 * L <= len; t0 += 2 * L) applyReflectorsChunk<Scalar, B, P, 2>(x, w0, ws, a, t0, vv, T);
-  for (; t0 + L <= len; t0 += L) applyReflectorsChunk<Scalar, B, P, 1>(x, w0, ws, a, t0, vv, T);
+  if constexpr (B >= 32) {  // 16 vector registers: 12 sums of Z, 3 rows of W, 1 coefficient
+    for (; t0 + 3 * L <= len; t0 += 3 * L) applyReflectorsChunk<Scalar, B, P, 3>(x, w0, ws, a, t0, v, vv, T);
+  }
+  for (; t0 + 2 * L <= len; t0 += 2 * L) applyReflectorsChunk<Scalar, B, P, 2>(x, w0, ws, a, t0, v, vv, T);
+  for (; t0 + L <= len; t0 += L) applyReflectorsChunk<Scalar, B, P, 1>(x, w0, ws, a, t0, v, vv, T);
 #endif
-  applyReflectorsScalar<Scalar, P>(x, w0, ws, a, t0, len, v, T);
+  applyReflectorsTail<Scalar, P>(x, w0, ws, a, t0, len, v, T);
 }
 
-/// Columns (reflectors) per panel of the Householder update. Four reflectors × two SIMD vectors
-/// fill 8 of the 16 SSE registers with the panel's Z; measured faster at n = 150…400 than wider
+/// Columns (reflectors) per panel of the Householder update. Four reflectors × two (SSE2) or
+/// three (AVX2) SIMD vectors hold the panel's Z in registers; measured faster at n = 150…400 than wider
 /// panels whose trailing update goes through Eigen's matrix products (docs/sri_core.md).
 constexpr int kFusedPanel = 4;
 
@@ -221,7 +326,7 @@ GVINS_SRI_INLINE void householderImpl(RowMatrixView<Scalar> R, VectorView<Scalar
   static thread_local std::vector<Scalar> vc;
   static thread_local std::vector<Scalar> vb;
   if (vc.size() < static_cast<std::size_t>(kFusedPanel * m)) vc.resize(static_cast<std::size_t>(kFusedPanel * m));
-  if (vb.size() < static_cast<std::size_t>(kFusedPanel * m * L)) vb.resize(static_cast<std::size_t>(kFusedPanel * m * L));
+  if (B < 32 && vb.size() < static_cast<std::size_t>(kFusedPanel * m * L)) vb.resize(static_cast<std::size_t>(kFusedPanel * m * L));
   Scalar* vbp = vb.data();
   int a = 0;  // active rows: lead < end of the panel
   for (int j0 = lead[0]; j0 < k;) {
@@ -237,13 +342,12 @@ GVINS_SRI_INLINE void householderImpl(RowMatrixView<Scalar> R, VectorView<Scalar
       for (int jj = 0; jj < jb; ++jj) {
         const int j = j0 + jj;
         Scalar* v = V + jj * a;
-        const Scalar t = makeReflectorRaw<Scalar>(R(j, j), v, a);
+        const Scalar t = makeReflectorRaw<Scalar, B>(R(j, j), v, a);
         tauv[jj] = t;
         if (t == Scalar(0)) continue;
         for (int c = jj + 1; c < jb; ++c) {
           Scalar* vcol = V + c * a;
-          Scalar dot = R(j, j0 + c);
-          for (int i = 0; i < a; ++i) dot += v[i] * vcol[i];
+          Scalar dot = R(j, j0 + c) + dotSimd<Scalar, B>(v, vcol, a);
           dot *= t;
           R(j, j0 + c) -= dot;
           for (int i = 0; i < a; ++i) vcol[i] -= dot * v[i];
@@ -256,8 +360,7 @@ GVINS_SRI_INLINE void householderImpl(RowMatrixView<Scalar> R, VectorView<Scalar
         if (tauv[q] == Scalar(0)) continue;
         Scalar g[kFusedPanel];
         for (int p = 0; p < q; ++p) {
-          Scalar d = 0;
-          for (int i = 0; i < a; ++i) d += V[p * a + i] * V[q * a + i];
+          const Scalar d = dotSimd<Scalar, B>(V + p * a, V + q * a, a);
           g[p] = -tauv[q] * d;
         }
         for (int p = 0; p < q; ++p) {
@@ -267,8 +370,10 @@ GVINS_SRI_INLINE void householderImpl(RowMatrixView<Scalar> R, VectorView<Scalar
         }
       }
 #ifdef GVINS_SRI_VECTOR_EXT
-      for (int i = 0; i < a; ++i) {
-        for (int p = 0; p < jb; ++p) putBroadcast<Scalar, B>(vbp, i * jb + p, V[p * a + i]);
+      if constexpr (B < 32) {
+        for (int i = 0; i < a; ++i) {
+          for (int p = 0; p < jb; ++p) putBroadcast<Scalar, B>(vbp, i * jb + p, V[p * a + i]);
+        }
       }
 #endif
       const int c1 = j0 + jb;
@@ -283,19 +388,19 @@ GVINS_SRI_INLINE void householderImpl(RowMatrixView<Scalar> R, VectorView<Scalar
       switch (jb) {
         case 4:
           applyReflectors<Scalar, B, 4>(x, w0, ws, a, nt, V, vbp, Tc);
-          applyReflectorsScalar<Scalar, 4>(xr, z.data(), 1, a, 0, 1, V, Tc);
+          applyReflectorsTail<Scalar, 4>(xr, z.data(), 1, a, 0, 1, V, Tc);
           break;
         case 3:
           applyReflectors<Scalar, B, 3>(x, w0, ws, a, nt, V, vbp, Tc);
-          applyReflectorsScalar<Scalar, 3>(xr, z.data(), 1, a, 0, 1, V, Tc);
+          applyReflectorsTail<Scalar, 3>(xr, z.data(), 1, a, 0, 1, V, Tc);
           break;
         case 2:
           applyReflectors<Scalar, B, 2>(x, w0, ws, a, nt, V, vbp, Tc);
-          applyReflectorsScalar<Scalar, 2>(xr, z.data(), 1, a, 0, 1, V, Tc);
+          applyReflectorsTail<Scalar, 2>(xr, z.data(), 1, a, 0, 1, V, Tc);
           break;
         default:
           applyReflectors<Scalar, B, 1>(x, w0, ws, a, nt, V, vbp, Tc);
-          applyReflectorsScalar<Scalar, 1>(xr, z.data(), 1, a, 0, 1, V, Tc);
+          applyReflectorsTail<Scalar, 1>(xr, z.data(), 1, a, 0, 1, V, Tc);
           break;
       }
       j0 += jb;
@@ -574,8 +679,10 @@ GVINS_SRI_INLINE void sweepImpl(RowMatrixView<Scalar> R, VectorView<Scalar> r, i
 
 // ---------------------------------------------------------------- instruction-set dispatch
 // The kernels are built twice: for the x86-64 baseline (SSE2, 16-byte vectors) and, in functions
-// with __attribute__((target("avx2"))), for AVX2 (32-byte vectors). The AVX2 path is taken when
-// the CPU (and OS) support it; GVINS_SRI_SIMD=sse2 in the environment forces the baseline (for
+// with __attribute__((target("avx2,fma"))), for AVX2 (32-byte vectors) with fused multiply-adds
+// (this file is compiled with -ffp-contract=fast, sri/CMakeLists.txt: a·b + c becomes one FMA
+// in the AVX2 functions; the baseline has no FMA instruction, so nothing changes there). The AVX2
+// path is taken when the CPU (and OS) support AVX2 and FMA; GVINS_SRI_SIMD=sse2 in the environment forces the baseline (for
 // benchmarks). Same algorithm and operation order per lane: results agree to rounding.
 namespace {
 #if defined(GVINS_SRI_VECTOR_EXT) && (defined(__x86_64__) || defined(__i386__)) && !defined(__AVX2__)
@@ -585,12 +692,12 @@ bool useAvx2() {
     const char* e = std::getenv("GVINS_SRI_SIMD");
     if (e && std::strcmp(e, "sse2") == 0) return false;
     __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2") != 0;
+    return __builtin_cpu_supports("avx2") != 0 && __builtin_cpu_supports("fma") != 0;
   }();
   return yes;
 }
 #define GVINS_SRI_AVX2_ENTRY(NAME, IMPL, SCALAR, PARAMS, ARGS) \
-  __attribute__((target("avx2"))) void NAME PARAMS { IMPL<SCALAR, 32> ARGS; }
+  __attribute__((target("avx2,fma"))) void NAME PARAMS { IMPL<SCALAR, 32> ARGS; }
 #define GVINS_SRI_ENTRIES(S)                                                                    \
   GVINS_SRI_AVX2_ENTRY(householderAvx2_##S, householderImpl, S,                                 \
                        (RowMatrixView<S> R, VectorView<S> r, RowMatrixView<S> W, VectorView<S> z, \
