@@ -69,7 +69,8 @@ void checkRowUpdate(RotationScheme scheme, int k, int m, unsigned seed, double t
 
 TEST(QrUpdate, HouseholderAndGivensCarryTheInformation) {
   unsigned seed = 1;
-  for (int k : {1, 2, 3, 4, 5, 7, 8, 9, 13, 40}) {
+  // k = 40 and 101: AVX2 chunks of 3 vectors, then 2, 1 and a scalar tail of every width.
+  for (int k : {1, 2, 3, 4, 5, 7, 8, 9, 13, 40, 101}) {
     for (int m : {1, 3, 4, 5, 17, 60}) {
       for (auto s : {RotationScheme::kBlockedHouseholder, RotationScheme::kGivens}) {
         checkRowUpdate<double>(s, k, m, seed, 1e-12);
