@@ -582,19 +582,61 @@ GVINS_SRI_INLINE void givensImpl(RowMatrixView<Scalar> R, VectorView<Scalar> r, 
   }
 }
 
+/// Two consecutive steps of the sweep fused on NV SIMD vectors of columns (base: row i of the
+/// first step): step A (row i, rotations ca/sa) and step B (row i − 1, rotations cb/sb), where
+/// B's rotation k needs A's new row i + k. Per column the order of the rotations is that of the
+/// two steps one after the other; each row is loaded and stored once for both steps.
+template <typename Scalar, int B, int NV>
+GVINS_SRI_INLINE void sweepPairChunk(Scalar* base, std::ptrdiff_t rs, int d, const Scalar* ca, const Scalar* sa,
+                                     const Scalar* cb, const Scalar* sb) {
+#ifdef GVINS_SRI_VECTOR_EXT
+  using V = Simd<Scalar, B>;
+  using Vec = typename V::type;
+  constexpr int L = V::kLanes;
+  Vec xa[NV];
+  Vec xb[NV];
+  for (int u = 0; u < NV; ++u) {
+    xa[u] = V::load(base + u * L);
+    xb[u] = V::load(base - rs + u * L);
+  }
+  for (int k = 0; k < d; ++k) {
+    const Vec cak = V::load(ca + k * L);
+    const Vec sak = V::load(sa + k * L);
+    const Vec cbk = V::load(cb + k * L);
+    const Vec sbk = V::load(sb + k * L);
+    const Scalar* bot = base + (k + 1) * rs;
+    Scalar* topb = base + (k - 1) * rs;
+    for (int u = 0; u < NV; ++u) {
+      const Vec y = V::load(bot + u * L);
+      const Vec ta = cak * xa[u] + sak * y;  // step A's new row i + k
+      xa[u] = cak * y - sak * xa[u];
+      V::store(topb + u * L, cbk * xb[u] + sbk * ta);
+      xb[u] = cbk * ta - sbk * xb[u];
+    }
+  }
+  for (int u = 0; u < NV; ++u) {
+    V::store(base + (d - 1) * rs + u * L, xb[u]);
+    V::store(base + d * rs + u * L, xa[u]);
+  }
+#endif
+}
+
 template <typename Scalar, int B>
 GVINS_SRI_INLINE void sweepImpl(RowMatrixView<Scalar> R, VectorView<Scalar> r, int c, int d, int t) {
   const int n = static_cast<int>(R.cols());
   if (d <= 0 || c <= t) return;
   constexpr int LB = B / static_cast<int>(sizeof(Scalar));
-  std::vector<Scalar> cs(static_cast<std::size_t>(d));
-  std::vector<Scalar> sn(static_cast<std::size_t>(d));
-  std::vector<Scalar> cb(static_cast<std::size_t>(d * LB));
-  std::vector<Scalar> sb(static_cast<std::size_t>(d * LB));
+  // Rotations of up to two steps: step h (0: row i, 1: row i − 1) at [h·d + k].
+  std::vector<Scalar> cs(static_cast<std::size_t>(2 * d));
+  std::vector<Scalar> sn(static_cast<std::size_t>(2 * d));
+  std::vector<Scalar> cb(static_cast<std::size_t>(2 * d * LB));
+  std::vector<Scalar> sb(static_cast<std::size_t>(2 * d * LB));
   const int cend = c + d;
-  for (int i = c - 1; i >= t; --i) {
-    // Rotation k acts on rows (i+k, i+k+1) and zeroes R(i+k+1, c+k); computed sequentially on
-    // the moved block's columns, where the previous rotations have to be applied first.
+  const std::ptrdiff_t rs = R.outerStride();
+  // Step of row i: rotation k acts on rows (i+k, i+k+1) and zeroes R(i+k+1, c+k); computed
+  // sequentially on the moved block's columns, where the previous rotations have to be applied
+  // first. The next step (row i − 1) only needs this one's result on these columns.
+  auto coefficients = [&](int i, int h) GVINS_SRI_LAMBDA_INLINE {
     for (int k = 0; k < d; ++k) {
       const int top = i + k;
       const int bot = top + 1;
@@ -608,72 +650,103 @@ GVINS_SRI_INLINE void sweepImpl(RowMatrixView<Scalar> R, VectorView<Scalar> r, i
         R(top, c + q) = ck * x + sk * y;
         R(bot, c + q) = ck * y - sk * x;
       }
-      cs[static_cast<std::size_t>(k)] = ck;
-      sn[static_cast<std::size_t>(k)] = sk;
-      putBroadcast<Scalar, B>(cb.data(), k, ck);
-      putBroadcast<Scalar, B>(sb.data(), k, sk);
+      cs[static_cast<std::size_t>(h * d + k)] = ck;
+      sn[static_cast<std::size_t>(h * d + k)] = sk;
+      putBroadcast<Scalar, B>(cb.data() + h * d * LB, k, ck);
+      putBroadcast<Scalar, B>(sb.data() + h * d * LB, k, sk);
     }
-    // The same chain on the other columns ≥ i and on r: one pass per row, the "bottom" result
-    // of rotation k is carried into rotation k+1.
-    // One pass per chunk of columns with the carried row in registers: each row of the window
-    // is loaded and stored once.
-    auto chain = [&](int col0, int len) GVINS_SRI_LAMBDA_INLINE {
-      if (len <= 0) return;
-      int q0 = 0;
-#ifdef GVINS_SRI_VECTOR_EXT
-      using V = Simd<Scalar, B>;
-      using Vec = typename V::type;
-      constexpr int L = V::kLanes;
-      Scalar* base = &R(i, col0);
-      const std::ptrdiff_t rs = R.outerStride();
-      for (; q0 + 2 * L <= len; q0 += 2 * L) {
-        Vec c0 = V::load(base + q0);
-        Vec c1 = V::load(base + q0 + L);
-        for (int k = 0; k < d; ++k) {
-          const Vec ck = V::load(cb.data() + k * L);
-          const Vec sk = V::load(sb.data() + k * L);
-          Scalar* top = base + k * rs + q0;
-          const Scalar* bot = top + rs;
-          const Vec y0 = V::load(bot);
-          const Vec y1 = V::load(bot + L);
-          V::store(top, ck * c0 + sk * y0);
-          V::store(top + L, ck * c1 + sk * y1);
-          c0 = ck * y0 - sk * c0;
-          c1 = ck * y1 - sk * c1;
-        }
-        V::store(base + d * rs + q0, c0);
-        V::store(base + d * rs + q0 + L, c1);
-      }
-#endif
-      for (int q = q0; q < len; ++q) {
-        Scalar x = R(i, col0 + q);
-        for (int k = 0; k < d; ++k) {
-          const Scalar y = R(i + k + 1, col0 + q);
-          R(i + k, col0 + q) = cs[static_cast<std::size_t>(k)] * x + sn[static_cast<std::size_t>(k)] * y;
-          x = cs[static_cast<std::size_t>(k)] * y - sn[static_cast<std::size_t>(k)] * x;
-        }
-        R(i + d, col0 + q) = x;
-      }
-    };
-    // Column i: only row i is non-zero there (the rows below are below their diagonals, whose
-    // storage is not read), so the chain reduces to scalars.
-    {
-      Scalar x = R(i, i);
-      for (int k = 0; k < d; ++k) {
-        R(i + k, i) = cs[static_cast<std::size_t>(k)] * x;
-        x = -sn[static_cast<std::size_t>(k)] * x;
-      }
-      R(i + d, i) = x;
-    }
-    chain(i + 1, c - i - 1);
-    chain(cend, n - cend);
-    Scalar x = r(i);
+  };
+  // The step's chain on one column (or on r): the "bottom" result of rotation k is carried into
+  // rotation k+1.
+  auto chainScalar = [&](Scalar* col, std::ptrdiff_t stride, int h) GVINS_SRI_LAMBDA_INLINE {
+    const Scalar* ch = cs.data() + h * d;
+    const Scalar* sh = sn.data() + h * d;
+    Scalar x = col[0];
     for (int k = 0; k < d; ++k) {
-      const Scalar y = r(i + k + 1);
-      r(i + k) = cs[static_cast<std::size_t>(k)] * x + sn[static_cast<std::size_t>(k)] * y;
-      x = cs[static_cast<std::size_t>(k)] * y - sn[static_cast<std::size_t>(k)] * x;
+      const Scalar y = col[(k + 1) * stride];
+      col[k * stride] = ch[k] * x + sh[k] * y;
+      x = ch[k] * y - sh[k] * x;
     }
-    r(i + d) = x;
+    col[d * stride] = x;
+  };
+  // Column i of row i's step: only row i is non-zero there (the rows below are below their
+  // diagonals, whose storage is not read), so the chain reduces to scalars.
+  auto firstColumn = [&](int i, int h) GVINS_SRI_LAMBDA_INLINE {
+    Scalar x = R(i, i);
+    for (int k = 0; k < d; ++k) {
+      R(i + k, i) = cs[static_cast<std::size_t>(h * d + k)] * x;
+      x = -sn[static_cast<std::size_t>(h * d + k)] * x;
+    }
+    R(i + d, i) = x;
+  };
+  // One step on the columns [col0, col0 + len): one pass per chunk of columns with the carried
+  // row in registers, each row of the window loaded and stored once.
+  auto chain = [&](int i, int col0, int len) GVINS_SRI_LAMBDA_INLINE {
+    if (len <= 0) return;
+    int q0 = 0;
+#ifdef GVINS_SRI_VECTOR_EXT
+    using V = Simd<Scalar, B>;
+    using Vec = typename V::type;
+    constexpr int L = V::kLanes;
+    Scalar* base = &R(i, col0);
+    for (; q0 + 2 * L <= len; q0 += 2 * L) {
+      Vec c0 = V::load(base + q0);
+      Vec c1 = V::load(base + q0 + L);
+      for (int k = 0; k < d; ++k) {
+        const Vec ck = V::load(cb.data() + k * L);
+        const Vec sk = V::load(sb.data() + k * L);
+        Scalar* top = base + k * rs + q0;
+        const Scalar* bot = top + rs;
+        const Vec y0 = V::load(bot);
+        const Vec y1 = V::load(bot + L);
+        V::store(top, ck * c0 + sk * y0);
+        V::store(top + L, ck * c1 + sk * y1);
+        c0 = ck * y0 - sk * c0;
+        c1 = ck * y1 - sk * c1;
+      }
+      V::store(base + d * rs + q0, c0);
+      V::store(base + d * rs + q0 + L, c1);
+    }
+#endif
+    for (int q = q0; q < len; ++q) chainScalar(&R(i, col0 + q), rs, 0);
+  };
+  // Steps of rows i and i − 1 fused on the columns [col0, col0 + len) (both act there).
+  auto pairChain = [&](int i, int col0, int len) GVINS_SRI_LAMBDA_INLINE {
+    if (len <= 0) return;
+    int q0 = 0;
+#ifdef GVINS_SRI_VECTOR_EXT
+    constexpr int L = Simd<Scalar, B>::kLanes;
+    Scalar* base = &R(i, col0);
+    const Scalar* ca = cb.data();
+    const Scalar* sa = sb.data();
+    const Scalar* cbb = cb.data() + d * LB;
+    const Scalar* sbb = sb.data() + d * LB;
+    for (; q0 + 2 * L <= len; q0 += 2 * L) sweepPairChunk<Scalar, B, 2>(base + q0, rs, d, ca, sa, cbb, sbb);
+    for (; q0 + L <= len; q0 += L) sweepPairChunk<Scalar, B, 1>(base + q0, rs, d, ca, sa, cbb, sbb);
+#endif
+    for (int q = q0; q < len; ++q) {
+      chainScalar(&R(i, col0 + q), rs, 0);
+      chainScalar(&R(i - 1, col0 + q), rs, 1);
+    }
+  };
+  int i = c - 1;
+  for (; i - 1 >= t; i -= 2) {  // pairs of steps: rows i, then i − 1
+    coefficients(i, 0);
+    coefficients(i - 1, 1);
+    firstColumn(i, 0);
+    chainScalar(&R(i - 1, i), rs, 1);  // column i: an ordinary column of step i − 1
+    firstColumn(i - 1, 1);
+    pairChain(i, i + 1, c - i - 1);
+    pairChain(i, cend, n - cend);
+    chainScalar(r.data() + i, 1, 0);
+    chainScalar(r.data() + i - 1, 1, 1);
+  }
+  if (i >= t) {  // a last single step
+    coefficients(i, 0);
+    firstColumn(i, 0);
+    chain(i, i + 1, c - i - 1);
+    chain(i, cend, n - cend);
+    chainScalar(r.data() + i, 1, 0);
   }
 }
 

@@ -159,8 +159,10 @@ void checkSweep(int n, int c, int d, int t, unsigned seed, double tol) {
 
 TEST(QrUpdate, SweepColumnsToFront) {
   unsigned seed = 1;
-  for (int n : {4, 9, 25}) {
-    for (int d : {1, 3, 6}) {
+  // Odd and even numbers of rows passed over (steps run in fused pairs), and n = 60 for the
+  // 2-vector chunks of float.
+  for (int n : {4, 9, 25, 60}) {
+    for (int d : {1, 3, 6, 9}) {
       for (int c = 0; c + d <= n; c += std::max(1, n / 5)) {
         for (int t : {0, c / 2, c}) {
           checkSweep<double>(n, c, d, t, seed, 1e-12);

@@ -21,7 +21,9 @@
 // - sweepColumnsToFront: re-triangularization after moving a block of d columns to an earlier
 //   position, with one chain of d adjacent-row Givens rotations per row passed over
 //   (Golub & Van Loan, Matrix Computations, 4th ed., §6.5 on updating QR after column
-//   permutations). This is how blocks that are not in front get marginalized.
+//   permutations). This is how blocks that are not in front get marginalized. The chains of
+//   two consecutive rows are applied in one pass over the columns (each row loaded and stored
+//   once per pair).
 #pragma once
 
 #include <span>
