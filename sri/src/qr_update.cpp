@@ -62,21 +62,13 @@ struct Simd;
       return v;                                                                        \
     }                                                                                  \
     GVINS_SRI_INLINE static void store(Scalar* p, type v) { std::memcpy(p, &v, sizeof(v)); } \
-    /* {s, s, ...}: one broadcast instruction (`type{} + s` keeps an add, since 0 + (-0) */ \
-    /* is +0; a lane-by-lane loop becomes a chain of inserts for float). */              \
-    GVINS_SRI_INLINE static type broadcast(Scalar s) {                                \
-      return splat(s, std::make_integer_sequence<int, kLanes>{});                      \
-    }                                                                                  \
-    template <int... I>                                                                \
-    GVINS_SRI_INLINE static type splat(Scalar s, std::integer_sequence<int, I...>) {  \
-      return type{((void)I, s)...};                                                    \
-    }                                                                                  \
   };
 GVINS_SRI_SIMD(16)
 GVINS_SRI_SIMD(32)
 #undef GVINS_SRI_SIMD
-/// Vector of *p in every lane, as a shuffle of lane 0 (GCC 12 builds {s, s, …} from a loaded
-/// float with a chain of vinsertps; the shuffle becomes one vbroadcastss/sd in AVX2 code).
+/// Vector of *p in every lane, as a shuffle of lane 0: in AVX2 code a scalar load and one
+/// register vbroadcastss/sd (GCC 12 builds {s, s, …} or `type{} + s` from a loaded float with a
+/// chain of vinsertps, and `type{} + s` keeps an add, since 0 + (−0) is +0).
 template <typename Scalar, int B, int... I>
 GVINS_SRI_INLINE typename Simd<Scalar, B>::type loadBroadcastImpl(const Scalar* p, std::integer_sequence<int, I...>) {
   typename Simd<Scalar, B>::type v{};
@@ -112,7 +104,7 @@ GVINS_SRI_INLINE Scalar dotSimd(const Scalar* a, const Scalar* b, int n) {
   using Vec = typename V::type;
   constexpr int L = V::kLanes;
   if (n >= 4 * L) {
-    Vec s0 = V::broadcast(Scalar(0));
+    Vec s0{};
     Vec s1 = s0;
     Vec s2 = s0;
     Vec s3 = s0;
@@ -236,8 +228,8 @@ GVINS_SRI_INLINE void applyReflectorsChunk(Scalar* const* x, Scalar* w0, std::pt
   using V = Simd<Scalar, B>;
   using Vec = typename V::type;
   constexpr int L = V::kLanes;
-  // V_W(i, p) as a full vector: AVX2 broadcasts it from v with one load; SSE2 has no broadcast
-  // load and reads the pre-broadcast table vv.
+  // V_W(i, p) as a full vector: AVX2 broadcasts it from v (a load and a register broadcast);
+  // SSE2 has no broadcast instruction and reads the pre-broadcast table vv.
   auto vcoef = [&](int i, int p) GVINS_SRI_LAMBDA_INLINE {
     if constexpr (B >= 32) {
       return loadBroadcast<Scalar, B>(v + p * a + i);
@@ -754,9 +746,10 @@ GVINS_SRI_INLINE void sweepImpl(RowMatrixView<Scalar> R, VectorView<Scalar> r, i
 // The kernels are built twice: for the x86-64 baseline (SSE2, 16-byte vectors) and, in functions
 // with __attribute__((target("avx2,fma"))), for AVX2 (32-byte vectors) with fused multiply-adds
 // (this file is compiled with -ffp-contract=fast, sri/CMakeLists.txt: a·b + c becomes one FMA
-// in the AVX2 functions; the baseline has no FMA instruction, so nothing changes there). The AVX2
-// path is taken when the CPU (and OS) support AVX2 and FMA; GVINS_SRI_SIMD=sse2 in the environment forces the baseline (for
-// benchmarks). Same algorithm and operation order per lane: results agree to rounding.
+// in the AVX2 functions; the baseline has no FMA instruction, so nothing changes there). The
+// AVX2 path is taken when the CPU (and OS) support AVX2 and FMA; GVINS_SRI_SIMD=sse2 in the
+// environment forces the baseline (for benchmarks and tests). Same algorithm; the FMAs and the
+// SIMD partial sums (more lanes with AVX2) round differently: results agree to rounding.
 namespace {
 #if defined(GVINS_SRI_VECTOR_EXT) && (defined(__x86_64__) || defined(__i386__)) && !defined(__AVX2__)
 #define GVINS_SRI_DISPATCH 1
