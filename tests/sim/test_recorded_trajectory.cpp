@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "gvins/base/parse_error.hpp"
+#include "gvins/sim/ground_truth_lag.hpp"
 #include "gvins/sim/recorded_trajectory.hpp"
 #include "gvins/vio/imu_propagation.hpp"
 #include "gvins/vio/so3.hpp"
@@ -114,6 +115,45 @@ TEST(RecordedTrajectory, RealImuIntegratesToTheTruth) {
   std::printf("1 s of real IMU from the spline truth: median position error %.1f mm (%zu windows)\n",
               median(ep) * 1e3, ep.size());
   EXPECT_LT(median(ep), 0.05);
+}
+
+// The EuRoC ground truth's clock against the IMU's: the lag τ that best matches the real gyro
+// (bias removed) to the truth's angular rate, ω_gyro(t) ≈ ω_truth(t + τ), on 50 ms means. On the
+// bundled 40 s of V1_02 the truth lags by about 0.7 ms (0.655 ms). A camera simulated from this
+// truth with offset t_d is therefore offset by t_d − τ on the IMU's clock, which is what the
+// replay's time-offset calibration must recover (tests/fusion/test_replay_time_offset.cpp).
+TEST(RecordedTrajectory, GroundTruthLagsTheGyroByAboutOneMillisecond) {
+  const RecordedTrajectory& tr = trajectory();
+  const std::vector<double> cost = gyroLagCost(tr, -3e-3, 3e-3, 0.25e-3);
+  const auto best = std::min_element(cost.begin(), cost.end()) - cost.begin();
+  ASSERT_GT(best, 0);
+  ASSERT_LT(best, static_cast<long>(cost.size()) - 1);
+  const double lag = gyroLag(tr);
+  std::printf("gyro against truth angular rate: lag %.3f ms, mean squared residual %.6f (rad/s)^2 at the lag, "
+              "%.6f at 0, %.6f at -3 ms, %.6f at +3 ms\n",
+              lag * 1e3, cost[static_cast<std::size_t>(best)], cost[cost.size() / 2], cost.front(), cost.back());
+  EXPECT_GT(lag, 0.4e-3);
+  EXPECT_LT(lag, 1.0e-3);
+  // A clear minimum: 3 ms either side costs 4-10 % more (what the 50 ms means leave of the
+  // vibration, ~0.034 rad/s RMS, is the floor).
+  EXPECT_GT(cost.front(), cost[static_cast<std::size_t>(best)] * 1.05);
+  EXPECT_GT(cost.back(), cost[static_cast<std::size_t>(best)] * 1.02);
+}
+
+// The lag estimate follows a known shift of the IMU stamps: stamping every sample 1.5 ms late
+// makes the gyro lag the truth by 1.5 ms more (τ − 1.5 ms).
+TEST(RecordedTrajectory, GyroLagFollowsShiftedImuStamps) {
+  const RecordedTrajectoryConfig c = v102();
+  std::vector<vio::ImuSample> imu = vio::readImuCsv(c.imuCsv);
+  const auto truth = vio::readGroundTruthCsv(c.groundTruthCsv);
+  const double base = gyroLag(trajectory());
+  for (vio::ImuSample& m : imu) m.t_ns += 1'500'000;
+  const RecordedTrajectory shifted(imu, truth, c);
+  const double lag = gyroLag(shifted);
+  std::printf("lag %.3f ms, with the IMU stamped 1.5 ms late %.3f ms\n", base * 1e3, lag * 1e3);
+  EXPECT_NEAR(lag, base - 1.5e-3, 0.1e-3);
+  EXPECT_THROW(gyroLagCost(shifted, 1e-3, 0.0, 1e-4), std::invalid_argument);
+  EXPECT_THROW(gyroLag(shifted, 0.0), std::invalid_argument);
 }
 
 TEST(RecordedTrajectory, RejectsBadSpans) {
