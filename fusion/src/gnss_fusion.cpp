@@ -231,26 +231,39 @@ bool GnssFusion<Scalar>::buildState(const vio::EstimatorBackend<Scalar>& est, st
 
 template <typename Scalar>
 Eigen::Vector3d GnssFusion<Scalar>::leverArm(const vio::EstimatorBackend<Scalar>& est) const {
-  if (leverBlock_.valid()) return est.estimate(leverBlock_).vector.template cast<double>();
+  if (leverBlock_.valid() && current(est)) return est.estimate(leverBlock_).vector.template cast<double>();
   return config_.leverArm;
 }
 
 template <typename Scalar>
+void GnssFusion<Scalar>::forgetState() {
+  frameBlock_ = {};
+  leverBlock_ = {};
+  clockBlock_ = {};
+  zwdBlock_ = {};
+  clockSystems_.clear();
+  lastUpdate_.reset();
+  ambiguities_.clear();
+  ambiguityTime_.reset();
+  stage_ = GnssFusionStage::kWaitingVio;
+}
+
+template <typename Scalar>
 std::optional<Eigen::Vector4d> GnssFusion<Scalar>::frame(const vio::EstimatorBackend<Scalar>& est) const {
-  if (!frameBlock_.valid()) return std::nullopt;
+  if (!frameBlock_.valid() || !current(est)) return std::nullopt;
   return Eigen::Vector4d(est.estimate(frameBlock_).vector.template cast<double>());
 }
 
 template <typename Scalar>
 std::optional<Eigen::VectorXd> GnssFusion<Scalar>::clocks(const vio::EstimatorBackend<Scalar>& est) const {
-  if (!clockBlock_.valid()) return std::nullopt;
+  if (!clockBlock_.valid() || !current(est)) return std::nullopt;
   return Eigen::VectorXd(est.estimate(clockBlock_).vector.template cast<double>());
 }
 
 template <typename Scalar>
 std::optional<AntennaKinematics> GnssFusion<Scalar>::antennaAt(const vio::EstimatorBackend<Scalar>& est,
                                                                std::int64_t t_ns) const {
-  if (!frameBlock_.valid()) return std::nullopt;
+  if (!frameBlock_.valid() || !current(est)) return std::nullopt;
   GnssStateValues s;
   if (!buildState(est, t_ns, s)) return std::nullopt;
   return antennaKinematics(s);
@@ -358,13 +371,14 @@ void GnssFusion<Scalar>::propagateClocks(vio::EstimatorBackend<Scalar>& est, con
 template <typename Scalar>
 std::map<SatId, double> GnssFusion<Scalar>::ambiguities(const vio::EstimatorBackend<Scalar>& est) const {
   std::map<SatId, double> out;
+  if (!current(est)) return out;
   for (const auto& [sat, a] : ambiguities_) out[sat] = static_cast<double>(est.estimate(a.id).vector[0]);
   return out;
 }
 
 template <typename Scalar>
 std::optional<double> GnssFusion<Scalar>::zenithWetDelay(const vio::EstimatorBackend<Scalar>& est) const {
-  if (!zwdBlock_.valid()) return std::nullopt;
+  if (!zwdBlock_.valid() || !current(est)) return std::nullopt;
   return static_cast<double>(est.estimate(zwdBlock_).vector[0]);
 }
 
@@ -643,6 +657,13 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
       rep.rtkFixed = rtk.quality == SolutionQuality::Fix;
       baseAge = rtk.age;
     }
+  }
+  // A new estimator state (the VIO started again, EstimatorBackend::generation): the client
+  // blocks are gone; frame, clocks, lever arm and ambiguities start again.
+  if (!current(est)) {
+    if (stage_ != GnssFusionStage::kWaitingVio && stage_ != GnssFusionStage::kWaitingFix) rep.reset = true;
+    forgetState();
+    generation_ = est.generation();
   }
   if (!est.initialized()) {
     stage_ = GnssFusionStage::kWaitingVio;

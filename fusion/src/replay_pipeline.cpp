@@ -219,6 +219,7 @@ void ReplaySummary::writeMetrics(std::ostream& os) const {
   os << "# gvins-replay figures: key,value (NaN: not evaluated); docs/replay.md\n";
   kv("frames", static_cast<double>(framesProcessed));
   kv("frames_initialized", static_cast<double>(framesInitialized));
+  kv("vio_resets", static_cast<double>(estimatorResets));
   kv("dataset_s", datasetSeconds);
   kv("wall_s", wallSeconds);
   kv("cpu_s", cpuSeconds);
@@ -282,7 +283,8 @@ void ReplaySummary::print(std::ostream& os) const {
   };
   row("camera input", featureTracks ? "simulated feature tracks" : "images (front end thread)");
   row("frames", std::to_string(framesProcessed) + " processed of " + std::to_string(frames) + ", " +
-                    std::to_string(framesInitialized) + " initialised, " + std::to_string(framesUpdated) + " with visual update");
+                    std::to_string(framesInitialized) + " initialised, " + std::to_string(framesUpdated) + " with visual update" +
+                    (estimatorResets ? ", " + std::to_string(estimatorResets) + " VIO resets (lock-out)" : std::string()));
   row("IMU samples", std::to_string(imuSamples));
   row("skipped frames", std::to_string(skippedBadImages) + " unreadable images, " + std::to_string(skippedMissingImages) +
                             " missing images");
@@ -603,6 +605,14 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
     estimatorMs.push_back(r.estimator_ms);
     sum.estimatorMsMax = std::max(sum.estimatorMsMax, r.estimator_ms);
     if (r.updated) ++sum.framesUpdated;
+    if (r.reset) {
+      ++sum.estimatorResets;
+      if (opt.progress) {
+        std::fprintf(stderr, "\n[gvins-replay] warning: visual lock-out at frame %zu (t %.2f s): the estimator "
+                             "starts again (lockout_reset_s; check the camera-IMU time offset and calibration)\n",
+                     sum.framesProcessed, static_cast<double>(frame->t_ns - firstT) * 1e-9);
+      }
+    }
     const bool init = est.initialized();
     if (init) {
       ++sum.framesInitialized;

@@ -44,7 +44,7 @@ Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic> priorFactor(const Prior<Sc
 }  // namespace
 
 template <typename Scalar>
-SriFilter<Scalar>::SriFilter(SriOptions options) : options_(options) {}
+SriFilter<Scalar>::SriFilter(SriOptions options) : options_(options), layout_(options.first_block_id) {}
 
 template <typename Scalar>
 RowMatrixView<Scalar> SriFilter<Scalar>::view(int row, int col, int rows, int cols) {

@@ -59,6 +59,17 @@ class ImuGnssTestBackend final : public vio::EstimatorBackend<Scalar> {
   }
 
   bool initialized() const override { return true; }
+  std::uint64_t generation() const override { return generation_; }
+  /// Simulates an estimator that dropped its state and started again (SriSwfEstimator::reset):
+  /// every client block is gone and generation() counts up; the IMU state stays.
+  void restart() {
+    std::vector<sri::BlockId> clients;
+    for (const sri::BlockInfo& b : filter_.layout().blocks()) {
+      if (b.id != blocks_.pose && b.id != blocks_.extra) clients.push_back(b.id);
+    }
+    if (!clients.empty()) filter_.marginalize(clients);
+    ++generation_;
+  }
   std::int64_t newestTime() const override { return t_; }
   vio::ImuState newestImuState() const override {
     vio::ImuState s;
@@ -127,6 +138,7 @@ class ImuGnssTestBackend final : public vio::EstimatorBackend<Scalar> {
   const sri::SriFilter<Scalar>& filter() const { return filter_; }
 
  private:
+  std::uint64_t generation_ = 1;
   static sri::BlockEstimate<Scalar> poseOf(const vio::ImuState& s) {
     return sri::BlockEstimate<Scalar>::fromPose(Eigen::Quaterniond(s.R_WI).template cast<Scalar>(),
                                                 s.p_WI.template cast<Scalar>());

@@ -314,6 +314,66 @@ TEST(SriSwfSimulation, StereoCircleDriftNeesAndFloat) {
   EXPECT_LT(np, 6.0);
 }
 
+// reset(): the state (clones, features, client blocks) is dropped and the estimator initialises
+// again from the next frames with the IMU it kept; no block id of the old state names a block of
+// the new one, generation() counts the new state, and the new state is as accurate as the first.
+TEST(SriSwfReset, StartsAgainWithNewIdsAndGeneration) {
+  test::SimScene sc;
+  sc.duration = 25.0;
+  sc.seed = 3;
+  sc.build();
+  SriSwfEstimator<double> est(sc.config());
+  EXPECT_EQ(est.generation(), 0u);
+  std::size_t k = 0;
+  std::size_t f = 0;
+  auto step = [&]() {
+    const FeatureFrame& fr = sc.frames[f++];
+    while (k < sc.imu.size() && sc.imu[k].t_ns <= fr.t_ns + 20'000'000) est.addImu(sc.imu[k++]);
+    return est.processFrame(fr);
+  };
+  while (f < 200) step();
+  ASSERT_TRUE(est.initialized());
+  EXPECT_EQ(est.generation(), 1u);
+  const sri::BlockId client = est.addBlock(sri::BlockSpec::vector("client", 2),
+                                           sri::BlockEstimate<double>::fromVector(Eigen::Vector2d::Zero()),
+                                           sri::Prior<double>::stdDev(2, 1.0));
+  const ImuBlocks old = est.newestImuBlocks();
+  std::uint64_t oldMax = 0;
+  for (const sri::BlockInfo& b : est.filter().layout().blocks()) oldMax = std::max(oldMax, b.id.value);
+  est.reset();
+  EXPECT_FALSE(est.initialized());
+  EXPECT_EQ(est.resets(), 1);
+  EXPECT_EQ(est.filter().dim(), 0);
+  EXPECT_FALSE(est.contains(client));
+  EXPECT_FALSE(est.contains(old.pose));
+  // Initialises again in motion within about a second (the IMU buffer was kept).
+  const std::size_t f0 = f;
+  while (f < sc.frames.size() && !step().initialized) {
+  }
+  ASSERT_TRUE(est.initialized());
+  EXPECT_LE(f - f0, 30u);
+  EXPECT_EQ(est.generation(), 2u);
+  for (const sri::BlockInfo& b : est.filter().layout().blocks()) EXPECT_GT(b.id.value, oldMax) << b.name;
+  EXPECT_FALSE(est.contains(client));
+  // Drift of the new state over the rest of the flight, aligned (yaw, position) at its start.
+  const ImuState e0 = est.newestImuState();
+  const ImuState t0 = sc.truth(e0.t_ns);
+  const Matrix3d dR = t0.R_WI * e0.R_WI.transpose();
+  const Matrix3d Rz = test::AnalyticMotion::rz(std::atan2(dR(1, 0), dR(0, 0)));
+  const Vector3d tz = t0.p_WI - Rz * e0.p_WI;
+  while (f < sc.frames.size()) ASSERT_FALSE(step().reset);
+  const ImuState e1 = est.newestImuState();
+  const ImuState t1 = sc.truth(e1.t_ns);
+  double dist = 0.0;
+  for (std::int64_t t = e0.t_ns; t < e1.t_ns; t += 50'000'000) {
+    dist += (sc.truth(t + 50'000'000).p_WI - sc.truth(t).p_WI).norm();
+  }
+  const double drift = (Rz * e1.p_WI + tz - t1.p_WI).norm();
+  std::fprintf(stderr, "  after the reset: %.1f m flown, drift %.3f m (%.3f %%)\n", dist, drift, 100 * drift / dist);
+  EXPECT_GT(dist, 100.0);
+  EXPECT_LT(drift / dist, 0.003);
+}
+
 void standstill(bool mono) {
   test::SimScene sc;
   sc.moving = false;
@@ -540,7 +600,7 @@ TEST(SriSwfConfig, YamlValuesAndErrorsNameLineAndField) {
   const std::string text =
       "window: 9\nmax_slam_features: 30\npixel_noise: 0.7\nprecision: float\nposition_random_walk: 0.002\n"
       "time_offset: -0.003\ncalibrate_time_offset: true\ntime_offset_sigma: 0.002\nsurface_noise: 0.001\n"
-      "attitude_random_walk: 3.0e-4\nfloat_householder: false\n"
+      "attitude_random_walk: 3.0e-4\nfloat_householder: false\nlockout_reset_s: 2.5\n"
       "init:\n  window: 0.8\n  mono_motion_frames: 25\n  mono_in_motion: false\n  mono_max_scale_sigma: 0.02\n"
       "  mono_gyro_bias: false\n  mono_max_gyro_bias: 0.05\n  mono_accel_error: 0.2\n"
       "cameras: [cam0/sensor.yaml, cam1/sensor.yaml]\nimu_yaml: imu0/sensor.yaml\n";
@@ -564,6 +624,8 @@ TEST(SriSwfConfig, YamlValuesAndErrorsNameLineAndField) {
   EXPECT_DOUBLE_EQ(c.time_offset_sigma, 0.002);
   EXPECT_DOUBLE_EQ(c.surface_noise, 0.001);
   EXPECT_DOUBLE_EQ(c.attitude_random_walk, 3.0e-4);
+  EXPECT_DOUBLE_EQ(c.lockout_reset_s, 2.5);
+  EXPECT_DOUBLE_EQ(SriSwfConfig{}.lockout_reset_s, 1.0);
   EXPECT_FALSE(c.float_householder);
   EXPECT_TRUE(SriSwfConfig{}.float_householder);
   {
@@ -602,6 +664,7 @@ TEST(SriSwfConfig, YamlValuesAndErrorsNameLineAndField) {
   expectError("cameras: [cam0/sensor.yaml]\ninit:\n  mono_max_gyro_bias: 0\n", 1, "init.mono_max_gyro_bias");
   expectError("cameras: [cam0/sensor.yaml]\ninit:\n  mono_gyro_bias: 7\n", 3, "init.mono_gyro_bias");
   expectError("cameras: [cam0/sensor.yaml]\ntime_offset: 5ms\n", 2, "time_offset");
+  expectError("cameras: [cam0/sensor.yaml]\nlockout_reset_s: -1\n", 1, "lockout_reset_s");
 }
 
 // ------------------------------------------------------------------ real data

@@ -39,6 +39,7 @@ void SriSwfConfig::validate() const {
   req(chi2_probability > 0, "chi2_probability must be > 0 (>= 1 disables the gate)");
   req(max_msckf_per_frame >= 0, "max_msckf_per_frame must be >= 0");
   req(reanchor_sigma > 0, "reanchor_sigma must be positive");
+  req(lockout_reset_s >= 0 && std::isfinite(lockout_reset_s), "lockout_reset_s must be >= 0");
   req(position_random_walk >= 0 && std::isfinite(position_random_walk), "position_random_walk must be >= 0");
   req(attitude_random_walk >= 0 && std::isfinite(attitude_random_walk), "attitude_random_walk must be >= 0");
   req(zero_velocity_sigma > 0, "zero_velocity_sigma must be positive");
@@ -165,6 +166,7 @@ SriSwfConfig parseRoot(const YAML::Node& root, const Ctx& c) {
       {"chi2_probability", d(cfg.chi2_probability, "chi2_probability")},
       {"max_msckf_per_frame", i(cfg.max_msckf_per_frame, "max_msckf_per_frame")},
       {"reanchor_sigma", d(cfg.reanchor_sigma, "reanchor_sigma")},
+      {"lockout_reset_s", d(cfg.lockout_reset_s, "lockout_reset_s")},
       {"position_random_walk", d(cfg.position_random_walk, "position_random_walk")},
       {"attitude_random_walk", d(cfg.attitude_random_walk, "attitude_random_walk")},
       {"zero_velocity_update", b(cfg.zero_velocity_update, "zero_velocity_update")},

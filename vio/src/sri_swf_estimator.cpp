@@ -128,13 +128,28 @@ struct SriSwfEstimator<Scalar>::Impl {
     if (observer) observer(step);
   }
 
-  static sri::SriOptions filterOptions(const SriSwfConfig& c) {
+  // Visual lock-out (SriSwfConfig::lockout_reset_s): features gated and rejected per frame over
+  // the last lockout_reset_s, and whether they were ≥ 20 with ≥ 90 % rejected.
+  struct GateCount {
+    std::int64_t t_ns;
+    int gated;
+    int rejected;
+  };
+  std::deque<GateCount> gate_log;
+  bool lockout = false;
+  std::uint64_t generation = 0;  // states created so far (EstimatorBackend::generation)
+  int resets = 0;
+
+  static sri::SriOptions filterOptions(const SriSwfConfig& c, std::uint64_t first_block_id) {
     sri::SriOptions o;
+    o.first_block_id = first_block_id;
     if (c.float_householder) o.auto_givens_ratio_float = std::numeric_limits<double>::infinity();
     return o;
   }
 
-  explicit Impl(const SriSwfConfig& c) : cfg(c), f(filterOptions(c)), prop(c.imu, c.gravity) {
+  /// `first_block_id`: where the filter's block ids start (after a reset: the old filter's next id).
+  Impl(const SriSwfConfig& c, std::uint64_t first_block_id)
+      : cfg(c), f(filterOptions(c, first_block_id)), prop(c.imu, c.gravity) {
     for (const CameraCalibration& cam : c.cameras) {
       CameraExtrinsic e;
       e.R_IC = Eigen::Quaterniond(Eigen::Matrix3d(cam.T_BS.topLeftCorner<3, 3>())).normalized().toRotationMatrix();
@@ -318,6 +333,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     fe_v = s.v_WI;
     t_init = s.t_ns;
     initialized = true;
+    ++generation;
   }
 
   /// Standstill test over the last init_window: accelerometer/gyro spread and the median feature
@@ -1316,6 +1332,7 @@ struct SriSwfEstimator<Scalar>::Impl {
         backup_R = f.rawR();
         backup_r = f.rawResidual();
         const sri::UpdateResult<Scalar> u = f.update(std::span<const Meas>(parts));
+        res.gated_features += static_cast<int>(parts.size());
         if (static_cast<double>(u.chi2) <= chi2Threshold(u.dof)) {
           res.updated = true;
         } else {
@@ -1327,6 +1344,7 @@ struct SriSwfEstimator<Scalar>::Impl {
               kept.push_back(std::move(parts[k]));
             } else {
               slam[part_ids[k]].seen = false;
+              ++res.rejected_features;
             }
           }
           if (!kept.empty()) {
@@ -1393,7 +1411,11 @@ struct SriSwfEstimator<Scalar>::Impl {
       if (!triangulate(tr.obs, p)) continue;
       featureRows(tr.obs, p, m);
       m.projectNuisance();
-      if (!gateWindow(m)) continue;
+      ++res.gated_features;
+      if (!gateWindow(m)) {
+        ++res.rejected_features;
+        continue;
+      }
       parts.push_back(m);
       ++res.msckf_features;
     }
@@ -1412,7 +1434,11 @@ struct SriSwfEstimator<Scalar>::Impl {
       if (!triangulate(tr.obs, p)) continue;
       featureRows(tr.obs, p, m);
       m.projectNuisance();
-      if (!gateWindow(m)) continue;
+      ++res.gated_features;
+      if (!gateWindow(m)) {
+        ++res.rejected_features;
+        continue;
+      }
       const Eigen::Vector3d f0 = inverseDepthOf(p, pose(newest.pose), ext(0));
       Slam s;
       s.block = f.addBlock(BlockSpec::vector("slam", 3), BlockEstimate<Scalar>::fromVector(f0.cast<Scalar>()),
@@ -1461,7 +1487,23 @@ struct SriSwfEstimator<Scalar>::Impl {
     clearCaches();
     trimImu();
     res.slam_features = static_cast<int>(slam.size());
+    checkLockout(frame.t_ns, res);
     return res;
+  }
+
+  void checkLockout(std::int64_t t_ns, const FrameResult& res) {
+    if (!(cfg.lockout_reset_s > 0.0)) return;
+    const auto span = static_cast<std::int64_t>(std::llround(cfg.lockout_reset_s * 1e9));
+    gate_log.push_back({t_ns, res.gated_features, res.rejected_features});
+    while (!gate_log.empty() && t_ns - gate_log.front().t_ns > span) gate_log.pop_front();
+    if (t_ns - t_init < span) return;  // a whole span of this state first
+    int gated = 0;
+    int rejected = 0;
+    for (const GateCount& g : gate_log) {
+      gated += g.gated;
+      rejected += g.rejected;
+    }
+    if (gated >= 20 && 10 * rejected >= 9 * gated) lockout = true;
   }
 };
 
@@ -1469,7 +1511,27 @@ struct SriSwfEstimator<Scalar>::Impl {
 template <typename Scalar>
 SriSwfEstimator<Scalar>::SriSwfEstimator(const SriSwfConfig& config) : config_(config) {
   config_.validate();
-  impl_ = std::make_unique<Impl>(config_);
+  impl_ = std::make_unique<Impl>(config_, 1);
+}
+
+template <typename Scalar>
+void SriSwfEstimator<Scalar>::reset() {
+  auto fresh = std::make_unique<Impl>(config_, impl_->f.nextBlockId());
+  fresh->imu = std::move(impl_->imu);
+  fresh->observer = std::move(impl_->observer);
+  fresh->generation = impl_->generation;
+  fresh->resets = impl_->resets + 1;
+  impl_ = std::move(fresh);
+}
+
+template <typename Scalar>
+int SriSwfEstimator<Scalar>::resets() const {
+  return impl_->resets;
+}
+
+template <typename Scalar>
+std::uint64_t SriSwfEstimator<Scalar>::generation() const {
+  return impl_->generation;
 }
 
 template <typename Scalar>
@@ -1484,6 +1546,12 @@ template <typename Scalar>
 FrameResult SriSwfEstimator<Scalar>::processFrame(const FeatureFrame& frame) {
   const auto t0 = std::chrono::steady_clock::now();
   FrameResult r = impl_->process(frame);
+  if (impl_->lockout) {
+    reset();
+    r.reset = true;
+    r.initialized = false;
+    r.slam_features = 0;
+  }
   r.estimator_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }

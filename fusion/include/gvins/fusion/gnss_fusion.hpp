@@ -63,7 +63,7 @@ struct GnssEpochReport {
   int recordChanges = 0;        ///< broadcast record changes carried over to ambiguities (vio+dopp+ppp)
   bool updated = false;         ///< at least one update applied
   bool clocksInitialized = false;  ///< this epoch
-  bool reset = false;           ///< outage reset this epoch
+  bool reset = false;           ///< outage reset this epoch, or the estimator started a new state
   bool rtkFixed = false;
   std::optional<Eigen::Vector3d> antennaEcef;  ///< after the update (at t_ns)
   std::optional<Eigen::Vector3d> antennaVelocityEcef;
@@ -127,9 +127,14 @@ class GnssFusion {
                                    const std::vector<sri::BlockId>& ambiguities = {});
   /// vio+dopp+ppp: marginalizes the ambiguity state of `sat` (arc ended, slipped or rejected).
   void dropAmbiguity(vio::EstimatorBackend<Scalar>& est, SatId sat);
+  /// Whether the ids held belong to the estimator's current state (EstimatorBackend::generation).
+  bool current(const vio::EstimatorBackend<Scalar>& est) const { return est.generation() == generation_; }
+  /// Forgets every id of the estimator's state and goes back to waiting for the VIO.
+  void forgetState();
 
   GnssFusionConfig config_;
   GnssFusionStage stage_ = GnssFusionStage::kWaitingVio;
+  std::uint64_t generation_ = 0;  // estimator generation the ids below belong to
   GnssAnchor anchor_;
   sri::BlockId frameBlock_, leverBlock_, clockBlock_, zwdBlock_;
   GpsTime zwdTime_;

@@ -56,6 +56,7 @@ class ReplayEstimator {
     double estimator_ms = 0.0;
     int msckf_features = 0;
     int slam_features = 0;
+    bool reset = false;  ///< the estimator dropped its state after this frame and initialises again
   };
   virtual ~ReplayEstimator() = default;
   virtual void addImu(const vio::ImuSample& s) = 0;
@@ -151,6 +152,7 @@ struct ReplayOptions {
 
 struct ReplaySummary {
   std::size_t frames = 0, framesProcessed = 0, framesInitialized = 0, framesUpdated = 0;
+  std::size_t estimatorResets = 0;  ///< VIO lock-outs: the estimator started again (vio_resets)
   std::size_t imuSamples = 0;
   std::size_t skippedBadImages = 0, skippedMissingImages = 0;
   std::size_t imuGaps = 0;

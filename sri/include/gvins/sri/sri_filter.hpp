@@ -77,6 +77,10 @@ struct SriOptions {
   /// A diagonal entry |R_jj| ≤ zero_pivot × max|R_ii| counts as no information in solve()
   /// (that error-state component is left at zero). 0: only exact zeros.
   double zero_pivot = 0.0;
+  /// Id of the first block (then counting up, never reused). A filter that replaces another one
+  /// whose ids may still be held somewhere (e.g. an estimator that starts again after a failure)
+  /// starts at the old filter's nextBlockId(), so that a stale id never names a new block.
+  std::uint64_t first_block_id = 1;
 };
 
 struct UpdateOptions {
@@ -114,6 +118,8 @@ class SriFilter {
 
   const SriOptions& options() const { return options_; }
   const StateLayout& layout() const { return layout_; }
+  /// The id the next added block gets (SriOptions::first_block_id).
+  std::uint64_t nextBlockId() const { return layout_.nextId(); }
   /// Error-state dimension.
   int dim() const { return n_; }
   /// Pre-allocates storage for a state of `dim` (the filter grows as needed otherwise).

@@ -30,6 +30,10 @@ struct Placement {
 
 class StateLayout {
  public:
+  /// Ids of inserted blocks are first_id, first_id + 1, ... (never reused).
+  explicit StateLayout(std::uint64_t first_id = 1) : next_id_(first_id) {}
+  /// The id the next inserted block gets.
+  std::uint64_t nextId() const { return next_id_; }
   /// Number of blocks and total error-state dimension.
   int size() const { return static_cast<int>(blocks_.size()); }
   int dim() const { return dim_; }

@@ -17,10 +17,10 @@
 // columns 0..5 → pose and 6..14 → extra. Both ids change at every propagation: ask for them
 // (newestImuBlocks()) right before building a measurement.
 //
-// Blocks a client owns keep their id until the client marginalizes or propagates them. Time-
-// varying client blocks (receiver clocks) are propagated lazily by the client at its own
-// measurement times with propagate() — exact for linear models such as clock bias/drift, since
-// nothing else observes them in between.
+// Blocks a client owns keep their id until the client marginalizes or propagates them, or the
+// estimator starts a new state (generation()). Time-varying client blocks (receiver clocks) are
+// propagated lazily by the client at its own measurement times with propagate() — exact for
+// linear models such as clock bias/drift, since nothing else observes them in between.
 //
 // Threading: not thread-safe; the driver calls the estimator and its clients from one thread, in
 // time order (see fusion/ and apps/replay).
@@ -76,6 +76,12 @@ class EstimatorBackend {
   // ------------------------------------------------------------------ status and IMU state
   /// True once the VIO is initialised (gravity aligned, newest state exists).
   virtual bool initialized() const = 0;
+  /// Counts the states the estimator has created: 0 before the first initialisation, then + 1
+  /// each time it initialises (again). An estimator may drop its state and start again (e.g.
+  /// after a visual lock-out, SriSwfEstimator::reset): the client blocks of an earlier
+  /// generation are then gone, and a client that sees a new generation forgets its ids and
+  /// starts its own initialisation again.
+  virtual std::uint64_t generation() const = 0;
   /// Time of the newest IMU state (ns, on the sensor clock = GPST in our datasets).
   virtual std::int64_t newestTime() const = 0;
   /// The newest navigation state (double, whatever Scalar the filter runs in).

@@ -64,6 +64,13 @@ struct SriSwfConfig {
   /// Re-anchoring noise (normalised coordinates / relative inverse depth) when the anchor clone
   /// of a SLAM feature leaves the window.
   double reanchor_sigma = 1e-4;
+  /// Visual lock-out: when, over this long (s), at least 20 features reached a χ² gate and at
+  /// least 90 % of them were rejected, the state is wrong (a bad initialisation, an unmodelled
+  /// time offset) and the gates keep it from recovering: the estimator drops the state and
+  /// initialises again (FrameResult::reset, generation()). Checked once a state is this old.
+  /// Measured on EuRoC V1_02's real IMU with an ignored −12.7 ms offset (docs/vio_estimator.md).
+  /// 0 disables it.
+  double lockout_reset_s = 1.0;
 
   /// m/√s, white velocity noise added to the position rows of every IMU propagation (σ² Δt).
   /// Stands for what the IMU model leaves out (discrete integration, vibration) and keeps the
@@ -207,6 +214,11 @@ struct FrameResult {
   int msckf_features = 0;    ///< MSCKF features used in the update
   int slam_features = 0;     ///< SLAM features in the state after the frame
   bool zero_velocity = false;  ///< a zero-velocity update was applied (standstill detected)
+  int gated_features = 0;      ///< features whose rows reached a χ² gate this frame
+  int rejected_features = 0;   ///< ... of which the gate rejected
+  /// The frame ended a visual lock-out (SriSwfConfig::lockout_reset_s): the state was dropped
+  /// and the estimator is initialising again (initialized is false).
+  bool reset = false;
 };
 
 template <typename Scalar>
@@ -261,9 +273,17 @@ class SriSwfEstimator final : public EstimatorBackend<Scalar> {
   /// ("propagate", "zupt", "slam_update", "correct", "msckf_update", "slam_init", "reanchor",
   /// "marginalize"). Empty function: none.
   void setStepObserver(std::function<void(const char* step)> observer);
+  /// Drops the whole state (clones, features, client blocks) and starts initialising again with
+  /// the next frames; the buffered IMU samples are kept. Block ids of the old state are never
+  /// reused, and generation() counts the new state when it is created. Called by processFrame
+  /// after a visual lock-out; a driver may call it too (e.g. a user's restart).
+  void reset();
+  /// Number of resets so far (lock-outs and reset() calls).
+  int resets() const;
 
   // ------------------------------------------------------------------ EstimatorBackend
   bool initialized() const override;
+  std::uint64_t generation() const override;
   std::int64_t newestTime() const override;
   ImuState newestImuState() const override;
   ImuBlocks newestImuBlocks() const override;
