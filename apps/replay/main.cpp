@@ -235,13 +235,14 @@ int main(int argc, char** argv) {
 
     // A gvins-sim dataset: its lever arm and the gravity its IMU was simulated with.
     const std::optional<SimDatasetInfo> info = readSimDatasetInfo(dataset);
-    // Estimator configuration: the file named by the config, else the dataset's calibration.
+    // Estimator configuration: the dataset's calibration (IMU noise, cameras, a simulation's
+    // gravity), changed by the estimator file of the config if there is one (a file without
+    // cameras, e.g. config/estimator_euroc.yaml, tunes the filter for any dataset).
+    fs::path mav0 = fs::path(dataset) / "mav0";
+    if (!fs::is_directory(mav0)) mav0 = dataset;
+    const bool datasetCalibration = fs::exists(mav0 / "imu0" / "sensor.yaml") && fs::exists(mav0 / "cam0" / "sensor.yaml");
     vio::SriSwfConfig ec;
-    if (!rc.estimatorConfig.empty()) {
-      ec = vio::loadSriSwfConfig(rc.estimatorConfig);
-    } else {
-      fs::path mav0 = fs::path(dataset) / "mav0";
-      if (!fs::is_directory(mav0)) mav0 = dataset;
+    if (datasetCalibration || rc.estimatorConfig.empty()) {
       ec.imu = vio::readImuSensorYaml((mav0 / "imu0" / "sensor.yaml").string()).noise;
       ec.cameras.push_back(vio::readCameraSensorYaml((mav0 / "cam0" / "sensor.yaml").string()));
       if (opt.frontend.useStereo && fs::exists(mav0 / "cam1" / "sensor.yaml"))
@@ -250,6 +251,7 @@ int main(int argc, char** argv) {
       if (info && info->gravityModel == "rotating")
         std::fprintf(stderr, "gvins-replay: note: the dataset's IMU includes the Earth rotation, which the estimator does not model\n");
     }
+    if (!rc.estimatorConfig.empty()) ec = vio::loadSriSwfConfig(rc.estimatorConfig, datasetCalibration ? &ec : nullptr);
     if (useFloat) ec.use_float = true;
     if (!timeCalib.empty()) ec.calibrate_time_offset = timeCalib == "on";
     if (timeOffset) ec.time_offset = *timeOffset;

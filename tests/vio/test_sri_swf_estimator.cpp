@@ -665,6 +665,22 @@ TEST(SriSwfConfig, YamlValuesAndErrorsNameLineAndField) {
   expectError("cameras: [cam0/sensor.yaml]\ninit:\n  mono_gyro_bias: 7\n", 3, "init.mono_gyro_bias");
   expectError("cameras: [cam0/sensor.yaml]\ntime_offset: 5ms\n", 2, "time_offset");
   expectError("cameras: [cam0/sensor.yaml]\nlockout_reset_s: -1\n", 1, "lockout_reset_s");
+  // With defaults (a dataset's calibration): the file changes a copy; cameras may be left out.
+  const SriSwfConfig t = parseSriSwfConfig("window: 7\nimu:\n  gyroscope_random_walk: 2.0e-4\n", "tune.yaml", dir, &c);
+  EXPECT_EQ(t.window, 7);
+  ASSERT_EQ(t.cameras.size(), 2u);
+  EXPECT_DOUBLE_EQ(t.cameras[1].intrinsics.fx, c.cameras[1].intrinsics.fx);
+  EXPECT_DOUBLE_EQ(t.imu.gyroscope_random_walk, 2.0e-4);
+  EXPECT_DOUBLE_EQ(t.imu.gyroscope_noise_density, c.imu.gyroscope_noise_density);
+  EXPECT_TRUE(t.use_float);  // kept from the defaults
+  EXPECT_EQ(parseSriSwfConfig("cameras: [cam0/sensor.yaml]\n", "t.yaml", dir, &c).cameras.size(), 1u);
+  const SriSwfConfig none;
+  try {
+    parseSriSwfConfig("window: 7\n", "tune.yaml", dir, &none);
+    ADD_FAILURE() << "defaults without cameras: no error";
+  } catch (const ParseError& e) {
+    EXPECT_EQ(e.field(), "cameras");
+  }
 }
 
 // ------------------------------------------------------------------ real data

@@ -120,8 +120,8 @@ void walk(const YAML::Node& map, const Ctx& c, const std::string& prefix, const 
   }
 }
 
-SriSwfConfig parseRoot(const YAML::Node& root, const Ctx& c) {
-  SriSwfConfig cfg;
+SriSwfConfig parseRoot(const YAML::Node& root, const Ctx& c, const SriSwfConfig* defaults) {
+  SriSwfConfig cfg = defaults ? *defaults : SriSwfConfig{};
   bool have_cams = false;
   auto d = [&](double& x, const std::string& f) { return [&x, &c, f](const YAML::Node& n) { x = num(n, c, f); }; };
   auto i = [&](int& x, const std::string& f) { return [&x, &c, f](const YAML::Node& n) { x = integer(n, c, f); }; };
@@ -218,7 +218,7 @@ SriSwfConfig parseRoot(const YAML::Node& root, const Ctx& c) {
   walk(root, c, "", top);
   // A Kalibr camchain's timeshift_cam_imu is the time offset unless `time_offset` is given.
   if (have_cams && !root["time_offset"]) cfg.time_offset = cfg.cameras.front().time_offset;
-  if (!have_cams) fail(c, lineOf(root), "cameras", "missing (cameras: [...] or camchain: ...)");
+  if (!have_cams && cfg.cameras.empty()) fail(c, lineOf(root), "cameras", "missing (cameras: [...] or camchain: ...)");
   try {
     cfg.validate();
   } catch (const std::invalid_argument& e) {
@@ -229,7 +229,8 @@ SriSwfConfig parseRoot(const YAML::Node& root, const Ctx& c) {
 
 }  // namespace
 
-SriSwfConfig parseSriSwfConfig(std::string_view text, const std::string& name, const std::string& base_dir) {
+SriSwfConfig parseSriSwfConfig(std::string_view text, const std::string& name, const std::string& base_dir,
+                               const SriSwfConfig* defaults) {
   const Ctx c{name, base_dir};
   if (text.size() > (1u << 20)) fail(c, 0, "", "file larger than 1 MiB");
   for (const char ch : text) {
@@ -238,19 +239,19 @@ SriSwfConfig parseSriSwfConfig(std::string_view text, const std::string& name, c
   try {
     const YAML::Node root = YAML::Load(std::string(text));
     if (!root.IsMap()) fail(c, lineOf(root), "", "expected a YAML mapping at the top level");
-    return parseRoot(root, c);
+    return parseRoot(root, c, defaults);
   } catch (const YAML::Exception& e) {
     fail(c, e.mark.is_null() ? 0 : e.mark.line + 1, "YAML", e.msg);
   }
 }
 
-SriSwfConfig loadSriSwfConfig(const std::string& path) {
+SriSwfConfig loadSriSwfConfig(const std::string& path, const SriSwfConfig* defaults) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ParseError(path, 0, "", "cannot open file");
   std::stringstream ss;
   ss << in.rdbuf();
   const std::string dir = std::filesystem::path(path).parent_path().string();
-  return parseSriSwfConfig(ss.str(), path, dir.empty() ? "." : dir);
+  return parseSriSwfConfig(ss.str(), path, dir.empty() ? "." : dir, defaults);
 }
 
 }  // namespace gvins::vio

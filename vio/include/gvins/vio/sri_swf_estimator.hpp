@@ -177,12 +177,14 @@ struct SriSwfConfig {
   void validate() const;
 };
 
-/// YAML configuration (all keys optional except cameras, unknown keys are errors):
+/// YAML configuration (all keys optional except cameras, unknown keys are errors; with `defaults`
+/// the file's keys change a copy of it, and cameras may be left out when it has them, e.g. a
+/// tuning file applied to a dataset's calibration):
 ///   imu: {gyroscope_noise_density, gyroscope_random_walk, accelerometer_noise_density,
 ///         accelerometer_random_walk, rate_hz}  or  imu_yaml: <EuRoC/Kalibr imu yaml path>
 ///   gravity, pixel_noise, surface_noise, window, max_slam_features, min_track_msckf, min_depth, max_depth,
-///   min_baseline_ratio, chi2_probability, max_msckf_per_frame, reanchor_sigma, position_random_walk,
-///   attitude_random_walk,
+///   min_baseline_ratio, chi2_probability, max_msckf_per_frame, reanchor_sigma, lockout_reset_s,
+///   position_random_walk, attitude_random_walk,
 ///   init: {window, static_max_accel_std, static_max_gyro_std, static_max_parallax, in_motion,
 ///          motion_frames, mono_in_motion, mono_motion_frames, mono_max_scale_sigma, mono_gyro_bias, mono_max_gyro_bias, mono_accel_error, position_sigma, yaw_sigma, tilt_sigma, velocity_sigma,
 ///          gyro_bias_sigma, accel_bias_sigma}, zero_velocity_update, zero_velocity_sigma,
@@ -191,9 +193,9 @@ struct SriSwfConfig {
 ///   cameras: [<EuRoC camera sensor.yaml path>, ...]  or  camchain: <Kalibr camchain path>
 /// Relative paths are relative to the YAML file's folder. Errors: gvins::ParseError naming the
 /// file, line and field.
-SriSwfConfig loadSriSwfConfig(const std::string& path);
+SriSwfConfig loadSriSwfConfig(const std::string& path, const SriSwfConfig* defaults = nullptr);
 SriSwfConfig parseSriSwfConfig(std::string_view text, const std::string& name,
-                               const std::string& base_dir = ".");
+                               const std::string& base_dir = ".", const SriSwfConfig* defaults = nullptr);
 
 /// First-estimate IMU transition (see SriSwfConfig::first_estimate_jacobians): replaces the
 /// blocks ∂δv₁/∂δθ₀ and ∂δp₁/∂δθ₀ of Φ (ImuErr order, right rotation perturbation) by
