@@ -13,6 +13,8 @@
 #     --images         render camera images and run the OpenCV front end (datasets of several GB
 #                      each, about 1x real time to render); default: simulated feature tracks
 #     --flights LIST   comma-separated flight names (e.g. uav_60m_1000m_6mps), default all ten
+#     --runs LIST      comma-separated run names (vio, psr, dpsr, ddcp, ... as in RUNS below;
+#                      outage_ddcp, outage_psr), default all; tables show n/a for the others
 #     --force          rerun replays whose outputs exist
 #     --keep-data      keep rendered datasets (--images deletes each after its runs)
 # Timing: the replays' own times are only usable with --jobs 1 on an idle machine; the GNSS share
@@ -40,6 +42,7 @@ IMAGES=0
 FORCE=0
 KEEP=0
 FLIGHTS=""
+ONLY_RUNS=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --build) BUILD=$2; shift ;;
@@ -47,9 +50,10 @@ while [ $# -gt 0 ]; do
     --jobs) JOBS=$2; shift ;;
     --images) IMAGES=1 ;;
     --flights) FLIGHTS=$2; shift ;;
+    --runs) ONLY_RUNS=$2; shift ;;
     --force) FORCE=1 ;;
     --keep-data) KEEP=1 ;;
-    -h|--help) sed -n '2,32p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,34p' "$0"; exit 0 ;;
     *) echo "paper_tables.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
   shift
@@ -102,6 +106,15 @@ RUNS=(
   "lever_good_calib|--mode vio+dopp+psr --lever-arm-calib on"
 )
 OUTAGE_RUNS=("outage_ddcp|--mode vio+dopp+ddcp" "outage_psr|--mode vio+dopp+psr")
+if [ -n "$ONLY_RUNS" ]; then  # keep the listed runs only
+  keep() {
+    local spec
+    for spec in "$@"; do case ",$ONLY_RUNS," in *",${spec%%|*},"*) printf '%s\n' "$spec" ;; esac; done
+  }
+  mapfile -t RUNS < <(keep "${RUNS[@]}")
+  mapfile -t OUTAGE_RUNS < <(keep "${OUTAGE_RUNS[@]}")
+  [ ${#RUNS[@]} -gt 0 ] || [ ${#OUTAGE_RUNS[@]} -gt 0 ] || { echo "paper_tables.sh: --runs $ONLY_RUNS names no run" >&2; exit 2; }
+fi
 
 simulate() {  # name config dir [extra yaml]
   local name=$1 cfg=$2 dir=$3
