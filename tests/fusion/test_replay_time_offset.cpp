@@ -215,13 +215,8 @@ fs::path recordedDataset(double offset = kRecordedOffset) {
   return dir;
 }
 
-ReplaySummary replayRecorded(const std::string& name, bool calibrate, double timeOffset,
-                             double datasetOffset = kRecordedOffset, double lockoutReset = 1.0) {
-  const fs::path d = recordedDataset(datasetOffset);
-  vio::SriSwfConfig ec = test::datasetEstimatorConfig(d);
-  ec.calibrate_time_offset = calibrate;
-  ec.time_offset = timeOffset;
-  ec.lockout_reset_s = lockoutReset;
+/// Replays the recorded dataset `d` with `ec` (double, VIO only) into scratch()/name.
+ReplaySummary replayRecordedWith(const fs::path& d, const std::string& name, const vio::SriSwfConfig& ec) {
   ReplayOptions o;
   o.outDir = (scratch() / name).string();
   o.progress = false;
@@ -230,8 +225,18 @@ ReplaySummary replayRecorded(const std::string& name, bool calibrate, double tim
   std::fprintf(stderr, "%-22s RMSE %.4f m, drift %.3f %%, resets %zu, NEES p %.2f th %.2f, t_d %s%.3f ms (sigma %.3f ms)\n",
                name.c_str(), s.local.positionRmse, s.local.driftPercent, s.estimatorResets, s.local.positionNeesFirstPose,
                s.local.orientationNeesFirstPose, s.timeOffset ? "" : "(fixed) ",
-               s.timeOffset.value_or(timeOffset) * 1e3, s.timeOffsetSigma.value_or(0.0) * 1e3);
+               s.timeOffset.value_or(ec.time_offset) * 1e3, s.timeOffsetSigma.value_or(0.0) * 1e3);
   return s;
+}
+
+ReplaySummary replayRecorded(const std::string& name, bool calibrate, double timeOffset,
+                             double datasetOffset = kRecordedOffset, double lockoutReset = 1.0) {
+  const fs::path d = recordedDataset(datasetOffset);
+  vio::SriSwfConfig ec = test::datasetEstimatorConfig(d);
+  ec.calibrate_time_offset = calibrate;
+  ec.time_offset = timeOffset;
+  ec.lockout_reset_s = lockoutReset;
+  return replayRecordedWith(d, name, ec);
 }
 
 // On the IMU's clock the simulated camera is late by t_d − τ, τ being the lag of EuRoC's ground
@@ -272,14 +277,7 @@ TEST(TimeOffsetReplay, EurocTuningIsConsistentOnTheRealImu) {
   EXPECT_DOUBLE_EQ(tuned.imu.accelerometer_noise_density, 10 * base.imu.accelerometer_noise_density);
   auto run = [&](const std::string& name, vio::SriSwfConfig ec) {
     ec.calibrate_time_offset = true;
-    ReplayOptions o;
-    o.outDir = (scratch() / name).string();
-    o.progress = false;
-    SriSwfReplayEstimator<double> est(ec);
-    const ReplaySummary s = runReplay(d.string(), est, nullptr, o);
-    std::fprintf(stderr, "%-16s RMSE %.4f m, drift %.3f %%, NEES p %.2f th %.2f\n", name.c_str(), s.local.positionRmse,
-                 s.local.driftPercent, s.local.positionNeesFirstPose, s.local.orientationNeesFirstPose);
-    return s;
+    return replayRecordedWith(d, name, ec);
   };
   const ReplaySummary nominal = run("v102_sensor_yaml", base);
   const ReplaySummary t = run("v102_euroc_yaml", tuned);
