@@ -81,6 +81,29 @@ TEST(StateLayout, InsertEraseReorderAndLookups) {
 
 // A filter with independent priors: marginalizing or reordering blocks must leave exactly the
 // other blocks' priors (block-diagonal covariance), whatever the position.
+// Ids count up from SriOptions::first_block_id and are never reused, also after marginalization;
+// a filter that replaces another continues its numbering.
+TEST(SriFilterBookkeeping, BlockIdsContinueAcrossFilters) {
+  SriFilter<double> a;
+  const auto mk = [](SriFilter<double>& f) {
+    return f.addBlock(BlockSpec::vector("b", 1), BlockEstimate<double>::fromVector(Eigen::VectorXd::Zero(1)),
+                      Prior<double>::stdDev(1, 1.0));
+  };
+  const BlockId a1 = mk(a);
+  const BlockId a2 = mk(a);
+  EXPECT_EQ(a1.value, 1u);
+  EXPECT_EQ(a2.value, 2u);
+  a.marginalize(a2);
+  EXPECT_EQ(mk(a).value, 3u);  // not 2 again
+  SriOptions o;
+  o.first_block_id = a.nextBlockId();
+  SriFilter<double> b(o);
+  const BlockId b1 = mk(b);
+  EXPECT_EQ(b1.value, 4u);
+  EXPECT_FALSE(b.layout().contains(a1));
+  EXPECT_EQ(StateLayout(7).nextId(), 7u);
+}
+
 TEST(SriFilterBookkeeping, RemoveFirstMiddleLastAndEmptyState) {
   SriFilter<double> f;
   EXPECT_EQ(f.dim(), 0);
