@@ -607,6 +607,11 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
     if (r.updated) ++sum.framesUpdated;
     if (r.reset) {
       ++sum.estimatorResets;
+      // The next poses are in the new state's VIO frame: the local evaluation covers the last
+      // state only, and trajectory.tum marks the jump.
+      tum.comment("VIO reset after a visual lock-out: the poses below are in a new VIO world frame");
+      localTrack.clear();
+      covs.clear();
       if (opt.progress) {
         std::fprintf(stderr, "\n[gvins-replay] warning: visual lock-out at frame %zu (t %.2f s): the estimator "
                              "starts again (lockout_reset_s; check the camera-IMU time offset and calibration)\n",
@@ -758,12 +763,16 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
   }
   sum.timeOffsetTruth = opt.timeOffsetTruth;
 
-  if (opt.evaluate && ds.hasGroundTruth() && poses.size() >= 2) {
+  if (opt.evaluate && ds.hasGroundTruth() && localTrack.size() >= 2) {
     vio::EvaluationOptions eo2;
     eo2.alignment = vio::AlignmentKind::Yaw4Dof;
     try {
       const auto r = vio::evaluateTrajectory(localTrack, vio::toTrajectorySamples(ds.groundTruth()), covs, eo2);
       std::ostringstream os;
+      if (sum.estimatorResets > 0) {
+        os << "(the VIO state after the last of " << sum.estimatorResets
+           << " resets only: the poses before it are in other VIO frames)\n";
+      }
       vio::printEvaluation(os, r);
       sum.evaluationTable = os.str();
       sum.local = accuracyOf(r);

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <functional>
 
 #include <opencv2/core.hpp>
@@ -747,4 +748,23 @@ TEST(TumTrajectory, ReaderFormatsAndErrors) {
   expectParseError([] { parseTumTrajectory("x 1 2 3 0 0 0 1\n", "t.txt"); }, 1, "timestamp");
   expectParseError([] { parseTumTrajectory("1e3 1 2 3 0 0 0 1\n", "t.txt"); }, 1, "timestamp");
   EXPECT_THROW(TumTrajectoryWriter("/nonexistent/dir/t.txt"), std::runtime_error);
+}
+
+TEST(TumTrajectory, CommentsBetweenPosesAreSkipped) {
+  const fs::path p = fs::temp_directory_path() / "gvins_tum_comment_test.txt";
+  {
+    TumTrajectoryWriter w(p.string());
+    w.write(1'000'000'000, Eigen::Matrix3d::Identity(), Eigen::Vector3d(1, 2, 3));
+    w.comment("VIO reset: new frame below");
+    w.write(2'000'000'000, Eigen::Matrix3d::Identity(), Eigen::Vector3d(4, 5, 6));
+    EXPECT_THROW(w.comment("two\nlines"), std::invalid_argument);
+    w.close();
+  }
+  std::ifstream in(p);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\n# VIO reset: new frame below\n"), std::string::npos) << text;
+  const auto back = readTumTrajectory(p.string());
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_EQ(back[1].p, Eigen::Vector3d(4, 5, 6));
+  fs::remove(p);
 }

@@ -77,6 +77,12 @@ void TumTrajectoryWriter::write(const TumPose& pose) {
                t % 1000000000, pose.p.x(), pose.p.y(), pose.p.z(), q.x(), q.y(), q.z(), q.w());
 }
 
+void TumTrajectoryWriter::comment(const std::string& text) {
+  if (!f_) throw std::runtime_error("trajectory file " + path_ + " is closed");
+  if (text.find_first_of("\r\n") != std::string::npos) throw std::invalid_argument("TUM comment with a line break");
+  std::fprintf(f_, "# %s\n", text.c_str());
+}
+
 void TumTrajectoryWriter::close() {
   if (!f_) return;
   const bool err = std::ferror(f_) != 0;

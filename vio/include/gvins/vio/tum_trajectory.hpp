@@ -43,6 +43,8 @@ class TumTrajectoryWriter {
 
   void write(const TumPose& pose);
   void write(std::int64_t t_ns, const Eigen::Matrix3d& R, const Eigen::Vector3d& p) { write(TumPose{t_ns, p, R}); }
+  /// A comment line "# text" between poses (readers skip it); `text` must be one line.
+  void comment(const std::string& text);
   /// Flushes and closes; throws std::runtime_error on a write error (disk full, ...).
   void close();
 
