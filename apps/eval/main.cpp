@@ -43,6 +43,9 @@ const char* kUsage =
     "                     docs/replay.md); default EST with its extension replaced by .cov.csv,\n"
     "                     used if it exists\n"
     "  --no-cov           ignore covariances\n"
+    "  --whole            evaluate every pose of EST even when it has gvins-replay's VIO reset\n"
+    "                     marks ('# VIO reset' comments; default: the poses after the last one,\n"
+    "                     the others are in earlier VIO frames)\n"
     "  --plots PREFIX     write PREFIXtrajectory_top.svg, PREFIXposition_error.svg,\n"
     "                     PREFIXrotation_error.svg (PREFIX may be a folder ending in '/')\n"
     "  -h, --help         this text\n"
@@ -89,6 +92,7 @@ int main(int argc, char** argv) {
   EvaluationOptions opt;
   std::string gtFormat = "auto", covPath, plots;
   bool noCov = false;
+  bool whole = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&]() -> std::string {
@@ -131,6 +135,8 @@ int main(int argc, char** argv) {
       covPath = value();
     } else if (a == "--no-cov") {
       noCov = true;
+    } else if (a == "--whole") {
+      whole = true;
     } else if (a == "--plots") {
       plots = value();
     } else if (!a.empty() && a[0] == '-') {
@@ -152,7 +158,15 @@ int main(int argc, char** argv) {
       }
       if (fs::is_directory(gtPath)) throw std::runtime_error("no state_groundtruth_estimate0/data.csv in " + gtPath);
     }
-    const auto est = toTrajectorySamples(readTumTrajectory(estPath));
+    auto est = toTrajectorySamples(readTumTrajectory(estPath));
+    // gvins-replay marks an estimator restart (visual lock-out) in the TUM file; the poses before
+    // the last mark are in other VIO frames.
+    if (const auto marks = readTumResetMarks(estPath); !marks.empty() && !whole) {
+      const std::size_t from = std::min(marks.back(), est.size());
+      std::printf("%s has %zu VIO reset mark(s): evaluating the %zu poses after the last one (--whole: all)\n",
+                  estPath.c_str(), marks.size(), est.size() - from);
+      est.erase(est.begin(), est.begin() + static_cast<std::ptrdiff_t>(from));
+    }
     const bool asl = gtFormat == "asl" || (gtFormat == "auto" && looksLikeAsl(gtPath));
     const auto gt = asl ? toTrajectorySamples(readGroundTruthCsv(gtPath)) : toTrajectorySamples(readTumTrajectory(gtPath));
     std::vector<PoseCovariance> cov;

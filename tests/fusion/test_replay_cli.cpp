@@ -183,4 +183,48 @@ TEST(ReplayCli, FloatPppWithProductsAndWithTheSsrStream) {
 }
 
 }  // namespace
+// gvins-eval on a trajectory with gvins-replay's reset mark: the poses before the mark are in
+// another VIO frame (here 90° of yaw and 100 m away); by default only the poses after it are
+// evaluated, --whole takes all (and the 4-DoF fit then cannot match both frames).
+TEST(EvalCli, ResetMarksSelectTheLastState) {
+  const fs::path d = scratch() / "eval_reset";
+  fs::create_directories(d);
+  std::ofstream gt(d / "gt.tum"), est(d / "est.tum");
+  gt << "# t x y z qx qy qz qw\n";
+  est << "# t x y z qx qy qz qw\n";
+  for (int i = 0; i < 200; ++i) {
+    const double t = 1.0 + 0.05 * i, x = 0.5 * i, y = 0.02 * i * i;
+    gt << t << " " << x << " " << y << " 1 0 0 0 1\n";
+    if (i == 80) est << "# VIO reset after a visual lock-out: the poses below are in a new VIO world frame\n";
+    const double e = 0.01 * std::sin(0.3 * i);  // 1 cm of error
+    if (i < 80) {
+      est << t << " " << -(y + e) + 100.0 << " " << x << " 1 0 0 0.7071067811865476 0.7071067811865476\n";
+    } else {
+      est << t << " " << x + e << " " << y << " 1 0 0 0 1\n";
+    }
+  }
+  gt.close();
+  est.close();
+  auto run = [&](const std::string& extra) {
+    const fs::path out = d / ("out" + extra + ".txt");
+    const std::string cmd = std::string(GVINS_BIN_DIR) + "/gvins-eval --align 4dof --no-cov " + extra + " " +
+                            (d / "est.tum").string() + " " + (d / "gt.tum").string() + " > " + out.string() + " 2>&1";
+    EXPECT_EQ(WEXITSTATUS(std::system(cmd.c_str())), 0) << cmd;
+    std::ifstream in(out);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  };
+  auto rmse = [](const std::string& text) {
+    const auto k = text.find("position [m]");
+    return k == std::string::npos ? -1.0 : std::strtod(text.c_str() + k + 12, nullptr);
+  };
+  const std::string last = run("");
+  const std::string all = run("--whole");
+  EXPECT_NE(last.find("1 VIO reset mark(s): evaluating the 120 poses"), std::string::npos) << last;
+  EXPECT_GT(rmse(last), 0.0);
+  EXPECT_LT(rmse(last), 0.02) << last;
+  EXPECT_GT(rmse(all), 1.0) << all;
+}
+
 }  // namespace gvins::fusion

@@ -32,6 +32,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       }
       case 3:
         gvins::vio::parseTumTrajectory(text, "traj.txt");
+        (void)gvins::vio::parseTumResetMarks(text, "traj.txt");
         break;
       default:
         gvins::vio::parseTumTrajectory(text, "traj.txt", gvins::vio::TumTimeUnit::Nanoseconds);

@@ -766,5 +766,11 @@ TEST(TumTrajectory, CommentsBetweenPosesAreSkipped) {
   const auto back = readTumTrajectory(p.string());
   ASSERT_EQ(back.size(), 2u);
   EXPECT_EQ(back[1].p, Eigen::Vector3d(4, 5, 6));
+  // The reset mark sits before pose 1 (gvins-replay's "# VIO reset" comments only).
+  EXPECT_EQ(readTumResetMarks(p.string()), std::vector<std::size_t>{1});
   fs::remove(p);
+  const auto marks = parseTumResetMarks("# t x\n1 0 0 0 0 0 0 1\n# VIO reset a\n# VIO reset b\n2 0 0 0 0 0 0 1\n"
+                                        "# other\n3 0 0 0 0 0 0 1\n# VIO reset c\n",
+                                        "m.tum");
+  EXPECT_EQ(marks, (std::vector<std::size_t>{1, 3}));
 }

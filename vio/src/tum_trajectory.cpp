@@ -51,6 +51,32 @@ std::vector<TumPose> readTumTrajectory(const std::string& path, TumTimeUnit unit
   return parseLines(r, unit);
 }
 
+namespace {
+std::vector<std::size_t> resetMarks(LineReader& r) {
+  std::vector<std::size_t> marks;
+  std::string line;
+  std::size_t poses = 0;
+  while (r.next(line)) {
+    if (!detail::isCommentOrBlank(line)) {
+      ++poses;
+    } else if (line.rfind("# VIO reset", 0) == 0 && (marks.empty() || marks.back() != poses)) {
+      marks.push_back(poses);
+    }
+  }
+  return marks;
+}
+}  // namespace
+
+std::vector<std::size_t> readTumResetMarks(const std::string& path) {
+  LineReader r(path);
+  return resetMarks(r);
+}
+
+std::vector<std::size_t> parseTumResetMarks(std::string_view text, const std::string& name) {
+  LineReader r(text, name);
+  return resetMarks(r);
+}
+
 std::vector<TumPose> parseTumTrajectory(std::string_view text, const std::string& name, TumTimeUnit unit) {
   LineReader r(text, name);
   return parseLines(r, unit);

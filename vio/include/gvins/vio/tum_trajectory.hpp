@@ -30,6 +30,12 @@ std::vector<TumPose> readTumTrajectory(const std::string& path, TumTimeUnit unit
 std::vector<TumPose> parseTumTrajectory(std::string_view text, const std::string& name,
                                         TumTimeUnit unit = TumTimeUnit::Seconds);
 
+/// Positions (pose indices, as readTumTrajectory counts them) of gvins-replay's reset marks: a
+/// comment line starting with "# VIO reset" before pose i means that the poses from i on are in
+/// a new VIO world frame (the estimator started again after a visual lock-out).
+std::vector<std::size_t> readTumResetMarks(const std::string& path);
+std::vector<std::size_t> parseTumResetMarks(std::string_view text, const std::string& name);
+
 /// Writes poses as they come (streaming); times with nanosecond resolution ("%d.%09d"),
 /// positions to 1e-9 m, quaternions with qw >= 0. Negative times are std::invalid_argument.
 class TumTrajectoryWriter {
