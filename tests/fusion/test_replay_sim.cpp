@@ -35,43 +35,48 @@ constexpr double kOutageStart = 35.0, kOutageLength = 60.0;  // s of flight time
 const fs::path& scratch() { return test::processScratchFolder("gvins_replay_sim_"); }
 
 /// The dataset, simulated once: a 120 s figure-eight at 30 m and 6 m/s with a 3° attitude wobble
-/// (rotational excitation for the lever arm), rover 5 Hz, base 1 Hz 3 km away.
+/// (rotational excitation for the lever arm), rover 5 Hz, base 1 Hz 3 km away. With
+/// `cameraOffset` (s) the images are stamped that much early and the rover has no outage.
+fs::path simulate(const std::string& name, double cameraOffset) {
+  const fs::path d = scratch() / name;
+  fs::remove_all(d);
+  std::ostringstream y;
+  y << "name: replay_sim_test\n"
+       "origin: {latitude_deg: 35.134707705, longitude_deg: 136.977577939, height_m: 104.853}\n"
+       "start_gpst: \"2024-06-24 08:20:00\"\n"
+       "trajectory: {type: flight, pattern: figure_eight, height_m: 30, length_m: 660, speed_mps: 6, laps: 1,\n"
+       "             takeoff_landing: false, hover_start_s: 3, hover_end_s: 2, wobble_deg: 3}\n"
+       "imu: {rate_hz: 200}\n"
+       "cameras:\n"
+       "  rate_hz: 20\n"
+       "  time_offset_s: "
+    << cameraOffset
+    << "\n"
+       "  output: features\n"
+       "  list:\n"
+       "    - {name: cam0, look: down, position_m: [0.06, 0.06, -0.04]}\n"
+       "    - {name: cam1, look: down, position_m: [0.06, -0.06, -0.04]}\n"
+       "lever_arm_m: ["
+    << kLever.x() << ", " << kLever.y() << ", " << kLever.z()
+    << "]\n"
+       "gnss:\n"
+       "  navigation: "
+    << GVINS_TEST_DATA
+    << "/gnss/nagoya_static_2024/base.nav.gz\n"
+       "  rover:\n"
+       "    rate_hz: 5\n";
+  if (cameraOffset == 0.0) y << "    outages: [{start_s: " << kOutageStart << ", duration_s: " << kOutageLength << "}]\n";
+  const sim::Scenario sc = sim::parseScenario(y.str(), "replay_sim_test.yaml");
+  sim::GenerationOptions opt;
+  opt.seed = 5;
+  opt.threads = 2;
+  const sim::GenerationSummary s = sim::generateDataset(sc, d, opt);
+  std::fprintf(stderr, "dataset: %.1f s, %.0f m, %zu frames per camera\n", s.duration, s.pathLength, s.framesPerCamera);
+  return d;
+}
+
 const fs::path& dataset() {
-  static const fs::path dir = [] {
-    const fs::path d = scratch() / "dataset";
-    fs::remove_all(d);
-    std::ostringstream y;
-    y << "name: replay_sim_test\n"
-         "origin: {latitude_deg: 35.134707705, longitude_deg: 136.977577939, height_m: 104.853}\n"
-         "start_gpst: \"2024-06-24 08:20:00\"\n"
-         "trajectory: {type: flight, pattern: figure_eight, height_m: 30, length_m: 660, speed_mps: 6, laps: 1,\n"
-         "             takeoff_landing: false, hover_start_s: 3, hover_end_s: 2, wobble_deg: 3}\n"
-         "imu: {rate_hz: 200}\n"
-         "cameras:\n"
-         "  rate_hz: 20\n"
-         "  output: features\n"
-         "  list:\n"
-         "    - {name: cam0, look: down, position_m: [0.06, 0.06, -0.04]}\n"
-         "    - {name: cam1, look: down, position_m: [0.06, -0.06, -0.04]}\n"
-         "lever_arm_m: ["
-      << kLever.x() << ", " << kLever.y() << ", " << kLever.z()
-      << "]\n"
-         "gnss:\n"
-         "  navigation: "
-      << GVINS_TEST_DATA
-      << "/gnss/nagoya_static_2024/base.nav.gz\n"
-         "  rover:\n"
-         "    rate_hz: 5\n"
-         "    outages: [{start_s: "
-      << kOutageStart << ", duration_s: " << kOutageLength << "}]\n";
-    const sim::Scenario sc = sim::parseScenario(y.str(), "replay_sim_test.yaml");
-    sim::GenerationOptions opt;
-    opt.seed = 5;
-    opt.threads = 2;
-    const sim::GenerationSummary s = sim::generateDataset(sc, d, opt);
-    std::fprintf(stderr, "dataset: %.1f s, %.0f m, %zu frames per camera\n", s.duration, s.pathLength, s.framesPerCamera);
-    return d;
-  }();
+  static const fs::path dir = simulate("dataset", 0.0);
   return dir;
 }
 
@@ -82,8 +87,7 @@ struct ReplayRun {
 };
 
 template <typename Scalar>
-ReplayRun replay(const std::string& name, GnssFusionConfig gc) {
-  const fs::path d = dataset();
+ReplayRun replay(const std::string& name, GnssFusionConfig gc, const fs::path& d = dataset()) {
   vio::SriSwfConfig ec;
   ec.gravity = *readSimDatasetInfo(d.string())->gravity;  // as gvins-replay does
   ec.imu = vio::readImuSensorYaml((d / "mav0" / "imu0" / "sensor.yaml").string()).noise;
@@ -92,13 +96,14 @@ ReplayRun replay(const std::string& name, GnssFusionConfig gc) {
   ec.use_float = std::is_same_v<Scalar, float>;
   SriSwfReplayEstimator<Scalar> est(ec);
   GnssFusionReplayClient<Scalar> gnss(gc, est.estimator());
+  const bool vioOnly = gc.mode == GnssFusionMode::kVio;
   ReplayOptions o;
   o.outDir = (scratch() / name).string();
   o.progress = false;
   o.modeName = toString(gc.mode);
   o.leverArmTruth = kLever;
   ReplayRun r;
-  r.summary = runReplay(d.string(), est, &gnss, o);
+  r.summary = runReplay(d.string(), est, vioOnly ? nullptr : &gnss, o);
   r.out = o.outDir;
   r.lever = r.summary.leverArm;
   return r;
@@ -221,6 +226,24 @@ TEST(ReplaySim, FloatAgreesWithDouble) {
   // the frame block and the VIO states share differently in float and double).
   EXPECT_NEAR(f.summary.global.positionRmse, d.summary.global.positionRmse, 0.05 * d.summary.global.positionRmse + 0.002);
   EXPECT_NEAR(f.summary.local.bodyVelocityRmse, d.summary.local.bodyVelocityRmse, 0.05 * d.summary.local.bodyVelocityRmse);
+}
+
+// Visual lock-out with and without GNSS: the same flight with the images stamped 80 ms early and
+// the offset ignored. VIO alone locks out three times and starts again (the local evaluation
+// covers the last state: 0.056 m); with VIO+Dopp+Ddcp the GNSS rows hold the state, so the
+// rejected features do not count as a lock-out (a restart would throw the GNSS state away) and
+// the antenna stays at cm level (0.029 m).
+TEST(ReplaySim, LockOutResetsVioButNotWhileGnssHoldsTheState) {
+  const fs::path d = simulate("dataset_offset", -0.08);
+  const ReplayRun vio = replay<double>("offset_vio", config(GnssFusionMode::kVio), d);
+  const ReplayRun ddcp = replay<double>("offset_ddcp", config(GnssFusionMode::kDoppDdcp), d);
+  std::fprintf(stderr, "80 ms ignored: VIO %zu resets, RMSE %.3f m; Ddcp %zu resets, antenna %.3f m\n",
+               vio.summary.estimatorResets, vio.summary.local.positionRmse, ddcp.summary.estimatorResets,
+               ddcp.summary.global.positionRmse);
+  EXPECT_GE(vio.summary.estimatorResets, 1u);
+  EXPECT_LT(vio.summary.local.positionRmse, 0.2);
+  EXPECT_EQ(ddcp.summary.estimatorResets, 0u);
+  EXPECT_LT(ddcp.summary.global.positionRmse, 0.1);
 }
 
 }  // namespace

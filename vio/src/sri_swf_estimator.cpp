@@ -137,6 +137,7 @@ struct SriSwfEstimator<Scalar>::Impl {
   };
   std::deque<GateCount> gate_log;
   bool lockout = false;
+  std::optional<std::int64_t> client_update_ns;  // newest applied client update (IMU time)
   std::uint64_t generation = 0;  // states created so far (EstimatorBackend::generation)
   int resets = 0;
 
@@ -1497,6 +1498,10 @@ struct SriSwfEstimator<Scalar>::Impl {
     gate_log.push_back({t_ns, res.gated_features, res.rejected_features});
     while (!gate_log.empty() && t_ns - gate_log.front().t_ns > span) gate_log.pop_front();
     if (t_ns - t_init < span) return;  // a whole span of this state first
+    // A client's measurements (GNSS) applied within the span hold the state: then the rejected
+    // features are a camera problem (time offset, calibration, a moving scene) that a restart
+    // would not fix, and it would throw the client's state away.
+    if (client_update_ns && t_ns - *client_update_ns <= span) return;
     int gated = 0;
     int rejected = 0;
     for (const GateCount& g : gate_log) {
@@ -1739,6 +1744,7 @@ BackendUpdate<Scalar> SriSwfEstimator<Scalar>::update(const sri::Measurement<Sca
   out.dof = u.dof;
   if (!u.applied) return out;
   impl_->f.correct();
+  impl_->client_update_ns = impl_->t_newest;
   out.applied = true;
   return out;
 }

@@ -67,7 +67,9 @@ struct SriSwfConfig {
   /// Visual lock-out: when, over this long (s), at least 20 features reached a χ² gate and at
   /// least 90 % of them were rejected, the state is wrong (a bad initialisation, an unmodelled
   /// time offset) and the gates keep it from recovering: the estimator drops the state and
-  /// initialises again (FrameResult::reset, generation()). Checked once a state is this old.
+  /// initialises again (FrameResult::reset, generation()). Checked once a state is this old, and
+  /// not while a client's measurements (GNSS, EstimatorBackend::update) were applied within the
+  /// span: they hold the state, and the rejections are then a camera problem.
   /// Measured on EuRoC V1_02's real IMU with an ignored −12.7 ms offset (docs/vio_estimator.md).
   /// 0 disables it.
   double lockout_reset_s = 1.0;
