@@ -13,6 +13,7 @@
 #include "gvins/sim/scenario.hpp"
 #include "gvins/vio/sensor_yaml.hpp"
 #include "gvins/vio/sri_swf_estimator.hpp"
+#include "generate_scenario.hpp"
 
 namespace gvins::fusion::test {
 
@@ -33,11 +34,7 @@ inline void simulateStereoFeatureDataset(const std::filesystem::path& dir, const
       "    - {name: cam0, look: down, position_m: [0.06, 0.06, -0.04], mount_rpy_deg: [0.4, -0.3, 0.2]}\n"
       "    - {name: cam1, look: down, position_m: [0.06, -0.06, -0.04], mount_rpy_deg: [-0.2, 0.3, -0.4]}\n"
       "gnss: none\n";
-  const sim::Scenario sc = sim::parseScenario(y, name + ".yaml");
-  sim::GenerationOptions opt;
-  opt.seed = seed;
-  opt.threads = 2;
-  sim::generateDataset(sc, dir, opt);
+  generateScenario(dir, y, name, seed);
 }
 
 /// Camera `k`'s calibration as the dataset states it (the simulation's truth).

@@ -20,6 +20,7 @@
 
 #include "gvins/sim/dataset_generator.hpp"
 #include "gvins/sim/scenario.hpp"
+#include "generate_scenario.hpp"
 #include "process_scratch_folder.hpp"
 
 namespace gvins::fusion {
@@ -52,11 +53,7 @@ const fs::path& dataset() {
         "gnss:\n"
         "  rover: {rate_hz: 5}\n"
         "  base: {enabled: false}\n";
-    const sim::Scenario sc = sim::parseScenario(y, "replay_cli_test.yaml");
-    sim::GenerationOptions opt;
-    opt.seed = 21;
-    opt.threads = 2;
-    const sim::GenerationSummary s = sim::generateDataset(sc, d, opt);
+    const sim::GenerationSummary s = test::generateScenario(d, y, "replay_cli_test", 21);
     std::fprintf(stderr, "dataset: %.1f s, %.0f m, %zu frames per camera\n", s.duration, s.pathLength, s.framesPerCamera);
     return d;
   }();

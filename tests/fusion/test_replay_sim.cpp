@@ -21,6 +21,7 @@
 #include "gvins/sim/dataset_generator.hpp"
 #include "gvins/sim/scenario.hpp"
 #include "gvins/vio/sensor_yaml.hpp"
+#include "generate_scenario.hpp"
 #include "process_scratch_folder.hpp"
 
 namespace gvins::fusion {
@@ -66,11 +67,7 @@ fs::path simulate(const std::string& name, double cameraOffset) {
        "  rover:\n"
        "    rate_hz: 5\n";
   if (cameraOffset == 0.0) y << "    outages: [{start_s: " << kOutageStart << ", duration_s: " << kOutageLength << "}]\n";
-  const sim::Scenario sc = sim::parseScenario(y.str(), "replay_sim_test.yaml");
-  sim::GenerationOptions opt;
-  opt.seed = 5;
-  opt.threads = 2;
-  const sim::GenerationSummary s = sim::generateDataset(sc, d, opt);
+  const sim::GenerationSummary s = test::generateScenario(d, y.str(), "replay_sim_test", 5);
   std::fprintf(stderr, "dataset: %.1f s, %.0f m, %zu frames per camera\n", s.duration, s.pathLength, s.framesPerCamera);
   return d;
 }

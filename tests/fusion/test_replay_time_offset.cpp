@@ -204,11 +204,7 @@ fs::path recordedDataset(double offset = kRecordedOffset) {
         "             0.999598781151, 0.0130119051815, 0.0251588363115, 0.0453689425024,\n"
         "             -0.0253898008918, 0.0179005838253, 0.999517347078, 0.00786212447038, 0, 0, 0, 1]\n"
         "gnss: none\n";
-    const sim::Scenario sc = sim::parseScenario(y, "v102_recorded_time_offset.yaml");
-    sim::GenerationOptions opt;
-    opt.seed = 7;
-    opt.threads = 2;
-    sim::generateDataset(sc, d, opt);
+    test::generateScenario(d, y, "v102_recorded_time_offset", 7);
     return d;
   }();
   made[offset] = dir;
