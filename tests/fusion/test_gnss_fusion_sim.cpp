@@ -171,6 +171,11 @@ RunResult run(GnssFusionConfig cfg, const SatelliteCut& cut = {}, const Ephemeri
       be.restart();  // the estimator drops its state: every client block is gone
       restartAt = -1.0;
       tight.reset();
+      // Between the restart and the next epoch the getters must not touch the stale ids.
+      EXPECT_FALSE(fusion.frame(be));
+      EXPECT_FALSE(fusion.clocks(be));
+      EXPECT_TRUE(fusion.ambiguities(be).empty());
+      EXPECT_EQ(fusion.leverArm(be), cfg.leverArm);
     }
     ObsEpoch obs = e.obs;
     if (tf > cut.after) {

@@ -343,6 +343,7 @@ TEST(SriSwfReset, StartsAgainWithNewIdsAndGeneration) {
   est.reset();
   EXPECT_FALSE(est.initialized());
   EXPECT_EQ(est.resets(), 1);
+  EXPECT_EQ(est.generation(), 2u);  // the old state's ids are stale at once
   EXPECT_EQ(est.filter().dim(), 0);
   EXPECT_FALSE(est.contains(client));
   EXPECT_FALSE(est.contains(old.pose));
@@ -352,7 +353,7 @@ TEST(SriSwfReset, StartsAgainWithNewIdsAndGeneration) {
   }
   ASSERT_TRUE(est.initialized());
   EXPECT_LE(f - f0, 30u);
-  EXPECT_EQ(est.generation(), 2u);
+  EXPECT_EQ(est.generation(), 3u);
   for (const sri::BlockInfo& b : est.filter().layout().blocks()) EXPECT_GT(b.id.value, oldMax) << b.name;
   EXPECT_FALSE(est.contains(client));
   // Drift of the new state over the rest of the flight, aligned (yaw, position) at its start.

@@ -138,7 +138,7 @@ struct SriSwfEstimator<Scalar>::Impl {
   std::deque<GateCount> gate_log;
   bool lockout = false;
   std::optional<std::int64_t> client_update_ns;  // newest applied client update (IMU time)
-  std::uint64_t generation = 0;  // states created so far (EstimatorBackend::generation)
+  std::uint64_t generation = 0;  // EstimatorBackend::generation: + 1 per initialisation and per reset
   int resets = 0;
 
   static sri::SriOptions filterOptions(const SriSwfConfig& c, std::uint64_t first_block_id) {
@@ -1524,7 +1524,9 @@ void SriSwfEstimator<Scalar>::reset() {
   auto fresh = std::make_unique<Impl>(config_, impl_->f.nextBlockId());
   fresh->imu = std::move(impl_->imu);
   fresh->observer = std::move(impl_->observer);
-  fresh->generation = impl_->generation;
+  // A new generation at once: the old state is gone even before the next one is created, and a
+  // client must not use its ids in between (its getters are called between epochs).
+  fresh->generation = impl_->generation + 1;
   fresh->resets = impl_->resets + 1;
   impl_ = std::move(fresh);
 }

@@ -76,11 +76,10 @@ class EstimatorBackend {
   // ------------------------------------------------------------------ status and IMU state
   /// True once the VIO is initialised (gravity aligned, newest state exists).
   virtual bool initialized() const = 0;
-  /// Counts the states the estimator has created: 0 before the first initialisation, then + 1
-  /// each time it initialises (again). An estimator may drop its state and start again (e.g.
-  /// after a visual lock-out, SriSwfEstimator::reset): the client blocks of an earlier
-  /// generation are then gone, and a client that sees a new generation forgets its ids and
-  /// starts its own initialisation again.
+  /// Changes whenever the estimator's state is replaced: 0 before the first initialisation, + 1
+  /// at each initialisation and + 1 when a state is dropped (e.g. after a visual lock-out,
+  /// SriSwfEstimator::reset). The client blocks of an earlier generation are gone: a client
+  /// that sees a new generation forgets its ids and starts its own initialisation again.
   virtual std::uint64_t generation() const = 0;
   /// Time of the newest IMU state (ns, on the sensor clock = GPST in our datasets).
   virtual std::int64_t newestTime() const = 0;

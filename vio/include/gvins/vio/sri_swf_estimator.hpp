@@ -279,7 +279,7 @@ class SriSwfEstimator final : public EstimatorBackend<Scalar> {
   void setStepObserver(std::function<void(const char* step)> observer);
   /// Drops the whole state (clones, features, client blocks) and starts initialising again with
   /// the next frames; the buffered IMU samples are kept. Block ids of the old state are never
-  /// reused, and generation() counts the new state when it is created. Called by processFrame
+  /// reused; generation() changes at once and again when the new state is created. Called by processFrame
   /// after a visual lock-out; a driver may call it too (e.g. a user's restart).
   void reset();
   /// Number of resets so far (lock-outs and reset() calls).
