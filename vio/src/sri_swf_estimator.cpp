@@ -861,39 +861,49 @@ struct SriSwfEstimator<Scalar>::Impl {
   }
 
   /// Gauss-Newton triangulation (inverse depth in the first observing camera).
+  /// One observation as triangulation sees it: world-to-camera rotation, camera centre, bearing.
+  struct Ray {
+    Eigen::Matrix3d R_CW;
+    Eigen::Vector3d c;
+    Eigen::Vector2d z;
+  };
+  std::vector<Ray> rays;  // triangulate()'s buffer
   bool triangulate(const std::vector<Obs>& obs, Eigen::Vector3d& p_W) {
     if (obs.size() < 2) return false;
-    // Linear initial guess: the point closest to all rays.
+    // The rays once (p_C = R_CW (p_W − c), as cameraPoint's p_C), then a linear initial guess:
+    // the point closest to all rays.
+    rays.resize(obs.size());
     Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
     Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
-    std::vector<Eigen::Vector3d> centres;
-    for (const Obs& o : obs) {
-      const PoseEstimate& P = obsPose(o.clone);
-      const CameraExtrinsic e = ext(o.cam);
-      const Eigen::Vector3d b = (P.R_WI * e.R_IC * Eigen::Vector3d(o.z.x(), o.z.y(), 1.0)).normalized();
-      const Eigen::Vector3d c = P.p_WI + P.R_WI * e.p_IC;
+    for (std::size_t k = 0; k < obs.size(); ++k) {
+      const PoseEstimate& P = obsPose(obs[k].clone);
+      const CameraExtrinsic e = ext(obs[k].cam);
+      Ray& ray = rays[k];
+      ray.R_CW = e.R_IC.transpose() * P.R_WI.transpose();
+      ray.c = P.p_WI + P.R_WI * e.p_IC;
+      ray.z = obs[k].z;
+      const Eigen::Vector3d b = (ray.R_CW.transpose() * Eigen::Vector3d(ray.z.x(), ray.z.y(), 1.0)).normalized();
       const Eigen::Matrix3d M = Eigen::Matrix3d::Identity() - b * b.transpose();
       A += M;
-      rhs += M * c;
-      centres.push_back(c);
+      rhs += M * ray.c;
     }
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(A);
     if (es.eigenvalues()(0) < 1e-9 * es.eigenvalues()(2)) return false;
     p_W = A.ldlt().solve(rhs);
     const PoseEstimate& P0 = obsPose(obs[0].clone);
     const CameraExtrinsic e0 = ext(obs[0].cam);
-    const CameraPoint c0 = cameraPoint(P0, e0, p_W);
-    if (!(c0.p_C.z() > cfg.min_depth)) return false;
-    Eigen::Vector3d fpar(c0.p_C.x() / c0.p_C.z(), c0.p_C.y() / c0.p_C.z(), 1.0 / c0.p_C.z());
+    const Eigen::Vector3d c0 = rays[0].R_CW * (p_W - rays[0].c);
+    if (!(c0.z() > cfg.min_depth)) return false;
+    Eigen::Vector3d fpar(c0.x() / c0.z(), c0.y() / c0.z(), 1.0 / c0.z());
     for (int it = 0; it < 8; ++it) {
       const AnchoredPoint ap = anchoredPoint(fpar, P0, e0);
       Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
       Eigen::Vector3d g = Eigen::Vector3d::Zero();
-      for (const Obs& o : obs) {
-        const CameraPoint cp = cameraPoint(obsPose(o.clone), ext(o.cam), ap.p_W);
-        if (!(cp.p_C.z() > 1e-6)) return false;
-        const Eigen::Vector2d r = o.z - cp.p_C.head<2>() / cp.p_C.z();
-        const Eigen::Matrix<double, 2, 3> J = projectionJacobian(cp.p_C) * cp.J_point * ap.J_feature;
+      for (const Ray& ray : rays) {
+        const Eigen::Vector3d p_C = ray.R_CW * (ap.p_W - ray.c);
+        if (!(p_C.z() > 1e-6)) return false;
+        const Eigen::Vector2d r = ray.z - p_C.head<2>() / p_C.z();
+        const Eigen::Matrix<double, 2, 3> J = projectionJacobian(p_C) * ray.R_CW * ap.J_feature;
         H += J.transpose() * J;
         g += J.transpose() * r;
       }
@@ -905,11 +915,11 @@ struct SriSwfEstimator<Scalar>::Impl {
     }
     p_W = anchoredPoint(fpar, P0, e0).p_W;
     double depth0 = 0.0, base = 0.0;
-    for (std::size_t k = 0; k < obs.size(); ++k) {
-      const double z = cameraPoint(obsPose(obs[k].clone), ext(obs[k].cam), p_W).p_C.z();
+    for (std::size_t k = 0; k < rays.size(); ++k) {
+      const double z = (rays[k].R_CW * (p_W - rays[k].c)).z();
       if (!(z >= cfg.min_depth && z <= cfg.max_depth)) return false;
       if (k == 0) depth0 = z;
-      base = std::max(base, (centres[k] - centres[0]).norm());
+      base = std::max(base, (rays[k].c - rays[0].c).norm());
     }
     return base >= cfg.min_baseline_ratio * depth0;
   }
