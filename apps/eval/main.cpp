@@ -158,10 +158,11 @@ int main(int argc, char** argv) {
       }
       if (fs::is_directory(gtPath)) throw std::runtime_error("no state_groundtruth_estimate0/data.csv in " + gtPath);
     }
-    auto est = toTrajectorySamples(readTumTrajectory(estPath));
     // gvins-replay marks an estimator restart (visual lock-out) in the TUM file; the poses before
     // the last mark are in other VIO frames.
-    if (const auto marks = readTumResetMarks(estPath); !marks.empty() && !whole) {
+    std::vector<std::size_t> marks;
+    auto est = toTrajectorySamples(readTumTrajectory(estPath, TumTimeUnit::Seconds, &marks));
+    if (!marks.empty() && !whole) {
       const std::size_t from = std::min(marks.back(), est.size());
       std::printf("%s has %zu VIO reset mark(s): evaluating the %zu poses after the last one (--whole: all)\n",
                   estPath.c_str(), marks.size(), est.size() - from);

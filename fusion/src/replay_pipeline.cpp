@@ -609,7 +609,7 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
       ++sum.estimatorResets;
       // The next poses are in the new state's VIO frame: the local evaluation covers the last
       // state only, and trajectory.tum marks the jump.
-      tum.comment("VIO reset after a visual lock-out: the poses below are in a new VIO world frame");
+      tum.markReset("after a visual lock-out: the poses below are in a new VIO world frame");
       localTrack.clear();
       covs.clear();
       if (opt.progress) {

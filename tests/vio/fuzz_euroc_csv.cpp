@@ -3,6 +3,7 @@
 // exception other than gvins::ParseError, or any crash/hang, is a bug.
 #include <cstdint>
 #include <string_view>
+#include <vector>
 
 #include "gvins/base/parse_error.hpp"
 #include "gvins/vio/euroc_csv.hpp"
@@ -30,10 +31,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         }
         break;
       }
-      case 3:
-        gvins::vio::parseTumTrajectory(text, "traj.txt");
-        (void)gvins::vio::parseTumResetMarks(text, "traj.txt");
+      case 3: {
+        std::vector<std::size_t> marks;
+        gvins::vio::parseTumTrajectory(text, "traj.txt", gvins::vio::TumTimeUnit::Seconds, &marks);
         break;
+      }
       default:
         gvins::vio::parseTumTrajectory(text, "traj.txt", gvins::vio::TumTimeUnit::Nanoseconds);
         break;

@@ -763,14 +763,17 @@ TEST(TumTrajectory, CommentsBetweenPosesAreSkipped) {
   std::ifstream in(p);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("\n# VIO reset: new frame below\n"), std::string::npos) << text;
-  const auto back = readTumTrajectory(p.string());
+  std::vector<std::size_t> fileMarks;
+  const auto back = readTumTrajectory(p.string(), TumTimeUnit::Seconds, &fileMarks);
   ASSERT_EQ(back.size(), 2u);
   EXPECT_EQ(back[1].p, Eigen::Vector3d(4, 5, 6));
   // The reset mark sits before pose 1 (gvins-replay's "# VIO reset" comments only).
-  EXPECT_EQ(readTumResetMarks(p.string()), std::vector<std::size_t>{1});
+  EXPECT_EQ(fileMarks, std::vector<std::size_t>{1});
   fs::remove(p);
-  const auto marks = parseTumResetMarks("# t x\n1 0 0 0 0 0 0 1\n# VIO reset a\n# VIO reset b\n2 0 0 0 0 0 0 1\n"
+  std::vector<std::size_t> marks;
+  const auto poses = parseTumTrajectory("# t x\n1 0 0 0 0 0 0 1\n# VIO reset a\n# VIO reset b\n2 0 0 0 0 0 0 1\n"
                                         "# other\n3 0 0 0 0 0 0 1\n# VIO reset c\n",
-                                        "m.tum");
+                                        "m.tum", TumTimeUnit::Seconds, &marks);
+  EXPECT_EQ(poses.size(), 3u);
   EXPECT_EQ(marks, (std::vector<std::size_t>{1, 3}));
 }

@@ -860,7 +860,6 @@ struct SriSwfEstimator<Scalar>::Impl {
     }
   }
 
-  /// Gauss-Newton triangulation (inverse depth in the first observing camera).
   /// One observation as triangulation sees it: world-to-camera rotation, camera centre, bearing.
   struct Ray {
     Eigen::Matrix3d R_CW;
@@ -868,6 +867,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     Eigen::Vector2d z;
   };
   std::vector<Ray> rays;  // triangulate()'s buffer
+  /// Gauss-Newton triangulation (inverse depth in the first observing camera).
   bool triangulate(const std::vector<Obs>& obs, Eigen::Vector3d& p_W) {
     if (obs.size() < 2) return false;
     // The rays once (p_C = R_CW (p_W − c), as cameraPoint's p_C), then a linear initial guess:

@@ -12,13 +12,20 @@
 namespace gvins::vio {
 
 namespace {
-std::vector<TumPose> parseLines(LineReader& reader, TumTimeUnit unit) {
+std::vector<TumPose> parseLines(LineReader& reader, TumTimeUnit unit, std::vector<std::size_t>* resetMarks) {
   static constexpr const char* kFields[8] = {"timestamp", "x", "y", "z", "qx", "qy", "qz", "qw"};
   std::vector<TumPose> out;
   std::string line;
   std::vector<std::string_view> f;
+  if (resetMarks) resetMarks->clear();
+  const std::string mark = "# " + std::string(kTumResetMark);
   while (reader.next(line)) {
-    if (detail::isCommentOrBlank(line)) continue;
+    if (detail::isCommentOrBlank(line)) {
+      if (resetMarks && line.rfind(mark, 0) == 0 && (resetMarks->empty() || resetMarks->back() != out.size())) {
+        resetMarks->push_back(out.size());
+      }
+      continue;
+    }
     const TextLocation where = reader.location();
     detail::splitFields(line, line.find(',') == std::string::npos, f);
     if (f.size() != 8) {
@@ -46,40 +53,15 @@ std::vector<TumPose> parseLines(LineReader& reader, TumTimeUnit unit) {
 }
 }  // namespace
 
-std::vector<TumPose> readTumTrajectory(const std::string& path, TumTimeUnit unit) {
+std::vector<TumPose> readTumTrajectory(const std::string& path, TumTimeUnit unit, std::vector<std::size_t>* resetMarks) {
   LineReader r(path);
-  return parseLines(r, unit);
+  return parseLines(r, unit, resetMarks);
 }
 
-namespace {
-std::vector<std::size_t> resetMarks(LineReader& r) {
-  std::vector<std::size_t> marks;
-  std::string line;
-  std::size_t poses = 0;
-  while (r.next(line)) {
-    if (!detail::isCommentOrBlank(line)) {
-      ++poses;
-    } else if (line.rfind("# VIO reset", 0) == 0 && (marks.empty() || marks.back() != poses)) {
-      marks.push_back(poses);
-    }
-  }
-  return marks;
-}
-}  // namespace
-
-std::vector<std::size_t> readTumResetMarks(const std::string& path) {
-  LineReader r(path);
-  return resetMarks(r);
-}
-
-std::vector<std::size_t> parseTumResetMarks(std::string_view text, const std::string& name) {
+std::vector<TumPose> parseTumTrajectory(std::string_view text, const std::string& name, TumTimeUnit unit,
+                                        std::vector<std::size_t>* resetMarks) {
   LineReader r(text, name);
-  return resetMarks(r);
-}
-
-std::vector<TumPose> parseTumTrajectory(std::string_view text, const std::string& name, TumTimeUnit unit) {
-  LineReader r(text, name);
-  return parseLines(r, unit);
+  return parseLines(r, unit, resetMarks);
 }
 
 TumTrajectoryWriter::TumTrajectoryWriter(const std::string& path, const std::string& header) : path_(path) {

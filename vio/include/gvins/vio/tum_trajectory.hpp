@@ -23,18 +23,20 @@ struct TumPose {
 
 enum class TumTimeUnit { Seconds, Nanoseconds };
 
+/// gvins-replay's reset mark: a comment line "# VIO reset ..." (TumTrajectoryWriter::markReset)
+/// before pose i means that the poses from i on are in a new VIO world frame (the estimator
+/// started again after a visual lock-out).
+inline constexpr std::string_view kTumResetMark = "VIO reset";
+
 /// Reads a trajectory; throws gvins::ParseError (file, line, field) for malformed lines,
 /// non-unit quaternions (|q| off by more than 1e-3; otherwise renormalised) and time stamps that
-/// do not increase strictly.
-std::vector<TumPose> readTumTrajectory(const std::string& path, TumTimeUnit unit = TumTimeUnit::Seconds);
+/// do not increase strictly. `resetMarks` (if given) receives the indices of the poses that
+/// follow reset marks (several marks before the same pose count once).
+std::vector<TumPose> readTumTrajectory(const std::string& path, TumTimeUnit unit = TumTimeUnit::Seconds,
+                                       std::vector<std::size_t>* resetMarks = nullptr);
 std::vector<TumPose> parseTumTrajectory(std::string_view text, const std::string& name,
-                                        TumTimeUnit unit = TumTimeUnit::Seconds);
-
-/// Positions (pose indices, as readTumTrajectory counts them) of gvins-replay's reset marks: a
-/// comment line starting with "# VIO reset" before pose i means that the poses from i on are in
-/// a new VIO world frame (the estimator started again after a visual lock-out).
-std::vector<std::size_t> readTumResetMarks(const std::string& path);
-std::vector<std::size_t> parseTumResetMarks(std::string_view text, const std::string& name);
+                                        TumTimeUnit unit = TumTimeUnit::Seconds,
+                                        std::vector<std::size_t>* resetMarks = nullptr);
 
 /// Writes poses as they come (streaming); times with nanosecond resolution ("%d.%09d"),
 /// positions to 1e-9 m, quaternions with qw >= 0. Negative times are std::invalid_argument.
@@ -51,6 +53,8 @@ class TumTrajectoryWriter {
   void write(std::int64_t t_ns, const Eigen::Matrix3d& R, const Eigen::Vector3d& p) { write(TumPose{t_ns, p, R}); }
   /// A comment line "# text" between poses (readers skip it); `text` must be one line.
   void comment(const std::string& text);
+  /// The reset mark (kTumResetMark) before the poses of a new VIO world frame, followed by `detail`.
+  void markReset(const std::string& detail) { comment(std::string(kTumResetMark) + " " + detail); }
   /// Flushes and closes; throws std::runtime_error on a write error (disk full, ...).
   void close();
 
