@@ -17,14 +17,15 @@ bool passesValidation(double ratio, double successRate, const AmbiguityResolutio
 }
 
 AmbiguityFix resolveAmbiguities(const Eigen::VectorXd& afloat, const Eigen::MatrixXd& Q,
-                                const AmbiguityResolutionOptions& o) {
+                                const AmbiguityResolutionOptions& o, const ReductionStart* basis) {
   AmbiguityFix fix;
   const int n = static_cast<int>(afloat.size());
   if (n == 0 || n < std::max(1, o.minFixed)) return fix;
   IlsSearchOptions so;
   so.candidates = 2;
   so.maxNodes = o.maxNodes;
-  const LambdaResult full = lambda(afloat, Q, so);
+  const LambdaResult full = lambda(afloat, Q, so, basis);
+  if (full.reduction.factor.d.size() == n) fix.basis = {full.reduction.Z, full.reduction.Zinv};
   fix.attempts = 1;
   fix.nodes = full.nodes;
   fix.fullRatio = full.ratio;

@@ -90,6 +90,8 @@ void RtkSolver::reset() {
   consecutiveFixes_ = 0;
   lastVelocity_.reset();
   pos_ = vel_ = sri::BlockId{};
+  arPairs_.clear();
+  arBasis_ = {};
 }
 
 Eigen::Vector3d RtkSolver::positionEstimate() const { return filter_.estimate(pos_).vector.head<3>(); }
@@ -596,7 +598,45 @@ void RtkSolver::resolve(RtkSolution& sol) {
   Q = Q.selfadjointView<Eigen::Lower>();
   const Eigen::MatrixXd Qaa = Q.bottomRightCorner(m, m);
   const Eigen::MatrixXd Qxa = Q.topRightCorner(3, m);
-  const AmbiguityFix fix = resolveAmbiguities(a, Qaa, cfg_.ar);
+  // Start LAMBDA from the previous epoch's reduced basis when every previous pair is still
+  // here: Z_start holds the old basis on the old pairs' rows and a unit column for each new pair
+  // (unimodular, and Z_start⁻¹ likewise).
+  ReductionStart start;
+  {
+    std::vector<std::pair<sri::BlockId, sri::BlockId>> now(static_cast<std::size_t>(m));
+    for (int k = 0; k < m; ++k) now[static_cast<std::size_t>(k)] = {pairs[static_cast<std::size_t>(k)].satId, pairs[static_cast<std::size_t>(k)].refId};
+    const int m0 = static_cast<int>(arPairs_.size());
+    std::vector<int> where(static_cast<std::size_t>(m0), -1);
+    bool all = m0 > 0 && m0 <= m && arBasis_.fits(m0);
+    for (int i = 0; i < m0 && all; ++i) {
+      const auto it = std::find(now.begin(), now.end(), arPairs_[static_cast<std::size_t>(i)]);
+      if (it == now.end()) all = false;
+      else where[static_cast<std::size_t>(i)] = static_cast<int>(it - now.begin());
+    }
+    if (all) {
+      start.Z = Eigen::MatrixXd::Zero(m, m);
+      start.Zinv = Eigen::MatrixXd::Zero(m, m);
+      std::vector<char> old(static_cast<std::size_t>(m), 0);
+      for (int i = 0; i < m0; ++i) {
+        const int r = where[static_cast<std::size_t>(i)];
+        old[static_cast<std::size_t>(r)] = 1;
+        for (int j = 0; j < m0; ++j) {
+          start.Z(r, j) = arBasis_.Z(i, j);
+          start.Zinv(j, r) = arBasis_.Zinv(j, i);
+        }
+      }
+      for (int r = 0, c = m0; r < m; ++r) {
+        if (old[static_cast<std::size_t>(r)]) continue;
+        start.Z(r, c) = 1.0;
+        start.Zinv(c, r) = 1.0;
+        ++c;
+      }
+    }
+    arPairs_ = std::move(now);
+  }
+  const AmbiguityFix fix = resolveAmbiguities(a, Qaa, cfg_.ar, start.Z.size() ? &start : nullptr);
+  arBasis_ = fix.basis;
+  if (!arBasis_.fits(m)) arPairs_.clear();
   sol.ratio = fix.fixed ? fix.ratio : fix.fullRatio;
   sol.successRate = fix.fixed ? fix.successRate : fix.fullSuccessRate;
   if (!fix.fixed) {

@@ -230,29 +230,23 @@ TEST(Lambda, OneDimensionRoundsAndNodeLimitIsReported) {
 /// permutations in the reduction): the integers are recovered, the transformation stays exact and
 /// its entries small. (The real-data counterpart, nagoya epochs in instantaneous mode, is in
 /// test_rtk.)
-TEST(Lambda, LargeMultiSystemProblemStaysExact) {
-  std::mt19937 rng(23);
-  std::normal_distribution<double> g(0.0, 1.0);
-  std::uniform_real_distribution<double> ang(0.0, 6.283), el(0.27, 1.5);
-  const int sats[3] = {11, 9, 13};
+/// Normal matrix of one epoch of dual-frequency DD phase (4 mm) and code (0.5 m) on three systems
+/// with 11, 9 and 13 satellites (60 ambiguities after the position's 3 columns), DDs against each
+/// system's first satellite; line-of-sight unit vectors los[system][satellite].
+Eigen::MatrixXd multiSystemNormalMatrix(const std::vector<std::vector<Eigen::Vector3d>>& los) {
   const double lam[3][2] = {{0.19029367, 0.24421021}, {0.19029367, 0.25482804}, {0.19203949, 0.24834936}};
   int n = 0;
-  for (int s : sats) n += 2 * (s - 1);
-  ASSERT_EQ(n, 60);
+  for (const auto& s : los) n += 2 * (static_cast<int>(s.size()) - 1);
   Eigen::MatrixXd N = Eigen::MatrixXd::Zero(3 + n, 3 + n);
   int col = 3;
   for (int sys = 0; sys < 3; ++sys) {
-    const int ns = sats[sys], m = ns - 1;
-    std::vector<Eigen::Vector3d> los(static_cast<std::size_t>(ns));
-    for (auto& u : los) {
-      const double a = ang(rng), e = el(rng);
-      u = Eigen::Vector3d(std::cos(e) * std::sin(a), std::cos(e) * std::cos(a), std::sin(e));
-    }
+    const auto& u = los[static_cast<std::size_t>(sys)];
+    const int m = static_cast<int>(u.size()) - 1;
     const Eigen::MatrixXd Ci = (Eigen::MatrixXd::Identity(m, m) + Eigen::MatrixXd::Ones(m, m)).inverse();
     for (int f = 0; f < 2; ++f) {
       Eigen::MatrixXd H = Eigen::MatrixXd::Zero(m, 3 + n), Hc = Eigen::MatrixXd::Zero(m, 3 + n);
       for (int j = 0; j < m; ++j) {
-        const Eigen::RowVector3d row = -(los[static_cast<std::size_t>(j) + 1] - los[0]).transpose();
+        const Eigen::RowVector3d row = -(u[static_cast<std::size_t>(j) + 1] - u[0]).transpose();
         H.block<1, 3>(j, 0) = row;
         Hc.block<1, 3>(j, 0) = row;
         H(j, col + f * m + j) = lam[sys][f];
@@ -261,6 +255,28 @@ TEST(Lambda, LargeMultiSystemProblemStaysExact) {
     }
     col += 2 * m;
   }
+  return N;
+}
+
+std::vector<std::vector<Eigen::Vector3d>> randomLinesOfSight(std::mt19937& rng) {
+  std::uniform_real_distribution<double> ang(0.0, 6.283), el(0.27, 1.5);
+  std::vector<std::vector<Eigen::Vector3d>> los;
+  for (int ns : {11, 9, 13}) {
+    los.emplace_back();
+    for (int i = 0; i < ns; ++i) {
+      const double a = ang(rng), e = el(rng);
+      los.back().emplace_back(std::cos(e) * std::sin(a), std::cos(e) * std::cos(a), std::sin(e));
+    }
+  }
+  return los;
+}
+
+TEST(Lambda, LargeMultiSystemProblemStaysExact) {
+  std::mt19937 rng(23);
+  std::normal_distribution<double> g(0.0, 1.0);
+  const Eigen::MatrixXd N = multiSystemNormalMatrix(randomLinesOfSight(rng));
+  const int n = static_cast<int>(N.rows()) - 3;
+  ASSERT_EQ(n, 60);
   const Eigen::MatrixXd Q = N.inverse().bottomRightCorner(n, n);
   const Eigen::MatrixXd L = Q.llt().matrixL();
   int correct = 0;
@@ -284,6 +300,65 @@ TEST(Lambda, LargeMultiSystemProblemStaysExact) {
     if (r.fixed[0] == truth) ++correct;
   }
   EXPECT_GE(correct, 19);
+}
+
+/// Warm start (ReductionStart): a filter's float ambiguities one epoch later (the satellites
+/// moved by ~0.1°, a second epoch of information) reduced from the previous epoch's basis give
+/// the same ILS solution and norms as a cold start, with a basis that meets the reduction
+/// conditions and far fewer permutations.
+TEST(Lambda, WarmStartFromThePreviousEpochMatchesTheColdStart) {
+  std::mt19937 rng(41);
+  std::normal_distribution<double> g(0.0, 1.0);
+  auto los = randomLinesOfSight(rng);
+  const Eigen::MatrixXd N1 = multiSystemNormalMatrix(los);
+  for (auto& s : los) {
+    for (auto& u : s) u = (u + 2e-4 * Eigen::Vector3d(g(rng), g(rng), g(rng))).normalized();
+  }
+  const Eigen::MatrixXd N2 = N1 + multiSystemNormalMatrix(los);
+  const int n = static_cast<int>(N1.rows()) - 3;
+  const Eigen::MatrixXd Q1 = N1.inverse().bottomRightCorner(n, n);
+  const Eigen::MatrixXd Q2 = N2.inverse().bottomRightCorner(n, n);
+  const Eigen::MatrixXd L2 = Q2.llt().matrixL();
+  Eigen::VectorXd truth(n), w(n);
+  for (int i = 0; i < n; ++i) {
+    truth[i] = std::round(50.0 * g(rng));
+    w[i] = g(rng);
+  }
+  const Eigen::VectorXd a1 = truth + Q1.llt().matrixL().toDenseMatrix() * w;
+  const LambdaResult first = lambda(a1, Q1);
+  ASSERT_TRUE(first.ok);
+  const ReductionStart start{first.reduction.Z, first.reduction.Zinv};
+  for (int trial = 0; trial < 10; ++trial) {
+    for (int i = 0; i < n; ++i) w[i] = g(rng);
+    const Eigen::VectorXd a2 = truth + L2 * w;
+    const LambdaResult cold = lambda(a2, Q2);
+    const LambdaResult warm = lambda(a2, Q2, {}, &start);
+    ASSERT_TRUE(cold.ok && warm.ok) << trial;
+    EXPECT_EQ(warm.fixed[0], cold.fixed[0]) << trial;
+    EXPECT_EQ(warm.fixed[1], cold.fixed[1]) << trial;
+    EXPECT_NEAR(warm.squaredNorms[0], cold.squaredNorms[0], 1e-8 * cold.squaredNorms[0]) << trial;
+    EXPECT_NEAR(warm.ratio, cold.ratio, 1e-8 * cold.ratio) << trial;
+    EXPECT_EQ(warm.fixed[0], truth) << trial;
+    // Cold: hundreds of permutations; warm: a handful.
+    EXPECT_GT(cold.reduction.permutations, 100);
+    EXPECT_LT(warm.reduction.permutations, cold.reduction.permutations / 10) << trial;
+    // The composed basis is unimodular, factors Zᵀ Q₂ Z and is reduced.
+    const auto& r = warm.reduction;
+    EXPECT_EQ(r.Z * r.Zinv, Eigen::MatrixXd::Identity(n, n)) << trial;
+    const Eigen::MatrixXd Qz = r.Z.transpose() * Q2 * r.Z;
+    EXPECT_LT((r.factor.L.transpose() * r.factor.d.asDiagonal() * r.factor.L - Qz).cwiseAbs().maxCoeff(),
+              1e-9 * Qz.cwiseAbs().maxCoeff());
+    for (int k = 0; k + 1 < n; ++k) {
+      const double l = r.factor.L(k + 1, k);
+      EXPECT_LE(std::abs(l), 0.5 + 1e-12) << k;
+      EXPECT_GE(r.factor.d[k] + l * l * r.factor.d[k + 1], (1.0 - 1e-9) * r.factor.d[k + 1]) << k;
+    }
+  }
+  // A start of the wrong size is ignored.
+  const ReductionStart small{Eigen::MatrixXd::Identity(3, 3), Eigen::MatrixXd::Identity(3, 3)};
+  const LambdaResult ignored = lambda(a1, Q1, {}, &small);
+  EXPECT_EQ(ignored.fixed[0], first.fixed[0]);
+  EXPECT_EQ(ignored.reduction.permutations, first.reduction.permutations);
 }
 
 /// Bootstrapping in the decorrelated domain: success counted by simulation must match

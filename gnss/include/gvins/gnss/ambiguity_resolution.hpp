@@ -62,13 +62,17 @@ struct AmbiguityFix {
   /// Full-set ratio and success rate (diagnostics, also when a subset was fixed).
   double fullRatio = 0.0;
   double fullSuccessRate = 0.0;
+  /// Reduced basis of the full set (empty if Q was not positive definite): the `start` of the
+  /// next resolution of the same ambiguities.
+  ReductionStart basis;
   int numFixed() const { return static_cast<int>(values.size()); }
 };
 
 /// Resolves float ambiguities â (cycles) with covariance Q. Never throws; `fixed` is false when
-/// nothing passed validation or Q is not positive definite.
+/// nothing passed validation or Q is not positive definite. `start`: see lambda().
 AmbiguityFix resolveAmbiguities(const Eigen::VectorXd& afloat, const Eigen::MatrixXd& Q,
-                                const AmbiguityResolutionOptions& options = {});
+                                const AmbiguityResolutionOptions& options = {},
+                                const ReductionStart* start = nullptr);
 
 /// Whether an accepted solution passes the validation rule (exposed for tests and tools).
 bool passesValidation(double ratio, double successRate, const AmbiguityResolutionOptions& options);

@@ -194,6 +194,11 @@ class RtkSolver {
   DdEpoch dd_;
   BaseSnapshot snapshot_;
   int consecutiveFixes_ = 0;
+  /// Previous resolution's DD ambiguities (SD block ids of satellite and reference) and its
+  /// reduced basis: the next epoch's LAMBDA starts from it (ReductionStart) while none of these
+  /// pairs has gone (new pairs enter with unit vectors).
+  std::vector<std::pair<sri::BlockId, sri::BlockId>> arPairs_;
+  ReductionStart arBasis_;
   RtkCounters counters_;
 };
 
