@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <set>
+#include <stdexcept>
+#include <unordered_map>
 
 #include <Eigen/Cholesky>
 
@@ -576,25 +578,41 @@ void RtkSolver::resolve(RtkSolution& sol) {
     return;
   }
   ++counters_.arAttempts;
-  // Joint covariance of [position; DD ambiguities] from the square-root factor: with M the rows
-  // selecting/combining state columns, cov = (M R⁻¹)(M R⁻¹)ᵀ, one triangular solve Rᵀ Y = Mᵀ.
-  const int n = filter_.dim();
-  const Eigen::MatrixXd R = filter_.squareRootInformation();
-  Eigen::MatrixXd Mt = Eigen::MatrixXd::Zero(n, 3 + m);
-  const int po = filter_.layout().block(pos_).offset;
-  for (int c = 0; c < 3; ++c) Mt(po + c, c) = 1.0;
+  // Joint covariance of [position; DD ambiguities] from the square-root factor: with F the rows
+  // of R⁻¹ of the position and of the SD ambiguities (SriFilter::covarianceFactor, ~n³/6), a DD's
+  // row is F_sat − F_ref and Q = Y Yᵀ over Y = [F_pos; F_sat − F_ref] (the earlier R⁻ᵀ Mᵀ solve
+  // with 3 + m right-hand sides cost about three times as much).
+  std::vector<sri::BlockId> ids{pos_};
+  std::unordered_map<std::uint64_t, int> rowOf;  // SD ambiguity block → row of F
+  auto listed = [&](sri::BlockId id) {
+    if (rowOf.emplace(id.value, 3 + static_cast<int>(ids.size()) - 1).second) ids.push_back(id);
+  };
   Eigen::VectorXd a(m);
   for (int k = 0; k < m; ++k) {
-    const int os = filter_.layout().block(pairs[static_cast<std::size_t>(k)].satId).offset;
-    const int orf = filter_.layout().block(pairs[static_cast<std::size_t>(k)].refId).offset;
-    Mt(os, 3 + k) = 1.0;
-    Mt(orf, 3 + k) = -1.0;
-    a[k] = filter_.estimate(pairs[static_cast<std::size_t>(k)].satId).vector[0] -
-           filter_.estimate(pairs[static_cast<std::size_t>(k)].refId).vector[0];
+    const Pair& p = pairs[static_cast<std::size_t>(k)];
+    listed(p.satId);
+    listed(p.refId);
+    a[k] = filter_.estimate(p.satId).vector[0] - filter_.estimate(p.refId).vector[0];
   }
-  const Eigen::MatrixXd Y = R.triangularView<Eigen::Upper>().transpose().solve(Mt);
+  Eigen::MatrixXd F;
+  try {
+    F = filter_.covarianceFactor(ids);
+  } catch (const std::domain_error&) {
+    F.resize(0, 0);
+  }
+  if (F.rows() != static_cast<Eigen::Index>(ids.size()) + 2) {  // a block without information
+    sol.ar = ArStatus::NotValidated;
+    consecutiveFixes_ = 0;
+    return;
+  }
+  Eigen::MatrixXd Y(3 + m, F.cols());
+  Y.topRows(3) = F.topRows(3);
+  for (int k = 0; k < m; ++k) {
+    const Pair& p = pairs[static_cast<std::size_t>(k)];
+    Y.row(3 + k) = F.row(rowOf.at(p.satId.value)) - F.row(rowOf.at(p.refId.value));
+  }
   Eigen::MatrixXd Q = Eigen::MatrixXd::Zero(3 + m, 3 + m);
-  Q.selfadjointView<Eigen::Lower>().rankUpdate(Y.transpose());
+  Q.selfadjointView<Eigen::Lower>().rankUpdate(Y);
   Q = Q.selfadjointView<Eigen::Lower>();
   const Eigen::MatrixXd Qaa = Q.bottomRightCorner(m, m);
   const Eigen::MatrixXd Qxa = Q.topRightCorner(3, m);
