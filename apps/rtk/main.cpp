@@ -3,7 +3,6 @@
 // navigation files; writes an RTKLIB-compatible .pos file.
 #include <unistd.h>
 #if defined(__GLIBC__)
-#include <malloc.h>
 #endif
 
 #include <algorithm>
@@ -20,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "gvins/base/heap_pages.hpp"
 #include "gvins/base/constants.hpp"
 #include "gvins/base/geodetic.hpp"
 #include "gvins/base/parse_error.hpp"
@@ -199,24 +199,11 @@ void printError(const gvins::ParseError& e) { std::fprintf(stderr, "gvins-rtk: e
 
 double pct(long a, long b) { return b > 0 ? 100.0 * static_cast<double>(a) / static_cast<double>(b) : 0.0; }
 
-/// Keeps freed heap memory in the process. Every rover epoch allocates and frees a few hundred kB
-/// (filter copies, the factor for the ambiguity covariance, LAMBDA matrices); with glibc's
-/// default thresholds each free at the top of the heap returned the pages with brk() and the next
-/// epoch faulted them in again: a third of gvins-rtk's CPU time (instantaneous mode, Nagoya) was
-/// spent in the kernel on trimming and page faults. Fixed thresholds (see mallopt(3):
-/// M_TRIM_THRESHOLD, M_MMAP_THRESHOLD) keep the pages; peak memory is unchanged.
-void keepHeapPages() {
-#if defined(__GLIBC__)
-  mallopt(M_MMAP_THRESHOLD, 32 << 20);
-  mallopt(M_TRIM_THRESHOLD, 256 << 20);
-#endif
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace gvins;
-  keepHeapPages();
+  gvins::keepHeapPages();
   const Args args = parseArgs(argc, argv);
   const auto wall0 = std::chrono::steady_clock::now();
 

@@ -2,7 +2,6 @@
 // navigation files, written as an RTKLIB-compatible .pos file.
 #include <unistd.h>
 #if defined(__GLIBC__)
-#include <malloc.h>
 #endif
 
 #include <chrono>
@@ -16,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "gvins/base/heap_pages.hpp"
 #include "gvins/base/constants.hpp"
 #include "gvins/base/geodetic.hpp"
 #include "gvins/base/parse_error.hpp"
@@ -207,22 +207,11 @@ std::string systemsText(const gvins::SppConfig& c) {
 
 void printError(const gvins::ParseError& e) { std::fprintf(stderr, "gvins-spp: error: %s\n", e.what()); }
 
-/// Keeps freed heap memory in the process (as gvins-rtk does): with glibc's default thresholds,
-/// blocks of 128 kB and more are mmap()ed and unmapped on free (zlib's buffers of every file,
-/// the reader buffers), and the heap top is trimmed with brk(), so the same memory is faulted
-/// in again; page faults are a large share of a short run's time.
-void keepHeapPages() {
-#if defined(__GLIBC__)
-  mallopt(M_MMAP_THRESHOLD, 32 << 20);
-  mallopt(M_TRIM_THRESHOLD, 256 << 20);
-#endif
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace gvins;
-  keepHeapPages();
+  gvins::keepHeapPages();
   const Args args = parseArgs(argc, argv);
   const auto wall0 = std::chrono::steady_clock::now();
   if (!args.score.empty()) {
