@@ -121,6 +121,30 @@ void BM_LambdaSingleEpoch(benchmark::State& st) {
 }
 BENCHMARK(BM_LambdaSingleEpoch)->Unit(benchmark::kMicrosecond);
 
+/// The same problem started from the basis of an earlier reduction of it (ReductionStart), as
+/// the RTK filter does from one epoch to the next: what the warm start costs when the basis still
+/// fits (the filter's covariance changes a little between epochs, so a few permutations remain).
+void BM_LambdaWarmStart(benchmark::State& st) {
+  std::mt19937 rng(7);
+  const Eigen::MatrixXd Q = singleEpochQ(rng, {12, 9, 12});
+  const Eigen::MatrixXd L = Q.llt().matrixL();
+  std::normal_distribution<double> g(0.0, 1.0);
+  Eigen::VectorXd w(Q.rows());
+  for (int i = 0; i < w.size(); ++i) w[i] = g(rng);
+  const Eigen::VectorXd a = L * w;
+  const gvins::LambdaResult cold = gvins::lambda(a, Q);
+  const gvins::ReductionStart start{cold.reduction.Z, cold.reduction.Zinv};
+  double perms = 0;
+  for (auto _ : st) {
+    const gvins::LambdaResult r = gvins::lambda(a, Q, {}, &start);
+    perms = r.reduction.permutations;
+    benchmark::DoNotOptimize(r.fixed);
+  }
+  st.counters["n"] = static_cast<double>(Q.rows());
+  st.counters["permutations"] = perms;
+}
+BENCHMARK(BM_LambdaWarmStart)->Unit(benchmark::kMicrosecond);
+
 void BM_LambdaReduction(benchmark::State& st) {
   std::mt19937 rng(7);
   const Eigen::MatrixXd Q = singleEpochQ(rng, {12, 9, 12});
