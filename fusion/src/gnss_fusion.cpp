@@ -65,7 +65,7 @@ const char* toString(GnssFusionStage s) {
 }
 
 template <typename Scalar>
-GnssFusion<Scalar>::GnssFusion(GnssFusionConfig config) : config_(std::move(config)) {}
+GnssFusion<Scalar>::GnssFusion(GnssFusionConfig config) : config_(std::move(config)), leverStart_(config_.leverArm) {}
 
 template <typename Scalar>
 GnssFusion<Scalar>::~GnssFusion() = default;
@@ -232,11 +232,21 @@ bool GnssFusion<Scalar>::buildState(const vio::EstimatorBackend<Scalar>& est, st
 template <typename Scalar>
 Eigen::Vector3d GnssFusion<Scalar>::leverArm(const vio::EstimatorBackend<Scalar>& est) const {
   if (leverBlock_.valid() && current(est)) return est.estimate(leverBlock_).vector.template cast<double>();
-  return config_.leverArm;
+  return carriedLever();  // no block yet, or the state is gone (its last estimate, if plausible)
+}
+
+template <typename Scalar>
+Eigen::Vector3d GnssFusion<Scalar>::carriedLever() const {
+  if (leverLast_ && ((*leverLast_ - config_.leverArm).cwiseAbs().array() <= 3.0 * config_.leverArmSigma).all()) {
+    return *leverLast_;
+  }
+  return leverStart_;
 }
 
 template <typename Scalar>
 void GnssFusion<Scalar>::forgetState() {
+  leverStart_ = carriedLever();
+  leverLast_.reset();
   frameBlock_ = {};
   leverBlock_ = {};
   clockBlock_ = {};
@@ -273,7 +283,7 @@ template <typename Scalar>
 void GnssFusion<Scalar>::ensureLever(vio::EstimatorBackend<Scalar>& est) {
   if (!config_.calibrateLeverArm || leverBlock_.valid()) return;
   leverBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_lever_arm", 3),
-                             sri::BlockEstimate<Scalar>::fromVector(config_.leverArm.template cast<Scalar>()),
+                             sri::BlockEstimate<Scalar>::fromVector(leverStart_.template cast<Scalar>()),
                              sri::Prior<Scalar>::stdDev(3, static_cast<Scalar>(config_.leverArmSigma)));
 }
 
@@ -592,6 +602,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
   GnssEpochReport rep;
   rep.time = roverRaw.time;
   auto finish = [&]() {
+    if (leverBlock_.valid() && current(est)) leverLast_ = est.estimate(leverBlock_).vector.template cast<double>();
     rep.stage = stage_;
     rep.elapsedMicroseconds =
         std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - wall0).count();

@@ -375,6 +375,48 @@ TEST(SriSwfReset, StartsAgainWithNewIdsAndGeneration) {
   EXPECT_LT(drift / dist, 0.003);
 }
 
+/// A reset keeps a time offset the state had calibrated (within 3 prior σ of the configured
+/// value) as the next state's start, and falls back to the configured value when the estimate
+/// lies further out. Images stamped 8 ms early (t_d = +8 ms), configured t_d = 0.
+TEST(SriSwfReset, CarriesTheCalibratedTimeOffsetIntoTheNextState) {
+  test::SimScene sc;
+  sc.duration = 25.0;
+  sc.seed = 3;
+  sc.build();
+  constexpr double kTd = 0.008;
+  for (FeatureFrame& fr : sc.frames) fr.t_ns -= static_cast<std::int64_t>(kTd * 1e9);
+  for (const double sigma : {0.005, 0.002}) {  // 3σ = 15 ms (carried) and 6 ms (not carried)
+    auto cfg = sc.config();
+    cfg.calibrate_time_offset = true;
+    cfg.time_offset = 0.0;
+    cfg.time_offset_sigma = sigma;
+    SriSwfEstimator<double> est(cfg);
+    std::size_t k = 0;
+    std::size_t f = 0;
+    auto step = [&]() {
+      const FeatureFrame& fr = sc.frames[f++];
+      while (k < sc.imu.size() && sc.imu[k].t_ns <= fr.t_ns + est.imuLeadNs()) est.addImu(sc.imu[k++]);
+      return est.processFrame(fr);
+    };
+    while (f < 200) step();
+    ASSERT_TRUE(est.initialized());
+    const double before = est.timeOffset().value;
+    std::fprintf(stderr, "  sigma %.3f s: t_d %.4f ms before the reset\n", sigma, 1e3 * before);
+    EXPECT_NEAR(before, kTd, 0.001) << sigma;
+    est.reset();
+    const bool carried = std::abs(before) <= 3.0 * sigma;
+    EXPECT_EQ(carried, sigma == 0.005);
+    EXPECT_EQ(est.timeOffset().value, carried ? before : 0.0) << sigma;
+    while (f < sc.frames.size() && !step().initialized) {
+    }
+    ASSERT_TRUE(est.initialized()) << sigma;
+    // The new state starts where the old one ended (to the ns the frames are shifted by), or at 0.
+    EXPECT_NEAR(est.timeOffset().value, carried ? before : 0.0, 1e-9) << sigma;
+    while (f < sc.frames.size()) step();
+    EXPECT_NEAR(est.timeOffset().value, kTd, 0.001) << sigma;
+  }
+}
+
 void standstill(bool mono) {
   test::SimScene sc;
   sc.moving = false;

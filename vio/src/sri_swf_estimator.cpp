@@ -95,7 +95,8 @@ struct SriSwfEstimator<Scalar>::Impl {
   std::int64_t t_newest = 0;
   ImuBlocks newest;
   std::deque<Clone> clones;
-  std::vector<CameraExtrinsic> ext_fixed;
+  std::vector<CameraExtrinsic> ext_fixed;  // configured (or carried over a reset) camera extrinsics
+  double td_start = 0.0;  // t_d before the time-offset block exists: configured, or carried over a reset
   std::vector<BlockId> ext_ids;  // calibrate_extrinsics
   BlockId td_id;                 // calibrate_time_offset: t_d (1-dim)
   // Motion of each clone at its IMU time τ = t_cam + td (time-offset calibration): body angular
@@ -150,7 +151,7 @@ struct SriSwfEstimator<Scalar>::Impl {
 
   /// `first_block_id`: where the filter's block ids start (after a reset: the old filter's next id).
   Impl(const SriSwfConfig& c, std::uint64_t first_block_id)
-      : cfg(c), f(filterOptions(c, first_block_id)), prop(c.imu, c.gravity) {
+      : cfg(c), f(filterOptions(c, first_block_id)), prop(c.imu, c.gravity), td_start(c.time_offset) {
     for (const CameraCalibration& cam : c.cameras) {
       CameraExtrinsic e;
       e.R_IC = Eigen::Quaterniond(Eigen::Matrix3d(cam.T_BS.topLeftCorner<3, 3>())).normalized().toRotationMatrix();
@@ -181,6 +182,27 @@ struct SriSwfEstimator<Scalar>::Impl {
     return chi2_thr[static_cast<std::size_t>(dof)];
   }
 
+  /// Before a reset: the calibrated camera extrinsics and time offset become the start values of
+  /// the next state (`next`, fresh from the configuration; the priors keep their configured σ),
+  /// each only when it lies within 3 prior σ of its configured value (per axis, so √3·3σ in
+  /// norm): a state that ran away may have dragged them off, and then the configuration is the
+  /// better start.
+  void carryCalibration(Impl& next) const {
+    if (!initialized) return;
+    const double k = 3.0 * std::sqrt(3.0);
+    for (std::size_t c = 0; c < ext_ids.size() && c < next.ext_fixed.size(); ++c) {
+      const CameraExtrinsic e = ext(static_cast<int>(c));
+      const CameraExtrinsic& e0 = next.ext_fixed[c];
+      const double dth = Eigen::AngleAxisd(e0.R_IC.transpose() * e.R_IC).angle();
+      const double dp = (e.p_IC - e0.p_IC).norm();
+      if (dth <= k * cfg.extrinsic_rotation_sigma && dp <= k * cfg.extrinsic_translation_sigma) next.ext_fixed[c] = e;
+    }
+    if (td_id.valid()) {
+      const double td = timeOffset();
+      if (std::abs(td - cfg.time_offset) <= 3.0 * cfg.time_offset_sigma) next.td_start = td;
+    }
+  }
+
   // ------------------------------------------------------------------ state access
   /// Mixed precision (sri_filter.hpp): blocks are created with values rounded to Scalar; a float
   /// filter then gets the double value it was computed as (R and r do not change).
@@ -202,7 +224,7 @@ struct SriSwfEstimator<Scalar>::Impl {
   /// Current t_d (s): the filter's estimate when calibrating, else the configured value.
   double timeOffset() const {
     if (td_id.valid()) return static_cast<double>(f.nominal(td_id).vector(0));
-    return cfg.time_offset;
+    return td_start;
   }
   /// Pose of clone `id` at the time its image was taken: the clone itself unless the time offset
   /// is calibrated, then the clone moved by its angular rate and velocity over t̂_d − td(clone).
@@ -1532,6 +1554,7 @@ SriSwfEstimator<Scalar>::SriSwfEstimator(const SriSwfConfig& config) : config_(c
 template <typename Scalar>
 void SriSwfEstimator<Scalar>::reset() {
   auto fresh = std::make_unique<Impl>(config_, impl_->f.nextBlockId());
+  impl_->carryCalibration(*fresh);
   fresh->imu = std::move(impl_->imu);
   fresh->observer = std::move(impl_->observer);
   // A new generation at once: the old state is gone even before the next one is created, and a

@@ -129,14 +129,21 @@ class GnssFusion {
   void dropAmbiguity(vio::EstimatorBackend<Scalar>& est, SatId sat);
   /// Whether the ids held belong to the estimator's current state (EstimatorBackend::generation).
   bool current(const vio::EstimatorBackend<Scalar>& est) const { return est.generation() == generation_; }
-  /// Forgets every id of the estimator's state and goes back to waiting for the VIO.
+  /// Forgets every id of the estimator's state and goes back to waiting for the VIO. A calibrated
+  /// lever arm within 3 prior σ (per axis) of the configured one becomes the next state's start
+  /// value (leverStart_); one further out (a state that ran away) does not.
   void forgetState();
+  /// The lever arm a new state starts from: the last estimate if within 3 prior σ of the
+  /// configured value, else the current start value.
+  Eigen::Vector3d carriedLever() const;
 
   GnssFusionConfig config_;
   GnssFusionStage stage_ = GnssFusionStage::kWaitingVio;
   std::uint64_t generation_ = 0;  // estimator generation the ids below belong to
   GnssAnchor anchor_;
   sri::BlockId frameBlock_, leverBlock_, clockBlock_, zwdBlock_;
+  Eigen::Vector3d leverStart_;                // lever arm before/at the lever block's creation
+  std::optional<Eigen::Vector3d> leverLast_;  // the lever block's estimate after the last epoch
   GpsTime zwdTime_;
   std::vector<System> clockSystems_;
   GpsTime clockTime_;

@@ -280,7 +280,10 @@ class SriSwfEstimator final : public EstimatorBackend<Scalar> {
   /// Drops the whole state (clones, features, client blocks) and starts initialising again with
   /// the next frames; the buffered IMU samples are kept. Block ids of the old state are never
   /// reused; generation() changes at once and again when the new state is created. Called by processFrame
-  /// after a visual lock-out; a driver may call it too (e.g. a user's restart).
+  /// after a visual lock-out; a driver may call it too (e.g. a user's restart). Calibrated
+  /// extrinsics and time offset carry over as the next state's start values (with their
+  /// configured prior σ) when they lie within 3 σ of the configuration; otherwise the
+  /// configured values start again.
   void reset();
   /// Number of resets so far (lock-outs and reset() calls).
   int resets() const;
