@@ -377,7 +377,8 @@ TEST(SriSwfReset, StartsAgainWithNewIdsAndGeneration) {
 
 /// A reset keeps a time offset the state had calibrated (within 3 prior σ of the configured
 /// value) as the next state's start, and falls back to the configured value when the estimate
-/// lies further out. Images stamped 8 ms early (t_d = +8 ms), configured t_d = 0.
+/// lies further out. Images stamped 8 ms early (t_d = +8 ms), configured t_d = 0. The calibrated
+/// extrinsics (configured = truth) carry over too.
 TEST(SriSwfReset, CarriesTheCalibratedTimeOffsetIntoTheNextState) {
   test::SimScene sc;
   sc.duration = 25.0;
@@ -390,6 +391,7 @@ TEST(SriSwfReset, CarriesTheCalibratedTimeOffsetIntoTheNextState) {
     cfg.calibrate_time_offset = true;
     cfg.time_offset = 0.0;
     cfg.time_offset_sigma = sigma;
+    cfg.calibrate_extrinsics = true;  // the truth: estimates stay within 3 σ and carry over
     SriSwfEstimator<double> est(cfg);
     std::size_t k = 0;
     std::size_t f = 0;
@@ -403,7 +405,10 @@ TEST(SriSwfReset, CarriesTheCalibratedTimeOffsetIntoTheNextState) {
     const double before = est.timeOffset().value;
     std::fprintf(stderr, "  sigma %.3f s: t_d %.4f ms before the reset\n", sigma, 1e3 * before);
     EXPECT_NEAR(before, kTd, 0.001) << sigma;
+    const Eigen::Matrix4d ext1 = est.cameraExtrinsic(1);
+    EXPECT_GT((ext1 - sc.config().cameras[1].T_BS).norm(), 0.0);  // calibrated, so moved a little
     est.reset();
+    EXPECT_LT((est.cameraExtrinsic(1) - ext1).norm(), 1e-12);  // carried
     const bool carried = std::abs(before) <= 3.0 * sigma;
     EXPECT_EQ(carried, sigma == 0.005);
     EXPECT_EQ(est.timeOffset().value, carried ? before : 0.0) << sigma;
