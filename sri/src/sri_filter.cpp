@@ -1,5 +1,7 @@
 #include "gvins/sri/sri_filter.hpp"
 
+#include <Eigen/LU>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -39,6 +41,20 @@ Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic> priorFactor(const Prior<Sc
     }
   }
   return Matrix::Zero(d, d);
+}
+
+/// Givens rotation [c s; −s c] taking (a, b) to (ρ, 0), ρ = hypot(a, b) (c = 1, s = 0 for b = 0).
+template <typename Scalar>
+Scalar makeGivensPair(Scalar a, Scalar b, Scalar& c, Scalar& s) {
+  if (b == Scalar(0)) {
+    c = Scalar(1);
+    s = Scalar(0);
+    return a;
+  }
+  const Scalar rho = std::hypot(a, b);
+  c = a / rho;
+  s = b / rho;
+  return rho;
 }
 
 }  // namespace
@@ -228,6 +244,75 @@ void SriFilter<Scalar>::marginalize(std::span<const BlockId> ids) {
     todo.erase(std::remove_if(todo.begin(), todo.end(),
                               [&](BlockId id) { return !layout_.contains(id); }),
                todo.end());
+  }
+}
+
+template <typename Scalar>
+void SriFilter<Scalar>::substitute(BlockId id, const Matrix& A, std::span<const std::pair<BlockId, Matrix>> B,
+                                   const BlockEstimate<double>& estimate) {
+  const int pos = position(id);
+  const BlockInfo& b = layout_.at(pos);
+  const int o = b.offset;
+  const int d = b.dim;
+  if (b.kind != BlockKind::kVector || !hasShape(estimate, b.kind, d)) {
+    throw std::invalid_argument("sri::SriFilter::substitute: block '" + b.name + "' is not a vector of that size");
+  }
+  if (A.rows() != d || A.cols() != d) throw std::invalid_argument("sri::SriFilter::substitute: A must be dim × dim");
+  for (const auto& [j, Bj] : B) {
+    const BlockInfo& bj = layout_.block(j);
+    if (bj.offset < o + d) {
+      throw std::invalid_argument("sri::SriFilter::substitute: block '" + bj.name + "' is not after '" + b.name + "'");
+    }
+    if (Bj.rows() != d || Bj.cols() != bj.dim) {
+      throw std::invalid_argument("sri::SriFilter::substitute: B of block '" + bj.name + "' must be dim × its dim");
+    }
+  }
+  const Eigen::FullPivLU<Matrix> lu(A);
+  if (!lu.isInvertible()) throw std::invalid_argument("sri::SriFilter::substitute: A is singular");
+  const Matrix Ainv = lu.inverse();
+  std::vector<Matrix> AB;
+  for (const auto& [j, Bj] : B) AB.push_back(Ainv * Bj);
+  // Rows that see the block: all rows up to its own (upper triangular R).
+  Eigen::Matrix<Scalar, 1, Eigen::Dynamic> Rx(d);
+  for (int i = 0; i < o + d; ++i) {
+    Scalar* row = rowPtr(i);
+    for (int q = 0; q < d; ++q) Rx(q) = row[o + q];
+    if (Rx.isZero(0)) continue;
+    for (std::size_t k = 0; k < B.size(); ++k) {
+      const BlockInfo& bj = layout_.block(B[k].first);
+      Eigen::Map<Eigen::Matrix<Scalar, 1, Eigen::Dynamic>>(row + bj.offset, bj.dim).noalias() -= Rx * AB[k];
+    }
+    Eigen::Map<Eigen::Matrix<Scalar, 1, Eigen::Dynamic>>(row + o, d).noalias() = Rx * Ainv;
+  }
+  // The block's own rows: its diagonal block R_xx A⁻¹ is full; Givens on those d rows (and r)
+  // over the columns from o on make it upper triangular again.
+  for (int c = 0; c < d; ++c) {
+    for (int k = d - 1; k > c; --k) {
+      Scalar* top = rowPtr(o + k - 1);
+      Scalar* bot = rowPtr(o + k);
+      Scalar cs;
+      Scalar sn;
+      top[o + c] = makeGivensPair(top[o + c], bot[o + c], cs, sn);
+      bot[o + c] = Scalar(0);
+      for (int col = o + c + 1; col < n_; ++col) {
+        const Scalar x = top[col];
+        const Scalar y = bot[col];
+        top[col] = cs * x + sn * y;
+        bot[col] = cs * y - sn * x;
+      }
+      Scalar& rx = rbuf_(off_ + o + k - 1);
+      Scalar& ry = rbuf_(off_ + o + k);
+      const Scalar x = rx;
+      const Scalar y = ry;
+      rx = cs * x + sn * y;
+      ry = cs * y - sn * x;
+    }
+  }
+  if constexpr (std::is_same_v<Scalar, double>) {
+    estimates_[static_cast<std::size_t>(pos)] = estimate;
+  } else {
+    nominal_[static_cast<std::size_t>(pos)] = estimate;
+    estimates_[static_cast<std::size_t>(pos)] = castEstimate<Scalar>(estimate);
   }
 }
 

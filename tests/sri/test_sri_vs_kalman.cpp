@@ -370,6 +370,56 @@ TEST_P(SriVsKalman, RandomLinearGaussianProblems) {
 // update(parts): the rows of several measurements at once (SLAM re-observations of one frame),
 // against the information form (Λ += Σ HᵀH, η += Σ Hᵀz, computed densely) and against update()
 // of the stacked measurement (same rows, same order: the same numbers).
+/// substitute(): the exact change of variables δx'_k = A δx_k + Σ B_j δx_j. With T the map from
+/// the old error state to the new one, the covariance must become T P Tᵀ and the mean T δ̂
+/// (δ̂ = R⁻¹ r, solve()), on a random factor with an update applied (r ≠ 0); the factor stays
+/// upper triangular; blocks before the substituted one, or a singular A, are refused.
+TEST(SriFilterSubstitute, IsTheLinearChangeOfVariables) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  auto rnd = [&](int r, int c) {
+    Md m(r, c);
+    for (int i = 0; i < r; ++i)
+      for (int j = 0; j < c; ++j) m(i, j) = u(rng);
+    return m;
+  };
+  SriFilter<double> f;
+  std::vector<BlockId> ids;
+  const int dims[] = {3, 3, 3, 6, 6, 9};
+  for (int d : dims) {
+    const Md L = rnd(d, d) + 3.0 * Md::Identity(d, d);
+    ids.push_back(f.addBlock(BlockSpec::vector("b", d), BlockEstimate<double>::fromVector(rnd(d, 1)),
+                             Prior<double>::covariance(L * L.transpose())));
+  }
+  Measurement<double> m(20);
+  for (std::size_t k = 0; k < ids.size(); ++k) m.jacobian(ids[k], dims[k]) = rnd(20, dims[k]);
+  m.residual() = rnd(20, 1);
+  m.setWhitened();
+  f.update(m);
+  const Md P0 = f.fullCovariance();
+  const Vd d0 = f.solve();
+  // Substitute block 1 (columns 3..5) with blocks 3 and 5 after it.
+  const Md A = rnd(3, 3) + 2.0 * Md::Identity(3, 3);
+  const Md B3 = rnd(3, 6), B5 = rnd(3, 9);
+  const int n = f.dim();
+  Md T = Md::Identity(n, n);
+  T.block(3, 3, 3, 3) = A;
+  T.block(3, f.layout().block(ids[3]).offset, 3, 6) = B3;
+  T.block(3, f.layout().block(ids[5]).offset, 3, 9) = B5;
+  const Vd x1 = rnd(3, 1);
+  const std::vector<std::pair<BlockId, Md>> B = {{ids[3], B3}, {ids[5], B5}};
+  f.substitute(ids[1], A, B, BlockEstimate<double>::fromVector(x1));
+  EXPECT_LT(relErr(f.fullCovariance(), T * P0 * T.transpose()), 1e-10);
+  EXPECT_LT((f.solve() - T * d0).norm(), 1e-10 * (1.0 + d0.norm()));
+  const Md R = f.squareRootInformation();
+  EXPECT_EQ(R.triangularView<Eigen::StrictlyLower>().toDenseMatrix().norm(), 0.0);
+  EXPECT_EQ(f.estimate(ids[1]).vector, x1);
+  // Refused: a B on an earlier block, a singular A.
+  const std::vector<std::pair<BlockId, Md>> before = {{ids[0], rnd(3, 3)}};
+  EXPECT_THROW(f.substitute(ids[1], A, before, BlockEstimate<double>::fromVector(x1)), std::invalid_argument);
+  EXPECT_THROW(f.substitute(ids[1], Md::Zero(3, 3), B, BlockEstimate<double>::fromVector(x1)), std::invalid_argument);
+}
+
 TEST(SriFilterUpdate, PartsEqualTheInformationSumAndTheirStack) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-1, 1);

@@ -38,7 +38,7 @@ void SriSwfConfig::validate() const {
   req(min_baseline_ratio >= 0, "min_baseline_ratio must be >= 0");
   req(chi2_probability > 0, "chi2_probability must be > 0 (>= 1 disables the gate)");
   req(max_msckf_per_frame >= 0, "max_msckf_per_frame must be >= 0");
-  req(reanchor_sigma > 0, "reanchor_sigma must be positive");
+  req(reanchor_sigma >= 0, "reanchor_sigma must be >= 0 (0: exact change of variables)");
   req(lockout_reset_s >= 0 && std::isfinite(lockout_reset_s), "lockout_reset_s must be >= 0");
   req(position_random_walk >= 0 && std::isfinite(position_random_walk), "position_random_walk must be >= 0");
   req(attitude_random_walk >= 0 && std::isfinite(attitude_random_walk), "attitude_random_walk must be >= 0");

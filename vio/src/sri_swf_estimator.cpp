@@ -1162,9 +1162,10 @@ struct SriSwfEstimator<Scalar>::Impl {
     return c && static_cast<double>(c->value) <= chi2Threshold(c->dof);
   }
 
-  /// Re-anchors SLAM features anchored at `old_anchor` to the newest clone (Propagation with a
-  /// small noise, then the old blocks are marginalized). Features that cannot be re-anchored
-  /// are returned for marginalization.
+  /// Re-anchors SLAM features anchored at `old_anchor` to the newest clone: with reanchor_sigma 0
+  /// an exact change of variables of each feature block in place (SriFilter::substitute), else a
+  /// Propagation with that noise into new blocks, then the old blocks are marginalized.
+  /// Features that cannot be re-anchored are returned for marginalization.
   std::vector<BlockId> reanchor(BlockId old_anchor) {
     std::vector<std::uint64_t> ids;
     std::vector<BlockId> drop;
@@ -1211,6 +1212,20 @@ struct SriSwfEstimator<Scalar>::Impl {
       items.push_back(it);
     }
     if (items.empty()) return drop;
+    if (!(cfg.reanchor_sigma > 0.0)) {
+      // Without noise the re-anchoring is an exact change of variables of each feature block in
+      // place (SriFilter::substitute: its columns and own rows only, no new block, no sweep).
+      for (const Item& it : items) {
+        Slam& s = slam[it.id];
+        std::vector<std::pair<BlockId, MatrixS>> B;
+        B.emplace_back(old_anchor, it.Ja.template cast<Scalar>());
+        B.emplace_back(newest.pose, it.Jb.template cast<Scalar>());
+        if (!ext_ids.empty()) B.emplace_back(ext_ids[0], it.Je.template cast<Scalar>());
+        f.substitute(s.block, MatrixS(it.Jf.template cast<Scalar>()), B, BlockEstimate<double>::fromVector(it.fnew));
+        s.anchor = newest.pose;
+      }
+      return drop;
+    }
     const int K = static_cast<int>(items.size());
     sri::Propagation<Scalar> step;
     MatrixS Pa_phi = MatrixS::Zero(3 * K, 6), Pb_phi = MatrixS::Zero(3 * K, 6), Pe_phi = MatrixS::Zero(3 * K, 6);
