@@ -30,6 +30,15 @@ Vd sriMean(const SriFilter<S>& f) {
   return x;
 }
 
+/// r × c matrix of independent uniform entries in [−1, 1].
+Md uniformMatrix(std::mt19937& rng, int r, int c) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  Md m(r, c);
+  for (int i = 0; i < r; ++i)
+    for (int j = 0; j < c; ++j) m(i, j) = u(rng);
+  return m;
+}
+
 double relErr(const Md& a, const Md& b) {
   const double nb = std::max(b.norm(), 1e-300);
   return (a - b).norm() / nb;
@@ -367,22 +376,13 @@ TEST_P(SriVsKalman, RandomLinearGaussianProblems) {
   EXPECT_LT(fp, 1e-4);
 }
 
-// update(parts): the rows of several measurements at once (SLAM re-observations of one frame),
-// against the information form (Λ += Σ HᵀH, η += Σ Hᵀz, computed densely) and against update()
-// of the stacked measurement (same rows, same order: the same numbers).
 /// substitute(): the exact change of variables δx'_k = A δx_k + Σ B_j δx_j. With T the map from
 /// the old error state to the new one, the covariance must become T P Tᵀ and the mean T δ̂
 /// (δ̂ = R⁻¹ r, solve()), on a random factor with an update applied (r ≠ 0); the factor stays
 /// upper triangular; blocks before the substituted one, or a singular A, are refused.
 TEST(SriFilterSubstitute, IsTheLinearChangeOfVariables) {
   std::mt19937 rng(11);
-  std::uniform_real_distribution<double> u(-1, 1);
-  auto rnd = [&](int r, int c) {
-    Md m(r, c);
-    for (int i = 0; i < r; ++i)
-      for (int j = 0; j < c; ++j) m(i, j) = u(rng);
-    return m;
-  };
+  auto rnd = [&](int r, int c) { return uniformMatrix(rng, r, c); };
   SriFilter<double> f;
   std::vector<BlockId> ids;
   const int dims[] = {3, 3, 3, 6, 6, 9};
@@ -420,15 +420,12 @@ TEST(SriFilterSubstitute, IsTheLinearChangeOfVariables) {
   EXPECT_THROW(f.substitute(ids[1], Md::Zero(3, 3), B, BlockEstimate<double>::fromVector(x1)), std::invalid_argument);
 }
 
+// update(parts): the rows of several measurements at once (SLAM re-observations of one frame),
+// against the information form (Λ += Σ HᵀH, η += Σ Hᵀz, computed densely) and against update()
+// of the stacked measurement (same rows, same order: the same numbers).
 TEST(SriFilterUpdate, PartsEqualTheInformationSumAndTheirStack) {
   std::mt19937 rng(5);
-  std::uniform_real_distribution<double> u(-1, 1);
-  auto rnd = [&](int r, int c) {
-    Md m(r, c);
-    for (int i = 0; i < r; ++i)
-      for (int j = 0; j < c; ++j) m(i, j) = u(rng);
-    return m;
-  };
+  auto rnd = [&](int r, int c) { return uniformMatrix(rng, r, c); };
   SriFilter<double> a, b;
   std::vector<BlockId> ids;
   const int dims[] = {3, 3, 6, 6, 9};
