@@ -2,8 +2,6 @@
 // from rover RINEX observations, base RINEX observations or an RTCM 3 log, and broadcast
 // navigation files; writes an RTKLIB-compatible .pos file.
 #include <unistd.h>
-#if defined(__GLIBC__)
-#endif
 
 #include <algorithm>
 #include <array>
@@ -19,9 +17,9 @@
 #include <string>
 #include <vector>
 
-#include "gvins/base/heap_pages.hpp"
 #include "gvins/base/constants.hpp"
 #include "gvins/base/geodetic.hpp"
+#include "gvins/base/heap_pages.hpp"
 #include "gvins/base/parse_error.hpp"
 #include "gvins/base/rinex_obs_reader.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
@@ -203,7 +201,7 @@ double pct(long a, long b) { return b > 0 ? 100.0 * static_cast<double>(a) / sta
 
 int main(int argc, char** argv) {
   using namespace gvins;
-  gvins::keepHeapPages();
+  keepHeapPages();
   const Args args = parseArgs(argc, argv);
   const auto wall0 = std::chrono::steady_clock::now();
 

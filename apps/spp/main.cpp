@@ -1,8 +1,6 @@
 // gvins-spp: single point positioning (and Doppler velocity) from RINEX observation and
 // navigation files, written as an RTKLIB-compatible .pos file.
 #include <unistd.h>
-#if defined(__GLIBC__)
-#endif
 
 #include <chrono>
 #include <cmath>
@@ -15,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "gvins/base/heap_pages.hpp"
 #include "gvins/base/constants.hpp"
 #include "gvins/base/geodetic.hpp"
+#include "gvins/base/heap_pages.hpp"
 #include "gvins/base/parse_error.hpp"
 #include "gvins/base/rinex_obs_reader.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
@@ -211,7 +209,7 @@ void printError(const gvins::ParseError& e) { std::fprintf(stderr, "gvins-spp: e
 
 int main(int argc, char** argv) {
   using namespace gvins;
-  gvins::keepHeapPages();
+  keepHeapPages();
   const Args args = parseArgs(argc, argv);
   const auto wall0 = std::chrono::steady_clock::now();
   if (!args.score.empty()) {
