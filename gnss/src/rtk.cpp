@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <set>
 #include <stdexcept>
 #include <unordered_map>
@@ -526,6 +527,45 @@ RtkSolution RtkSolver::process(const ObsEpoch& rover) {
   return sol;
 }
 
+namespace {
+
+/// Start basis for this epoch's LAMBDA from the previous epoch's reduced basis (of the DD pairs
+/// `before`), when every one of those pairs is still among `now`: the old basis on the old pairs'
+/// rows and a unit column for each new pair (unimodular, and its inverse likewise). nullopt if a
+/// pair has gone (or there is no previous basis): the reduction starts cold.
+std::optional<ReductionStart> embedBasis(const std::vector<std::pair<sri::BlockId, sri::BlockId>>& before,
+                                         const ReductionStart& basis,
+                                         const std::vector<std::pair<sri::BlockId, sri::BlockId>>& now) {
+  const int m0 = static_cast<int>(before.size());
+  const int m = static_cast<int>(now.size());
+  if (m0 == 0 || m0 > m || !basis.fits(m0)) return std::nullopt;
+  std::vector<int> where(static_cast<std::size_t>(m0));
+  for (int i = 0; i < m0; ++i) {
+    const auto it = std::find(now.begin(), now.end(), before[static_cast<std::size_t>(i)]);
+    if (it == now.end()) return std::nullopt;
+    where[static_cast<std::size_t>(i)] = static_cast<int>(it - now.begin());
+  }
+  ReductionStart start{Eigen::MatrixXd::Zero(m, m), Eigen::MatrixXd::Zero(m, m)};
+  std::vector<char> old(static_cast<std::size_t>(m), 0);
+  for (int i = 0; i < m0; ++i) {
+    const int r = where[static_cast<std::size_t>(i)];
+    old[static_cast<std::size_t>(r)] = 1;
+    for (int j = 0; j < m0; ++j) {
+      start.Z(r, j) = basis.Z(i, j);
+      start.Zinv(j, r) = basis.Zinv(j, i);
+    }
+  }
+  for (int r = 0, c = m0; r < m; ++r) {
+    if (old[static_cast<std::size_t>(r)]) continue;
+    start.Z(r, c) = 1.0;
+    start.Zinv(c, r) = 1.0;
+    ++c;
+  }
+  return start;
+}
+
+}  // namespace
+
 void RtkSolver::resolve(RtkSolution& sol) {
   if (cfg_.ambiguityMode == AmbiguityMode::Off) {
     sol.ar = ArStatus::Off;
@@ -616,43 +656,11 @@ void RtkSolver::resolve(RtkSolution& sol) {
   Q = Q.selfadjointView<Eigen::Lower>();
   const Eigen::MatrixXd Qaa = Q.bottomRightCorner(m, m);
   const Eigen::MatrixXd Qxa = Q.topRightCorner(3, m);
-  // Start LAMBDA from the previous epoch's reduced basis when every previous pair is still
-  // here: Z_start holds the old basis on the old pairs' rows and a unit column for each new pair
-  // (unimodular, and Z_start⁻¹ likewise).
-  ReductionStart start;
-  {
-    std::vector<std::pair<sri::BlockId, sri::BlockId>> now(static_cast<std::size_t>(m));
-    for (int k = 0; k < m; ++k) now[static_cast<std::size_t>(k)] = {pairs[static_cast<std::size_t>(k)].satId, pairs[static_cast<std::size_t>(k)].refId};
-    const int m0 = static_cast<int>(arPairs_.size());
-    std::vector<int> where(static_cast<std::size_t>(m0), -1);
-    bool all = m0 > 0 && m0 <= m && arBasis_.fits(m0);
-    for (int i = 0; i < m0 && all; ++i) {
-      const auto it = std::find(now.begin(), now.end(), arPairs_[static_cast<std::size_t>(i)]);
-      if (it == now.end()) all = false;
-      else where[static_cast<std::size_t>(i)] = static_cast<int>(it - now.begin());
-    }
-    if (all) {
-      start.Z = Eigen::MatrixXd::Zero(m, m);
-      start.Zinv = Eigen::MatrixXd::Zero(m, m);
-      std::vector<char> old(static_cast<std::size_t>(m), 0);
-      for (int i = 0; i < m0; ++i) {
-        const int r = where[static_cast<std::size_t>(i)];
-        old[static_cast<std::size_t>(r)] = 1;
-        for (int j = 0; j < m0; ++j) {
-          start.Z(r, j) = arBasis_.Z(i, j);
-          start.Zinv(j, r) = arBasis_.Zinv(j, i);
-        }
-      }
-      for (int r = 0, c = m0; r < m; ++r) {
-        if (old[static_cast<std::size_t>(r)]) continue;
-        start.Z(r, c) = 1.0;
-        start.Zinv(c, r) = 1.0;
-        ++c;
-      }
-    }
-    arPairs_ = std::move(now);
-  }
-  const AmbiguityFix fix = resolveAmbiguities(a, Qaa, cfg_.ar, start.Z.size() ? &start : nullptr);
+  std::vector<std::pair<sri::BlockId, sri::BlockId>> now(static_cast<std::size_t>(m));
+  for (int k = 0; k < m; ++k) now[static_cast<std::size_t>(k)] = {pairs[static_cast<std::size_t>(k)].satId, pairs[static_cast<std::size_t>(k)].refId};
+  const std::optional<ReductionStart> start = embedBasis(arPairs_, arBasis_, now);
+  arPairs_ = std::move(now);
+  const AmbiguityFix fix = resolveAmbiguities(a, Qaa, cfg_.ar, start ? &*start : nullptr);
   arBasis_ = fix.basis;
   if (!arBasis_.fits(m)) arPairs_.clear();
   sol.ratio = fix.fixed ? fix.ratio : fix.fullRatio;

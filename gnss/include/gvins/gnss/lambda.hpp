@@ -93,7 +93,7 @@ struct LambdaResult {
 /// A unimodular basis to start the reduction from: Z and Z⁻¹ of an earlier reduction of the same
 /// ambiguities in the same order (in a filter, the previous epoch's). The float covariance changes
 /// little between epochs, so ZᵀQZ is nearly reduced already and only a few permutations remain
-/// (on the Nagoya RTK problem of 60 ambiguities ~1000 per epoch cold, a few dozen warm). The result
+/// (simulated Ddcp flight, 60 DD ambiguities: ~1000 per epoch cold, < 1 warm on average). The result
 /// satisfies the same reduction conditions, so the ILS solution and the ratio do not depend on the
 /// start; the reduced basis itself, and with it the bootstrapped success rate and the subsets of
 /// partial fixing, may differ slightly.
