@@ -270,17 +270,17 @@ void SriFilter<Scalar>::substitute(BlockId id, const Matrix& A, std::span<const 
   const Eigen::FullPivLU<Matrix> lu(A);
   if (!lu.isInvertible()) throw std::invalid_argument("sri::SriFilter::substitute: A is singular");
   const Matrix Ainv = lu.inverse();
-  std::vector<Matrix> AB;
-  for (const auto& [j, Bj] : B) AB.push_back(Ainv * Bj);
+  // A⁻¹ B_j with the column offset of block j.
+  std::vector<std::pair<int, Matrix>> AB;
+  for (const auto& [j, Bj] : B) AB.emplace_back(layout_.block(j).offset, Ainv * Bj);
   // Rows that see the block: all rows up to its own (upper triangular R).
   Eigen::Matrix<Scalar, 1, Eigen::Dynamic> Rx(d);
   for (int i = 0; i < o + d; ++i) {
     Scalar* row = rowPtr(i);
     for (int q = 0; q < d; ++q) Rx(q) = row[o + q];
     if (Rx.isZero(0)) continue;
-    for (std::size_t k = 0; k < B.size(); ++k) {
-      const BlockInfo& bj = layout_.block(B[k].first);
-      Eigen::Map<Eigen::Matrix<Scalar, 1, Eigen::Dynamic>>(row + bj.offset, bj.dim).noalias() -= Rx * AB[k];
+    for (const auto& [oj, ABj] : AB) {
+      Eigen::Map<Eigen::Matrix<Scalar, 1, Eigen::Dynamic>>(row + oj, ABj.cols()).noalias() -= Rx * ABj;
     }
     Eigen::Map<Eigen::Matrix<Scalar, 1, Eigen::Dynamic>>(row + o, d).noalias() = Rx * Ainv;
   }

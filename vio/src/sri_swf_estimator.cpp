@@ -221,7 +221,8 @@ struct SriSwfEstimator<Scalar>::Impl {
     if (it == pose_cache.end()) it = pose_cache.emplace(id.value, poseOf(f.nominal(id))).first;
     return it->second;
   }
-  /// Current t_d (s): the filter's estimate when calibrating, else the configured value.
+  /// Current t_d (s): the filter's estimate when calibrating, else td_start (the configured
+  /// value, or the one carried over a reset).
   double timeOffset() const {
     if (td_id.valid()) return static_cast<double>(f.nominal(td_id).vector(0));
     return td_start;
