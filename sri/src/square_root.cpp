@@ -52,6 +52,40 @@ DenseMatrix<Scalar> triangularFactor(const DenseMatrix<Scalar>& S) {
   return DenseMatrix<Scalar>(U.template triangularView<Eigen::Upper>());
 }
 
+namespace {
+
+/// X ← U⁻¹ in place on the upper triangle of X (X holds U on entry; the strict lower triangle
+/// stays zero), recursive halving down to column solves.
+template <typename Scalar>
+void invertUpperInPlace(Eigen::Ref<DenseMatrix<Scalar>> X) {
+  const Eigen::Index k = X.rows();
+  constexpr Eigen::Index kLeaf = 24;
+  if (k <= kLeaf) {
+    const DenseMatrix<Scalar> U = X.template triangularView<Eigen::Upper>();
+    X.setIdentity();
+    U.template triangularView<Eigen::Upper>().solveInPlace(X);
+    return;
+  }
+  const Eigen::Index h = k / 2;
+  invertUpperInPlace<Scalar>(X.topLeftCorner(h, h));
+  invertUpperInPlace<Scalar>(X.bottomRightCorner(k - h, k - h));
+  // B ← −A⁻¹ (B C⁻¹).
+  auto B = X.topRightCorner(h, k - h);
+  const DenseMatrix<Scalar> BC = B * X.bottomRightCorner(k - h, k - h).template triangularView<Eigen::Upper>();
+  B.noalias() = -(X.topLeftCorner(h, h).template triangularView<Eigen::Upper>() * BC);
+}
+
+}  // namespace
+
+template <typename Scalar>
+DenseMatrix<Scalar> upperTriangularInverse(
+    const Eigen::Map<const RowMatrix<Scalar>, Eigen::Unaligned, Eigen::OuterStride<>>& U) {
+  const Eigen::Index k = U.rows();
+  DenseMatrix<Scalar> X = U.template triangularView<Eigen::Upper>();
+  if (k > 0) invertUpperInPlace<Scalar>(X);
+  return X;
+}
+
 template <typename Scalar>
 std::optional<DenseMatrix<Scalar>> sqrtInformationFromCovariance(const DenseMatrix<Scalar>& P) {
   auto L = choleskyLower<Scalar>(P);
@@ -66,6 +100,8 @@ std::optional<DenseMatrix<Scalar>> sqrtInformationFromCovariance(const DenseMatr
   template std::optional<DenseMatrix<S>> choleskyLower<S>(const DenseMatrix<S>&);             \
   template void solveLowerInPlace<S>(const DenseMatrix<S>&, DenseMatrix<S>&);                 \
   template DenseMatrix<S> triangularFactor<S>(const DenseMatrix<S>&);                         \
+  template DenseMatrix<S> upperTriangularInverse<S>(                                          \
+      const Eigen::Map<const RowMatrix<S>, Eigen::Unaligned, Eigen::OuterStride<>>&);          \
   template std::optional<DenseMatrix<S>> sqrtInformationFromCovariance<S>(const DenseMatrix<S>&);
 GVINS_SRI_INSTANTIATE(float)
 GVINS_SRI_INSTANTIATE(double)

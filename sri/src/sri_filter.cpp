@@ -856,12 +856,7 @@ typename SriFilter<Scalar>::Matrix SriFilter<Scalar>::covarianceFactor(
   const auto Rt = listedTrailing(ids, "covarianceFactor", cols, copy);
   if (!Rt) return Matrix();
   const int k = static_cast<int>(Rt->rows());
-  // X = R_t⁻¹, upper triangular: column j solves R_t x = e_j on its first j + 1 rows.
-  Matrix X = Matrix::Zero(k, k);
-  for (int j = 0; j < k; ++j) {
-    X(j, j) = Scalar(1);
-    Rt->topLeftCorner(j + 1, j + 1).template triangularView<Eigen::Upper>().solveInPlace(X.col(j).head(j + 1));
-  }
+  const Matrix X = upperTriangularInverse<Scalar>(*Rt);
   Matrix F(static_cast<Eigen::Index>(cols.size()), k);
   for (std::size_t r = 0; r < cols.size(); ++r) F.row(static_cast<Eigen::Index>(r)) = X.row(cols[r]);
   return F;

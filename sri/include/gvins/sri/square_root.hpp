@@ -7,6 +7,8 @@
 
 #include <Eigen/Core>
 
+#include "gvins/sri/qr_update.hpp"
+
 namespace gvins::sri {
 
 template <typename Scalar>
@@ -30,11 +32,24 @@ DenseMatrix<Scalar> triangularFactor(const DenseMatrix<Scalar>& S);
 template <typename Scalar>
 std::optional<DenseMatrix<Scalar>> sqrtInformationFromCovariance(const DenseMatrix<Scalar>& P);
 
+/// U⁻¹ of an upper-triangular U (k × k, non-zero diagonal; only the upper triangle is read),
+/// blocked: U = [A B; 0 C] gives U⁻¹ = [A⁻¹, −A⁻¹ B C⁻¹; 0, C⁻¹] (Higham, "Accuracy and
+/// Stability of Numerical Algorithms", 2nd ed., sec. 14.2), the off-diagonal blocks as
+/// triangular matrix products, so that most of the k³/3 flops run in Eigen's blocked kernels
+/// instead of k triangular vector solves.
+template <typename Scalar>
+DenseMatrix<Scalar> upperTriangularInverse(
+    const Eigen::Map<const RowMatrix<Scalar>, Eigen::Unaligned, Eigen::OuterStride<>>& U);
+
 extern template std::optional<DenseMatrix<float>> choleskyLower<float>(const DenseMatrix<float>&);
 extern template std::optional<DenseMatrix<double>> choleskyLower<double>(
     const DenseMatrix<double>&);
 extern template void solveLowerInPlace<float>(const DenseMatrix<float>&, DenseMatrix<float>&);
 extern template void solveLowerInPlace<double>(const DenseMatrix<double>&, DenseMatrix<double>&);
+extern template DenseMatrix<float> upperTriangularInverse<float>(
+    const Eigen::Map<const RowMatrix<float>, Eigen::Unaligned, Eigen::OuterStride<>>&);
+extern template DenseMatrix<double> upperTriangularInverse<double>(
+    const Eigen::Map<const RowMatrix<double>, Eigen::Unaligned, Eigen::OuterStride<>>&);
 extern template DenseMatrix<float> triangularFactor<float>(const DenseMatrix<float>&);
 extern template DenseMatrix<double> triangularFactor<double>(const DenseMatrix<double>&);
 extern template std::optional<DenseMatrix<float>> sqrtInformationFromCovariance<float>(
