@@ -458,7 +458,7 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
                                "t x y z qx qy qz qw  (IMU pose in the VIO world frame; gvins-replay " + opt.modeName + ")");
   vio::PoseCovarianceWriter cov((out / "trajectory.cov.csv").string());
   OutFile timing(out / "timing.csv");
-  timing.out() << "# t [ns],frame,features,frontend_ms,estimator_ms,gnss_ms,gnss_epochs,initialized,updated,msckf_features,slam_features\n";
+  timing.out() << "# t [ns],frame,features,frontend_ms,estimator_ms,gnss_ms,gnss_epochs,initialized,updated,msckf_features,slam_features,state_dim\n";
   std::unique_ptr<OutFile> posFile, ecefFile, epochFile;
   std::unique_ptr<PosWriter> posWriter;
   std::vector<Geodetic> kml;
@@ -702,9 +702,9 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
       gnssSum += gnssMs;
     }
     char b[256];
-    std::snprintf(b, sizeof b, "%" PRId64 ",%" PRIu64 ",%zu,%.3f,%.3f,%.3f,%d,%d,%d,%d,%d\n", frame->t_ns, frame->index,
+    std::snprintf(b, sizeof b, "%" PRId64 ",%" PRIu64 ",%zu,%.3f,%.3f,%.3f,%d,%d,%d,%d,%d,%d\n", frame->t_ns, frame->index,
                   frame->features.size(), frame->timing.total, r.estimator_ms, gnssMs, gnssCount, init ? 1 : 0,
-                  r.updated ? 1 : 0, r.msckf_features, r.slam_features);
+                  r.updated ? 1 : 0, r.msckf_features, r.slam_features, r.state_dim);
     timing.out() << b;
     if (opt.progress && (Clock::now() - lastProgress > std::chrono::seconds(1) || sum.framesProcessed == total)) {
       lastProgress = Clock::now();

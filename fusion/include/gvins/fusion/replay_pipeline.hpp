@@ -57,6 +57,7 @@ class ReplayEstimator {
     int msckf_features = 0;
     int slam_features = 0;
     bool reset = false;  ///< the estimator dropped its state after this frame and initialises again
+    int state_dim = 0;   ///< error-state dimension after the frame (columns of the square-root factor)
   };
   virtual ~ReplayEstimator() = default;
   virtual void addImu(const vio::ImuSample& s) = 0;
