@@ -64,14 +64,14 @@ SriFilter<Scalar>::SriFilter(SriOptions options) : options_(options), layout_(op
 
 template <typename Scalar>
 RowMatrixView<Scalar> SriFilter<Scalar>::view(int row, int col, int rows, int cols) {
-  return RowMatrixView<Scalar>(rowPtr(row) + col, rows, cols, Eigen::OuterStride<>(cap_));
+  return RowMatrixView<Scalar>(rowPtr(row) + col, rows, cols, Eigen::OuterStride<>(ld_));
 }
 
 template <typename Scalar>
 Eigen::Map<const RowMatrix<Scalar>, Eigen::Unaligned, Eigen::OuterStride<>>
 SriFilter<Scalar>::cview(int row, int col, int rows, int cols) const {
   return Eigen::Map<const RowMatrix<Scalar>, Eigen::Unaligned, Eigen::OuterStride<>>(
-      rowPtr(row) + col, rows, cols, Eigen::OuterStride<>(cap_));
+      rowPtr(row) + col, rows, cols, Eigen::OuterStride<>(ld_));
 }
 
 template <typename Scalar>
@@ -95,23 +95,28 @@ void SriFilter<Scalar>::relocate(int need) {
   if (need > cap) cap = std::max({need + need / 2, 2 * cap, 32});
   const int off = (cap - need) / 4;  // headroom in front for blocks inserted there
   if (cap != cap_) {
-    RowMatrix<Scalar> buf(cap, cap);
+    constexpr int kLine = 64 / static_cast<int>(sizeof(Scalar));
+    int lines = (cap + kLine - 1) / kLine;
+    if (lines % 2 == 0) ++lines;
+    const int ld = lines * kLine;
+    RowMatrix<Scalar> buf(cap, ld);
     Vector rbuf = Vector::Zero(cap);
     for (int i = 0; i < n_; ++i) {
-      std::memcpy(buf.data() + static_cast<std::ptrdiff_t>(off + i) * cap + off, rowPtr(i),
+      std::memcpy(buf.data() + static_cast<std::ptrdiff_t>(off + i) * ld + off, rowPtr(i),
                   sizeof(Scalar) * static_cast<std::size_t>(n_));
     }
     if (n_ > 0) rbuf.segment(off, n_) = rbuf_.segment(off_, n_);
     buf_ = std::move(buf);
     rbuf_ = std::move(rbuf);
     cap_ = cap;
+    ld_ = ld;
     off_ = off;
     return;
   }
   if (off == off_) return;
   // Same buffer: move rows in an order that never overwrites a row not yet moved.
   auto moveRow = [&](int i) {
-    std::memmove(buf_.data() + static_cast<std::ptrdiff_t>(off + i) * cap_ + off, rowPtr(i),
+    std::memmove(buf_.data() + static_cast<std::ptrdiff_t>(off + i) * ld_ + off, rowPtr(i),
                  sizeof(Scalar) * static_cast<std::size_t>(n_));
   };
   if (off < off_) {
@@ -142,13 +147,13 @@ void SriFilter<Scalar>::openColumns(int c, int d) {
     const int noff = off_ - d;
     for (int i = 0; i < c; ++i) {
       Scalar* src = rowPtr(i);
-      Scalar* dst = buf_.data() + static_cast<std::ptrdiff_t>(noff + i) * cap_ + noff;
+      Scalar* dst = buf_.data() + static_cast<std::ptrdiff_t>(noff + i) * ld_ + noff;
       std::memmove(dst + i, src + i, sz * static_cast<std::size_t>(c - i));
       std::memmove(dst + c + d, src + c, sz * static_cast<std::size_t>(n_ - c));
       std::fill(dst + c, dst + c + d, Scalar(0));
     }
     for (int q = 0; q < d; ++q) {
-      Scalar* dst = buf_.data() + static_cast<std::ptrdiff_t>(noff + c + q) * cap_ + noff;
+      Scalar* dst = buf_.data() + static_cast<std::ptrdiff_t>(noff + c + q) * ld_ + noff;
       std::fill(dst + c, dst + n_ + d, Scalar(0));
     }
     for (int i = 0; i < c; ++i) rbuf_(noff + i) = rbuf_(off_ + i);

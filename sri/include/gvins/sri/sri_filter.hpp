@@ -219,9 +219,9 @@ class SriFilter {
 
  private:
   int position(BlockId id) const { return layout_.index(id); }
-  Scalar* rowPtr(int i) { return buf_.data() + static_cast<std::ptrdiff_t>(off_ + i) * cap_ + off_; }
+  Scalar* rowPtr(int i) { return buf_.data() + static_cast<std::ptrdiff_t>(off_ + i) * ld_ + off_; }
   const Scalar* rowPtr(int i) const {
-    return buf_.data() + static_cast<std::ptrdiff_t>(off_ + i) * cap_ + off_;
+    return buf_.data() + static_cast<std::ptrdiff_t>(off_ + i) * ld_ + off_;
   }
   RowMatrixView<Scalar> view(int row, int col, int rows, int cols);
   Eigen::Map<const RowMatrix<Scalar>, Eigen::Unaligned, Eigen::OuterStride<>> cview(int row, int col,
@@ -252,9 +252,13 @@ class SriFilter {
   StateLayout layout_;
   std::vector<BlockEstimate<Scalar>> estimates_;  // parallel to layout_.blocks()
   std::vector<BlockEstimate<double>> nominal_;    // float filters only: double values, parallel
-  RowMatrix<Scalar> buf_;                         // cap_ × cap_, R at (off_, off_)
+  RowMatrix<Scalar> buf_;                         // cap_ × ld_, R at (off_, off_)
   Vector rbuf_;                                   // cap_, r at off_
   int cap_ = 0;
+  // Row stride: cap_ rounded up to an odd number of 64-byte cache lines. With a power-of-two
+  // stride (e.g. 512 doubles, 4 KiB) the rows that a sweep or an update rotates together all map
+  // to the same L1 cache set and evict each other.
+  int ld_ = 0;
   int off_ = 0;
   int n_ = 0;
   // Update workspace.
