@@ -11,6 +11,11 @@
 //   MargDenseQR     the naive alternative: permute the clone first and HouseholderQR all of R
 //   EkfMarg         covariance form: delete the clone's rows and columns of P
 //   Solve           back-substitution R Δx = r
+//   SweepStride     sweepColumnsToFront alone, the IMU propagation's marginalization (9 columns
+//                   18 from the end of a dense n = 240 factor moved to the front), with the
+//                   factor stored at a row stride of 240 to 1032 elements: a
+//                   4 KiB stride (512 doubles, 1024 floats) puts the rotated rows in one L1 set, which
+//                   is why SriFilter pads its stride to an odd number of cache lines
 //   KernelSlamRows  householderRowUpdate alone on the shape of the VIO bench's SLAM update
 //                   (n = 240: 50 features of 3 in front of 90 window columns; 3 rows per
 //                   feature from its column on, 50 rows from the window on): kernel speed
@@ -25,6 +30,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
 
+#include "gvins/sri/qr_update.hpp"
 #include "vio_window.hpp"
 
 namespace gvins::sri::bench {
@@ -238,6 +244,35 @@ void sizes(benchmark::internal::Benchmark* b) {
     return *std::min_element(v.begin(), v.end());
   });
 }
+template <typename S>
+void BM_SweepStride(benchmark::State& state) {
+  const int n = 240;
+  const int ld = static_cast<int>(state.range(0));
+  constexpr int d = 9;
+  const int c = n - 2 * d;
+  RowMatrix<S> buf = RowMatrix<S>::Zero(n, ld);
+  Eigen::Matrix<S, Eigen::Dynamic, 1> r = Eigen::Matrix<S, Eigen::Dynamic, 1>::Ones(n);
+  std::uint32_t seed = 12345;
+  for (int i = 0; i < n; ++i) {
+    for (int j = i; j < n; ++j) {
+      seed = seed * 1664525u + 1013904223u;
+      buf(i, j) = static_cast<S>(static_cast<double>(seed >> 8) / 16777216.0 - 0.5);
+    }
+    buf(i, i) += S(4);
+  }
+  RowMatrixView<S> R(buf.data(), n, n, Eigen::OuterStride<>(ld));
+  for (auto _ : state) {
+    sweepColumnsToFront<S>(R, VectorView<S>(r.data(), n), c, d, 0);
+    benchmark::DoNotOptimize(buf.data());
+  }
+  state.counters["stride_bytes"] = static_cast<double>(ld) * static_cast<double>(sizeof(S));
+}
+
+void strideSizes(benchmark::internal::Benchmark* b) {
+  for (int ld : {240, 256, 264, 512, 520, 1024, 1032}) b->Args({ld});
+  b->Unit(benchmark::kMicrosecond);
+}
+
 void margSizes(benchmark::internal::Benchmark* b) {
   for (int n : {150, 300, 400}) {
     for (int order : {0, 1}) b->Args({n, order});
@@ -273,6 +308,8 @@ BENCHMARK(BM_EkfMarg<double>)->Apply(nSizes);
 BENCHMARK(BM_EkfMarg<float>)->Apply(nSizes);
 BENCHMARK(BM_Solve<double>)->Apply(nSizes);
 BENCHMARK(BM_Solve<float>)->Apply(nSizes);
+BENCHMARK(BM_SweepStride<double>)->Apply(strideSizes);
+BENCHMARK(BM_SweepStride<float>)->Apply(strideSizes);
 BENCHMARK(BM_KernelSlamRows<double>)->UseManualTime()->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_KernelSlamRows<float>)->UseManualTime()->Unit(benchmark::kMicrosecond);
 
