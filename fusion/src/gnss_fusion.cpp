@@ -87,7 +87,8 @@ int GnssFusion<Scalar>::clockIndex(SatId sat) const {
 
 template <typename Scalar>
 std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& rover, const EphemerisStore& nav,
-                                                                 const Eigen::Vector3d& x) const {
+                                                                 const Eigen::Vector3d& x, TransmitStates* states) const {
+  if (states && !(states->receiveTime() == rover.time)) states = nullptr;
   std::vector<SatelliteModel> out;
   const Geodetic g = ecefToGeodetic(x);
   const IonosphereParameters& iono = nav.ionosphere();
@@ -105,7 +106,7 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     if (so.sat.system == System::Glonass) channel = nav.glonassChannels().get(so.sat.prn);
     const auto f = carrierFrequency(so.sat.system, band, channel);
     if (!f) continue;
-    const auto tx = satelliteAtTransmit(nav, so.sat, rover.time, s->pseudorange);
+    const auto tx = states ? states->get(so.sat, s->pseudorange) : satelliteAtTransmit(nav, so.sat, rover.time, s->pseudorange);
     if (!tx) continue;
     SatelliteModel m;
     m.sat = so.sat;
@@ -651,6 +652,9 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
   // estimate (RtkSolver::differences: no float filter, no ambiguity resolution); Ddcp runs the
   // whole RTK module for its fixed ambiguities.
   const bool fullRtk = rtk_ && config_.mode == GnssFusionMode::kDoppDdcp;
+  // Satellite states of this epoch, computed once for the RTK module's differences and the
+  // fusion's satellite models.
+  TransmitStates states(nav, rover.time);
   std::optional<double> baseAge;
   if (rtk_) {
     if (base && (!lastBase_ || base->time > *lastBase_)) {
@@ -664,7 +668,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
       lastBase_ = base->time;
     }
     if (fullRtk) {
-      const RtkSolution rtk = rtk_->process(roverRaw);
+      const RtkSolution rtk = rtk_->process(roverRaw, &states);
       rep.rtkFixed = rtk.quality == SolutionQuality::Fix;
       baseAge = rtk.age;
     }
@@ -774,7 +778,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
     // Tight stage.
     const SppSolution* sppVel = config_.mode == GnssFusionMode::kGpsVel ? &sppNow() : nullptr;
     const bool needClocks = config_.usesDoppler();
-    std::vector<SatelliteModel> models = satelliteModels(rover, nav, k.x_E);
+    std::vector<SatelliteModel> models = satelliteModels(rover, nav, k.x_E, &states);
     if (needClocks && !clockBlock_.valid()) {
       if (!initClocks(est, models, k, tMeas)) return finish();
       rep.clocksInitialized = true;
@@ -906,7 +910,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
     }
     const std::size_t nIndependent = rows.size();
     std::vector<DoubleDifference> phase;
-    if (rtk_ && !fullRtk) baseAge = rtk_->differences(rover, k.x_E);
+    if (rtk_ && !fullRtk) baseAge = rtk_->differences(rover, k.x_E, &states);
     if (baseAge && config_.usesDifferences() && *baseAge <= config_.maxBaseAge) {
       const DdEpoch& e = rtk_->measurements();
       // Base clock per system: mean base code OMC (clock + errors common to the base).

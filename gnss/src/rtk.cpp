@@ -369,7 +369,7 @@ bool RtkSolver::rejectOutlier(RtkSolution& sol) {
   return true;
 }
 
-std::optional<double> RtkSolver::differences(const ObsEpoch& rover, const Eigen::Vector3d& x) {
+std::optional<double> RtkSolver::differences(const ObsEpoch& rover, const Eigen::Vector3d& x, TransmitStates* states) {
   GlonassChannels ch = roverChannels_;
   ch.mergeMissing(nav_.glonassChannels());
   roverSlips_.process(rover, ch);
@@ -378,11 +378,11 @@ std::optional<double> RtkSolver::differences(const ObsEpoch& rover, const Eigen:
     dd_.time = rover.time;
     return std::nullopt;
   }
-  builder_.form(rover, roverSlips_, snapshot_, *base_.position(), x, dd_);
+  builder_.form(rover, roverSlips_, snapshot_, *base_.position(), x, dd_, states);
   return snapshot_.age;
 }
 
-RtkSolution RtkSolver::process(const ObsEpoch& rover) {
+RtkSolution RtkSolver::process(const ObsEpoch& rover, TransmitStates* states) {
   RtkSolution sol;
   sol.time = rover.time;
   const SppSolution spp = spp_.solve(rover);
@@ -434,7 +434,7 @@ RtkSolution RtkSolver::process(const ObsEpoch& rover) {
   if (spp.velocity.valid) lastVelocity_ = spp.velocity.velocity;
 
   Eigen::Vector3d x0 = positionEstimate();
-  builder_.form(rover, roverSlips_, snapshot_, basePos, x0, dd_);
+  builder_.form(rover, roverSlips_, snapshot_, basePos, x0, dd_, states);
 
   // Prefit gate on DD code (gross errors, multipath spikes), widened by the uncertainty of the
   // predicted position (a DD line-of-sight difference is at most 2 in length).

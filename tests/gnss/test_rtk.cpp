@@ -27,6 +27,7 @@
 #include "gvins/gnss/double_difference.hpp"
 #include "gvins/gnss/pos_reader.hpp"
 #include "gvins/gnss/rtk.hpp"
+#include "gvins/gnss/transmit_states.hpp"
 #include "gvins/rtcm/encoder.hpp"
 
 using namespace gvins;
@@ -633,3 +634,71 @@ TEST(RtkBadInput, MismatchedSignalsAndNoCommonSatellites) {
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Satellite states shared between steps of one epoch (TransmitStates): the first request of a
+// satellite computes satelliteAtTransmit, later ones (another code) get that state; an
+// implausible pseudorange is refused without being stored. An RTK run whose epochs share their
+// states with a caller that asked first with other codes (L2 pseudoranges, 5 m of ionosphere
+// and group delay away from the L1 codes the differences use) gives the same positions.
+TEST(TransmitStatesShared, SameStatesAndTheSameRtkSolution) {
+  const Dataset& d = nagoya();
+  const ObsEpoch& e0 = d.rover.at(10);
+  TransmitStates ts(d.nav, e0.time);
+  int checked = 0;
+  for (const SatObs& so : e0.sats) {
+    const SignalObs* first = nullptr;
+    const SignalObs* other = nullptr;
+    for (const SignalObs& s : so.signals) {
+      if (!s.hasCode() || !(s.pseudorange > 1e6)) continue;
+      if (!first) first = &s;
+      else if (!other && std::abs(s.pseudorange - first->pseudorange) > 0.1) other = &s;
+    }
+    if (!first || !other) continue;
+    EXPECT_FALSE(ts.get(so.sat, 12.0).has_value());  // implausible: refused, not stored
+    const auto direct = satelliteAtTransmit(d.nav, so.sat, e0.time, first->pseudorange);
+    const auto a = ts.get(so.sat, first->pseudorange);
+    const auto b = ts.get(so.sat, other->pseudorange);  // the stored state, not a new one
+    ASSERT_EQ(direct.has_value(), a.has_value());
+    ASSERT_EQ(a.has_value(), b.has_value());
+    if (!a) continue;
+    EXPECT_EQ((a->state.position - direct->state.position).norm(), 0.0);
+    EXPECT_EQ(a->transmitTime - direct->transmitTime, 0.0);
+    EXPECT_EQ((b->state.position - a->state.position).norm(), 0.0);
+    const auto fresh = satelliteAtTransmit(d.nav, so.sat, e0.time, other->pseudorange);
+    ASSERT_TRUE(fresh.has_value());
+    EXPECT_LT((fresh->state.position - a->state.position).norm(), 1e-3);  // what sharing changes
+    ++checked;
+  }
+  EXPECT_GE(checked, 10);
+
+  // RTK over 120 epochs, with and without states filled first from the second code.
+  const RunResult plain = runRtk(d, nagoyaConfig(), d.base, 0, 120);
+  RtkSolver s(d.nav, nagoyaConfig());
+  s.setRoverGlonassChannels(d.roverHeader.glonassChannels);
+  s.setBaseGlonassChannels(d.baseHeader.glonassChannels);
+  s.setBasePosition(d.basePosition);
+  std::size_t b = 0;
+  int compared = 0;
+  for (int i = 0; i < 120; ++i) {
+    const ObsEpoch& e = d.rover[static_cast<std::size_t>(i)];
+    while (b < d.base.size() && (b == 0 || d.base[b - 1].time - e.time <= BaseStation::kSyncTolerance)) s.addBaseEpoch(d.base[b++]);
+    TransmitStates states(d.nav, e.time);
+    for (const SatObs& so : e.sats) {
+      for (auto it = so.signals.rbegin(); it != so.signals.rend(); ++it) {
+        if (it->hasCode() && it->pseudorange > 1e6) {
+          (void)states.get(so.sat, it->pseudorange);
+          break;
+        }
+      }
+    }
+    const RtkSolution r = s.process(e, &states);
+    const RtkSolution& p = plain.sol[static_cast<std::size_t>(i)];
+    ASSERT_EQ(r.quality, p.quality) << "epoch " << i;
+    if (r.quality == SolutionQuality::Fix || r.quality == SolutionQuality::Float) {
+      EXPECT_LT((r.position - p.position).norm(), 1e-3) << "epoch " << i;
+      ++compared;
+    }
+  }
+  EXPECT_GE(compared, 100);
+}

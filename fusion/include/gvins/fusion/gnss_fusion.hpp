@@ -36,6 +36,7 @@
 #include "gvins/gnss/carrier_smoothing.hpp"
 #include "gvins/gnss/rtk.hpp"
 #include "gvins/gnss/spp.hpp"
+#include "gvins/gnss/transmit_states.hpp"
 #include "gvins/vio/estimator_backend.hpp"
 
 namespace gvins::fusion {
@@ -99,9 +100,10 @@ class GnssFusion {
   const std::vector<System>& clockSystems() const { return clockSystems_; }
   /// Antenna position/velocity (ECEF) at time t_ns from the current estimates (frame needed).
   std::optional<AntennaKinematics> antennaAt(const vio::EstimatorBackend<Scalar>& est, std::int64_t t_ns) const;
-  /// Satellite models of an epoch at antenna position x (for tests and diagnostics).
+  /// Satellite models of an epoch at antenna position x (for tests and diagnostics); `states`
+  /// (optional): the epoch's satellite states, shared with the single differences.
   std::vector<SatelliteModel> satelliteModels(const ObsEpoch& rover, const EphemerisStore& nav,
-                                              const Eigen::Vector3d& x) const;
+                                              const Eigen::Vector3d& x, TransmitStates* states = nullptr) const;
   /// Clock system index of a satellite (QZSS shares GPS's clock), or -1 if not estimated.
   int clockIndex(SatId sat) const;
   /// Zenith wet delay residual estimate (m), when estimated.

@@ -35,6 +35,7 @@
 #include "gvins/gnss/base_station.hpp"
 #include "gvins/gnss/cycle_slip_detector.hpp"
 #include "gvins/gnss/rtk_config.hpp"
+#include "gvins/gnss/transmit_states.hpp"
 
 namespace gvins {
 
@@ -147,8 +148,10 @@ class DoubleDifferenceBuilder {
   /// Forms the SDs and DDs of a rover epoch at the rover position `x` (linearisation point for
   /// elevations and the troposphere; residuals can be evaluated anywhere later). `roverSlips` must
   /// have processed this rover epoch.
+  /// `states` (optional, for rover.time): satellite states already computed for this epoch.
   void form(const ObsEpoch& rover, const CycleSlipDetector& roverSlips, const BaseSnapshot& base,
-            const Eigen::Vector3d& basePosition, const Eigen::Vector3d& x, DdEpoch& out);
+            const Eigen::Vector3d& basePosition, const Eigen::Vector3d& x, DdEpoch& out,
+            TransmitStates* states = nullptr);
   /// Chooses the references and forms the DD lists of `e` again (e.g. after SDs were removed as
   /// outliers: remove them by clearing hasPhase/hasCode).
   void formDoubleDifferences(DdEpoch& e);

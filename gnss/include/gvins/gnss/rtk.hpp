@@ -128,8 +128,9 @@ class RtkSolver {
 
   /// Base epochs, in time order, up to (and, for interpolation, one past) each rover epoch.
   void addBaseEpoch(const ObsEpoch& epoch);
-  /// Processes one rover epoch.
-  RtkSolution process(const ObsEpoch& rover);
+  /// Processes one rover epoch. `states` (optional): satellite states of this epoch that the
+  /// caller has computed (or wants filled) for its own use, shared with the differences.
+  RtkSolution process(const ObsEpoch& rover, TransmitStates* states = nullptr);
   /// The single and double differences of the last processed epoch, with the fixed ambiguities of
   /// the DD phases when the epoch was fixed (for the fusion and for diagnostics).
   const DdEpoch& measurements() const { return dd_; }
@@ -139,7 +140,7 @@ class RtkSolver {
   /// The differences go to measurements(); returns the base data's age (s), or nullopt when
   /// the base has no usable data for this epoch (measurements() is then empty). Do not mix
   /// with process() on the same solver.
-  std::optional<double> differences(const ObsEpoch& rover, const Eigen::Vector3d& x);
+  std::optional<double> differences(const ObsEpoch& rover, const Eigen::Vector3d& x, TransmitStates* states = nullptr);
   /// Forgets the float solution and all ambiguities (base buffer and slip history stay).
   void reset();
 
