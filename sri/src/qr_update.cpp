@@ -13,30 +13,6 @@ namespace gvins::sri {
 
 namespace {
 
-/// Givens rotation [c s; −s c] with −s·a + c·b = 0 and c·a + s·b = ρ = hypot(a, b) ≥ 0 for
-/// b ≠ 0 (Golub & Van Loan, Algorithm 5.1.3, scaled against overflow).
-template <typename Scalar>
-inline Scalar makeGivens(Scalar a, Scalar b, Scalar& c, Scalar& s) {
-  if (b == Scalar(0)) {  // identity (ρ = a keeps its sign; the sign of a row of R is free)
-    c = Scalar(1);
-    s = Scalar(0);
-    return a;
-  }
-  const Scalar aa = std::abs(a);
-  const Scalar ab = std::abs(b);
-  Scalar rho;
-  if (ab > aa) {
-    const Scalar t = a / b;
-    rho = ab * std::sqrt(Scalar(1) + t * t);
-  } else {
-    const Scalar t = b / a;
-    rho = aa * std::sqrt(Scalar(1) + t * t);
-  }
-  c = a / rho;
-  s = b / rho;
-  return rho;
-}
-
 #if defined(__GNUC__) || defined(__clang__)
 #define GVINS_SRI_VECTOR_EXT 1
 // 32-byte vectors only pass between always-inlined functions (never through a call), so the

@@ -43,20 +43,6 @@ Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic> priorFactor(const Prior<Sc
   return Matrix::Zero(d, d);
 }
 
-/// Givens rotation [c s; −s c] taking (a, b) to (ρ, 0), ρ = hypot(a, b) (c = 1, s = 0 for b = 0).
-template <typename Scalar>
-Scalar makeGivensPair(Scalar a, Scalar b, Scalar& c, Scalar& s) {
-  if (b == Scalar(0)) {
-    c = Scalar(1);
-    s = Scalar(0);
-    return a;
-  }
-  const Scalar rho = std::hypot(a, b);
-  c = a / rho;
-  s = b / rho;
-  return rho;
-}
-
 }  // namespace
 
 template <typename Scalar>
@@ -297,7 +283,7 @@ void SriFilter<Scalar>::substitute(BlockId id, const Matrix& A, std::span<const 
       Scalar* bot = rowPtr(o + k);
       Scalar cs;
       Scalar sn;
-      top[o + c] = makeGivensPair(top[o + c], bot[o + c], cs, sn);
+      top[o + c] = makeGivens(top[o + c], bot[o + c], cs, sn);
       bot[o + c] = Scalar(0);
       for (int col = o + c + 1; col < n_; ++col) {
         const Scalar x = top[col];
@@ -313,12 +299,7 @@ void SriFilter<Scalar>::substitute(BlockId id, const Matrix& A, std::span<const 
       ry = cs * y - sn * x;
     }
   }
-  if constexpr (std::is_same_v<Scalar, double>) {
-    estimates_[static_cast<std::size_t>(pos)] = estimate;
-  } else {
-    nominal_[static_cast<std::size_t>(pos)] = estimate;
-    estimates_[static_cast<std::size_t>(pos)] = castEstimate<Scalar>(estimate);
-  }
+  storeNominal(pos, estimate);
 }
 
 template <typename Scalar>
@@ -412,6 +393,11 @@ void SriFilter<Scalar>::setNominal(BlockId id, const BlockEstimate<double>& valu
     throw std::invalid_argument("sri::SriFilter::setNominal: value of block '" + b.name +
                                 "' is not the current estimate up to rounding");
   }
+  storeNominal(pos, value);
+}
+
+template <typename Scalar>
+void SriFilter<Scalar>::storeNominal(int pos, const BlockEstimate<double>& value) {
   if constexpr (std::is_same_v<Scalar, double>) {
     estimates_[static_cast<std::size_t>(pos)] = value;
   } else {

@@ -26,6 +26,7 @@
 //   once per pair).
 #pragma once
 
+#include <cmath>
 #include <span>
 
 #include <Eigen/Core>
@@ -38,6 +39,31 @@ template <typename Scalar>
 using RowMatrixView = Eigen::Map<RowMatrix<Scalar>, Eigen::Unaligned, Eigen::OuterStride<>>;
 template <typename Scalar>
 using VectorView = Eigen::Map<Eigen::Matrix<Scalar, Eigen::Dynamic, 1>>;
+
+/// Givens rotation [c s; −s c] with −s·a + c·b = 0 and c·a + s·b = ρ = hypot(a, b) ≥ 0 for
+/// b ≠ 0 (Golub & Van Loan, Algorithm 5.1.3, scaled against overflow); for b = 0 the identity
+/// (ρ = a keeps its sign; the sign of a row of R is free). Returns ρ.
+template <typename Scalar>
+inline Scalar makeGivens(Scalar a, Scalar b, Scalar& c, Scalar& s) {
+  if (b == Scalar(0)) {
+    c = Scalar(1);
+    s = Scalar(0);
+    return a;
+  }
+  const Scalar aa = std::abs(a);
+  const Scalar ab = std::abs(b);
+  Scalar rho;
+  if (ab > aa) {
+    const Scalar t = a / b;
+    rho = ab * std::sqrt(Scalar(1) + t * t);
+  } else {
+    const Scalar t = b / a;
+    rho = aa * std::sqrt(Scalar(1) + t * t);
+  }
+  c = a / rho;
+  s = b / rho;
+  return rho;
+}
 
 /// Which orthogonal transformations an update uses.
 enum class RotationScheme : unsigned char {

@@ -219,6 +219,9 @@ class SriFilter {
 
  private:
   int position(BlockId id) const { return layout_.index(id); }
+  /// The block at `pos` takes `value` (the double value of a float filter, rounded for
+  /// estimates_); R and r are not touched.
+  void storeNominal(int pos, const BlockEstimate<double>& value);
   Scalar* rowPtr(int i) { return buf_.data() + static_cast<std::ptrdiff_t>(off_ + i) * ld_ + off_; }
   const Scalar* rowPtr(int i) const {
     return buf_.data() + static_cast<std::ptrdiff_t>(off_ + i) * ld_ + off_;
