@@ -88,7 +88,6 @@ int GnssFusion<Scalar>::clockIndex(SatId sat) const {
 template <typename Scalar>
 std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& rover, const EphemerisStore& nav,
                                                                  const Eigen::Vector3d& x, TransmitStates* states) const {
-  if (states && !(states->receiveTime() == rover.time)) states = nullptr;
   std::vector<SatelliteModel> out;
   const Geodetic g = ecefToGeodetic(x);
   const IonosphereParameters& iono = nav.ionosphere();
@@ -106,7 +105,7 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     if (so.sat.system == System::Glonass) channel = nav.glonassChannels().get(so.sat.prn);
     const auto f = carrierFrequency(so.sat.system, band, channel);
     if (!f) continue;
-    const auto tx = states ? states->get(so.sat, s->pseudorange) : satelliteAtTransmit(nav, so.sat, rover.time, s->pseudorange);
+    const auto tx = transmitState(states, nav, so.sat, rover.time, s->pseudorange);
     if (!tx) continue;
     SatelliteModel m;
     m.sat = so.sat;

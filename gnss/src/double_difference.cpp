@@ -95,7 +95,6 @@ void DoubleDifferenceBuilder::reset() {
 void DoubleDifferenceBuilder::form(const ObsEpoch& rover, const CycleSlipDetector& roverSlips, const BaseSnapshot& base,
                                    const Eigen::Vector3d& basePosition, const Eigen::Vector3d& x, DdEpoch& out,
                                    TransmitStates* states) {
-  if (states && !(states->receiveTime() == rover.time)) states = nullptr;
   out.clear();
   out.time = rover.time;
   out.baseTime = base.time;
@@ -183,7 +182,7 @@ void DoubleDifferenceBuilder::form(const ObsEpoch& rover, const CycleSlipDetecto
         }
       }
     }
-    const auto tx = states ? states->get(so.sat, pr) : satelliteAtTransmit(nav_, so.sat, rover.time, pr);
+    const auto tx = transmitState(states, nav_, so.sat, rover.time, pr);
     if (!tx) {
       ++stats_.noEphemeris;
       continue;

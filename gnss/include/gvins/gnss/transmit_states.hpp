@@ -42,4 +42,12 @@ class TransmitStates {
   std::vector<std::pair<SatId, std::optional<TransmitState>>> states_;
 };
 
+/// The state from `states` when it is given and holds this receive time, else
+/// satelliteAtTransmit(nav, ...) directly: the one call for steps that may or may not share.
+inline std::optional<TransmitState> transmitState(TransmitStates* states, const EphemerisStore& nav, SatId sat,
+                                                  const GpsTime& receiveTime, double pseudorange) {
+  if (states && states->receiveTime() == receiveTime) return states->get(sat, pseudorange);
+  return satelliteAtTransmit(nav, sat, receiveTime, pseudorange);
+}
+
 }  // namespace gvins
