@@ -169,12 +169,23 @@ void Measurement<Scalar>::whitenSqrtInformation(const Matrix& S) {
 }
 
 template <typename Scalar>
-int Measurement<Scalar>::projectNuisance() {
+int Measurement<Scalar>::projectNuisance(Measurement* nuisanceRows) {
   if (!whitened_) throw std::logic_error("sri::Measurement::projectNuisance: whiten first");
+  if (nuisanceRows == this) throw std::invalid_argument("sri::Measurement::projectNuisance: output is the input");
   const int q = nuisanceDim();
   const int m = rows();
+  if (nuisanceRows) {
+    nuisanceRows->reset(0);
+    nuisanceRows->blocks_ = blocks_;
+    nuisanceRows->whitened_ = true;
+  }
   if (q == 0) return 0;
   if (m <= q) {  // no information left about the state
+    if (nuisanceRows) {
+      nuisanceRows->H_ = H_;
+      nuisanceRows->nuisance_ = nuisance_;
+      nuisanceRows->residual_ = residual_;
+    }
     reset(0);
     whitened_ = true;
     return m;
@@ -192,26 +203,48 @@ int Measurement<Scalar>::projectNuisance() {
   A.leftCols(q) = nuisance_;
   A.middleCols(q, p) = H_;
   A.col(q + p) = residual_;
+  // First non-zero column of every row within [H r] (an MSCKF row has its clone's columns and
+  // the calibration blocks after them; rows are in observation order): a rotation of rows i − 1
+  // and i only touches the columns from the smaller of their leads on (zeros in both stay zero),
+  // and both rows then start there.
+  static thread_local std::vector<int> lead;
+  lead.resize(static_cast<std::size_t>(m));
+  for (int i = 0; i < m; ++i) {
+    const Scalar* h = A.row(i).data() + q;
+    int l = 0;
+    while (l < p && h[l] == Scalar(0)) ++l;
+    lead[static_cast<std::size_t>(i)] = l;
+  }
+  auto rotate = [](Scalar* x, Scalar* y, int len, Scalar c, Scalar s) {
+    for (int col = 0; col < len; ++col) {
+      const Scalar xv = x[col];
+      const Scalar yv = y[col];
+      x[col] = c * xv + s * yv;
+      y[col] = c * yv - s * xv;
+    }
+  };
   for (int j = 0; j < q; ++j) {
-    const int len = w - j;
     for (int i = m - 1; i > j; --i) {
-      Scalar* yrow = A.row(i).data() + j;
-      const Scalar b = yrow[0];
+      Scalar* yrow = A.row(i).data();
+      const Scalar b = yrow[j];
       if (b == Scalar(0)) continue;
-      Scalar* xrow = A.row(i - 1).data() + j;
-      const Scalar a = xrow[0];
-      const Scalar rho = std::hypot(a, b);
-      const Scalar c = a / rho;
-      const Scalar s = b / rho;
-      for (int col = 0; col < len; ++col) {
-        const Scalar x = xrow[col];
-        const Scalar y = yrow[col];
-        xrow[col] = c * x + s * y;
-        yrow[col] = c * y - s * x;
-      }
+      Scalar* xrow = A.row(i - 1).data();
+      Scalar c, s;
+      makeGivens(xrow[j], b, c, s);
+      rotate(xrow + j, yrow + j, q - j, c, s);
+      int& lx = lead[static_cast<std::size_t>(i - 1)];
+      int& ly = lead[static_cast<std::size_t>(i)];
+      const int l = std::min(lx, ly);
+      lx = ly = l;
+      rotate(xrow + q + l, yrow + q + l, p + 1 - l, c, s);
     }
   }
   const int keep = m - q;
+  if (nuisanceRows) {
+    nuisanceRows->nuisance_ = A.topRows(q).leftCols(q).template triangularView<Eigen::Upper>();
+    nuisanceRows->H_ = A.topRows(q).middleCols(q, p);
+    nuisanceRows->residual_ = A.topRows(q).col(q + p);
+  }
   H_ = A.bottomRows(keep).middleCols(q, p);
   residual_ = A.bottomRows(keep).col(q + p);
   nuisance_.resize(keep, 0);

@@ -7,13 +7,13 @@
 #include <limits>
 #include <stdexcept>
 #include <type_traits>
-#include <unordered_set>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
 #include "gvins/sri/chi_square.hpp"
+#include "gvins/sri/qr_update.hpp"
 #include "gvins/vio/imu_propagation.hpp"
 #include "gvins/vio/so3.hpp"
 #include "gvins/vio/visual_jacobians.hpp"
@@ -950,6 +950,7 @@ struct SriSwfEstimator<Scalar>::Impl {
   /// Declares the block columns of a feature's rows at once (one allocation): the feature and
   /// anchor blocks (if valid), the observing clones, the extrinsics.
   std::vector<BlockId> decl_ids;
+  std::vector<std::uint64_t> observed_ids;  // processImuTime's per-frame list (capacity kept)
   std::vector<int> decl_dims;
   void declareBlocks(Meas& m, BlockId feature, BlockId anchor, const std::vector<Obs>& obs) {
     decl_ids.clear();
@@ -967,17 +968,22 @@ struct SriSwfEstimator<Scalar>::Impl {
     m.addBlocks(decl_ids, decl_dims);
   }
 
-  /// Rows of a feature at world point p_W (nuisance columns) for the listed observations.
-  void featureRows(const std::vector<Obs>& obs, const Eigen::Vector3d& p_W, Meas& m) {
+  /// Rows of a feature at world point p_W (nuisance columns) for the listed observations; the
+  /// Jacobians at p_J (default p_W; a new SLAM feature's at the point its first-estimate anchor
+  /// gives, as slamRows).
+  void featureRows(const std::vector<Obs>& obs, const Eigen::Vector3d& p_W, Meas& m,
+                   const Eigen::Vector3d* p_J = nullptr) {
     m.reset(2 * static_cast<int>(obs.size()));
     declareBlocks(m, BlockId{}, BlockId{}, obs);
     auto N = m.nuisance(3);
     for (std::size_t k = 0; k < obs.size(); ++k) {
       const Obs& o = obs[k];
       const int r = 2 * static_cast<int>(k);
-      const CameraPoint cp = cameraPoint(obsPose(o.clone), ext(o.cam), p_W);
-      const CameraPoint cj = cfg.first_estimate_jacobians ? cameraPoint(poseJ(o.clone), ext(o.cam), p_W) : cp;
-      const double is = inverseSigma(o.cam, cp.p_C.z());
+      // Jacobians at the first estimates, the residual at the current poses (p_C only).
+      const bool fej = cfg.first_estimate_jacobians;
+      const CameraPoint cj = cameraPoint(fej ? poseJ(o.clone) : obsPose(o.clone), ext(o.cam), p_J ? *p_J : p_W);
+      const Eigen::Vector3d p_C = fej || p_J ? pointInCamera(obsPose(o.clone), ext(o.cam), p_W) : cj.p_C;
+      const double is = inverseSigma(o.cam, p_C.z());
       const Eigen::Matrix<double, 2, 3> Jp = is * projectionJacobian(cj.p_C);
       m.jacobian(o.clone, 6).middleRows(r, 2) += (Jp * cj.J_pose).template cast<Scalar>();
       if (!ext_ids.empty()) {
@@ -988,7 +994,7 @@ struct SriSwfEstimator<Scalar>::Impl {
         m.jacobian(td_id, 1).middleRows(r, 2) += (Jp * timeOffsetColumn(o.clone, cj)).template cast<Scalar>();
       }
       N.middleRows(r, 2) = (Jp * cj.J_point).template cast<Scalar>();
-      m.residual().segment(r, 2) = (is * (o.z - cp.p_C.head<2>() / cp.p_C.z())).template cast<Scalar>();
+      m.residual().segment(r, 2) = (is * (o.z - p_C.head<2>() / p_C.z())).template cast<Scalar>();
     }
     m.setWhitened();
   }
@@ -1005,10 +1011,10 @@ struct SriSwfEstimator<Scalar>::Impl {
     for (std::size_t k = 0; k < obs.size(); ++k) {
       const Obs& o = obs[k];
       const int r = 2 * static_cast<int>(k);
-      const CameraPoint cp = cameraPoint(obsPose(o.clone), ext(o.cam), ap.p_W);
-      if (!(cp.p_C.z() > cfg.min_depth)) return false;
-      const CameraPoint cj = fej ? cameraPoint(poseJ(o.clone), ext(o.cam), apj.p_W) : cp;
-      const double is = inverseSigma(o.cam, cp.p_C.z());
+      const Eigen::Vector3d p_C = pointInCamera(obsPose(o.clone), ext(o.cam), ap.p_W);
+      if (!(p_C.z() > cfg.min_depth)) return false;
+      const CameraPoint cj = cameraPoint(fej ? poseJ(o.clone) : obsPose(o.clone), ext(o.cam), apj.p_W);
+      const double is = inverseSigma(o.cam, p_C.z());
       const Eigen::Matrix<double, 2, 3> Jp = is * projectionJacobian(cj.p_C);
       const Eigen::Matrix<double, 2, 3> A = Jp * cj.J_point;
       m.jacobian(s.block, 3).middleRows(r, 2) += (A * apj.J_feature).template cast<Scalar>();
@@ -1022,7 +1028,7 @@ struct SriSwfEstimator<Scalar>::Impl {
       if (td_id.valid()) {
         m.jacobian(td_id, 1).middleRows(r, 2) += (Jp * timeOffsetColumn(o.clone, cj)).template cast<Scalar>();
       }
-      m.residual().segment(r, 2) = (is * (o.z - cp.p_C.head<2>() / cp.p_C.z())).template cast<Scalar>();
+      m.residual().segment(r, 2) = (is * (o.z - p_C.head<2>() / p_C.z())).template cast<Scalar>();
     }
     m.setWhitened();
     triangularizeBlock(m, s.block, 3);
@@ -1047,9 +1053,9 @@ struct SriSwfEstimator<Scalar>::Impl {
         auto F = m.jacobianAt(b);
         const Scalar y = F(i, j);
         if (y == Scalar(0)) continue;
-        const Scalar x = F(i - 1, j);
-        const Scalar rho = std::hypot(x, y);
-        m.rotateRows(i - 1, i, x / rho, y / rho);
+        Scalar c, sn;
+        sri::makeGivens(F(i - 1, j), y, c, sn);
+        m.rotateRows(i - 1, i, c, sn);
         F(i, j) = Scalar(0);
       }
     }
@@ -1352,8 +1358,12 @@ struct SriSwfEstimator<Scalar>::Impl {
     addObservations(frame);
     const bool dropping = static_cast<int>(clones.size()) > cfg.window;
     const BlockId oldest = clones.front().id;
-    std::unordered_set<std::uint64_t> observed;
-    for (const FeatureObservation& o : frame.features) observed.insert(o.id);
+    // Ids seen in this frame, sorted (binary search: ~150 ids, looked up for every track).
+    std::vector<std::uint64_t>& observed = observed_ids;
+    observed.clear();
+    for (const FeatureObservation& o : frame.features) observed.push_back(o.id);
+    std::sort(observed.begin(), observed.end());
+    auto isObserved = [&observed](std::uint64_t id) { return std::binary_search(observed.begin(), observed.end(), id); };
 
     // 1. SLAM re-observations (newest clone). The update's post-fit residual ‖e‖² equals the
     // innovation χ² (docs/sri_core.md §5), so all rows are applied at once (R and r saved
@@ -1429,7 +1439,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     };
     std::vector<Cand> cands;
     for (auto& [id, tr] : tracks) {
-      const bool alive = observed.count(id) != 0;
+      const bool alive = isObserved(id);
       if (!alive) {
         if (tr.frames >= cfg.min_track_msckf) cands.push_back({id, tr.frames, false});
       } else if (dropping && !tr.obs.empty() && tr.obs.front().clone == oldest) {
@@ -1451,7 +1461,12 @@ struct SriSwfEstimator<Scalar>::Impl {
         msckf_ids.push_back(c.id);
       }
     }
-    // 2b. MSCKF updates.
+    // 2b. MSCKF features and new SLAM features: rows projected onto the left null space of
+    // the feature's position, gated, stacked, compressed and applied in one update. A new SLAM
+    // feature's projected rows are exactly those of its full rows [H_f H_x] after they have been
+    // triangularized in the feature columns (all Jacobians with respect to the point, its inverse
+    // depth and its anchor pose lie in the span of H_f), so they join the stack; its state block is
+    // then initialised by the three rows Q₁ᵀ[H_f H_x r] alone (2c).
     parts.clear();
     Meas m;
     for (std::uint64_t id : msckf_ids) {
@@ -1465,8 +1480,35 @@ struct SriSwfEstimator<Scalar>::Impl {
         ++res.rejected_features;
         continue;
       }
-      parts.push_back(m);
+      parts.push_back(std::move(m));
       ++res.msckf_features;
+    }
+    struct NewSlam {
+      std::uint64_t id;
+      Eigen::Vector3d f0;   // inverse depth in camera 0 of the newest clone
+      AnchoredPoint apj;    // its world point and Jacobians at the anchor's first estimate
+      Meas top;  // Q₁ᵀ[H_f H_x r]: feature position (nuisance, triangular), H_x, residual
+    };
+    std::vector<NewSlam> fresh;
+    for (std::uint64_t id : slam_new) {
+      const Track& tr = tracks[id];
+      Eigen::Vector3d p;
+      if (!triangulate(tr.obs, p)) continue;
+      NewSlam ns{id, inverseDepthOf(p, pose(newest.pose), ext(0)), AnchoredPoint{}, Meas{}};
+      // Linearised where the SLAM rows of this feature will be (slamRows): at the point that the
+      // inverse depth gives with the anchor's first estimate, so that the rows keep the
+      // unobservable directions of the first-estimate Jacobians.
+      ns.apj = anchoredPoint(ns.f0, cfg.first_estimate_jacobians ? poseJ(newest.pose) : pose(newest.pose), ext(0));
+      featureRows(tr.obs, p, m, &ns.apj.p_W);
+      m.projectNuisance(&ns.top);
+      ++res.gated_features;
+      if (!gateWindow(m)) {
+        ++res.rejected_features;
+        continue;
+      }
+      if (ns.top.rows() != 3) continue;  // too few observations to fix the point
+      if (m.rows() > 0) parts.push_back(std::move(m));
+      fresh.push_back(std::move(ns));
     }
     if (!parts.empty()) {
       stackAll(parts, total);
@@ -1475,38 +1517,42 @@ struct SriSwfEstimator<Scalar>::Impl {
       res.updated = true;
       notify("msckf_update");
     }
-    // 2c. New SLAM features: triangulate, gate the projected rows, add the block with no prior
-    // and apply the full rows (the block gets its information from them).
-    for (std::uint64_t id : slam_new) {
-      const Track& tr = tracks[id];
-      Eigen::Vector3d p;
-      if (!triangulate(tr.obs, p)) continue;
-      featureRows(tr.obs, p, m);
-      m.projectNuisance();
-      ++res.gated_features;
-      if (!gateWindow(m)) {
-        ++res.rejected_features;
-        continue;
-      }
-      const Eigen::Vector3d f0 = inverseDepthOf(p, pose(newest.pose), ext(0));
+    // 2c. New SLAM features: the block (inverse depth in camera 0 of the newest clone, no prior)
+    // and its three rows, by the chain rule δp_W = J_f δf + J_a δx_anchor + J_e δext₀ at the
+    // Jacobians' linearisation point (first estimates with FEJ, as slamRows).
+    for (NewSlam& ns : fresh) {
+      const Eigen::Vector3d& f0 = ns.f0;
+      const AnchoredPoint& apj = ns.apj;
       Slam s;
       s.block = f.addBlock(BlockSpec::vector("slam", 3), BlockEstimate<Scalar>::fromVector(f0.cast<Scalar>()),
                            sri::Prior<Scalar>::uninformative(), Placement::before(clones.front().id));
       setExact(s.block, BlockEstimate<double>::fromVector(f0));
       s.anchor = newest.pose;
       s.seen = true;
-      if (!slamRows(s, tr.obs, m)) {
-        f.marginalize(s.block);
-        continue;
+      const Meas& top = ns.top;
+      const Eigen::Matrix3d Rf = top.nuisanceJacobian().template cast<double>();
+      m.reset(3);
+      decl_ids.assign(1, s.block);
+      decl_dims.assign(1, 3);
+      for (int b = 0; b < top.numBlocks(); ++b) {
+        decl_ids.push_back(top.blockId(b));
+        decl_dims.push_back(top.blockDim(b));
       }
+      m.addBlocks(decl_ids, decl_dims);
+      for (int b = 0; b < top.numBlocks(); ++b) m.jacobianAt(b + 1) = top.jacobianAt(b);
+      m.jacobian(s.block, 3) = (Rf * apj.J_feature).template cast<Scalar>();
+      m.jacobian(s.anchor, 6) += (Rf * apj.J_anchor).template cast<Scalar>();
+      if (!ext_ids.empty()) m.jacobian(ext_ids[0], 6) += (Rf * apj.J_ext).template cast<Scalar>();
+      m.residual() = top.residual();
+      m.setWhitened();
       f.update(m);
-      slam.emplace(id, s);
+      slam.emplace(ns.id, s);
       res.updated = true;
     }
     if (!slam_new.empty()) notify("slam_init");
     for (const Cand& c : cands) tracks.erase(c.id);  // used (or unusable): restart alive ones
     for (auto it = tracks.begin(); it != tracks.end();) {
-      it = observed.count(it->first) ? std::next(it) : tracks.erase(it);
+      it = isObserved(it->first) ? std::next(it) : tracks.erase(it);
     }
     f.correct();
     notify("correct");

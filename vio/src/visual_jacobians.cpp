@@ -4,6 +4,11 @@
 
 namespace gvins::vio {
 
+Eigen::Vector3d pointInCamera(const PoseEstimate& pose, const CameraExtrinsic& ext, const Eigen::Vector3d& p_W) {
+  const Eigen::Vector3d p_I = pose.R_WI.transpose() * (p_W - pose.p_WI);
+  return ext.R_IC.transpose() * (p_I - ext.p_IC);
+}
+
 CameraPoint cameraPoint(const PoseEstimate& pose, const CameraExtrinsic& ext, const Eigen::Vector3d& p_W) {
   CameraPoint c;
   const Eigen::Vector3d p_I = pose.R_WI.transpose() * (p_W - pose.p_WI);

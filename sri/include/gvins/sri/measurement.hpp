@@ -47,6 +47,7 @@ class Measurement {
   /// projectNuisance() before the update.
   Eigen::Block<Matrix> nuisance(int dim);
   int nuisanceDim() const { return static_cast<int>(nuisance_.cols()); }
+  const Matrix& nuisanceJacobian() const { return nuisance_; }
 
   /// Block columns, in insertion order.
   int numBlocks() const { return static_cast<int>(blocks_.size()); }
@@ -86,7 +87,13 @@ class Measurement {
   /// bottom up and the top nuisanceDim() rows, which carry all the information about the
   /// nuisance, are dropped. The nuisance Jacobian must have full column rank. Returns the number
   /// of rows removed. Throws std::logic_error if not whitened.
-  int projectNuisance();
+  ///
+  /// `nuisanceRows` (optional) receives the removed rows Q₁ᵀ[N H r]: the nuisance columns as an
+  /// upper-triangular q × q factor, the same block columns and the residual, whitened (all rows
+  /// when rows() ≤ q). With them the information about the nuisance is kept: a new state block
+  /// for it is initialised by these q rows alone (chain rule onto its parameters), since the
+  /// projected rows are orthogonal to every Jacobian in the nuisance's column space.
+  int projectNuisance(Measurement* nuisanceRows = nullptr);
   /// If rows() exceeds the number of state columns p, replaces [H r] by the first p rows of its
   /// QR factorization (Householder): the update is unchanged; the residual of the dropped rows,
   /// which no state can explain, is kept in discardedChiSquare(). Throws std::logic_error if not

@@ -39,6 +39,9 @@ struct CameraPoint {
 };
 
 CameraPoint cameraPoint(const PoseEstimate& pose, const CameraExtrinsic& ext, const Eigen::Vector3d& p_W);
+/// cameraPoint's p_C alone (no Jacobians): for residuals whose Jacobians are evaluated elsewhere
+/// (first estimates).
+Eigen::Vector3d pointInCamera(const PoseEstimate& pose, const CameraExtrinsic& ext, const Eigen::Vector3d& p_W);
 
 /// ∂(x/z, y/z)/∂p_C.
 Eigen::Matrix<double, 2, 3> projectionJacobian(const Eigen::Vector3d& p_C);
