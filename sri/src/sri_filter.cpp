@@ -264,11 +264,14 @@ void SriFilter<Scalar>::substitute(BlockId id, const Matrix& A, std::span<const 
   // A⁻¹ B_j with the column offset of block j.
   std::vector<std::pair<int, Matrix>> AB;
   for (const auto& [j, Bj] : B) AB.emplace_back(layout_.block(j).offset, Ainv * Bj);
-  // Rows that see the block: all rows up to its own (upper triangular R).
+  // Rows that see the block: all rows up to its own (upper triangular R). In the block's own
+  // rows only the entries on and right of the diagonal belong to R (the storage below the
+  // diagonal is unspecified and must not be read).
   Eigen::Matrix<Scalar, 1, Eigen::Dynamic> Rx(d);
   for (int i = 0; i < o + d; ++i) {
     Scalar* row = rowPtr(i);
-    for (int q = 0; q < d; ++q) Rx(q) = row[o + q];
+    const int q0 = std::max(0, i - o);
+    for (int q = 0; q < d; ++q) Rx(q) = q < q0 ? Scalar(0) : row[o + q];
     if (Rx.isZero(0)) continue;
     for (const auto& [oj, ABj] : AB) {
       Eigen::Map<Eigen::Matrix<Scalar, 1, Eigen::Dynamic>>(row + oj, ABj.cols()).noalias() -= Rx * ABj;
