@@ -268,6 +268,7 @@ int main(int argc, char** argv) {
       if (carrierSmoothing) gc->carrierSmoothing = *carrierSmoothing;
       opt.leverArmTruth = trueLever;
     }
+    ec = estimatorConfigFor(ec, *gnssMode);
     const ReplaySummary s = ec.use_float ? run<float>(dataset, ec, gc, opt) : run<double>(dataset, ec, gc, opt);
     s.print(std::cout);
     for (const auto& f : s.files) std::cout << "wrote " << f << "\n";

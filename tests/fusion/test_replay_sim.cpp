@@ -91,6 +91,7 @@ ReplayRun replay(const std::string& name, GnssFusionConfig gc, const fs::path& d
   ec.cameras.push_back(vio::readCameraSensorYaml((d / "mav0" / "cam0" / "sensor.yaml").string()));
   ec.cameras.push_back(vio::readCameraSensorYaml((d / "mav0" / "cam1" / "sensor.yaml").string()));
   ec.use_float = std::is_same_v<Scalar, float>;
+  ec = estimatorConfigFor(ec, gc.mode);
   SriSwfReplayEstimator<Scalar> est(ec);
   GnssFusionReplayClient<Scalar> gnss(gc, est.estimator());
   const bool vioOnly = gc.mode == GnssFusionMode::kVio;
@@ -226,8 +227,11 @@ TEST(ReplaySim, FloatAgreesWithDouble) {
 }
 
 // Visual lock-out with and without GNSS: the same flight with the images stamped 80 ms early and
-// the offset ignored. VIO alone locks out three times and starts again (the local evaluation
-// covers the last state: 0.056 m); with VIO+Dopp+Ddcp the GNSS rows hold the state, so the
+// the offset ignored. VIO alone locks out and starts again (the local evaluation covers the
+// last state, which still runs with the 80 ms error, 0.5 m of motion at 6 m/s: 0.118 m with two
+// resets at 62ca80c, 0.240 m with three since the re-anchoring fix 03de91b, which changes where
+// the last segment starts; the bound is a sanity check of the restarted state, not an accuracy
+// target); with VIO+Dopp+Ddcp the GNSS rows hold the state, so the
 // rejected features do not count as a lock-out (a restart would throw the GNSS state away) and
 // the antenna stays at cm level (0.029 m).
 TEST(ReplaySim, LockOutResetsVioButNotWhileGnssHoldsTheState) {
@@ -238,7 +242,7 @@ TEST(ReplaySim, LockOutResetsVioButNotWhileGnssHoldsTheState) {
                vio.summary.estimatorResets, vio.summary.local.positionRmse, ddcp.summary.estimatorResets,
                ddcp.summary.global.positionRmse);
   EXPECT_GE(vio.summary.estimatorResets, 1u);
-  EXPECT_LT(vio.summary.local.positionRmse, 0.2);
+  EXPECT_LT(vio.summary.local.positionRmse, 0.3);
   EXPECT_EQ(ddcp.summary.estimatorResets, 0u);
   EXPECT_LT(ddcp.summary.global.positionRmse, 0.1);
 }

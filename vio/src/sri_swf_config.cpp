@@ -180,6 +180,7 @@ SriSwfConfig parseRoot(const YAML::Node& root, const Ctx& c, const SriSwfConfig*
       {"calibrate_time_offset", b(cfg.calibrate_time_offset, "calibrate_time_offset")},
       {"time_offset_sigma", d(cfg.time_offset_sigma, "time_offset_sigma")},
       {"float_householder", b(cfg.float_householder, "float_householder")},
+      {"imu_extra_first", b(cfg.imu_extra_first, "imu_extra_first")},
       {"precision",
        [&](const YAML::Node& n) {
          const std::string s = str(n, c, "precision");

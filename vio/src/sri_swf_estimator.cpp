@@ -347,7 +347,7 @@ struct SriSwfEstimator<Scalar>::Impl {
         Eigen::Vector3d::Constant(cfg.init_accel_bias_sigma);
     const BlockId eid = f.addBlock(BlockSpec::vector("imu_extra", 9),
                                    BlockEstimate<Scalar>::fromVector(x.cast<Scalar>()),
-                                   sri::Prior<Scalar>::stdDevs(sd.cast<Scalar>()));
+                                   sri::Prior<Scalar>::stdDevs(sd.cast<Scalar>()), extraPlacement());
     setExact(eid, BlockEstimate<double>::fromVector(x));
     newest = {pid, eid};
     t_newest = s.t_ns;
@@ -848,7 +848,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     Eigen::Matrix<double, 9, 1> x;
     x << s.v_WI, s.bg, s.ba;
     step.addNewBlock(BlockSpec::vector("imu_extra", 9), BlockEstimate<Scalar>::fromVector(x.cast<Scalar>()),
-                     Placement::back());
+                     extraPlacement());
     step.setTransition(newest.pose, Phi.leftCols<6>().cast<Scalar>());
     step.setTransition(newest.extra, Phi.rightCols<9>().cast<Scalar>());
     step.setNoiseCovariance(Qd.cast<Scalar>());
@@ -890,6 +890,15 @@ struct SriSwfEstimator<Scalar>::Impl {
     Eigen::Vector2d z;
   };
   std::vector<Ray> rays;  // triangulate()'s buffer
+  /// Where the IMU extra goes (SriSwfConfig::imu_extra_first).
+  Placement extraPlacement() const { return cfg.imu_extra_first ? Placement::front() : Placement::back(); }
+  /// A client's block: kFront in front of everything; parameters after the newest pose, i.e.
+  /// at the back, or before the extra when that is last.
+  Placement clientPlacement(ClientBlockRegion region) const {
+    if (region == ClientBlockRegion::kFront) return Placement::front();
+    return cfg.imu_extra_first ? Placement::back() : Placement::before(newest.extra);
+  }
+
   /// Gauss-Newton triangulation (inverse depth in the first observing camera).
   bool triangulate(const std::vector<Obs>& obs, Eigen::Vector3d& p_W) {
     if (obs.size() < 2) return false;
@@ -1778,9 +1787,7 @@ template <typename Scalar>
 sri::BlockId SriSwfEstimator<Scalar>::addBlock(const sri::BlockSpec& spec, const sri::BlockEstimate<Scalar>& estimate,
                                                const sri::Prior<Scalar>& prior, ClientBlockRegion region) {
   if (!impl_->initialized) throw std::logic_error("SriSwfEstimator::addBlock: not initialised");
-  const Placement where =
-      region == ClientBlockRegion::kFront ? Placement::front() : Placement::before(impl_->newest.extra);
-  return impl_->f.addBlock(spec, estimate, prior, where);
+  return impl_->f.addBlock(spec, estimate, prior, impl_->clientPlacement(region));
 }
 
 template <typename Scalar>
@@ -1789,8 +1796,7 @@ std::vector<sri::BlockId> SriSwfEstimator<Scalar>::propagate(const sri::Propagat
   if (!impl_->initialized) throw std::logic_error("SriSwfEstimator::propagate: not initialised");
   sri::Propagation<Scalar> p;
   for (const auto& nb : step.newBlocks()) {
-    p.addNewBlock(nb.spec, nb.estimate,
-                  region == ClientBlockRegion::kFront ? Placement::front() : Placement::before(impl_->newest.extra));
+    p.addNewBlock(nb.spec, nb.estimate, impl_->clientPlacement(region));
   }
   for (const auto& [id, phi] : step.transitions()) p.setTransition(id, phi);
   if (step.noiseIsSqrtInformation()) {
