@@ -380,12 +380,11 @@ TEST_P(SriVsKalman, RandomLinearGaussianProblems) {
 /// the old error state to the new one, the covariance must become T P Tᵀ and the mean T δ̂
 /// (δ̂ = R⁻¹ r, solve()), on a random factor with an update applied (r ≠ 0); the factor stays
 /// upper triangular; blocks before the substituted one, or a singular A, are refused.
-TEST(SriFilterSubstitute, IsTheLinearChangeOfVariables) {
-  std::mt19937 rng(11);
+/// A filter of vector blocks of the given dimensions with random priors and one random 20-row
+/// update applied (r ≠ 0); the ids in order.
+std::vector<BlockId> randomFilter(SriFilter<double>& f, std::mt19937& rng, std::span<const int> dims) {
   auto rnd = [&](int r, int c) { return uniformMatrix(rng, r, c); };
-  SriFilter<double> f;
   std::vector<BlockId> ids;
-  const int dims[] = {3, 3, 3, 6, 6, 9};
   for (int d : dims) {
     const Md L = rnd(d, d) + 3.0 * Md::Identity(d, d);
     ids.push_back(f.addBlock(BlockSpec::vector("b", d), BlockEstimate<double>::fromVector(rnd(d, 1)),
@@ -396,6 +395,15 @@ TEST(SriFilterSubstitute, IsTheLinearChangeOfVariables) {
   m.residual() = rnd(20, 1);
   m.setWhitened();
   f.update(m);
+  return ids;
+}
+
+TEST(SriFilterSubstitute, IsTheLinearChangeOfVariables) {
+  std::mt19937 rng(11);
+  auto rnd = [&](int r, int c) { return uniformMatrix(rng, r, c); };
+  SriFilter<double> f;
+  const int dims[] = {3, 3, 3, 6, 6, 9};
+  const std::vector<BlockId> ids = randomFilter(f, rng, dims);
   const Md P0 = f.fullCovariance();
   const Vd d0 = f.solve();
   // Substitute block 1 (columns 3..5) with blocks 3 and 5 after it.
@@ -428,18 +436,8 @@ TEST(SriFilterSubstitute, IgnoresTheStorageBelowTheDiagonal) {
   std::mt19937 rng(12);
   auto rnd = [&](int r, int c) { return uniformMatrix(rng, r, c); };
   SriFilter<double> f;
-  std::vector<BlockId> ids;
   const int dims[] = {9, 3, 3, 6, 6};
-  for (int d : dims) {
-    const Md L = rnd(d, d) + 3.0 * Md::Identity(d, d);
-    ids.push_back(f.addBlock(BlockSpec::vector("b", d), BlockEstimate<double>::fromVector(rnd(d, 1)),
-                             Prior<double>::covariance(L * L.transpose())));
-  }
-  Measurement<double> m(20);
-  for (std::size_t k = 0; k < ids.size(); ++k) m.jacobian(ids[k], dims[k]) = rnd(20, dims[k]);
-  m.residual() = rnd(20, 1);
-  m.setWhitened();
-  f.update(m);
+  const std::vector<BlockId> ids = randomFilter(f, rng, dims);
   const Md P0 = f.fullCovariance();
   const Vd d0 = f.solve();
   const int n = f.dim();
