@@ -98,6 +98,58 @@ TEST(Measurement, NullSpaceProjectionEqualsSchurComplement) {
   EXPECT_NEAR(z.residual().squaredNorm(), r.dot(Pn * r), 1e-10);
 }
 
+// projectNuisance(&top): the removed rows are Q₁ᵀ[N H r] with an upper-triangular nuisance
+// factor, and [top; projected] is an orthogonal transform of the original rows (same Gram matrix
+// of [N H r]). Rows as in MSCKF: two per observation on its own clone block (a staircase, which
+// the rotations skip up to each row's first non-zero column) and a dense calibration block.
+TEST(Measurement, NuisanceRowsCompleteTheProjection) {
+  std::mt19937 rng(9);
+  const int clones = 6, m = 2 * clones;
+  Measurement<double> z(m);
+  Md A = Md::Zero(m, 3 + 6 * clones + 6 + 1);  // [N | clones | calibration | r], the original
+  for (int k = 0; k < clones; ++k) {
+    const Md Hk = randm(rng, 2, 6);
+    z.jacobian(BlockId{static_cast<std::uint64_t>(k + 1)}, 6).middleRows(2 * k, 2) = Hk;
+    A.block(2 * k, 3 + 6 * k, 2, 6) = Hk;
+  }
+  const Md He = randm(rng, m, 6), Hf = randm(rng, m, 3);
+  const Vd r = randm(rng, m, 1);
+  z.jacobian(BlockId{100}, 6) = He;
+  z.nuisance(3) = Hf;
+  z.residual() = r;
+  A.middleCols(3 + 6 * clones, 6) = He;
+  A.leftCols(3) = Hf;
+  A.rightCols(1) = r;
+  z.setWhitened();
+  Measurement<double> top;
+  EXPECT_EQ(z.projectNuisance(&top), 3);
+  ASSERT_EQ(top.rows(), 3);
+  ASSERT_EQ(top.nuisanceDim(), 3);
+  ASSERT_EQ(top.numBlocks(), z.numBlocks());
+  const Md Rf = top.nuisanceJacobian();
+  EXPECT_EQ(Md(Rf.triangularView<Eigen::StrictlyLower>()).norm(), 0.0);
+  Md B = Md::Zero(m, A.cols());  // [top; projected] in the same columns
+  B.topLeftCorner(3, 3) = Rf;
+  B.block(0, 3, 3, 6 * clones + 6) = top.stackedJacobian();
+  B.block(3, 3, m - 3, 6 * clones + 6) = z.stackedJacobian();
+  B.block(0, A.cols() - 1, 3, 1) = top.residual();
+  B.block(3, A.cols() - 1, m - 3, 1) = z.residual();
+  EXPECT_LT((B.transpose() * B - A.transpose() * A).norm(), 1e-10 * (A.transpose() * A).norm());
+  // The projected rows carry the Schur complement, as without the output.
+  const Md Pn = Md::Identity(m, m) - Hf * (Hf.transpose() * Hf).inverse() * Hf.transpose();
+  const Md Hx = A.middleCols(3, 6 * clones + 6);
+  EXPECT_LT((z.stackedJacobian().transpose() * z.stackedJacobian() - Hx.transpose() * Pn * Hx).norm(), 1e-10);
+  // Fewer rows than nuisance columns: everything goes to `top`.
+  Measurement<double> few(2);
+  few.jacobian(BlockId{1}, 6) = randm(rng, 2, 6);
+  few.nuisance(3) = randm(rng, 2, 3);
+  few.setWhitened();
+  EXPECT_EQ(few.projectNuisance(&top), 2);
+  EXPECT_EQ(few.rows(), 0);
+  EXPECT_EQ(top.rows(), 2);
+  EXPECT_THROW(few.projectNuisance(&few), std::invalid_argument);
+}
+
 // MSCKF equivalence: updating with the projected rows equals adding the feature as a state with
 // no prior information, updating with the full rows and marginalizing the feature.
 TEST(Measurement, ProjectionEqualsFeatureStateMarginalized) {

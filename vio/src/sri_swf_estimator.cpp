@@ -959,8 +959,8 @@ struct SriSwfEstimator<Scalar>::Impl {
   /// Declares the block columns of a feature's rows at once (one allocation): the feature and
   /// anchor blocks (if valid), the observing clones, the extrinsics.
   std::vector<BlockId> decl_ids;
-  std::vector<std::uint64_t> observed_ids;  // processImuTime's per-frame list (capacity kept)
   std::vector<int> decl_dims;
+  std::vector<std::uint64_t> observed_ids;  // processImuTime's per-frame list (capacity kept)
   void declareBlocks(Meas& m, BlockId feature, BlockId anchor, const std::vector<Obs>& obs) {
     decl_ids.clear();
     decl_dims.clear();
