@@ -1541,14 +1541,8 @@ struct SriSwfEstimator<Scalar>::Impl {
       const Meas& top = ns.top;
       const Eigen::Matrix3d Rf = top.nuisanceJacobian().template cast<double>();
       m.reset(3);
-      decl_ids.assign(1, s.block);
-      decl_dims.assign(1, 3);
-      for (int b = 0; b < top.numBlocks(); ++b) {
-        decl_ids.push_back(top.blockId(b));
-        decl_dims.push_back(top.blockDim(b));
-      }
-      m.addBlocks(decl_ids, decl_dims);
-      for (int b = 0; b < top.numBlocks(); ++b) m.jacobianAt(b + 1) = top.jacobianAt(b);
+      declareBlocks(m, s.block, s.anchor, tracks[ns.id].obs);  // top's blocks and the feature
+      for (int b = 0; b < top.numBlocks(); ++b) m.jacobian(top.blockId(b), top.blockDim(b)) = top.jacobianAt(b);
       m.jacobian(s.block, 3) = (Rf * apj.J_feature).template cast<Scalar>();
       m.jacobian(s.anchor, 6) += (Rf * apj.J_anchor).template cast<Scalar>();
       if (!ext_ids.empty()) m.jacobian(ext_ids[0], 6) += (Rf * apj.J_ext).template cast<Scalar>();

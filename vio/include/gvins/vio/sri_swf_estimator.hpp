@@ -173,7 +173,8 @@ struct SriSwfConfig {
   /// updates, which never touch the extra, no longer carry its columns. Rows on the first block
   /// are dense over the whole state, so a backend client whose rows touch the velocity on every
   /// epoch (GNSS Doppler, the fusion sets it) wants it last. bench_vio_estimator /50 (the target
-  /// frame): float 1.05 → 0.98 ms, double 1.31 → 1.23 ms (docs/vio_estimator.md).
+  /// frame): float 1.05–1.08 → 1.00–1.02 ms, double 1.32–1.38 → 1.24–1.26 ms
+  /// (docs/vio_estimator.md).
   bool imu_extra_first = true;
 
   /// Precision the application should instantiate (SriSwfEstimator<float> or <double>).
