@@ -263,11 +263,36 @@ GVINS_SRI_INLINE void applyReflectors(Scalar* const* x, Scalar* w0, std::ptrdiff
   int t0 = 0;
 #ifdef GVINS_SRI_VECTOR_EXT
   constexpr int L = Simd<Scalar, B>::kLanes;
+  // A remainder of r < L columns as one more SIMD vector over the last L columns [len − L, len),
+  // which overlaps L − r columns of the main loop: its inputs are saved before the main loop and the
+  // chunk is computed on the copy, so the overlapped columns get the same values twice (columns
+  // are independent, the per-lane operations are the same). The scalar tail cost as much as the
+  // vectors on ~100-column trailing blocks with float's 8 lanes (docs/sri_core.md).
+  const int rem = len % L;
+  const bool overlap = rem != 0 && len >= L;
+  static thread_local std::vector<Scalar> saved;
+  if (overlap) {
+    const std::size_t need = static_cast<std::size_t>((a + P) * L);
+    if (saved.size() < need) saved.resize(need);
+    const int tl = len - L;
+    for (int p = 0; p < P; ++p) std::memcpy(saved.data() + p * L, x[p] + tl, sizeof(Scalar) * L);
+    for (int i = 0; i < a; ++i) std::memcpy(saved.data() + (P + i) * L, w0 + i * ws + tl, sizeof(Scalar) * L);
+  }
   if constexpr (B >= 32) {  // 16 vector registers: 12 sums of Z, 3 rows of W, 1 coefficient
     for (; t0 + 3 * L <= len; t0 += 3 * L) applyReflectorsChunk<Scalar, B, P, 3>(x, w0, ws, a, t0, v, vv, T);
   }
   for (; t0 + 2 * L <= len; t0 += 2 * L) applyReflectorsChunk<Scalar, B, P, 2>(x, w0, ws, a, t0, v, vv, T);
   for (; t0 + L <= len; t0 += L) applyReflectorsChunk<Scalar, B, P, 1>(x, w0, ws, a, t0, v, vv, T);
+  if (overlap) {
+    Scalar* sx[P];
+    for (int p = 0; p < P; ++p) sx[p] = saved.data() + p * L;
+    applyReflectorsChunk<Scalar, B, P, 1>(sx, saved.data() + P * L, L, a, 0, v, vv, T);
+    // Whole vectors back (one load and store each; the overlapped columns get their own values).
+    const int tl = len - L;
+    for (int p = 0; p < P; ++p) std::memcpy(x[p] + tl, saved.data() + p * L, sizeof(Scalar) * L);
+    for (int i = 0; i < a; ++i) std::memcpy(w0 + i * ws + tl, saved.data() + (P + i) * L, sizeof(Scalar) * L);
+    return;
+  }
 #endif
   applyReflectorsTail<Scalar, P>(x, w0, ws, a, t0, len, v, T);
 }
