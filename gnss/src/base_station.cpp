@@ -249,30 +249,41 @@ void BaseStation::extrapolate(int b, const GpsTime& t, BaseSnapshot& out) {
     for (int k = first; k < b; ++k) model(epochs_[static_cast<std::size_t>(k)]);
     eb.rates.assign(eb.signals.size(), std::numeric_limits<double>::quiet_NaN());
     std::vector<double> all;
-    std::vector<std::size_t> cursor(static_cast<std::size_t>(b - first), 0);
-    for (std::size_t i = 0; i < eb.signals.size(); ++i) {
-      const BaseSignal& s1 = eb.signals[i];
-      if (!s1.hasPhase) continue;
-      // Sums for the slope over (t - t_b, omc - omc_b), the held epoch included.
+    // Sums for the slope over (t - t_b, omc - omc_b), the held epoch included. Epochs outer,
+    // signals inner: both signal lists are sorted, so each epoch is one merge pass over
+    // contiguous memory (signals outer touched every epoch's list once per signal: 7000 scattered
+    // reads per base epoch, 0.2 ms). Per signal the sums still run over the epochs in order.
+    struct Sums {
       double n = 1.0, st = 0.0, sy = 0.0, stt = 0.0, sty = 0.0, tmin = 0.0;
-      for (int k = first; k < b; ++k) {
-        const Epoch& e = epochs_[static_cast<std::size_t>(k)];
-        std::size_t& j = cursor[static_cast<std::size_t>(k - first)];
+    };
+    std::vector<Sums> sums(eb.signals.size());
+    for (int k = first; k < b; ++k) {
+      const Epoch& e = epochs_[static_cast<std::size_t>(k)];
+      const double x = e.time - eb.time;
+      std::size_t j = 0;
+      for (std::size_t i = 0; i < eb.signals.size(); ++i) {
+        const BaseSignal& s1 = eb.signals[i];
+        if (!s1.hasPhase) continue;
         while (j < e.signals.size() && signalLess(e.signals[j], s1)) ++j;
-        if (j == e.signals.size()) continue;
+        if (j == e.signals.size()) break;
         const BaseSignal& s0 = e.signals[j];
         if (!(s0.sat == s1.sat) || !(s0.code == s1.code) || !s0.hasPhase || !(s0.arcStart == s1.arcStart)) continue;
-        const double x = e.time - eb.time, y = s0.phaseOmc - s1.phaseOmc;
-        n += 1.0;
-        st += x;
-        sy += y;
-        stt += x * x;
-        sty += x * y;
-        tmin = std::min(tmin, x);
+        const double y = s0.phaseOmc - s1.phaseOmc;
+        Sums& a = sums[i];
+        a.n += 1.0;
+        a.st += x;
+        a.sy += y;
+        a.stt += x * x;
+        a.sty += x * y;
+        a.tmin = std::min(a.tmin, x);
       }
-      const double den = n * stt - st * st;
-      if (n < 2.0 || -tmin < kMinRateSpan || !(den > 0.0)) continue;
-      eb.rates[i] = (n * sty - st * sy) / den;
+    }
+    for (std::size_t i = 0; i < eb.signals.size(); ++i) {
+      if (!eb.signals[i].hasPhase) continue;
+      const Sums& a = sums[i];
+      const double den = a.n * a.stt - a.st * a.st;
+      if (a.n < 2.0 || -a.tmin < kMinRateSpan || !(den > 0.0)) continue;
+      eb.rates[i] = (a.n * a.sty - a.st * a.sy) / den;
       all.push_back(eb.rates[i]);
     }
     eb.ratesUsable = all.size() >= 3;
