@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numeric>
 #include <vector>
 
@@ -26,8 +27,7 @@ void Measurement<Scalar>::reset(int rows) {
 }
 
 template <typename Scalar>
-Eigen::Block<typename Measurement<Scalar>::Matrix> Measurement<Scalar>::jacobian(BlockId id,
-                                                                                 int dim) {
+Eigen::Block<typename Measurement<Scalar>::JacobianMatrix> Measurement<Scalar>::jacobian(BlockId id, int dim) {
   if (!id.valid() || dim <= 0) {
     throw std::invalid_argument("sri::Measurement::jacobian: invalid block id or dimension");
   }
@@ -53,7 +53,7 @@ void Measurement<Scalar>::rotateRows(int a, int b, Scalar c, Scalar s) {
   if (a < 0 || b < 0 || a >= rows() || b >= rows() || a == b) {
     throw std::invalid_argument("sri::Measurement::rotateRows: bad row pair");
   }
-  auto rot = [&](Matrix& M) {
+  auto rot = [&](auto& M) {
     for (Eigen::Index col = 0; col < M.cols(); ++col) {
       const Scalar x = M(a, col), y = M(b, col);
       M(a, col) = c * x + s * y;
@@ -191,26 +191,18 @@ int Measurement<Scalar>::projectNuisance(Measurement* nuisanceRows) {
     return m;
   }
   // Zero the nuisance column j below row j, from the bottom up, with rotations of adjacent rows;
-  // the rows j+1.. of the nuisance columns then span its left null space. The rotations run on
-  // a row-major copy of [nuisance H r] (contiguous rows instead of strided column-major ones;
-  // the same operations element by element); columns < j of the nuisance are already zero in
-  // both rows and are skipped. The copy is a per-thread buffer (not a member: measurements are
-  // copied when stacked, and a member buffer would be copied with them).
+  // the rows j+1.. of the nuisance columns then span its left null space. H is row-major, so the
+  // rotations run on contiguous rows in place; columns < j of the nuisance are already zero in
+  // both rows and are skipped.
   const int p = static_cast<int>(H_.cols());
-  const int w = q + p + 1;
-  static thread_local RowMatrix<Scalar> A;
-  A.resize(m, w);
-  A.leftCols(q) = nuisance_;
-  A.middleCols(q, p) = H_;
-  A.col(q + p) = residual_;
-  // First non-zero column of every row within [H r] (an MSCKF row has its clone's columns and
-  // the calibration blocks after them; rows are in observation order): a rotation of rows i − 1
-  // and i only touches the columns from the smaller of their leads on (zeros in both stay zero),
-  // and both rows then start there.
+  // First non-zero column of every row of H (an MSCKF row has its clone's columns and the
+  // calibration blocks after them; rows are in observation order): a rotation of rows i − 1 and
+  // i only touches the columns from the smaller of their leads on (zeros in both stay zero), and
+  // both rows then start there.
   static thread_local std::vector<int> lead;
   lead.resize(static_cast<std::size_t>(m));
   for (int i = 0; i < m; ++i) {
-    const Scalar* h = A.row(i).data() + q;
+    const Scalar* h = H_.row(i).data();
     int l = 0;
     while (l < p && h[l] == Scalar(0)) ++l;
     lead[static_cast<std::size_t>(i)] = l;
@@ -225,28 +217,41 @@ int Measurement<Scalar>::projectNuisance(Measurement* nuisanceRows) {
   };
   for (int j = 0; j < q; ++j) {
     for (int i = m - 1; i > j; --i) {
-      Scalar* yrow = A.row(i).data();
-      const Scalar b = yrow[j];
+      const Scalar b = nuisance_(i, j);
       if (b == Scalar(0)) continue;
-      Scalar* xrow = A.row(i - 1).data();
       Scalar c, s;
-      makeGivens(xrow[j], b, c, s);
-      rotate(xrow + j, yrow + j, q - j, c, s);
+      makeGivens(nuisance_(i - 1, j), b, c, s);
+      for (int k = j; k < q; ++k) {
+        const Scalar xv = nuisance_(i - 1, k);
+        const Scalar yv = nuisance_(i, k);
+        nuisance_(i - 1, k) = c * xv + s * yv;
+        nuisance_(i, k) = c * yv - s * xv;
+      }
       int& lx = lead[static_cast<std::size_t>(i - 1)];
       int& ly = lead[static_cast<std::size_t>(i)];
       const int l = std::min(lx, ly);
       lx = ly = l;
-      rotate(xrow + q + l, yrow + q + l, p + 1 - l, c, s);
+      rotate(H_.row(i - 1).data() + l, H_.row(i).data() + l, p - l, c, s);
+      const Scalar xv = residual_(i - 1);
+      const Scalar yv = residual_(i);
+      residual_(i - 1) = c * xv + s * yv;
+      residual_(i) = c * yv - s * xv;
     }
   }
   const int keep = m - q;
   if (nuisanceRows) {
-    nuisanceRows->nuisance_ = A.topRows(q).leftCols(q).template triangularView<Eigen::Upper>();
-    nuisanceRows->H_ = A.topRows(q).middleCols(q, p);
-    nuisanceRows->residual_ = A.topRows(q).col(q + p);
+    nuisanceRows->nuisance_ = nuisance_.topRows(q).template triangularView<Eigen::Upper>();
+    nuisanceRows->H_ = H_.topRows(q);
+    nuisanceRows->residual_ = residual_.head(q);
   }
-  H_ = A.bottomRows(keep).middleCols(q, p);
-  residual_ = A.bottomRows(keep).col(q + p);
+  // The kept rows to the front (contiguous in row-major storage), then shrink.
+  if (p > 0) {
+    std::memmove(H_.data(), H_.data() + static_cast<std::ptrdiff_t>(q) * p,
+                 sizeof(Scalar) * static_cast<std::size_t>(keep) * static_cast<std::size_t>(p));
+  }
+  std::memmove(residual_.data(), residual_.data() + q, sizeof(Scalar) * static_cast<std::size_t>(keep));
+  H_.conservativeResize(keep, p);
+  residual_.conservativeResize(keep);
   nuisance_.resize(keep, 0);
   return q;
 }
@@ -303,9 +308,11 @@ void Measurement<Scalar>::stack(const Measurement& other) {
   }
   const int m0 = rows();
   const int m1 = other.rows();
-  Matrix H = Matrix::Zero(m0 + m1, H_.cols());
-  H.topRows(m0) = H_;
+  // The joint block list first (other's new blocks after mine), then one allocation.
   std::vector<Entry> blocks = blocks_;
+  std::vector<int> colOf;  // column of each of other's blocks in the joint list
+  colOf.reserve(other.blocks_.size());
+  int cols = static_cast<int>(H_.cols());
   for (const Entry& e : other.blocks_) {
     int col = -1;
     for (const Entry& mine : blocks) {
@@ -315,12 +322,17 @@ void Measurement<Scalar>::stack(const Measurement& other) {
       }
     }
     if (col < 0) {
-      col = static_cast<int>(H.cols());
-      H.conservativeResize(Eigen::NoChange, col + e.dim);
-      H.rightCols(e.dim).setZero();
+      col = cols;
+      cols += e.dim;
       blocks.push_back({e.id, col, e.dim});
     }
-    H.block(m0, col, m1, e.dim) = other.H_.block(0, e.col, m1, e.dim);
+    colOf.push_back(col);
+  }
+  JacobianMatrix H = JacobianMatrix::Zero(m0 + m1, cols);
+  H.topLeftCorner(m0, H_.cols()) = H_;
+  for (std::size_t k = 0; k < other.blocks_.size(); ++k) {
+    const Entry& e = other.blocks_[k];
+    H.block(m0, colOf[k], m1, e.dim) = other.H_.block(0, e.col, m1, e.dim);
   }
   Vector r(m0 + m1);
   r << residual_, other.residual_;

@@ -23,6 +23,10 @@ template <typename Scalar>
 class Measurement {
  public:
   using Matrix = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
+  /// The stacked Jacobian's storage: row-major, so that the row operations of the null-space
+  /// projection, the compression and the filter update (which copies rows into its row-major
+  /// work matrix) run on contiguous memory.
+  using JacobianMatrix = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   using Vector = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
 
   explicit Measurement(int rows = 0) { reset(rows); }
@@ -34,7 +38,7 @@ class Measurement {
   /// Jacobian w.r.t. a state block, rows() × dim (error-state columns with the block's
   /// convention, block.hpp). Zero on first access; later calls return the same columns and
   /// throw std::invalid_argument if `dim` differs.
-  Eigen::Block<Matrix> jacobian(BlockId id, int dim);
+  Eigen::Block<JacobianMatrix> jacobian(BlockId id, int dim);
   /// Declares block columns at once (one allocation, zero-initialised), appended in this order;
   /// blocks already present are kept (their dimension must match). Saves the reallocation that
   /// every new block costs in jacobian() when many blocks are stacked.
@@ -53,11 +57,11 @@ class Measurement {
   int numBlocks() const { return static_cast<int>(blocks_.size()); }
   BlockId blockId(int i) const { return blocks_[static_cast<std::size_t>(i)].id; }
   int blockDim(int i) const { return blocks_[static_cast<std::size_t>(i)].dim; }
-  Eigen::Block<const Matrix> jacobianAt(int i) const {
+  Eigen::Block<const JacobianMatrix> jacobianAt(int i) const {
     const Entry& e = blocks_[static_cast<std::size_t>(i)];
     return H_.block(0, e.col, rows(), e.dim);
   }
-  Eigen::Block<Matrix> jacobianAt(int i) {
+  Eigen::Block<JacobianMatrix> jacobianAt(int i) {
     const Entry& e = blocks_[static_cast<std::size_t>(i)];
     return H_.block(0, e.col, rows(), e.dim);
   }
@@ -65,7 +69,7 @@ class Measurement {
   /// [row a; row b] ← [c s; −s c] [row a; row b]; whitened rows stay whitened.
   void rotateRows(int a, int b, Scalar c, Scalar s);
   /// All block columns side by side (rows() × Σ dims), in insertion order.
-  const Matrix& stackedJacobian() const { return H_; }
+  const JacobianMatrix& stackedJacobian() const { return H_; }
 
   // --- Noise. The filter needs unit-covariance rows; one of these must be called once.
   /// Rows already have unit noise covariance.
@@ -116,7 +120,7 @@ class Measurement {
   template <typename Op>
   void transformRows(Op&& op);
 
-  Matrix H_;         // rows × Σ block dims
+  JacobianMatrix H_;  // rows × Σ block dims
   Matrix nuisance_;  // rows × nuisance dim
   Vector residual_;
   std::vector<Entry> blocks_;
