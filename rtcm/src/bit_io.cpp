@@ -15,7 +15,8 @@ void BitReader::need(std::size_t bits, const char* field) const {
 void BitWriter::put(int bits, std::uint64_t v) {
   for (int k = bits - 1; k >= 0; --k) {
     if ((bits_ & 7) == 0) buf_.push_back(0);
-    if ((v >> k) & 1u) buf_.back() |= static_cast<std::uint8_t>(0x80u >> (bits_ & 7));
+    // A field wider than 64 bits (e.g. a zero-filled block) has zeros above bit 63.
+    if (k < 64 && ((v >> k) & 1u)) buf_.back() |= static_cast<std::uint8_t>(0x80u >> (bits_ & 7));
     ++bits_;
   }
 }

@@ -12,7 +12,7 @@ namespace gvins::rtcm {
 
 class BitWriter {
  public:
-  /// Unsigned field of 1..64 bits; throws if v >= 2^bits.
+  /// Unsigned field of 1..64 bits (wider: zeros above bit 63); throws if v >= 2^bits.
   void u(int bits, std::uint64_t v, const char* field);
   /// Two's complement field; throws if v is outside [-2^(bits-1), 2^(bits-1)).
   void s(int bits, std::int64_t v, const char* field);
