@@ -14,6 +14,17 @@
 
 namespace gvins::sri {
 
+namespace {
+/// (x, y) ← (c x + s y, c y − s x): one entry pair of a Givens rotation of two rows.
+template <typename Scalar>
+inline void rotatePair(Scalar& x, Scalar& y, Scalar c, Scalar s) {
+  const Scalar xv = x;
+  const Scalar yv = y;
+  x = c * xv + s * yv;
+  y = c * yv - s * xv;
+}
+}  // namespace
+
 template <typename Scalar>
 void Measurement<Scalar>::reset(int rows) {
   if (rows < 0) throw std::invalid_argument("sri::Measurement: negative row count");
@@ -54,17 +65,11 @@ void Measurement<Scalar>::rotateRows(int a, int b, Scalar c, Scalar s) {
     throw std::invalid_argument("sri::Measurement::rotateRows: bad row pair");
   }
   auto rot = [&](auto& M) {
-    for (Eigen::Index col = 0; col < M.cols(); ++col) {
-      const Scalar x = M(a, col), y = M(b, col);
-      M(a, col) = c * x + s * y;
-      M(b, col) = c * y - s * x;
-    }
+    for (Eigen::Index col = 0; col < M.cols(); ++col) rotatePair(M(a, col), M(b, col), c, s);
   };
   rot(H_);
   rot(nuisance_);
-  const Scalar x = residual_(a), y = residual_(b);
-  residual_(a) = c * x + s * y;
-  residual_(b) = c * y - s * x;
+  rotatePair(residual_(a), residual_(b), c, s);
 }
 
 template <typename Scalar>
@@ -207,35 +212,21 @@ int Measurement<Scalar>::projectNuisance(Measurement* nuisanceRows) {
     while (l < p && h[l] == Scalar(0)) ++l;
     lead[static_cast<std::size_t>(i)] = l;
   }
-  auto rotate = [](Scalar* x, Scalar* y, int len, Scalar c, Scalar s) {
-    for (int col = 0; col < len; ++col) {
-      const Scalar xv = x[col];
-      const Scalar yv = y[col];
-      x[col] = c * xv + s * yv;
-      y[col] = c * yv - s * xv;
-    }
-  };
   for (int j = 0; j < q; ++j) {
     for (int i = m - 1; i > j; --i) {
       const Scalar b = nuisance_(i, j);
       if (b == Scalar(0)) continue;
       Scalar c, s;
       makeGivens(nuisance_(i - 1, j), b, c, s);
-      for (int k = j; k < q; ++k) {
-        const Scalar xv = nuisance_(i - 1, k);
-        const Scalar yv = nuisance_(i, k);
-        nuisance_(i - 1, k) = c * xv + s * yv;
-        nuisance_(i, k) = c * yv - s * xv;
-      }
+      for (int k = j; k < q; ++k) rotatePair(nuisance_(i - 1, k), nuisance_(i, k), c, s);
       int& lx = lead[static_cast<std::size_t>(i - 1)];
       int& ly = lead[static_cast<std::size_t>(i)];
       const int l = std::min(lx, ly);
       lx = ly = l;
-      rotate(H_.row(i - 1).data() + l, H_.row(i).data() + l, p - l, c, s);
-      const Scalar xv = residual_(i - 1);
-      const Scalar yv = residual_(i);
-      residual_(i - 1) = c * xv + s * yv;
-      residual_(i) = c * yv - s * xv;
+      Scalar* x = H_.row(i - 1).data();
+      Scalar* y = H_.row(i).data();
+      for (int col = l; col < p; ++col) rotatePair(x[col], y[col], c, s);
+      rotatePair(residual_(i - 1), residual_(i), c, s);
     }
   }
   const int keep = m - q;

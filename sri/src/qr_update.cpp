@@ -268,13 +268,12 @@ GVINS_SRI_INLINE void applyReflectors(Scalar* const* x, Scalar* w0, std::ptrdiff
   // chunk is computed on the copy, so the overlapped columns get the same values twice (columns
   // are independent, the per-lane operations are the same). The scalar tail cost as much as the
   // vectors on ~100-column trailing blocks with float's 8 lanes (docs/sri_core.md).
-  const int rem = len % L;
-  const bool overlap = rem != 0 && len >= L;
+  const bool overlap = len % L != 0 && len >= L;
+  const int tl = len - L;  // first column of the overlapping vector
   static thread_local std::vector<Scalar> saved;
   if (overlap) {
     const std::size_t need = static_cast<std::size_t>((a + P) * L);
     if (saved.size() < need) saved.resize(need);
-    const int tl = len - L;
     for (int p = 0; p < P; ++p) std::memcpy(saved.data() + p * L, x[p] + tl, sizeof(Scalar) * L);
     for (int i = 0; i < a; ++i) std::memcpy(saved.data() + (P + i) * L, w0 + i * ws + tl, sizeof(Scalar) * L);
   }
@@ -288,7 +287,6 @@ GVINS_SRI_INLINE void applyReflectors(Scalar* const* x, Scalar* w0, std::ptrdiff
     for (int p = 0; p < P; ++p) sx[p] = saved.data() + p * L;
     applyReflectorsChunk<Scalar, B, P, 1>(sx, saved.data() + P * L, L, a, 0, v, vv, T);
     // Whole vectors back (one load and store each; the overlapped columns get their own values).
-    const int tl = len - L;
     for (int p = 0; p < P; ++p) std::memcpy(x[p] + tl, saved.data() + p * L, sizeof(Scalar) * L);
     for (int i = 0; i < a; ++i) std::memcpy(w0 + i * ws + tl, saved.data() + (P + i) * L, sizeof(Scalar) * L);
     return;
