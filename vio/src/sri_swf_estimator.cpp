@@ -124,6 +124,19 @@ struct SriSwfEstimator<Scalar>::Impl {
   Eigen::Vector3d fe_v = Eigen::Vector3d::Zero();
   std::int64_t t_init = 0;
   mutable std::vector<double> chi2_thr;
+  // Client gates (update(m, p)): the quantiles of the last probability asked for, by dof.
+  double client_gate_p = -1.0;
+  std::vector<double> client_gate_thr;
+  double clientGate(double p, int dof) {
+    if (p != client_gate_p) {
+      client_gate_p = p;
+      client_gate_thr.clear();
+    }
+    if (static_cast<int>(client_gate_thr.size()) <= dof) client_gate_thr.resize(static_cast<std::size_t>(dof + 1), -1.0);
+    double& q = client_gate_thr[static_cast<std::size_t>(dof)];
+    if (q < 0.0) q = sri::chiSquareQuantile(p, dof);
+    return q;
+  }
   std::function<void(const char*)> observer;  // setStepObserver (diagnostics)
   void notify(const char* step) {
     if (observer) observer(step);
@@ -1835,7 +1848,7 @@ BackendUpdate<Scalar> SriSwfEstimator<Scalar>::update(const sri::Measurement<Sca
   // for rows on the trailing blocks (GNSS) a copy of that block instead of chiSquare()'s solves.
   sri::UpdateOptions opt;
   const int dof = m.rows() + m.discardedRows();
-  if (gate_probability < 1.0 && dof > 0) opt.max_chi2 = sri::chiSquareQuantile(gate_probability, dof);
+  if (gate_probability < 1.0 && dof > 0) opt.max_chi2 = impl_->clientGate(gate_probability, dof);
   const sri::UpdateResult<Scalar> u = impl_->f.update(m, opt);
   out.chi2 = u.chi2;
   out.dof = u.dof;

@@ -140,6 +140,7 @@ class GnssFusion {
   Eigen::Vector3d carriedLever() const;
 
   GnssFusionConfig config_;
+  std::optional<double> rowGateQuantile_;  // χ²(1) quantile of config_.rowGate, once
   GnssFusionStage stage_ = GnssFusionStage::kWaitingVio;
   std::uint64_t generation_ = 0;  // estimator generation the ids below belong to
   GnssAnchor anchor_;
