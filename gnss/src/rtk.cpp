@@ -88,6 +88,7 @@ void RtkSolver::addBaseEpoch(const ObsEpoch& epoch) { base_.addEpoch(epoch); }
 
 void RtkSolver::reset() {
   filter_ = Filter();
+  held_.clear();
   amb_.clear();
   initialized_ = false;
   consecutiveFixes_ = 0;
@@ -369,6 +370,32 @@ bool RtkSolver::rejectOutlier(RtkSolution& sol) {
   return true;
 }
 
+std::optional<double> RtkSolver::differencesWithHeldFix(const ObsEpoch& rover, const Eigen::Vector3d& x, int& fixed,
+                                                       TransmitStates* states) {
+  fixed = 0;
+  const std::optional<double> age = differences(rover, x, states);
+  if (!age || held_.empty()) return age;
+  auto signal = [&](int i) {
+    const SingleDifference& s = dd_.sd[static_cast<std::size_t>(i)];
+    return HeldSignal{s.sat, s.code, s.roverArc, s.baseArc};
+  };
+  for (DoubleDifference& d : dd_.phase) {
+    const HeldSignal sat = signal(d.satellite), ref = signal(d.reference);
+    const SingleDifference& s = dd_.sd[static_cast<std::size_t>(d.satellite)];
+    const SingleDifference& f = dd_.sd[static_cast<std::size_t>(d.reference)];
+    if (s.halfCycle || f.halfCycle || s.roverSlip || s.baseSlip || f.roverSlip || f.baseSlip) continue;
+    for (const HeldDd& h : held_) {
+      if (h.satellite == sat && h.reference == ref) {
+        d.fixedCycles = h.cycles;
+        d.ambiguityMeters = h.meters;
+        ++fixed;
+        break;
+      }
+    }
+  }
+  return age;
+}
+
 std::optional<double> RtkSolver::differences(const ObsEpoch& rover, const Eigen::Vector3d& x, TransmitStates* states) {
   GlonassChannels ch = roverChannels_;
   ch.mergeMissing(nav_.glonassChannels());
@@ -383,6 +410,7 @@ std::optional<double> RtkSolver::differences(const ObsEpoch& rover, const Eigen:
 }
 
 RtkSolution RtkSolver::process(const ObsEpoch& rover, TransmitStates* states) {
+  held_.clear();  // filled again below if this epoch ends fixed
   RtkSolution sol;
   sol.time = rover.time;
   const SppSolution spp = spp_.solve(rover);
@@ -524,6 +552,16 @@ RtkSolution RtkSolver::process(const ObsEpoch& rover, TransmitStates* states) {
     sol.velocityCovariance = filter_.covariance(vid);
   }
   resolve(sol);
+  // The fix to hold (differencesWithHeldFix): the DD phases that got an ambiguity.
+  if (sol.quality == SolutionQuality::Fix) {
+    for (const DoubleDifference& d : dd_.phase) {
+      if (!d.ambiguityMeters || !d.fixedCycles) continue;
+      const SingleDifference& s = dd_.sd[static_cast<std::size_t>(d.satellite)];
+      const SingleDifference& f = dd_.sd[static_cast<std::size_t>(d.reference)];
+      held_.push_back({{s.sat, s.code, s.roverArc, s.baseArc}, {f.sat, f.code, f.roverArc, f.baseArc}, *d.fixedCycles,
+                       *d.ambiguityMeters});
+    }
+  }
   return sol;
 }
 

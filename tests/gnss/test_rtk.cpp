@@ -446,6 +446,69 @@ TEST(CycleSlips, InjectedSlipsAreDetectedAndTheFixSurvives) {
   }
 }
 
+// RtkSolver::differencesWithHeldFix (the fusion's Ddcp between base epochs): the module runs
+// every fifth epoch and the epochs in between take its fix. The held integers are those an every-
+// epoch run resolves for the same pairs, the held DD phase residuals at the surveyed position are
+// at the centimetre level, and a slip between two runs takes the slipped satellite's DDs out of
+// the held set until the module runs again.
+TEST(RtkHeldFix, EpochsBetweenRunsTakeTheSameIntegers) {
+  const Dataset& d = nagoya();
+  const SatId g = SatId(System::Gps, 13);
+  const RunResult every = runRtk(d, nagoyaConfig(), d.base, 0, 60, true);
+  for (const bool slipped : {false, true}) {
+    const auto doctor = slip(g, '1', 5, 32);  // between the runs at 30 and 35
+    RtkSolver s(d.nav, nagoyaConfig());
+    s.setRoverGlonassChannels(d.roverHeader.glonassChannels);
+    s.setBaseGlonassChannels(d.baseHeader.glonassChannels);
+    s.setBasePosition(d.basePosition);
+    std::size_t b = 0;
+    int held = 0, compared = 0, slippedHeld = 0;
+    for (int i = 0; i < 60; ++i) {
+      ObsEpoch e = d.rover[static_cast<std::size_t>(i)];
+      if (slipped) doctor(e, i);
+      while (b < d.base.size() && (b == 0 || d.base[b - 1].time - e.time <= BaseStation::kSyncTolerance)) {
+        s.addBaseEpoch(d.base[b]);
+        ++b;
+      }
+      if (i % 5 == 0) {
+        (void)s.process(e);
+        continue;
+      }
+      int fixed = 0;
+      ASSERT_TRUE(s.differencesWithHeldFix(e, d.truth, fixed).has_value()) << i;
+      if (i > 5) EXPECT_GT(fixed, 10) << i;  // fixed from the first runs on (every epoch fixes)
+      const DdEpoch& h = s.measurements();
+      const DdEpoch& ref = every.dd[static_cast<std::size_t>(i)];
+      for (const DoubleDifference& dd : h.phase) {
+        if (!dd.ambiguityMeters) continue;
+        ++held;
+        const SingleDifference& sd = h.sd[static_cast<std::size_t>(dd.satellite)];
+        const SingleDifference& rd = h.sd[static_cast<std::size_t>(dd.reference)];
+        if (i >= 32 && i < 35 && (sd.sat == g || rd.sat == g) && sd.code.band == '1') ++slippedHeld;
+        EXPECT_LT(std::abs(ddPhaseResidual(h, dd, d.truth).residual), 0.03) << i;
+        // The every-epoch run's fix of the same pair, where it has one.
+        for (const DoubleDifference& q : ref.phase) {
+          const SingleDifference& qs = ref.sd[static_cast<std::size_t>(q.satellite)];
+          const SingleDifference& qr = ref.sd[static_cast<std::size_t>(q.reference)];
+          if (qs.sat != sd.sat || qs.code != sd.code || qr.sat != rd.sat || qr.code != rd.code || !q.fixedCycles) continue;
+          if (slipped && i >= 32 && (sd.sat == g || rd.sat == g)) continue;  // that run has no slip
+          EXPECT_EQ(*q.fixedCycles, *dd.fixedCycles) << i;
+          ++compared;
+        }
+      }
+    }
+    std::printf("held fix (%s): %d held DD phases, %d compared with the every-epoch run, G13 L1 held after 32: %d\n",
+                slipped ? "slip at 32" : "no slip", held, compared, slippedHeld);
+    EXPECT_GT(held, 1000) << slipped;
+    EXPECT_GT(compared, 800) << slipped;
+    if (slipped) {
+      EXPECT_EQ(slippedHeld, 0);  // the slipped signal left the held set until the next run
+    } else {
+      EXPECT_GT(slippedHeld, 0);  // without the slip it is held there
+    }
+  }
+}
+
 TEST(CycleSlips, DetectorTests) {
   const Dataset& d = nagoya();
   CycleSlipDetector det;

@@ -138,9 +138,20 @@ class RtkSolver {
   /// differences about the rover position `x`), without SPP, the float filter and ambiguity
   /// resolution: for users of the code differences alone (e.g. the fusion's SD pseudoranges).
   /// The differences go to measurements(); returns the base data's age (s), or nullopt when
-  /// the base has no usable data for this epoch (measurements() is then empty). Do not mix
-  /// with process() on the same solver.
+  /// the base has no usable data for this epoch (measurements() is then empty). Between
+  /// process() epochs it only forms differences (the float filter and its ambiguities wait for
+  /// the next process(), which predicts over the whole interval).
   std::optional<double> differences(const ObsEpoch& rover, const Eigen::Vector3d& x, TransmitStates* states = nullptr);
+  /// differences() with the fixed ambiguities of the last process() epoch that ended fixed, on
+  /// the DD phases whose satellite and reference signals continue the arcs they had then (same
+  /// rover and base arc starts: no slip, no gap since). For a caller that runs the whole module
+  /// only now and then (the fusion's Ddcp at the base epochs) and holds the fix in between.
+  /// Returns the base data's age as differences() does; `fixed` receives the number of DD phases
+  /// that got an ambiguity.
+  std::optional<double> differencesWithHeldFix(const ObsEpoch& rover, const Eigen::Vector3d& x, int& fixed,
+                                               TransmitStates* states = nullptr);
+  /// True when the last process() epoch ended fixed (its fix is held for differencesWithHeldFix).
+  bool hasHeldFix() const { return !held_.empty(); }
   /// Forgets the float solution and all ambiguities (base buffer and slip history stay).
   void reset();
 
@@ -194,6 +205,18 @@ class RtkSolver {
   std::unordered_set<std::uint32_t> forced_;  // ambiguities to re-initialise (post-fit outliers)
   DdEpoch dd_;
   BaseSnapshot snapshot_;
+  /// The fixed DD phases of the last process() epoch that ended fixed (differencesWithHeldFix).
+  struct HeldSignal {
+    SatId sat;
+    ObsCode code;
+    GpsTime roverArc, baseArc;
+    bool operator==(const HeldSignal&) const = default;
+  };
+  struct HeldDd {
+    HeldSignal satellite, reference;
+    double cycles = 0.0, meters = 0.0;
+  };
+  std::vector<HeldDd> held_;
   int consecutiveFixes_ = 0;
   /// Previous resolution's DD ambiguities (SD block ids of satellite and reference) and its
   /// reduced basis: the next epoch's LAMBDA starts from it (ReductionStart) while none of these
