@@ -656,8 +656,13 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
   // fusion's satellite models.
   TransmitStates states(nav, rover.time);
   std::optional<double> baseAge;
+  // Ddcp runs the whole RTK module at every epoch until it fixes, then at the base epochs only
+  // (no extrapolated base there) and holds the fix in between (RtkSolver::differencesWithHeldFix,
+  // in the tight stage below): the ambiguities are constant along the arcs.
+  bool rtkProcessed = false;
   if (rtk_) {
-    if (base && (!lastBase_ || base->time > *lastBase_)) {
+    const bool newBase = base && (!lastBase_ || base->time > *lastBase_);
+    if (newBase) {
       if (baseSmoother_) {
         ObsEpoch b = *base;
         baseSmoother_->apply(b, nav.glonassChannels());
@@ -667,10 +672,11 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
       }
       lastBase_ = base->time;
     }
-    if (fullRtk) {
+    if (fullRtk && (newBase || !rtk_->hasHeldFix() || !config_.rtkHoldFix)) {
       const RtkSolution rtk = rtk_->process(roverRaw, &states);
       rep.rtkFixed = rtk.quality == SolutionQuality::Fix;
       baseAge = rtk.age;
+      rtkProcessed = true;
     }
   }
   // A new estimator state (the VIO started again, EstimatorBackend::generation): the client
@@ -911,6 +917,11 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
     const std::size_t nIndependent = rows.size();
     std::vector<DoubleDifference> phase;
     if (rtk_ && !fullRtk) baseAge = rtk_->differences(rover, k.x_E, &states);
+    if (fullRtk && !rtkProcessed) {
+      int heldFixed = 0;
+      baseAge = rtk_->differencesWithHeldFix(roverRaw, k.x_E, heldFixed, &states);
+      rep.rtkFixed = heldFixed > 0;
+    }
     if (baseAge && config_.usesDifferences() && *baseAge <= config_.maxBaseAge) {
       const DdEpoch& e = rtk_->measurements();
       // Base clock per system: mean base code OMC (clock + errors common to the base).

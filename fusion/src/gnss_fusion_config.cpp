@@ -136,6 +136,8 @@ GnssFusionConfig parseGnssFusionConfig(std::string_view yaml, const std::string&
       c.broadcastRecordChanges = rd.boolean(v, f);
     } else if (key == "phase_windup") {
       c.phaseWindup = rd.boolean(v, f);
+    } else if (key == "rtk_hold_fix") {
+      c.rtkHoldFix = rd.boolean(v, f);
     } else if (key == "max_ambiguities") {
       c.maxAmbiguities = static_cast<int>(rd.number(v, f, 0.0, 1000.0));
     } else if (key == "estimate_zwd") {
@@ -171,7 +173,7 @@ GnssFusionConfig parseGnssFusionConfig(std::string_view yaml, const std::string&
   static const std::set<std::string> kKeys = {
       "mode", "lever_arm", "calibrate_lever_arm", "lever_arm_sigma", "min_rotation_rate", "systems",
       "elevation_mask_deg", "ionosphere", "bands", "ephemeris_error_m", "precise_ephemeris_error_m", "code_sigma",
-      "carrier_smoothing", "smoothed_code_factor", "phase_sigma", "ambiguity_sigma", "ambiguity_reset_rejections", "max_ambiguities", "phase_windup", "broadcast_ambiguity_random_walk", "broadcast_record_changes", "estimate_zwd", "zwd_sigma", "zwd_random_walk",
+      "carrier_smoothing", "smoothed_code_factor", "phase_sigma", "ambiguity_sigma", "ambiguity_reset_rejections", "max_ambiguities", "phase_windup", "rtk_hold_fix", "broadcast_ambiguity_random_walk", "broadcast_record_changes", "estimate_zwd", "zwd_sigma", "zwd_random_walk",
       "doppler_sigma",
       "clock_bias_random_walk", "clock_drift_random_walk", "row_gate", "epoch_gate", "frame_yaw_sigma_deg",
       "frame_min_speed", "outage_reset", "clock_ransac_threshold", "base_position", "max_base_age"};

@@ -63,7 +63,8 @@ TEST(GnssFusionConfig, FloatPppKeys) {
       "  phase_windup: false\n"
       "  max_ambiguities: 25\n"
       "  broadcast_ambiguity_random_walk: 0.01\n"
-      "  broadcast_record_changes: false\n");
+      "  broadcast_record_changes: false\n"
+      "  rtk_hold_fix: false\n");
   EXPECT_EQ(c.mode, GnssFusionMode::kDoppPpp);
   EXPECT_TRUE(c.usesPseudorange());
   EXPECT_FALSE(c.usesDifferences());
@@ -79,6 +80,8 @@ TEST(GnssFusionConfig, FloatPppKeys) {
   EXPECT_DOUBLE_EQ(c.broadcastAmbiguityRandomWalk, 0.01);
   EXPECT_FALSE(c.broadcastRecordChanges);
   EXPECT_TRUE(GnssFusionConfig{}.broadcastRecordChanges);
+  EXPECT_FALSE(c.rtkHoldFix);
+  EXPECT_TRUE(GnssFusionConfig{}.rtkHoldFix);
   // The wet delay state: on by default in vio+dopp+ppp only; estimate_zwd switches it for the
   // other pseudorange modes (never for modes without undifferenced codes).
   EXPECT_TRUE(c.zwdState());
@@ -140,7 +143,8 @@ TEST(GnssFusionConfig, ErrorsNameFileLineAndField) {
                           "  smoothed_code_factor: 2\n", "  phase_sigma: 0\n", "  ambiguity_sigma: -1\n",
                           "  ambiguity_reset_rejections: 0\n", "  estimate_zwd: maybe\n", "  zwd_sigma: -0.1\n",
                           "  phase_windup: 2\n", "  max_ambiguities: -1\n",
-                          "  broadcast_ambiguity_random_walk: -1\n", "  broadcast_record_changes: 3\n"}) {
+                          "  broadcast_ambiguity_random_walk: -1\n", "  broadcast_record_changes: 3\n",
+                          "  rtk_hold_fix: sometimes\n"}) {
     try {
       parseGnssFusionConfig(std::string("gnss_fusion:\n  mode: vio+dopp+psr\n") + bad, "b.yaml");
       FAIL() << "no error for " << bad;

@@ -27,6 +27,8 @@
 //     ambiguity_reset_rejections: 3       # consecutive gated-out phase rows that restart an ambiguity
 //     max_ambiguities: 0                  # ambiguity states at most, highest satellites first (0: all)
 //     phase_windup: true                  # correct the phases for wind-up (vio+dopp+ppp)
+//     rtk_hold_fix: true                  # vio+dopp+ddcp: once fixed, the RTK module runs at the base
+//                                         # epochs only and its fix is held in between (false: every epoch)
 //     broadcast_ambiguity_random_walk: 0.005  # m/√s on ambiguities of broadcast-orbit satellites
 //     broadcast_record_changes: true      # carry the modelled-range jump of a new broadcast record over
 //     estimate_zwd: true                  # zenith wet delay residual as a state (default: vio+dopp+ppp only)
@@ -134,6 +136,10 @@ struct GnssFusionConfig {
   /// satellite up alike, which the clock absorbs, and its tilts change the differences by
   /// millimetres; tests/gnss/test_phase_windup.cpp).
   bool phaseWindup = true;
+  /// vio+dopp+ddcp: while the RTK module is fixed it runs at the base epochs only (there the base
+  /// is measured, not extrapolated) and the DD phases in between take the fix it held
+  /// (RtkSolver::differencesWithHeldFix, same arcs only). false: the module runs every epoch.
+  bool rtkHoldFix = true;
   /// vio+dopp+ppp: random walk (m/√s) of the ambiguity states of satellites on broadcast orbits
   /// and clocks (no products, no SSR), whose errors drift by centimetres per minute as the true
   /// orbit departs from the record; 0: constant ambiguities.
