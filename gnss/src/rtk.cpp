@@ -375,15 +375,11 @@ std::optional<double> RtkSolver::differencesWithHeldFix(const ObsEpoch& rover, c
   fixed = 0;
   const std::optional<double> age = differences(rover, x, states);
   if (!age || held_.empty()) return age;
-  auto signal = [&](int i) {
-    const SingleDifference& s = dd_.sd[static_cast<std::size_t>(i)];
-    return HeldSignal{s.sat, s.code, s.roverArc, s.baseArc};
-  };
   for (DoubleDifference& d : dd_.phase) {
-    const HeldSignal sat = signal(d.satellite), ref = signal(d.reference);
     const SingleDifference& s = dd_.sd[static_cast<std::size_t>(d.satellite)];
     const SingleDifference& f = dd_.sd[static_cast<std::size_t>(d.reference)];
     if (s.halfCycle || f.halfCycle || s.roverSlip || s.baseSlip || f.roverSlip || f.baseSlip) continue;
+    const HeldSignal sat = HeldSignal::of(s), ref = HeldSignal::of(f);
     for (const HeldDd& h : held_) {
       if (h.satellite == sat && h.reference == ref) {
         d.fixedCycles = h.cycles;
@@ -558,8 +554,7 @@ RtkSolution RtkSolver::process(const ObsEpoch& rover, TransmitStates* states) {
       if (!d.ambiguityMeters || !d.fixedCycles) continue;
       const SingleDifference& s = dd_.sd[static_cast<std::size_t>(d.satellite)];
       const SingleDifference& f = dd_.sd[static_cast<std::size_t>(d.reference)];
-      held_.push_back({{s.sat, s.code, s.roverArc, s.baseArc}, {f.sat, f.code, f.roverArc, f.baseArc}, *d.fixedCycles,
-                       *d.ambiguityMeters});
+      held_.push_back({HeldSignal::of(s), HeldSignal::of(f), *d.fixedCycles, *d.ambiguityMeters});
     }
   }
   return sol;

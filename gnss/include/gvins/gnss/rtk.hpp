@@ -210,6 +210,7 @@ class RtkSolver {
     SatId sat;
     ObsCode code;
     GpsTime roverArc, baseArc;
+    static HeldSignal of(const SingleDifference& sd) { return {sd.sat, sd.code, sd.roverArc, sd.baseArc}; }
     bool operator==(const HeldSignal&) const = default;
   };
   struct HeldDd {
