@@ -476,7 +476,9 @@ TEST(RtkHeldFix, EpochsBetweenRunsTakeTheSameIntegers) {
       }
       int fixed = 0;
       ASSERT_TRUE(s.differencesWithHeldFix(e, d.truth, fixed).has_value()) << i;
-      if (i > 5) EXPECT_GT(fixed, 10) << i;  // fixed from the first runs on (every epoch fixes)
+      if (i > 5) {
+        EXPECT_GT(fixed, 10) << i;  // fixed from the first runs on (every epoch fixes)
+      }
       const DdEpoch& h = s.measurements();
       const DdEpoch& ref = every.dd[static_cast<std::size_t>(i)];
       for (const DoubleDifference& dd : h.phase) {
