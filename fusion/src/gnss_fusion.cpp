@@ -497,8 +497,7 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
       // A block without information (e.g. a new frame block): rows pass the row gate.
     }
   }
-  if (rowGate && !rowGateQuantile_) rowGateQuantile_ = sri::chiSquareQuantile(config_.rowGate, 1);
-  const double q1 = rowGate ? *rowGateQuantile_ : 0.0;
+  const double q1 = rowGate ? rowGateQuantile_(config_.rowGate, 1) : 0.0;
   // All rows as [h | J] at once; the gate's h P hᵀ and J Σ_k Jᵀ of every row from two products.
   const auto nr = static_cast<Eigen::Index>(rows.size());
   Eigen::MatrixXd HJ(nr, dim + 9);

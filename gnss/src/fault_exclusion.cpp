@@ -1,7 +1,6 @@
 #include "gvins/gnss/fault_exclusion.hpp"
 
 #include <algorithm>
-#include <array>
 #include <limits>
 
 #include "gvins/sri/chi_square.hpp"
@@ -11,18 +10,9 @@ namespace gvins {
 double globalTestThreshold(int dof, double pfa) {
   if (dof < 1) return 0.0;
   if (!(pfa > 0.0 && pfa < 1.0)) return std::numeric_limits<double>::infinity();  // no test
-  // Cache of the common case (same pfa, small dof): the quantile costs ~100 CDF evaluations.
-  static thread_local double cachedPfa = -1.0;
-  static thread_local std::array<double, 128> cache{};
-  if (dof < static_cast<int>(cache.size())) {
-    if (pfa != cachedPfa) {
-      cache.fill(0.0);
-      cachedPfa = pfa;
-    }
-    if (cache[dof] == 0.0) cache[dof] = sri::chiSquareQuantile(1.0 - pfa, dof);
-    return cache[dof];
-  }
-  return sri::chiSquareQuantile(1.0 - pfa, dof);
+  // The common case repeats the same pfa: each quantile is computed once per dof.
+  static thread_local sri::ChiSquareQuantiles quantiles;
+  return quantiles(1.0 - pfa, dof);
 }
 
 FaultExclusionResult detectAndExclude(std::vector<char>& use,

@@ -53,6 +53,18 @@ double chiSquareCdf(double x, int dof) {
   return lowerGammaP(0.5 * dof, 0.5 * x);
 }
 
+double ChiSquareQuantiles::operator()(double p, int dof) {
+  if (dof < 1) return chiSquareQuantile(p, dof);  // throws
+  if (p != p_) {
+    p_ = p;
+    q_.clear();
+  }
+  if (static_cast<std::size_t>(dof) >= q_.size()) q_.resize(static_cast<std::size_t>(dof) + 1, 0.0);
+  double& q = q_[static_cast<std::size_t>(dof)];
+  if (q == 0.0) q = chiSquareQuantile(p, dof);  // throws for p outside (0, 1)
+  return q;
+}
+
 double chiSquareQuantile(double p, int dof) {
   if (dof < 1 || !(p > 0.0 && p < 1.0)) {
     throw std::invalid_argument("chiSquareQuantile: need 0 < p < 1 and dof ≥ 1");

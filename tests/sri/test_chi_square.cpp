@@ -73,5 +73,17 @@ TEST(ChiSquare, QuantilesMatchPublishedTables) {
   EXPECT_NEAR(chiSquareCdf(2.0, 2), 1.0 - std::exp(-1.0), 1e-14);  // exponential with mean 2
 }
 
+// ChiSquareQuantiles (the gates' table): the values of chiSquareQuantile whatever the order of
+// the dofs asked for and across changes of the probability; the same errors.
+TEST(ChiSquare, QuantileTableGivesTheDirectValues) {
+  ChiSquareQuantiles t;
+  for (const double p : {0.99, 0.999, 0.99}) {
+    for (const int dof : {5, 1, 40, 5, 2, 40}) EXPECT_EQ(t(p, dof), chiSquareQuantile(p, dof)) << p << " " << dof;
+  }
+  EXPECT_THROW(t(0.99, 0), std::invalid_argument);
+  EXPECT_THROW(t(1.0, 3), std::invalid_argument);
+  EXPECT_EQ(t(0.95, 3), chiSquareQuantile(0.95, 3));  // usable after the errors
+}
+
 }  // namespace
 }  // namespace gvins::sri

@@ -123,20 +123,8 @@ struct SriSwfEstimator<Scalar>::Impl {
   std::unordered_map<std::uint64_t, PoseEstimate> fe_pose;
   Eigen::Vector3d fe_v = Eigen::Vector3d::Zero();
   std::int64_t t_init = 0;
-  mutable std::vector<double> chi2_thr;
-  // Client gates (update(m, p)): the quantiles of the last probability asked for, by dof.
-  double client_gate_p = -1.0;
-  std::vector<double> client_gate_thr;
-  double clientGate(double p, int dof) {
-    if (p != client_gate_p) {
-      client_gate_p = p;
-      client_gate_thr.clear();
-    }
-    if (static_cast<int>(client_gate_thr.size()) <= dof) client_gate_thr.resize(static_cast<std::size_t>(dof + 1), -1.0);
-    double& q = client_gate_thr[static_cast<std::size_t>(dof)];
-    if (q < 0.0) q = sri::chiSquareQuantile(p, dof);
-    return q;
-  }
+  mutable sri::ChiSquareQuantiles chi2_thr;  // visual gates (cfg.chi2_probability)
+  sri::ChiSquareQuantiles client_gate;        // client gates (update(m, p))
   std::function<void(const char*)> observer;  // setStepObserver (diagnostics)
   void notify(const char* step) {
     if (observer) observer(step);
@@ -185,14 +173,7 @@ struct SriSwfEstimator<Scalar>::Impl {
 
   double chi2Threshold(int dof) const {
     if (cfg.chi2_probability >= 1.0) return std::numeric_limits<double>::infinity();
-    if (static_cast<int>(chi2_thr.size()) <= dof) {
-      const int old = static_cast<int>(chi2_thr.size());
-      chi2_thr.resize(static_cast<std::size_t>(dof + 16));
-      for (int d = std::max(old, 1); d < static_cast<int>(chi2_thr.size()); ++d) {
-        chi2_thr[static_cast<std::size_t>(d)] = sri::chiSquareQuantile(cfg.chi2_probability, d);
-      }
-    }
-    return chi2_thr[static_cast<std::size_t>(dof)];
+    return chi2_thr(cfg.chi2_probability, dof);
   }
 
   /// Before a reset: the calibrated camera extrinsics and time offset become the start values of
@@ -1848,7 +1829,7 @@ BackendUpdate<Scalar> SriSwfEstimator<Scalar>::update(const sri::Measurement<Sca
   // for rows on the trailing blocks (GNSS) a copy of that block instead of chiSquare()'s solves.
   sri::UpdateOptions opt;
   const int dof = m.rows() + m.discardedRows();
-  if (gate_probability < 1.0 && dof > 0) opt.max_chi2 = impl_->clientGate(gate_probability, dof);
+  if (gate_probability < 1.0 && dof > 0) opt.max_chi2 = impl_->client_gate(gate_probability, dof);
   const sri::UpdateResult<Scalar> u = impl_->f.update(m, opt);
   out.chi2 = u.chi2;
   out.dof = u.dof;

@@ -37,6 +37,7 @@
 #include "gvins/gnss/rtk.hpp"
 #include "gvins/gnss/spp.hpp"
 #include "gvins/gnss/transmit_states.hpp"
+#include "gvins/sri/chi_square.hpp"
 #include "gvins/vio/estimator_backend.hpp"
 
 namespace gvins::fusion {
@@ -140,7 +141,7 @@ class GnssFusion {
   Eigen::Vector3d carriedLever() const;
 
   GnssFusionConfig config_;
-  std::optional<double> rowGateQuantile_;  // χ²(1) quantile of config_.rowGate, once
+  sri::ChiSquareQuantiles rowGateQuantile_;  // χ²(1) quantile of config_.rowGate
   GnssFusionStage stage_ = GnssFusionStage::kWaitingVio;
   std::uint64_t generation_ = 0;  // estimator generation the ids below belong to
   GnssAnchor anchor_;
