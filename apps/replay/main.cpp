@@ -57,8 +57,9 @@ const char* kUsage =
     "                         the time-offset error in the summary)\n"
     "  --rover F --base F --nav F   GNSS files (default DATASET/gnss/rover.obs, base.obs, nav file)\n"
     "  --sp3 F --clk F        precise orbit / clock products, repeatable (default: the *.sp3 and\n"
-    "                         *.clk files in DATASET/gnss); they replace the broadcast orbits and\n"
-    "                         clocks where they cover a satellite\n"
+    "                         *.clk files in DATASET/gnss, except in vio+dopp+dpsr and vio+dopp+ddcp,\n"
+    "                         whose differences cancel the orbit/clock errors); they replace the\n"
+    "                         broadcast orbits and clocks where they cover a satellite\n"
     "  --atx F                ANTEX satellite antenna offsets for the products (IGS SP3 orbits are\n"
     "                         centres of mass; default: *.atx in DATASET/gnss)\n"
     "  --bia F                Bias-SINEX code biases (OSB) for the products' clocks, repeatable\n"
@@ -267,6 +268,8 @@ int main(int argc, char** argv) {
       if (leverArm) gc->leverArm = *leverArm;
       if (carrierSmoothing) gc->carrierSmoothing = *carrierSmoothing;
       opt.leverArmTruth = trueLever;
+      // The differential modes keep the broadcast orbits unless products are named (ReplayOptions::folderProducts).
+      opt.folderProducts = !gc->usesDifferences();
     }
     ec = estimatorConfigFor(ec, *gnssMode);
     const ReplaySummary s = ec.use_float ? run<float>(dataset, ec, gc, opt) : run<double>(dataset, ec, gc, opt);

@@ -298,6 +298,9 @@ void ReplaySummary::print(std::ostream& os) const {
                            " before VIO initialisation");
     row("GNSS [ms/epoch]", f("mean %.3f", gnssMsMean) + f(" (%.3f ms per frame)", gnssMsPerFrame));
     std::string products = "broadcast";
+    if (folderProductsSkipped)
+      products += " (differential rows cancel the orbit/clock errors; the folder's precise products were not read, "
+                  "--sp3/--clk to use them)";
     if (preciseSatellites > 0) {
       products = "precise products, " + std::to_string(preciseSatellites) + " satellites";
       if (antexAntennas > 0) products += ", ANTEX " + std::to_string(antexAntennas) + " satellite antennas";
@@ -377,7 +380,13 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
     if (!opt.broadcastOnly) {
       // The folder's files where none were given (an --atx / --bia file replaces the folder's).
       PreciseProductFiles found;
-      if (opt.sp3Files.empty() && opt.clockFiles.empty()) found = findPreciseProducts(gdir);
+      if (opt.sp3Files.empty() && opt.clockFiles.empty()) {
+        found = findPreciseProducts(gdir);
+        if (!opt.folderProducts && !found.orbits.empty()) {
+          sum.folderProductsSkipped = true;
+          found = PreciseProductFiles{};
+        }
+      }
       const std::vector<std::string>& sp3 = opt.sp3Files.empty() ? found.orbits : opt.sp3Files;
       const std::vector<std::string>& clk = opt.clockFiles.empty() ? found.clocks : opt.clockFiles;
       const std::vector<std::string>& atx = opt.antennaFiles.empty() ? found.antennas : opt.antennaFiles;

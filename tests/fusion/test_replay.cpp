@@ -369,7 +369,7 @@ TEST(Replay, GnssEpochsHandedOverUpToTheNewestState) {
 
 // Precise products in the dataset's gnss folder are loaded (precise_satellites); products of
 // another day than the rover observations are loaded too but the replay warns that they do not
-// reach the rover epochs.
+// reach the rover epochs. With folderProducts off (the differential modes) they are not read.
 TEST(Replay, PreciseProductsInTheGnssFolder) {
   const fs::path g = kData / "gnss" / "geonet_0759_3040_2005";
   const auto stamps = cameraStamps(kV101 / "mav0" / "cam0" / "data.csv");
@@ -410,6 +410,20 @@ TEST(Replay, PreciseProductsInTheGnssFolder) {
     EXPECT_EQ(s.codeBiases, readBiasSinex((kData / "fuzz" / "bias_sinex" / "valid_gps_galileo.bia").string()).entries.size());
     EXPECT_GT(s.codeBiases, 0u);
     EXPECT_EQ(err.find("precise products cover") != std::string::npos, !sameDay) << err;
+    EXPECT_FALSE(s.folderProductsSkipped);
+    // The differential modes' setting: the folder's products are not read, and the summary says so;
+    // products named explicitly still are.
+    ReplayOptions f = o;
+    f.folderProducts = false;
+    const ReplaySummary skipped = runReplay(d.string(), est, &gnss, f);
+    EXPECT_EQ(skipped.preciseSatellites, 0u);
+    EXPECT_EQ(skipped.antexAntennas, 0u);
+    EXPECT_EQ(skipped.codeBiases, 0u);
+    EXPECT_TRUE(skipped.folderProductsSkipped);
+    f.sp3Files = {(d / "gnss" / "products.sp3").string()};
+    const ReplaySummary named = runReplay(d.string(), est, &gnss, f);
+    EXPECT_EQ(named.preciseSatellites, nav.satellites().size());
+    EXPECT_FALSE(named.folderProductsSkipped);
     o.broadcastOnly = true;
     EXPECT_EQ(runReplay(d.string(), est, &gnss, o).preciseSatellites, 0u);
   }

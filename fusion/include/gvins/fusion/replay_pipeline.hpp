@@ -133,6 +133,12 @@ struct ReplayOptions {
   /// Bias-SINEX code biases for the products (default: *.bia / *.bsx in DATASET/gnss, as above).
   std::vector<std::string> biasFiles;
   bool broadcastOnly = false;
+  /// Read the *.sp3 / *.clk (and *.atx, *.bia) of <dataset>/gnss when no --sp3/--clk were given.
+  /// gvins-replay turns it off for the differential modes (vio+dopp+dpsr, vio+dopp+ddcp): their
+  /// code and phase rows difference the satellite orbit and clock errors away (3 km baseline:
+  /// orbit error × 1.5·10⁻⁴), the ten simulated flights give the same RMSE to ±1 mm either way,
+  /// and the products' interpolation costs ~17 % of their GNSS time (docs/gnss_fusion.md).
+  bool folderProducts = true;
   /// Recorded RTCM 3 streams of SSR corrections (gvins/rtcm/ssr_file.hpp; e.g. a gvins-sim
   /// dataset's gnss/ssr.rtcm3): they correct the broadcast records where no precise products
   /// cover a satellite (with broadcastOnly: everywhere). Not read from the folder by default.
@@ -166,6 +172,7 @@ struct ReplaySummary {
   /// Satellites with precise products loaded (0: broadcast orbits and clocks only).
   std::size_t preciseSatellites = 0;
   std::size_t antexAntennas = 0;  ///< satellite antenna entries of the ANTEX files used with the products
+  bool folderProductsSkipped = false;  ///< the dataset folder has precise products that were not read (folderProducts off)
   std::size_t codeBiases = 0;     ///< entries of the Bias-SINEX files used with the products
   std::size_t ssrMessages = 0;    ///< SSR messages read from the ReplayOptions::ssrFiles
   /// vio+dopp+ppp: carrier-phase rows used / gated out over the run, most ambiguity states at once.
