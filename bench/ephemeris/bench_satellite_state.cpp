@@ -1,12 +1,15 @@
 // Satellite state computation speed: ns per satellite and system (Keplerian for GPS, Galileo,
 // BeiDou MEO/IGSO and GEO, QZSS; GLONASS RK4 for several distances from tb), the full store path
-// (record selection + state) and RINEX navigation parsing.
+// (record selection + state), precise-orbit interpolation (11-node Lagrange, SP3 positions with and
+// without velocity records) and RINEX navigation parsing.
 #include <benchmark/benchmark.h>
 
 #include <string>
 #include <vector>
 
+#include "gvins/ephemeris/broadcast_sp3.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
+#include "gvins/ephemeris/precise_ephemeris.hpp"
 
 using namespace gvins;
 
@@ -94,6 +97,38 @@ void BM_StoreSatelliteState(benchmark::State& state) {
   state.counters["usable"] = static_cast<double>(found) / static_cast<double>(state.iterations());
 }
 BENCHMARK(BM_StoreSatelliteState);
+
+// Precise products: the broadcast orbits of the file sampled as a 15-min SP3 table (positions,
+// Arg 1: also velocity records), interpolated per satellite at 1 s steps over 08:20-08:25.
+void BM_PreciseSatelliteState(benchmark::State& state) {
+  EphemerisStore store;
+  store.add(nav());
+  const GpsTime t0 = GpsTime::fromWeekTow(2320, 116400.0);
+  Sp3Data sp3 = broadcastSp3(store, t0 - 3 * 3600.0, t0 + 3 * 3600.0, 900.0);
+  if (state.range(0) != 0) {
+    for (auto& e : sp3.epochs) {
+      for (auto& r : e.records) {
+        const auto st = store.satelliteState(r.sat, e.time);
+        if (st) r.velocity = st->velocity;
+      }
+    }
+  }
+  PreciseEphemeris pe;
+  pe.add(sp3);
+  const std::vector<SatId> sats = pe.satellites();
+  std::size_t i = 0;
+  double dt = 0.0;
+  for (auto _ : state) {
+    const auto st = pe.satelliteState(sats[i], t0 + dt);
+    benchmark::DoNotOptimize(st);
+    if (++i == sats.size()) {
+      i = 0;
+      dt = dt >= 299.0 ? 0.0 : dt + 1.0;
+    }
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_PreciseSatelliteState)->Arg(0)->Arg(1);
 
 void BM_ReadRinexNav(benchmark::State& state) {
   std::size_t records = 0;

@@ -1,9 +1,9 @@
 // Interpolation of precise orbits (SP3) and clocks (SP3 or RINEX clock files).
 //
-// Positions: Lagrange polynomial through the nodes around t, evaluated with Neville's recursion
-// in time normalised by the epoch interval (x = (t_i - t)/h, so the evaluation point is x = 0 and
-// all |x| stay below the order), together with its first and second derivatives (velocity and
-// acceleration). This is the usual way of interpolating IGS SP3 orbits in the rotating ECEF frame
+// Positions: Lagrange polynomial through the nodes around t, in time normalised by the epoch
+// interval (x = (t_i - t)/h, so the evaluation point is x = 0 and all |x| stay below the order),
+// evaluated from the Lagrange basis weights at x = 0 together with its first and second
+// derivatives (velocity and acceleration). This is the usual way of interpolating IGS SP3 orbits in the rotating ECEF frame
 // (e.g. Schenewerk 2003, "A brief review of basic GPS orbit interpolation strategies", GPS
 // Solutions 6: a 10th-order polynomial over 15-min nodes is at the mm-cm level).
 // Clocks: linear between the two samples bracketing t (IGS clock products are white-noise-like
@@ -28,28 +28,48 @@ struct Interpolant {
   Eigen::Vector3d value, first, second;  // value and derivatives with respect to t (per s, per s^2)
 };
 
-// Neville's recursion on vectors with first and second derivatives, at x = 0. `x` are the nodes'
-// normalised abscissae (distinct), h the normalisation (s).
-Interpolant neville(const std::array<double, kMaxNodes>& x, const std::array<Eigen::Vector3d, kMaxNodes>& y,
-                    int n, double h) {
-  std::array<Eigen::Vector3d, kMaxNodes> p, d1, d2;
+// Lagrange basis polynomials L_i(x) = prod_{j != i} (x - x_j) / (x_i - x_j) of the nodes' normalised
+// abscissae (distinct), with their first and second derivatives, at x = 0: each product is carried
+// as its Taylor series to second order (c0 + c1 x + c2 x^2), one factor at a time. The weights
+// depend only on the abscissae, so the positions, the SP3 velocities and all three coordinates
+// share them: O(n^2) scalar work once, then O(n) per interpolated vector (Neville's recursion with
+// derivatives was O(n^2) per vector).
+struct LagrangeWeights {
+  std::array<double, kMaxNodes> value{}, first{}, second{};
+};
+
+LagrangeWeights lagrangeWeights(const std::array<double, kMaxNodes>& x, int n) {
+  LagrangeWeights w;
   for (int i = 0; i < n; ++i) {
-    p[i] = y[i];
-    d1[i].setZero();
-    d2[i].setZero();
-  }
-  // After step m, p[i] is the polynomial through nodes i..i+m evaluated at 0:
-  // P_{i..j} = ((0 - x_j) P_{i..j-1} - (0 - x_i) P_{i+1..j}) / (x_i - x_j)
-  for (int m = 1; m < n; ++m) {
-    for (int i = 0; i + m < n; ++i) {
-      const int j = i + m;
-      const double inv = 1.0 / (x[i] - x[j]);
-      d2[i] = (2.0 * d1[i] - x[j] * d2[i] - 2.0 * d1[i + 1] + x[i] * d2[i + 1]) * inv;
-      d1[i] = (p[i] - x[j] * d1[i] - p[i + 1] + x[i] * d1[i + 1]) * inv;
-      p[i] = (-x[j] * p[i] + x[i] * p[i + 1]) * inv;
+    double c0 = 1.0, c1 = 0.0, c2 = 0.0, denominator = 1.0;
+    for (int j = 0; j < n; ++j) {
+      if (j == i) continue;
+      // times the factor (x - x_j): one division per basis polynomial, not per factor
+      c2 = c1 - x[j] * c2;
+      c1 = c0 - x[j] * c1;
+      c0 = -x[j] * c0;
+      denominator *= x[i] - x[j];
     }
+    const double inv = 1.0 / denominator;
+    w.value[i] = c0 * inv;
+    w.first[i] = c1 * inv;
+    w.second[i] = 2.0 * c2 * inv;
   }
-  return {p[0], d1[0] / h, d2[0] / (h * h)};
+  return w;
+}
+
+// The interpolating polynomial of the node values y and its derivatives with respect to t at the
+// evaluation point (h: the normalisation of the abscissae, s).
+Interpolant interpolate(const LagrangeWeights& w, const std::array<Eigen::Vector3d, kMaxNodes>& y, int n, double h) {
+  Interpolant r{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  for (int i = 0; i < n; ++i) {
+    r.value += w.value[i] * y[i];
+    r.first += w.first[i] * y[i];
+    r.second += w.second[i] * y[i];
+  }
+  r.first /= h;
+  r.second /= h * h;
+  return r;
 }
 
 }  // namespace
@@ -169,12 +189,13 @@ std::optional<SatelliteState> PreciseEphemeris::satelliteState(SatId sat, const 
       haveVelocity = false;
     }
   }
-  const Interpolant p = neville(x, pos, n, h);
+  const LagrangeWeights w = lagrangeWeights(x, n);
+  const Interpolant p = interpolate(w, pos, n, h);
   SatelliteState st;
   st.position = p.value;
   Eigen::Vector3d accel = p.second;
   if (haveVelocity) {
-    const Interpolant v = neville(x, vel, n, h);  // the SP3 V records
+    const Interpolant v = interpolate(w, vel, n, h);  // the SP3 V records
     st.velocity = v.value;
     accel = v.first;
   } else {
