@@ -126,12 +126,6 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     m.troposphere = tropo.slant;
     m.mapWet = tropo.mapWet;
     m.shapiro = shapiroDelay(m.position, x);
-    if (so.sat.system == System::BeiDou && iono.beidou) {
-      m.ionosphere = beidouKlobucharDelayB1I(*iono.beidou, g, m.azel, rover.time) *
-                     ionosphereFrequencyScale(*carrierFrequency(System::BeiDou, '2'), *f);
-    } else if (iono.gps) {
-      m.ionosphere = klobucharDelayL1(*iono.gps, g, m.azel, rover.time) * ionosphereFrequencyScale(fL1, *f);
-    }
     m.pseudorange = s->pseudorange;
     const double sinEl = std::max(std::sin(m.azel.elevation), 0.1);
     // Code: white noise and multipath growing with 1/sin(el), plus 30 % of the broadcast
@@ -150,9 +144,6 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     // to `smoothed_code_factor` of the raw sigma.
     const double smoothingFactor =
         smoother_ ? std::max(config_.smoothedCodeFactor, smoother_->noiseFactor(so.sat)) : 1.0;
-    m.codeVariance = std::pow(config_.codeSigma * smoothingFactor, 2) * (0.5 + 0.5 / (sinEl * sinEl)) +
-                     std::pow(0.3 * m.ionosphere, 2) +
-                     ephemerisVariance;
     // Dual frequency: the ionosphere-free pair with the first other band tracked (`bands`: the
     // SPP band order, GPS/QZSS L5 before L2), group delays combined alike; its noise is the
     // single-band noise times sqrt(a1² + a2²) (2.98 for L1/L2, 2.59 for L1/L5) and it carries no
@@ -192,6 +183,18 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
         }
         break;
       }
+    }
+    if (!m.ionosphereFree) {
+      // Single frequency (broadcast ionosphere, or no second band tracked): the broadcast model,
+      // evaluated only here (an ionosphere-free pair needs none).
+      if (so.sat.system == System::BeiDou && iono.beidou) {
+        m.ionosphere = beidouKlobucharDelayB1I(*iono.beidou, g, m.azel, rover.time) *
+                       ionosphereFrequencyScale(*carrierFrequency(System::BeiDou, '2'), *f);
+      } else if (iono.gps) {
+        m.ionosphere = klobucharDelayL1(*iono.gps, g, m.azel, rover.time) * ionosphereFrequencyScale(fL1, *f);
+      }
+      m.codeVariance = std::pow(config_.codeSigma * smoothingFactor, 2) * (0.5 + 0.5 / (sinEl * sinEl)) +
+                       std::pow(0.3 * m.ionosphere, 2) + ephemerisVariance;
     }
     m.dopplerVariance = std::pow(config_.dopplerSigma, 2) * (0.5 + 0.5 / (sinEl * sinEl));
     const SignalObs* d = s->hasDoppler() ? s : nullptr;
