@@ -3,8 +3,8 @@
 // Positions: Lagrange polynomial through the nodes around t, in time normalised by the epoch
 // interval (x = (t_i - t)/h, so the evaluation point is x = 0 and all |x| stay below the order),
 // evaluated from the Lagrange basis weights at x = 0 together with its first and second
-// derivatives (velocity and acceleration). This is the usual way of interpolating IGS SP3 orbits in the rotating ECEF frame
-// (e.g. Schenewerk 2003, "A brief review of basic GPS orbit interpolation strategies", GPS
+// derivatives (velocity and acceleration). This is the usual way of interpolating IGS SP3 orbits
+// in the rotating ECEF frame (e.g. Schenewerk 2003, "A brief review of basic GPS orbit interpolation strategies", GPS
 // Solutions 6: a 10th-order polynomial over 15-min nodes is at the mm-cm level).
 // Clocks: linear between the two samples bracketing t (IGS clock products are white-noise-like
 // at 30 s - 5 min; higher-order fits do not help).

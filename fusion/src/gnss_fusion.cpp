@@ -128,8 +128,8 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     m.shapiro = shapiroDelay(m.position, x);
     m.pseudorange = s->pseudorange;
     const double sinEl = std::max(std::sin(m.azel.elevation), 0.1);
-    // Code: white noise and multipath growing with 1/sin(el), plus 30 % of the broadcast
-    // ionosphere (Klobuchar corrects about half of the delay; IS-GPS-200N 20.3.3.5.2.5).
+    // Code variance (below: single frequency after the pair search, the pair inside it): white
+    // noise and multipath growing with 1/sin(el), and the ephemeris error.
     // Broadcast orbit/clock error (SISRE) of the system: a bias per satellite, in the variance so
     // that systems with poorer broadcast products weigh less.
     // Precise products (SP3/RINEX clock) or SSR corrections where the store has them: centimetres
@@ -186,7 +186,8 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     }
     if (!m.ionosphereFree) {
       // Single frequency (broadcast ionosphere, or no second band tracked): the broadcast model,
-      // evaluated only here (an ionosphere-free pair needs none).
+      // evaluated only here (an ionosphere-free pair needs none), and 30 % of it in the code
+      // variance (Klobuchar corrects about half of the delay; IS-GPS-200N 20.3.3.5.2.5).
       if (so.sat.system == System::BeiDou && iono.beidou) {
         m.ionosphere = beidouKlobucharDelayB1I(*iono.beidou, g, m.azel, rover.time) *
                        ionosphereFrequencyScale(*carrierFrequency(System::BeiDou, '2'), *f);

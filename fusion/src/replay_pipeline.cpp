@@ -382,8 +382,8 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
       PreciseProductFiles found;
       if (opt.sp3Files.empty() && opt.clockFiles.empty()) {
         found = findPreciseProducts(gdir);
-        if (!opt.folderProducts && !found.orbits.empty()) {
-          sum.folderProductsSkipped = true;
+        if (!opt.folderProducts) {
+          sum.folderProductsSkipped = !found.orbits.empty() || !found.clocks.empty();
           found = PreciseProductFiles{};
         }
       }

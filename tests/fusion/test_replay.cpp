@@ -427,6 +427,25 @@ TEST(Replay, PreciseProductsInTheGnssFolder) {
     o.broadcastOnly = true;
     EXPECT_EQ(runReplay(d.string(), est, &gnss, o).preciseSatellites, 0u);
   }
+  // A folder with a clock file and no orbits: an error where the folder's products are read
+  // (clocks need an SP3 file), skipped like any other folder product where they are not.
+  const fs::path d = copyV101("clk_only");
+  fs::create_directories(d / "gnss");
+  fs::copy_file(kData / "fuzz" / "rinex_clock" / "valid_v300", d / "gnss" / "products.clk",
+                fs::copy_options::overwrite_existing);
+  StubEstimator est;
+  StubGnss gnss;
+  ReplayOptions o = quietOptions(d.parent_path() / "out_clk_only");
+  o.sensorToGpst_ns = ns(rover[1].time) + 10'000'000 - stamps[2];
+  o.roverObs = (g / "07590920.05o.gz").string();
+  o.navFile = (g / "07590920.05n.gz").string();
+  const ParseError e = expectParseError([&] { runReplay(d.string(), est, &gnss, o); });
+  EXPECT_EQ(e.file(), (d / "gnss" / "products.clk").string());
+  EXPECT_EQ(e.field(), "precise clock");
+  o.folderProducts = false;
+  const ReplaySummary skipped = runReplay(d.string(), est, &gnss, o);
+  EXPECT_TRUE(skipped.folderProductsSkipped);
+  EXPECT_EQ(skipped.preciseSatellites, 0u);
 }
 
 TEST(Replay, GlobalAccuracyAgainstEcefTruth) {
