@@ -245,8 +245,9 @@ void SriFilter<Scalar>::substitute(BlockId id, const Matrix& A, std::span<const 
   const BlockInfo& b = layout_.at(pos);
   const int o = b.offset;
   const int d = b.dim;
-  if (b.kind != BlockKind::kVector || !hasShape(estimate, b.kind, d)) {
-    throw std::invalid_argument("sri::SriFilter::substitute: block '" + b.name + "' is not a vector of that size");
+  if (!hasShape(estimate, b.kind, d)) {
+    throw std::invalid_argument("sri::SriFilter::substitute: the new estimate of block '" + b.name +
+                                "' does not have its kind and size");
   }
   if (A.rows() != d || A.cols() != d) throw std::invalid_argument("sri::SriFilter::substitute: A must be dim × dim");
   for (const auto& [j, Bj] : B) {

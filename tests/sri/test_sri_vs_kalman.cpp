@@ -428,6 +428,47 @@ TEST(SriFilterSubstitute, IsTheLinearChangeOfVariables) {
   EXPECT_THROW(f.substitute(ids[1], Md::Zero(3, 3), B, BlockEstimate<double>::fromVector(x1)), std::invalid_argument);
 }
 
+/// substitute() on a pose block (the VIO's world re-anchoring re-expresses every pose and the
+/// velocity in a new world frame whose offset is a later block): the same linear algebra on the
+/// error columns, the caller's pose becomes the estimate; an estimate of another kind is refused.
+TEST(SriFilterSubstitute, PoseBlockIsTheLinearChangeOfVariables) {
+  std::mt19937 rng(13);
+  auto rnd = [&](int r, int c) { return uniformMatrix(rng, r, c); };
+  SriFilter<double> f;
+  const BlockId v0 = f.addBlock(BlockSpec::vector("feature", 3), BlockEstimate<double>::fromVector(rnd(3, 1)),
+                                Prior<double>::stdDev(3, 2.0));
+  const Eigen::Quaterniond q0(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()));
+  const BlockId pose = f.addBlock(BlockSpec::pose("clone"), BlockEstimate<double>::fromPose(q0, Eigen::Vector3d(1, 2, 3)),
+                                  Prior<double>::stdDev(6, 0.5));
+  const BlockId frame = f.addBlock(BlockSpec::vector("frame", 4), BlockEstimate<double>::fromVector(rnd(4, 1)),
+                                   Prior<double>::stdDev(4, 3.0));
+  Measurement<double> m(12);
+  m.jacobian(v0, 3) = rnd(12, 3);
+  m.jacobian(pose, 6) = rnd(12, 6);
+  m.jacobian(frame, 4) = rnd(12, 4);
+  m.residual() = rnd(12, 1);
+  m.setWhitened();
+  f.update(m);
+  const Md P0 = f.fullCovariance();
+  const Vd d0 = f.solve();
+  Md A = Md::Identity(6, 6);
+  A.block(3, 3, 3, 3) = Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Md Bf = rnd(6, 4);
+  const int n = f.dim();
+  const int o = f.layout().block(pose).offset;
+  Md T = Md::Identity(n, n);
+  T.block(o, o, 6, 6) = A;
+  T.block(o, f.layout().block(frame).offset, 6, 4) = Bf;
+  const Eigen::Quaterniond q1(Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()) * q0);
+  const std::vector<std::pair<BlockId, Md>> B = {{frame, Bf}};
+  f.substitute(pose, A, B, BlockEstimate<double>::fromPose(q1, Eigen::Vector3d(-2, 1, 3)));
+  EXPECT_LT(relErr(f.fullCovariance(), T * P0 * T.transpose()), 1e-10);
+  EXPECT_LT((f.solve() - T * d0).norm(), 1e-10 * (1.0 + d0.norm()));
+  EXPECT_LT(f.estimate(pose).rotation.angularDistance(q1), 1e-12);
+  EXPECT_EQ(f.estimate(pose).vector, Eigen::Vector3d(-2, 1, 3));
+  EXPECT_THROW(f.substitute(pose, A, B, BlockEstimate<double>::fromVector(rnd(6, 1))), std::invalid_argument);
+}
+
 /// substitute() reads only R: the storage below the diagonal is unspecified (sri_filter.hpp) and
 /// holds leftovers of earlier rotations in a running filter. Filled with garbage here, the result
 /// must be the same change of variables. (Before the fix the block's own rows read it: in the VIO,

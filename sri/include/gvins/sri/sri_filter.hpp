@@ -136,13 +136,16 @@ class SriFilter {
   /// (sweepColumnsToFront). Throws std::out_of_range for an unknown id.
   void marginalize(std::span<const BlockId> ids);
   void marginalize(BlockId id) { marginalize(std::span<const BlockId>(&id, 1)); }
-  /// Exact change of variables of one vector block, without noise: its error state becomes
+  /// Exact change of variables of one block, without noise: its error state becomes
   /// δx' = A δx + Σ_j B_j δx_j over blocks j that all come after it in the order (e.g. a SLAM
-  /// feature re-anchored to a later clone). R's columns are substituted (R_x A⁻¹, and
-  /// R_j −= R_x A⁻¹ B_j) on the rows that see the block, its own dim rows are re-triangularized
-  /// (Givens, O(dim²·n)), r is unchanged, and `estimate` becomes the block's value: no new
-  /// block, no marginalization sweep. Throws std::invalid_argument for a singular or misshaped
-  /// A or B_j, a B_j on a block at or before this one, or a block that is not a vector.
+  /// feature re-anchored to a later clone, or a pose re-expressed in another world frame whose
+  /// offset is block j). R's columns are substituted (R_x A⁻¹, and R_j −= R_x A⁻¹ B_j) on the
+  /// rows that see the block, its own dim rows are re-triangularized (Givens, O(dim²·n)), r is
+  /// unchanged, and `estimate` becomes the block's value: no new block, no marginalization sweep.
+  /// Any kind of block: for rotations and poses A and B_j are the caller's first-order maps of the
+  /// error state (δθ, [δθ; δp]) at the new `estimate`. Throws std::invalid_argument for a
+  /// singular or misshaped A or B_j, a B_j on a block at or before this one, or an estimate of
+  /// another kind or size.
   void substitute(BlockId id, const Matrix& A, std::span<const std::pair<BlockId, Matrix>> B,
                   const BlockEstimate<double>& estimate);
   /// Changes the order of the blocks (`order` lists every block once) and re-triangularizes
