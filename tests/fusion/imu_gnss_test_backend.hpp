@@ -114,6 +114,11 @@ class ImuGnssTestBackend final : public vio::EstimatorBackend<Scalar> {
     return filter_.propagate(s);
   }
   void marginalize(std::span<const sri::BlockId> ids) override { filter_.marginalize(ids); }
+  vio::WorldFrameChange reanchorWorld(sri::BlockId frame) override {
+    const vio::ReanchoredPose poses[] = {{blocks_.pose, std::nullopt, std::nullopt}};
+    const vio::ReanchoredVelocity velocities[] = {{blocks_.extra, std::nullopt}};
+    return vio::reanchorWorld(filter_, frame, poses, velocities);
+  }
   bool contains(sri::BlockId id) const override { return filter_.layout().contains(id); }
   const sri::BlockEstimate<Scalar>& estimate(sri::BlockId id) const override { return filter_.estimate(id); }
   Matrix covariance(std::span<const sri::BlockId> ids) const override { return filter_.covariance(ids); }

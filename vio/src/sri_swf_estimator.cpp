@@ -49,9 +49,16 @@ double median(std::vector<double> v) {
 }  // namespace
 
 void applyFirstEstimates(Eigen::Matrix<double, 15, 15>& Phi, const Eigen::Matrix3d& R0, const Eigen::Vector3d& p0,
-                         const Eigen::Vector3d& v0, const Eigen::Vector3d& p1, const Eigen::Vector3d& v1, double dt,
-                         double gravity) {
+                         const Eigen::Vector3d& v0, const Eigen::Matrix3d& R1, const Eigen::Vector3d& p1,
+                         const Eigen::Vector3d& v1, double dt, double gravity) {
   const Eigen::Vector3d g(0.0, 0.0, -gravity);
+  // Attitude: Φ_θθ = ΔRᵀ maps the yaw direction R₀ᵀe_z to (R₀ΔR)ᵀe_z, not to R₁ᵀe_z when the
+  // first estimate R₀ differs from the estimate R₁ was propagated from (a tilt correction since):
+  // the smallest change that makes it so (rank one along w = R₀ᵀe_z, as the observability-
+  // constrained transition of Hesch et al. 2014, eq. (35)); zero at Φ's own linearization point.
+  const Eigen::Vector3d w = R0.transpose() * Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d u = R1.transpose() * Eigen::Vector3d::UnitZ();
+  Phi.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta) += (u - Phi.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta) * w) * w.transpose();
   Phi.block<3, 3>(ImuErr::kVel, ImuErr::kTheta) = -so3::skew(v1 - v0 - g * dt) * R0;
   Phi.block<3, 3>(ImuErr::kPos, ImuErr::kTheta) = -so3::skew(p1 - p0 - v0 * dt - 0.5 * dt * dt * g) * R0;
 }
@@ -829,7 +836,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     const double dt = static_cast<double>(t - t_newest) * 1e-9;
     if (cfg.first_estimate_jacobians) {
       if (auto it = fe_pose.find(newest.pose.value); it != fe_pose.end()) {
-        applyFirstEstimates(Phi, it->second.R_WI, it->second.p_WI, fe_v, s.p_WI, s.v_WI, dt, cfg.gravity);
+        applyFirstEstimates(Phi, it->second.R_WI, it->second.p_WI, fe_v, s.R_WI, s.p_WI, s.v_WI, dt, cfg.gravity);
       }
     }
     Qd.diagonal().array() += 1e-14;  // keeps Q' positive definite for back-to-back frames
@@ -884,6 +891,40 @@ struct SriSwfEstimator<Scalar>::Impl {
     Eigen::Vector2d z;
   };
   std::vector<Ray> rays;  // triangulate()'s buffer
+  /// EstimatorBackend::reanchorWorld: every clone (the newest pose is one) and the velocity in
+  /// the extra change variables (world_frame_change.hpp), with the frame's Jacobian at the first
+  /// estimates where they are used (the handed-over uncertainty then lies along the
+  /// unobservable directions the visual rows keep: unobservableDirections()); the first
+  /// estimates and clone velocities follow, the pose caches are dropped. SLAM features are
+  /// anchored in a clone's camera and the calibration parameters live in the body: they do not
+  /// change.
+  WorldFrameChange reanchorWorld(BlockId frame) {
+    std::vector<ReanchoredPose> poses;
+    poses.reserve(clones.size());
+    for (const Clone& c : clones) {
+      ReanchoredPose rp{c.id, std::nullopt, std::nullopt};
+      if (cfg.first_estimate_jacobians) {
+        if (auto it = fe_pose.find(c.id.value); it != fe_pose.end()) {
+          rp.R_lin = it->second.R_WI;
+          rp.p_lin = it->second.p_WI;
+        }
+      }
+      poses.push_back(rp);
+    }
+    // The velocity's as in unobservableDirections(): fe_v once the newest pose has a first estimate.
+    const bool fe_velocity = cfg.first_estimate_jacobians && fe_pose.count(newest.pose.value) != 0;
+    const ReanchoredVelocity velocity[] = {{newest.extra, fe_velocity ? std::optional<Eigen::Vector3d>(fe_v) : std::nullopt}};
+    const WorldFrameChange c = vio::reanchorWorld(f, frame, poses, velocity);
+    for (auto& [id, P] : fe_pose) {
+      P.R_WI = c.attitude(P.R_WI);
+      P.p_WI = c.point(P.p_WI);
+    }
+    fe_v = c.direction(fe_v);
+    for (auto& [id, m] : clone_motion) m.v = c.direction(m.v);
+    clearCaches();
+    return c;
+  }
+
   /// Where the IMU extra goes (SriSwfConfig::imu_extra_first).
   Placement extraPlacement() const { return cfg.imu_extra_first ? Placement::front() : Placement::back(); }
   /// A client's block: kFront in front of everything; parameters after the newest pose, i.e.
@@ -1677,6 +1718,13 @@ std::vector<std::int64_t> SriSwfEstimator<Scalar>::cloneTimes() const {
 }
 
 template <typename Scalar>
+std::vector<sri::BlockId> SriSwfEstimator<Scalar>::cloneBlocks() const {
+  std::vector<sri::BlockId> ids;
+  for (const auto& c : impl_->clones) ids.push_back(c.id);
+  return ids;
+}
+
+template <typename Scalar>
 int SriSwfEstimator<Scalar>::slamFeatureCount() const {
   return static_cast<int>(impl_->slam.size());
 }
@@ -1800,6 +1848,12 @@ std::vector<sri::BlockId> SriSwfEstimator<Scalar>::propagate(const sri::Propagat
 template <typename Scalar>
 void SriSwfEstimator<Scalar>::marginalize(std::span<const sri::BlockId> ids) {
   impl_->f.marginalize(ids);
+}
+
+template <typename Scalar>
+WorldFrameChange SriSwfEstimator<Scalar>::reanchorWorld(sri::BlockId frame) {
+  if (!impl_->initialized) throw std::logic_error("SriSwfEstimator::reanchorWorld: not initialised");
+  return impl_->reanchorWorld(frame);
 }
 
 template <typename Scalar>

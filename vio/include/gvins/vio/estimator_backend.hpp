@@ -42,6 +42,7 @@
 #include "gvins/sri/state_layout.hpp"
 #include "gvins/vio/imu_integration.hpp"
 #include "gvins/vio/imu_state.hpp"
+#include "gvins/vio/world_frame_change.hpp"
 
 namespace gvins::vio {
 
@@ -107,6 +108,12 @@ class EstimatorBackend {
   virtual std::vector<sri::BlockId> propagate(const sri::Propagation<Scalar>& step,
                                               ClientBlockRegion region = ClientBlockRegion::kParameters) = 0;
   virtual void marginalize(std::span<const sri::BlockId> ids) = 0;
+  /// Re-expresses the whole state in the world frame W' held by the client block `frame`
+  /// (kVector(4) [ψ; t]: x_W' = Rz(ψ) x_W + t, world_frame_change.hpp) and marginalizes the
+  /// block: poses, velocity and the estimator's first estimates move to W', the block's
+  /// information moves into them, and newestImuState() etc. are in W' from then on. Returns the
+  /// change applied. Ids of the estimator's own blocks stay valid.
+  virtual WorldFrameChange reanchorWorld(sri::BlockId frame) = 0;
   virtual bool contains(sri::BlockId id) const = 0;
   virtual const sri::BlockEstimate<Scalar>& estimate(sri::BlockId id) const = 0;
   /// Joint marginal covariance of the listed blocks (sri_filter.hpp's rules apply).

@@ -217,13 +217,14 @@ SriSwfConfig parseSriSwfConfig(std::string_view text, const std::string& name,
 /// First-estimate IMU transition (see SriSwfConfig::first_estimate_jacobians): replaces the
 /// blocks ∂δv₁/∂δθ₀ and ∂δp₁/∂δθ₀ of Φ (ImuErr order, right rotation perturbation) by
 /// −[v₁ − v₀ − g Δt]× R₀ and −[p₁ − p₀ − v₀ Δt − ½ g Δt²]× R₀ with (R₀, p₀, v₀) the first estimate
-/// of the state at the start and (p₁, v₁) the propagated state (g = (0, 0, −gravity)). With
-/// (R₀, p₀, v₀) equal to the estimate Φ was computed at, these are Φ's own blocks; with any first
-/// estimate, Φ maps the yaw and translation directions of the start state onto those of the
-/// propagated one (observability: Φ N₀ = N₁).
+/// of the state at the start and (R₁, p₁, v₁) the propagated state (g = (0, 0, −gravity)), and
+/// adds to ∂δθ₁/∂δθ₀ the rank-one term that maps R₀ᵀe_z onto R₁ᵀe_z. With (R₀, p₀, v₀) equal to
+/// the estimate Φ was computed at, Φ is unchanged; with any first estimate, Φ maps the yaw and
+/// translation directions of the start state onto those of the propagated one (observability:
+/// Φ N₀ = N₁, in θ too).
 void applyFirstEstimates(Eigen::Matrix<double, 15, 15>& Phi, const Eigen::Matrix3d& R0, const Eigen::Vector3d& p0,
-                         const Eigen::Vector3d& v0, const Eigen::Vector3d& p1, const Eigen::Vector3d& v1, double dt,
-                         double gravity);
+                         const Eigen::Vector3d& v0, const Eigen::Matrix3d& R1, const Eigen::Vector3d& p1,
+                         const Eigen::Vector3d& v1, double dt, double gravity);
 
 /// What processFrame did.
 struct FrameResult {
@@ -266,6 +267,8 @@ class SriSwfEstimator final : public EstimatorBackend<Scalar> {
   const SriSwfConfig& config() const { return config_; }
   /// Current window: clone times, oldest first (the newest = newestTime()).
   std::vector<std::int64_t> cloneTimes() const;
+  /// The clones' pose blocks (kPose [δθ; δp]), in the order of cloneTimes().
+  std::vector<sri::BlockId> cloneBlocks() const;
   int slamFeatureCount() const;
   /// Extrinsic pose T_IC of camera `cam` (estimated when calibrate_extrinsics).
   Eigen::Matrix4d cameraExtrinsic(int cam) const;
@@ -320,6 +323,7 @@ class SriSwfEstimator final : public EstimatorBackend<Scalar> {
   std::vector<sri::BlockId> propagate(const sri::Propagation<Scalar>& step,
                                       ClientBlockRegion region = ClientBlockRegion::kParameters) override;
   void marginalize(std::span<const sri::BlockId> ids) override;
+  WorldFrameChange reanchorWorld(sri::BlockId frame) override;
   bool contains(sri::BlockId id) const override;
   const sri::BlockEstimate<Scalar>& estimate(sri::BlockId id) const override;
   Matrix covariance(std::span<const sri::BlockId> ids) const override;
