@@ -252,6 +252,7 @@ void GnssFusion<Scalar>::forgetState() {
   leverStart_ = carriedLever();
   leverLast_.reset();
   frameBlock_ = {};
+  worldChange_.reset();
   leverBlock_ = {};
   clockBlock_ = {};
   zwdBlock_ = {};
@@ -264,7 +265,9 @@ void GnssFusion<Scalar>::forgetState() {
 
 template <typename Scalar>
 std::optional<Eigen::Vector4d> GnssFusion<Scalar>::frame(const vio::EstimatorBackend<Scalar>& est) const {
-  if (!frameBlock_.valid() || !current(est)) return std::nullopt;
+  if (!current(est)) return std::nullopt;
+  if (worldChange_) return Eigen::Vector4d::Zero();  // the estimator's world is ENU now
+  if (!frameBlock_.valid()) return std::nullopt;
   return Eigen::Vector4d(est.estimate(frameBlock_).vector.template cast<double>());
 }
 
@@ -277,7 +280,7 @@ std::optional<Eigen::VectorXd> GnssFusion<Scalar>::clocks(const vio::EstimatorBa
 template <typename Scalar>
 std::optional<AntennaKinematics> GnssFusion<Scalar>::antennaAt(const vio::EstimatorBackend<Scalar>& est,
                                                                std::int64_t t_ns) const {
-  if (!frameBlock_.valid() || !current(est)) return std::nullopt;
+  if ((!frameBlock_.valid() && !worldChange_) || !current(est)) return std::nullopt;
   GnssStateValues s;
   if (!buildState(est, t_ns, s)) return std::nullopt;
   return antennaKinematics(s);
@@ -780,7 +783,16 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
       const sri::BlockId id = frameBlock_;
       const auto P = est.covariance(std::span<const sri::BlockId>(&id, 1));
       const double sth = config_.frameYawSigmaDeg * constants::kDegToRad;
-      if (static_cast<double>(P(0, 0)) < sth * sth) stage_ = GnssFusionStage::kTight;
+      if (static_cast<double>(P(0, 0)) < sth * sth) {
+        stage_ = GnssFusionStage::kTight;
+        // The paper marginalizes the converged frame and keeps the VIO frame; here the estimator
+        // moves into ENU with it (an exact change of variables, world_frame_change.hpp), so the
+        // GNSS information on the yaw stays in the poses and the rows lose the frame's columns.
+        if (config_.frameReanchor) {
+          worldChange_ = est.reanchorWorld(frameBlock_);
+          frameBlock_ = {};
+        }
+      }
     } catch (const std::exception&) {
     }
   } else {

@@ -487,6 +487,11 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
   std::vector<vio::TrajectorySample> localTrack;  // poses with the estimated velocity
   std::vector<vio::PoseCovariance> covs;
   std::vector<double> estimatorMs;
+  // Local outputs (trajectory.tum, covariances, the local evaluation) are odometry in the VIO
+  // world frame of the start. Once the GNSS fusion has moved the estimator into ENU
+  // (ReplayGnss::worldChange), `localMap` takes ENU to that frame and absorbs the yaw and position
+  // part of every GNSS correction, as the frame block did while it was a state.
+  std::optional<vio::WorldFrameChange> localMap;
   // GNSS solutions, stamped on the sensor clock: all, and those after the frame initialisation.
   std::vector<EcefTruthSample> antennaTrack, antennaTight;
   std::int64_t firstTight = -1;
@@ -621,6 +626,7 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
       tum.markReset("after a visual lock-out: the poses below are in a new VIO world frame");
       localTrack.clear();
       covs.clear();
+      localMap.reset();
       if (opt.progress) {
         std::fprintf(stderr, "\n[gvins-replay] warning: visual lock-out at frame %zu (t %.2f s): the estimator "
                              "starts again (lockout_reset_s; check the camera-IMU time offset and calibration)\n",
@@ -630,11 +636,19 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
     const bool init = est.initialized();
     if (init) {
       ++sum.framesInitialized;
-      const vio::ImuState s = est.newestImuState();
+      vio::ImuState s = est.newestImuState();
+      vio::Matrix6d P = est.poseCovariance();
+      if (localMap) {  // the estimator is in ENU: to the local frame (δθ is in the body, δp rotates)
+        s.R_WI = localMap->attitude(s.R_WI);
+        s.p_WI = localMap->point(s.p_WI);
+        s.v_WI = localMap->direction(s.v_WI);
+        vio::Matrix6d T = vio::Matrix6d::Identity();
+        T.bottomRightCorner<3, 3>() = localMap->rotation();
+        P = T * P * T.transpose();
+      }
       const vio::TumPose p{s.t_ns, s.p_WI, s.R_WI};
       if (poses.empty() || p.t_ns > poses.back().t_ns) {
         tum.write(p);
-        const vio::Matrix6d P = est.poseCovariance();
         cov.write(s.t_ns, P);
         poses.push_back(p);
         localTrack.push_back({s.t_ns, s.R_WI, s.p_WI, s.v_WI});
@@ -645,6 +659,7 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
     double gnssMs = 0.0;
     int gnssCount = 0;
     if (gnss) {
+      const vio::ImuState before = init ? est.newestImuState() : vio::ImuState{};
       const std::int64_t tState = init ? est.newestImuState().t_ns : frame->t_ns;
       const GpsTime limit = gpsFromNs(tState + opt.sensorToGpst_ns);
       while (g.haveRover && g.nextRover.time <= limit) {
@@ -709,6 +724,19 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
         g.haveRover = g.rover->next(g.nextRover);
       }
       gnssSum += gnssMs;
+      if (init && gnss->worldChange()) {
+        // The local pose before these epochs, and the estimate after them (same time): the map
+        // takes the one onto the other in yaw and position, so the local track goes on from
+        // where it was (the first time, across the estimator's move into ENU).
+        const vio::ImuState after = est.newestImuState();
+        const Eigen::Matrix3d Rt = localMap ? localMap->attitude(before.R_WI) : before.R_WI;
+        const Eigen::Vector3d pt = localMap ? localMap->point(before.p_WI) : before.p_WI;
+        const Eigen::Matrix3d D = Rt * after.R_WI.transpose();
+        vio::WorldFrameChange m;
+        m.yaw = std::atan2(D(1, 0) - D(0, 1), D(0, 0) + D(1, 1));
+        m.t = pt - m.rotation() * after.p_WI;
+        localMap = m;
+      }
     }
     char b[256];
     std::snprintf(b, sizeof b, "%" PRId64 ",%" PRIu64 ",%zu,%.3f,%.3f,%.3f,%d,%d,%d,%d,%d,%d\n", frame->t_ns, frame->index,

@@ -64,8 +64,11 @@ TEST(GnssFusionConfig, FloatPppKeys) {
       "  max_ambiguities: 25\n"
       "  broadcast_ambiguity_random_walk: 0.01\n"
       "  broadcast_record_changes: false\n"
-      "  rtk_hold_fix: false\n");
+      "  rtk_hold_fix: false\n"
+      "  frame_reanchor: false\n");
   EXPECT_EQ(c.mode, GnssFusionMode::kDoppPpp);
+  EXPECT_FALSE(c.frameReanchor);
+  EXPECT_TRUE(GnssFusionConfig{}.frameReanchor);
   EXPECT_TRUE(c.usesPseudorange());
   EXPECT_FALSE(c.usesDifferences());
   EXPECT_TRUE(c.integration());
@@ -144,7 +147,7 @@ TEST(GnssFusionConfig, ErrorsNameFileLineAndField) {
                           "  ambiguity_reset_rejections: 0\n", "  estimate_zwd: maybe\n", "  zwd_sigma: -0.1\n",
                           "  phase_windup: 2\n", "  max_ambiguities: -1\n",
                           "  broadcast_ambiguity_random_walk: -1\n", "  broadcast_record_changes: 3\n",
-                          "  rtk_hold_fix: sometimes\n"}) {
+                          "  rtk_hold_fix: sometimes\n", "  frame_reanchor: 1.5\n"}) {
     try {
       parseGnssFusionConfig(std::string("gnss_fusion:\n  mode: vio+dopp+psr\n") + bad, "b.yaml");
       FAIL() << "no error for " << bad;

@@ -226,7 +226,14 @@ RunResult run(GnssFusionConfig cfg, const SatelliteCut& cut = {}, const Ephemeri
   out.lever = fusion.leverArm(be);
   out.ambiguities = fusion.ambiguities(be);
   out.zwd = fusion.zenithWetDelay(be);
-  if (const auto fr = fusion.frame(be)) out.yawError = std::remainder(fr->x() + kYaw0, 2 * constants::kPi);
+  // Yaw error of the newest attitude in local ENU (R_NI = Rz(ψ) R_WI; ψ = 0 once the backend was
+  // re-anchored in ENU) against the simulated one (the flight's frame is ENU at the origin; the
+  // anchor's ENU differs by the meridian convergence, ~1e-4 rad here).
+  if (const auto fr = fusion.frame(be)) {
+    const vio::ImuState s = be.newestImuState();
+    const sim::TrajectoryState ts = sc.traj->evaluate(sc.frame.flightTimeOfStamp(s.t_ns));
+    out.yawError = vio::so3::log(yawRotation(fr->x()) * s.R_WI * ts.R_WB.transpose()).z();
+  }
   out.meanMicros = nAll ? micros / nAll : 0.0;
   std::fprintf(stderr,
                "%-28s tight after %5.1f s (yaw err %6.2f deg) | %4d epochs: pos RMS %7.3f m (hor %7.3f) vel RMS "

@@ -5,10 +5,11 @@
 //      RTK solver (gnss/ RtkSolver, LAMBDA) on rover + base for the SD code and the fixed DD phase.
 //   2. Frame initialisation (stage kFrameInit): client block [ψ, p_NW] with an uninformative prior
 //      added at the first SPP fix with enough speed (yaw guess from the velocity headings), updated
-//      with the SPP position/velocity predicted through the IMU integration until σ_ψ < σ_θ. The
-//      block is then KEPT as a state (not marginalised as in the paper): the VIO yaw and position
-//      drift, and a frame that stays in the state absorbs it with the GNSS information instead of
-//      freezing the first estimate.
+//      with the SPP position/velocity predicted through the IMU integration until σ_ψ < σ_θ. Then
+//      (frameReanchor) the estimator re-expresses its state in ENU and the block is marginalized
+//      (EstimatorBackend::reanchorWorld, an exact change of variables): as in the paper the frame
+//      leaves the state, but its information moves into the poses, so the VIO's yaw and position
+//      drift stay observable to the GNSS rows instead of being frozen with the first estimate.
 //   3. Clocks (stage kTight): c·dt per constellation + c·ḋt initialised by RANSAC + least squares
 //      (gnss_clock_init.hpp) at the current antenna estimate, added as one client block and
 //      propagated lazily at each GNSS epoch (bias += drift·Δt, random walks).
@@ -38,6 +39,7 @@
 #include "gvins/gnss/spp.hpp"
 #include "gvins/gnss/transmit_states.hpp"
 #include "gvins/sri/chi_square.hpp"
+#include "gvins/vio/world_frame_change.hpp"
 #include "gvins/vio/estimator_backend.hpp"
 
 namespace gvins::fusion {
@@ -92,8 +94,16 @@ class GnssFusion {
   const GnssFusionConfig& config() const { return config_; }
   GnssFusionStage stage() const { return stage_; }
   bool clocksInitialized() const { return clockBlock_.valid(); }
-  /// [ψ, p_NW] and the anchor, when the frame block exists.
+  /// [ψ, p_NW] of the estimator's world frame in local ENU at the anchor: the frame block's
+  /// estimate while it is a state, zero once the estimator was re-anchored in ENU
+  /// (frameReanchor); nullopt before the frame initialisation.
   std::optional<Eigen::Vector4d> frame(const vio::EstimatorBackend<Scalar>& est) const;
+  /// The change of the estimator's world frame made at the frame's convergence (frameReanchor),
+  /// while the estimator's state is that of the re-anchoring: its inverse takes the estimator's
+  /// poses back to the VIO world frame they started in.
+  std::optional<vio::WorldFrameChange> worldChange(const vio::EstimatorBackend<Scalar>& est) const {
+    return current(est) ? worldChange_ : std::nullopt;
+  }
   const GnssAnchor& anchor() const { return anchor_; }
   Eigen::Vector3d leverArm(const vio::EstimatorBackend<Scalar>& est) const;
   /// Clock estimate [c·dt per clock system..., c·ḋt] and the systems (clock indices).
@@ -146,6 +156,7 @@ class GnssFusion {
   std::uint64_t generation_ = 0;  // estimator generation the ids below belong to
   GnssAnchor anchor_;
   sri::BlockId frameBlock_, leverBlock_, clockBlock_, zwdBlock_;
+  std::optional<vio::WorldFrameChange> worldChange_;  // set when the estimator was re-anchored in ENU
   Eigen::Vector3d leverStart_;                // lever arm before/at the lever block's creation
   std::optional<Eigen::Vector3d> leverLast_;  // the lever block's estimate after the last epoch
   GpsTime zwdTime_;

@@ -40,6 +40,7 @@
 #include "gvins/vio/imu_sample.hpp"
 #include "gvins/vio/imu_state.hpp"
 #include "gvins/vio/pose_covariance_csv.hpp"
+#include "gvins/vio/world_frame_change.hpp"
 
 namespace gvins {
 class EphemerisStore;
@@ -98,6 +99,11 @@ class ReplayGnss {
   virtual ReplayGnssOutcome processEpoch(const ObsEpoch& rover, const ObsEpoch* base, const EphemerisStore& nav) = 0;
   /// The current GNSS-IMU lever-arm estimate (^I p_r, m), when the client has one.
   virtual std::optional<Eigen::Vector3d> leverArm() const { return std::nullopt; }
+  /// The change the client made to the estimator's world frame (GnssFusion::worldChange). Once
+  /// set, the local outputs (trajectory.tum, covariances, the local evaluation) no longer follow
+  /// the estimator's world: they go on in the VIO world frame of the start as odometry, the yaw
+  /// and position part of each GNSS correction absorbed (replay_pipeline.cpp, localMap).
+  virtual std::optional<vio::WorldFrameChange> worldChange() const { return std::nullopt; }
 };
 
 enum class ImuGapPolicy { Error, Warn };

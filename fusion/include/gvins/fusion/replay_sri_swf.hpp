@@ -68,6 +68,7 @@ class GnssFusionReplayClient final : public ReplayGnss {
     return o;
   }
   std::optional<Eigen::Vector3d> leverArm() const override { return fusion_.leverArm(est_); }
+  std::optional<vio::WorldFrameChange> worldChange() const override { return fusion_.worldChange(est_); }
   GnssFusion<Scalar>& fusion() { return fusion_; }
 
  private:
