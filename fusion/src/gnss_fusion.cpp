@@ -1,6 +1,7 @@
 #include "gvins/fusion/gnss_fusion.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 
@@ -738,6 +739,33 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
     stage_ = GnssFusionStage::kFrameInit;
   }
 
+  // The paper marginalizes the converged frame and keeps the VIO frame; here the estimator moves
+  // into ENU with it (an exact change of variables, world_frame_change.hpp), so the GNSS
+  // information on the yaw stays in the poses and the rows lose the frame's columns. Not at the
+  // convergence itself: the SPP rows of the initialisation leave the frame's position metres off
+  // (height σ ~12 m on demo_short), which the first raw rows correct at once; moved with them,
+  // the local outputs (fixed to the frame of the move) would jump by that much. So the move waits
+  // until the IMU's position in N, p_N = p_NW + Rz(ψ) p_W, is known to
+  // frame_reanchor_position_sigma (p_NW alone is not: far from the VIO origin its σ is the yaw's
+  // times the distance).
+  if (stage_ == GnssFusionStage::kTight && frameBlock_.valid() && config_.frameReanchor) {
+    const vio::ImuBlocks ib = est.newestImuBlocks();
+    const std::array<sri::BlockId, 2> ids{ib.pose, frameBlock_};
+    const Eigen::MatrixXd P = est.covariance(std::span<const sri::BlockId>(ids)).template cast<double>();
+    const double yaw = static_cast<double>(est.estimate(frameBlock_).vector[0]);
+    const Eigen::Matrix3d Rz = yawRotation(yaw);
+    Eigen::Matrix<double, 3, 10> J = Eigen::Matrix<double, 3, 10>::Zero();  // ∂p_N/∂[δθ δp | ψ p_NW]
+    J.block<3, 3>(0, 3) = Rz;
+    J.col(6) = Eigen::Vector3d::UnitZ().cross(Rz * est.newestImuState().p_WI);
+    J.block<3, 3>(0, 7).setIdentity();
+    const Eigen::Matrix3d Pn = J * P * J.transpose();
+    const double sth = config_.frameYawSigmaDeg * constants::kDegToRad;
+    const double sp = config_.frameReanchorPositionSigma;
+    if (P(6, 6) < sth * sth && Pn.diagonal().maxCoeff() < sp * sp) {
+      worldChange_ = est.reanchorWorld(frameBlock_);
+      frameBlock_ = {};
+    }
+  }
   GnssStateValues s;
   if (!buildState(est, t_ns, s)) return finish();
   AntennaKinematics k = antennaKinematics(s);
@@ -783,16 +811,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
       const sri::BlockId id = frameBlock_;
       const auto P = est.covariance(std::span<const sri::BlockId>(&id, 1));
       const double sth = config_.frameYawSigmaDeg * constants::kDegToRad;
-      if (static_cast<double>(P(0, 0)) < sth * sth) {
-        stage_ = GnssFusionStage::kTight;
-        // The paper marginalizes the converged frame and keeps the VIO frame; here the estimator
-        // moves into ENU with it (an exact change of variables, world_frame_change.hpp), so the
-        // GNSS information on the yaw stays in the poses and the rows lose the frame's columns.
-        if (config_.frameReanchor) {
-          worldChange_ = est.reanchorWorld(frameBlock_);
-          frameBlock_ = {};
-        }
-      }
+      if (static_cast<double>(P(0, 0)) < sth * sth) stage_ = GnssFusionStage::kTight;
     } catch (const std::exception&) {
     }
   } else {

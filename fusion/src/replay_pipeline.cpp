@@ -241,6 +241,7 @@ void ReplaySummary::writeMetrics(std::ostream& os) const {
   kv("ambiguity_states_max", static_cast<double>(ambiguityStatesMax));
   kv("broadcast_record_changes", static_cast<double>(recordChanges));
   kv("frame_init_s", frameInitSeconds);
+  kv("enu_move_s", enuMoveSeconds);
   auto acc = [&](const std::string& p, const Accuracy& a) {
     kv((p + "position_rmse_m").c_str(), a.positionRmse);
     kv((p + "horizontal_rmse_m").c_str(), a.horizontalRmse);
@@ -314,6 +315,7 @@ void ReplaySummary::print(std::ostream& os) const {
                                      " gated out; up to " + std::to_string(ambiguityStatesMax) + " ambiguity states" +
                                      (recordChanges > 0 ? "; " + std::to_string(recordChanges) + " broadcast record changes carried over" : ""));
     if (std::isfinite(frameInitSeconds)) row("frame initialised", f("%.1f s after the first frame", frameInitSeconds));
+    if (std::isfinite(enuMoveSeconds)) row("estimator in ENU", f("%.1f s after the first frame", enuMoveSeconds));
   }
   if (leverArm) {
     std::string t = f("%.3f", leverArm->x()) + f(" %.3f", leverArm->y()) + f(" %.3f m", leverArm->z());
@@ -487,10 +489,9 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
   std::vector<vio::TrajectorySample> localTrack;  // poses with the estimated velocity
   std::vector<vio::PoseCovariance> covs;
   std::vector<double> estimatorMs;
-  // Local outputs (trajectory.tum, covariances, the local evaluation) are odometry in the VIO
-  // world frame of the start. Once the GNSS fusion has moved the estimator into ENU
-  // (ReplayGnss::worldChange), `localMap` takes ENU to that frame and absorbs the yaw and position
-  // part of every GNSS correction, as the frame block did while it was a state.
+  // Local outputs (trajectory.tum, covariances, the local evaluation) stay in the VIO world frame
+  // of the start: once the GNSS fusion has moved the estimator into ENU (ReplayGnss::worldChange),
+  // `localMap` takes ENU back to it, fixed at the move.
   std::optional<vio::WorldFrameChange> localMap;
   // GNSS solutions, stamped on the sensor clock: all, and those after the frame initialisation.
   std::vector<EcefTruthSample> antennaTrack, antennaTight;
@@ -659,7 +660,6 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
     double gnssMs = 0.0;
     int gnssCount = 0;
     if (gnss) {
-      const vio::ImuState before = init ? est.newestImuState() : vio::ImuState{};
       const std::int64_t tState = init ? est.newestImuState().t_ns : frame->t_ns;
       const GpsTime limit = gpsFromNs(tState + opt.sensorToGpst_ns);
       while (g.haveRover && g.nextRover.time <= limit) {
@@ -724,18 +724,9 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
         g.haveRover = g.rover->next(g.nextRover);
       }
       gnssSum += gnssMs;
-      if (init && gnss->worldChange()) {
-        // The local pose before these epochs, and the estimate after them (same time): the map
-        // takes the one onto the other in yaw and position, so the local track goes on from
-        // where it was (the first time, across the estimator's move into ENU).
-        const vio::ImuState after = est.newestImuState();
-        const Eigen::Matrix3d Rt = localMap ? localMap->attitude(before.R_WI) : before.R_WI;
-        const Eigen::Vector3d pt = localMap ? localMap->point(before.p_WI) : before.p_WI;
-        const Eigen::Matrix3d D = Rt * after.R_WI.transpose();
-        vio::WorldFrameChange m;
-        m.yaw = std::atan2(D(1, 0) - D(0, 1), D(0, 0) + D(1, 1));
-        m.t = pt - m.rotation() * after.p_WI;
-        localMap = m;
+      if (init && !localMap && gnss->worldChange()) {
+        localMap = gnss->worldChange()->inverse();
+        if (!std::isfinite(sum.enuMoveSeconds)) sum.enuMoveSeconds = static_cast<double>(frame->t_ns - firstT) * 1e-9;
       }
     }
     char b[256];

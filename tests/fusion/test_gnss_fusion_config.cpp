@@ -65,10 +65,12 @@ TEST(GnssFusionConfig, FloatPppKeys) {
       "  broadcast_ambiguity_random_walk: 0.01\n"
       "  broadcast_record_changes: false\n"
       "  rtk_hold_fix: false\n"
-      "  frame_reanchor: false\n");
+      "  frame_reanchor: false\n"
+      "  frame_reanchor_position_sigma: 0.2\n");
   EXPECT_EQ(c.mode, GnssFusionMode::kDoppPpp);
   EXPECT_FALSE(c.frameReanchor);
   EXPECT_TRUE(GnssFusionConfig{}.frameReanchor);
+  EXPECT_DOUBLE_EQ(c.frameReanchorPositionSigma, 0.2);
   EXPECT_TRUE(c.usesPseudorange());
   EXPECT_FALSE(c.usesDifferences());
   EXPECT_TRUE(c.integration());
@@ -147,7 +149,8 @@ TEST(GnssFusionConfig, ErrorsNameFileLineAndField) {
                           "  ambiguity_reset_rejections: 0\n", "  estimate_zwd: maybe\n", "  zwd_sigma: -0.1\n",
                           "  phase_windup: 2\n", "  max_ambiguities: -1\n",
                           "  broadcast_ambiguity_random_walk: -1\n", "  broadcast_record_changes: 3\n",
-                          "  rtk_hold_fix: sometimes\n", "  frame_reanchor: 1.5\n"}) {
+                          "  rtk_hold_fix: sometimes\n", "  frame_reanchor: 1.5\n",
+                          "  frame_reanchor_position_sigma: 0\n"}) {
     try {
       parseGnssFusionConfig(std::string("gnss_fusion:\n  mode: vio+dopp+psr\n") + bad, "b.yaml");
       FAIL() << "no error for " << bad;

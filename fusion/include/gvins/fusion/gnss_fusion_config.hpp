@@ -41,8 +41,9 @@
 //     epoch_gate: 0.99999                 # chi-square probability of the stacked rows
 //     frame_yaw_sigma_deg: 3              # convergence threshold σ_θ
 //     frame_min_speed: 1.0                # m/s before the yaw guess from velocity headings
-//     frame_reanchor: true                # at convergence re-express the VIO state in ENU and
+//     frame_reanchor: true                # once converged re-express the VIO state in ENU and
 //                                         # marginalize the frame block (false: keep it as a state)
+//     frame_reanchor_position_sigma: 0.5  # m, largest frame position σ for that
 //     outage_reset: 60                    # s without GNSS update: clocks/ambiguities reset
 //     clock_ransac_threshold: 5.0         # m (pseudorange) for the clock RANSAC
 //     base_position: [x, y, z]            # ECEF of the base antenna (dpsr/ddcp)
@@ -165,10 +166,13 @@ struct GnssFusionConfig {
   double epochGate = 0.99999;
   double frameYawSigmaDeg = 3.0;
   double frameMinSpeed = 1.0;
-  /// At convergence the estimator re-expresses its state in local ENU (EstimatorBackend::
+  /// After convergence the estimator re-expresses its state in local ENU (EstimatorBackend::
   /// reanchorWorld) and the frame block is marginalized, so the GNSS rows no longer carry its 4
   /// columns; false keeps it as a state (as before 6 Dec 2026; the same estimate to first order).
   bool frameReanchor = true;
+  /// ... once, in the tight stage, the frame's position σ (every axis) is below this too (m):
+  /// the raw rows first correct the SPP-level position of the initialisation.
+  double frameReanchorPositionSigma = 0.5;
   double outageReset = 60.0;
   double clockRansacThreshold = 5.0;
   std::optional<Eigen::Vector3d> basePosition;

@@ -99,10 +99,9 @@ class ReplayGnss {
   virtual ReplayGnssOutcome processEpoch(const ObsEpoch& rover, const ObsEpoch* base, const EphemerisStore& nav) = 0;
   /// The current GNSS-IMU lever-arm estimate (^I p_r, m), when the client has one.
   virtual std::optional<Eigen::Vector3d> leverArm() const { return std::nullopt; }
-  /// The change the client made to the estimator's world frame (GnssFusion::worldChange). Once
-  /// set, the local outputs (trajectory.tum, covariances, the local evaluation) no longer follow
-  /// the estimator's world: they go on in the VIO world frame of the start as odometry, the yaw
-  /// and position part of each GNSS correction absorbed (replay_pipeline.cpp, localMap).
+  /// The change the client made to the estimator's world frame (GnssFusion::worldChange): the
+  /// local outputs (trajectory.tum, covariances, the local evaluation) undo it, so that they stay
+  /// in the VIO world frame of the start.
   virtual std::optional<vio::WorldFrameChange> worldChange() const { return std::nullopt; }
 };
 
@@ -209,6 +208,9 @@ struct ReplaySummary {
   Accuracy local;   ///< trajectory.tum vs ground truth, 4-DoF aligned
   Accuracy global;  ///< GNSS antenna solutions after the frame initialisation, ENU, no alignment
   double frameInitSeconds = kNaN;  ///< from the first processed frame to the first tight GNSS epoch
+  /// From the first processed frame to the frame after which the estimator was in ENU
+  /// (GnssFusionConfig::frameReanchor; NaN if it never moved, or with frame_reanchor off).
+  double enuMoveSeconds = kNaN;
   std::optional<Eigen::Vector3d> leverArm, leverArmTruth;  ///< final estimate; options' truth
   /// Camera-IMU time offset (s): final estimate and 1-σ when calibrated; options' truth.
   std::optional<double> timeOffset, timeOffsetSigma, timeOffsetTruth;
