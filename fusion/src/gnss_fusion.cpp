@@ -751,19 +751,26 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
   if (stage_ == GnssFusionStage::kTight && frameBlock_.valid() && config_.frameReanchor) {
     const vio::ImuBlocks ib = est.newestImuBlocks();
     const std::array<sri::BlockId, 2> ids{ib.pose, frameBlock_};
-    const Eigen::MatrixXd P = est.covariance(std::span<const sri::BlockId>(ids)).template cast<double>();
-    const double yaw = static_cast<double>(est.estimate(frameBlock_).vector[0]);
-    const Eigen::Matrix3d Rz = yawRotation(yaw);
-    Eigen::Matrix<double, 3, 10> J = Eigen::Matrix<double, 3, 10>::Zero();  // ∂p_N/∂[δθ δp | ψ p_NW]
-    J.block<3, 3>(0, 3) = Rz;
-    J.col(6) = Eigen::Vector3d::UnitZ().cross(Rz * est.newestImuState().p_WI);
-    J.block<3, 3>(0, 7).setIdentity();
-    const Eigen::Matrix3d Pn = J * P * J.transpose();
-    const double sth = config_.frameYawSigmaDeg * constants::kDegToRad;
-    const double sp = config_.frameReanchorPositionSigma;
-    if (P(6, 6) < sth * sth && Pn.diagonal().maxCoeff() < sp * sp) {
-      worldChange_ = est.reanchorWorld(frameBlock_);
-      frameBlock_ = {};
+    std::optional<Eigen::MatrixXd> P;
+    try {
+      P = est.covariance(std::span<const sri::BlockId>(ids)).template cast<double>();
+    } catch (const std::exception&) {
+      // not informed (yet): no move at this epoch
+    }
+    if (P) {
+      const double yaw = static_cast<double>(est.estimate(frameBlock_).vector[0]);
+      const Eigen::Matrix3d Rz = yawRotation(yaw);
+      Eigen::Matrix<double, 3, 10> J = Eigen::Matrix<double, 3, 10>::Zero();  // ∂p_N/∂[δθ δp | ψ p_NW]
+      J.block<3, 3>(0, 3) = Rz;
+      J.col(6) = Eigen::Vector3d::UnitZ().cross(Rz * est.newestImuState().p_WI);
+      J.block<3, 3>(0, 7).setIdentity();
+      const Eigen::Matrix3d Pn = J * *P * J.transpose();
+      const double sth = config_.frameYawSigmaDeg * constants::kDegToRad;
+      const double sp = config_.frameReanchorPositionSigma;
+      if ((*P)(6, 6) < sth * sth && Pn.diagonal().maxCoeff() < sp * sp) {
+        worldChange_ = est.reanchorWorld(frameBlock_);
+        frameBlock_ = {};
+      }
     }
   }
   GnssStateValues s;
