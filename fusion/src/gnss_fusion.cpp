@@ -317,6 +317,27 @@ bool GnssFusion<Scalar>::startFrame(vio::EstimatorBackend<Scalar>& est, const Sp
 }
 
 template <typename Scalar>
+bool GnssFusion<Scalar>::frameKnownInEnu(const vio::EstimatorBackend<Scalar>& est) const {
+  const vio::ImuBlocks ib = est.newestImuBlocks();
+  const std::array<sri::BlockId, 2> ids{ib.pose, frameBlock_};
+  Eigen::MatrixXd P;
+  try {
+    P = est.covariance(std::span<const sri::BlockId>(ids)).template cast<double>();
+  } catch (const std::exception&) {
+    return false;  // not informed (yet)
+  }
+  const Eigen::Matrix3d Rz = yawRotation(static_cast<double>(est.estimate(frameBlock_).vector[0]));
+  Eigen::Matrix<double, 3, 10> J = Eigen::Matrix<double, 3, 10>::Zero();  // ∂p_N/∂[δθ δp | ψ p_NW]
+  J.block<3, 3>(0, 3) = Rz;
+  J.col(6) = Eigen::Vector3d::UnitZ().cross(Rz * est.newestImuState().p_WI);
+  J.block<3, 3>(0, 7).setIdentity();
+  const Eigen::Matrix3d Pn = J * P * J.transpose();
+  const double sth = config_.frameYawSigmaDeg * constants::kDegToRad;
+  const double sp = config_.frameReanchorPositionSigma;
+  return P(6, 6) < sth * sth && Pn.diagonal().maxCoeff() < sp * sp;
+}
+
+template <typename Scalar>
 bool GnssFusion<Scalar>::initClocks(vio::EstimatorBackend<Scalar>& est, const std::vector<SatelliteModel>& models,
                                     const AntennaKinematics& k, const GpsTime& t) {
   clockSystems_.clear();
@@ -748,30 +769,9 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
   // until the IMU's position in N, p_N = p_NW + Rz(ψ) p_W, is known to
   // frame_reanchor_position_sigma (p_NW alone is not: far from the VIO origin its σ is the yaw's
   // times the distance).
-  if (stage_ == GnssFusionStage::kTight && frameBlock_.valid() && config_.frameReanchor) {
-    const vio::ImuBlocks ib = est.newestImuBlocks();
-    const std::array<sri::BlockId, 2> ids{ib.pose, frameBlock_};
-    std::optional<Eigen::MatrixXd> P;
-    try {
-      P = est.covariance(std::span<const sri::BlockId>(ids)).template cast<double>();
-    } catch (const std::exception&) {
-      // not informed (yet): no move at this epoch
-    }
-    if (P) {
-      const double yaw = static_cast<double>(est.estimate(frameBlock_).vector[0]);
-      const Eigen::Matrix3d Rz = yawRotation(yaw);
-      Eigen::Matrix<double, 3, 10> J = Eigen::Matrix<double, 3, 10>::Zero();  // ∂p_N/∂[δθ δp | ψ p_NW]
-      J.block<3, 3>(0, 3) = Rz;
-      J.col(6) = Eigen::Vector3d::UnitZ().cross(Rz * est.newestImuState().p_WI);
-      J.block<3, 3>(0, 7).setIdentity();
-      const Eigen::Matrix3d Pn = J * *P * J.transpose();
-      const double sth = config_.frameYawSigmaDeg * constants::kDegToRad;
-      const double sp = config_.frameReanchorPositionSigma;
-      if ((*P)(6, 6) < sth * sth && Pn.diagonal().maxCoeff() < sp * sp) {
-        worldChange_ = est.reanchorWorld(frameBlock_);
-        frameBlock_ = {};
-      }
-    }
+  if (stage_ == GnssFusionStage::kTight && frameBlock_.valid() && config_.frameReanchor && frameKnownInEnu(est)) {
+    worldChange_ = est.reanchorWorld(frameBlock_);
+    frameBlock_ = {};
   }
   GnssStateValues s;
   if (!buildState(est, t_ns, s)) return finish();

@@ -724,9 +724,11 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
         g.haveRover = g.rover->next(g.nextRover);
       }
       gnssSum += gnssMs;
-      if (init && !localMap && gnss->worldChange()) {
-        localMap = gnss->worldChange()->inverse();
-        if (!std::isfinite(sum.enuMoveSeconds)) sum.enuMoveSeconds = static_cast<double>(frame->t_ns - firstT) * 1e-9;
+      if (init && !localMap) {
+        if (const auto c = gnss->worldChange()) {
+          localMap = c->inverse();
+          if (!std::isfinite(sum.enuMoveSeconds)) sum.enuMoveSeconds = static_cast<double>(frame->t_ns - firstT) * 1e-9;
+        }
       }
     }
     char b[256];

@@ -891,6 +891,11 @@ struct SriSwfEstimator<Scalar>::Impl {
     Eigen::Vector2d z;
   };
   std::vector<Ray> rays;  // triangulate()'s buffer
+  /// Whether the Jacobians linearize the newest velocity at fe_v: with first estimates, once the
+  /// newest pose has one (unobservableDirections() and reanchorWorld() build N and B from it).
+  bool velocityHasFirstEstimate() const {
+    return cfg.first_estimate_jacobians && fe_pose.count(newest.pose.value) != 0;
+  }
   /// EstimatorBackend::reanchorWorld: every clone (the newest pose is one) and the velocity in
   /// the extra change variables (world_frame_change.hpp), with the frame's Jacobian at the first
   /// estimates where they are used (the handed-over uncertainty then lies along the
@@ -911,9 +916,8 @@ struct SriSwfEstimator<Scalar>::Impl {
       }
       poses.push_back(rp);
     }
-    // The velocity's as in unobservableDirections(): fe_v once the newest pose has a first estimate.
-    const bool fe_velocity = cfg.first_estimate_jacobians && fe_pose.count(newest.pose.value) != 0;
-    const ReanchoredVelocity velocity[] = {{newest.extra, fe_velocity ? std::optional<Eigen::Vector3d>(fe_v) : std::nullopt}};
+    const ReanchoredVelocity velocity[] = {
+        {newest.extra, velocityHasFirstEstimate() ? std::optional<Eigen::Vector3d>(fe_v) : std::nullopt}};
     const WorldFrameChange c = vio::reanchorWorld(f, frame, poses, velocity);
     for (auto& [id, P] : fe_pose) {
       P.R_WI = c.attitude(P.R_WI);
@@ -1322,8 +1326,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     const bool fej = cfg.first_estimate_jacobians;
     for (const sri::BlockInfo& b : f.layout().blocks()) {
       if (b.id == newest.extra) {
-        const bool use_fe = fej && fe_pose.count(newest.pose.value) != 0;
-        const Eigen::Vector3d v = use_fe ? fe_v : Eigen::Vector3d(f.nominal(b.id).vector.head(3));
+        const Eigen::Vector3d v = velocityHasFirstEstimate() ? fe_v : Eigen::Vector3d(f.nominal(b.id).vector.head(3));
         N.block<3, 1>(b.offset, 0) = ez.cross(v);
         continue;
       }

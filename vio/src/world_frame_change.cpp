@@ -1,6 +1,5 @@
 #include "gvins/vio/world_frame_change.hpp"
 
-#include <cmath>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -26,13 +25,6 @@ WorldFrameChange WorldFrameChange::inverse() const {
   WorldFrameChange c;
   c.yaw = -yaw;
   c.t = -(rotation().transpose() * t);
-  return c;
-}
-
-WorldFrameChange WorldFrameChange::then(const WorldFrameChange& next) const {
-  WorldFrameChange c;
-  c.yaw = std::remainder(yaw + next.yaw, 2.0 * EIGEN_PI);
-  c.t = next.rotation() * t + next.t;
   return c;
 }
 

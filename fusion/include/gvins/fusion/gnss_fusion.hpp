@@ -98,7 +98,7 @@ class GnssFusion {
   /// estimate while it is a state, zero once the estimator was re-anchored in ENU
   /// (frameReanchor); nullopt before the frame initialisation.
   std::optional<Eigen::Vector4d> frame(const vio::EstimatorBackend<Scalar>& est) const;
-  /// The change of the estimator's world frame made at the frame's convergence (frameReanchor),
+  /// The change of the estimator's world frame made once the frame had converged (frameReanchor),
   /// while the estimator's state is that of the re-anchoring: its inverse takes the estimator's
   /// poses back to the VIO world frame they started in.
   std::optional<vio::WorldFrameChange> worldChange(const vio::EstimatorBackend<Scalar>& est) const {
@@ -127,6 +127,9 @@ class GnssFusion {
   bool buildState(const vio::EstimatorBackend<Scalar>& est, std::int64_t t_ns, GnssStateValues& s) const;
   void ensureLever(vio::EstimatorBackend<Scalar>& est);
   bool startFrame(vio::EstimatorBackend<Scalar>& est, const SppSolution& spp, std::int64_t t_ns);
+  /// Whether the converged frame may be folded into the state: its yaw σ < σ_θ and the σ of the
+  /// IMU's ENU position p_N = p_NW + Rz(ψ) p_W below frameReanchorPositionSigma on every axis.
+  bool frameKnownInEnu(const vio::EstimatorBackend<Scalar>& est) const;
   bool initClocks(vio::EstimatorBackend<Scalar>& est, const std::vector<SatelliteModel>& models,
                   const AntennaKinematics& k, const GpsTime& t);
   void propagateClocks(vio::EstimatorBackend<Scalar>& est, const GpsTime& t);

@@ -43,7 +43,7 @@
 //     frame_min_speed: 1.0                # m/s before the yaw guess from velocity headings
 //     frame_reanchor: true                # once converged re-express the VIO state in ENU and
 //                                         # marginalize the frame block (false: keep it as a state)
-//     frame_reanchor_position_sigma: 0.5  # m, largest frame position σ for that
+//     frame_reanchor_position_sigma: 0.5  # m, ... once the IMU's ENU position σ is below this
 //     outage_reset: 60                    # s without GNSS update: clocks/ambiguities reset
 //     clock_ransac_threshold: 5.0         # m (pseudorange) for the clock RANSAC
 //     base_position: [x, y, z]            # ECEF of the base antenna (dpsr/ddcp)
@@ -170,8 +170,9 @@ struct GnssFusionConfig {
   /// reanchorWorld) and the frame block is marginalized, so the GNSS rows no longer carry its 4
   /// columns; false keeps it as a state (as before 6 Dec 2026; the same estimate to first order).
   bool frameReanchor = true;
-  /// ... once, in the tight stage, the frame's position σ (every axis) is below this too (m):
-  /// the raw rows first correct the SPP-level position of the initialisation.
+  /// ... once, in the tight stage, the σ of the IMU's ENU position (every axis, from the newest
+  /// pose and the frame) is below this too (m): the raw rows first correct the SPP-level position
+  /// of the initialisation.
   double frameReanchorPositionSigma = 0.5;
   double outageReset = 60.0;
   double clockRansacThreshold = 5.0;

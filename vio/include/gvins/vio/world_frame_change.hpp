@@ -4,8 +4,9 @@
 // A client that estimated where the VIO world frame W lies in a frame of its own (fusion/: the VIO
 // frame's yaw and origin in local ENU, paper Sec. III-A) holds [ψ; t] as a client block; once it
 // has converged, reanchorWorld() re-expresses the estimator's state in W' and marginalizes the
-// block (EstimatorBackend::reanchorWorld). This is an exact change of variables at the current
-// estimates, so the information the block carried (e.g. the GNSS yaw) moves into the poses:
+// block (EstimatorBackend::reanchorWorld). This is an exact change of variables (at the
+// linearization values given, below), so the information the block carried (e.g. the GNSS yaw)
+// moves into the poses:
 // unlike fixing the block (the paper's marginalization of the converged frame in the VIO frame),
 // the VIO's own gauge prior on its first pose does not keep pinning the global yaw afterwards.
 #pragma once
@@ -32,8 +33,6 @@ struct WorldFrameChange {
   Eigen::Matrix3d attitude(const Eigen::Matrix3d& R_WI) const { return rotation() * R_WI; }
   /// W' → W.
   WorldFrameChange inverse() const;
-  /// First this, then `next` (W → W' → W'').
-  WorldFrameChange then(const WorldFrameChange& next) const;
 };
 
 /// A pose block (kPose of R_WI, p_WI, either perturbation convention) to re-express, and where
