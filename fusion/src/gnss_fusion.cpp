@@ -480,10 +480,10 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
   const vio::ImuBlocks ib = est.newestImuBlocks();
   const int nc = clockBlock_.valid() ? static_cast<int>(clockSystems_.size()) + 1 : 0;
   accepted.assign(rows.size(), false);
-  // The blocks GNSS rows touch: newest pose and extra, frame, lever arm, clocks (all at the back
-  // of the state); a row as a vector h over them, in this order.
-  std::vector<sri::BlockId> blocks{ib.pose, ib.extra};
-  std::vector<int> dims{6, 9};
+  // The blocks GNSS rows touch: newest pose, velocity and bias, frame, lever arm, clocks (all at
+  // the back of the state); a row as a vector h over them, in this order.
+  std::vector<sri::BlockId> blocks{ib.pose, ib.velocity, ib.bias};
+  std::vector<int> dims{6, 3, 6};
   int dim = 15;
   auto addBlock = [&](sri::BlockId id, int size) {
     blocks.push_back(id);
@@ -606,7 +606,7 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
   sri::Measurement<Scalar> m(static_cast<int>(nk) + (nuisance ? 9 : 0));
   for (std::size_t bi = 0, col = 0; bi < blocks.size(); col += static_cast<std::size_t>(dims[bi]), ++bi) {
     const auto c = static_cast<Eigen::Index>(col);
-    if (bi >= 2 && A.middleCols(c, dims[bi]).isZero(0.0)) continue;  // e.g. the lever arm without excitation
+    if (bi >= 3 && A.middleCols(c, dims[bi]).isZero(0.0)) continue;  // e.g. the lever arm without excitation
     m.jacobian(blocks[bi], dims[bi]).topRows(nk) = A.middleCols(c, dims[bi]).template cast<Scalar>();
   }
   m.residual().head(nk) = A.col(dim + 9).template cast<Scalar>();

@@ -1,8 +1,8 @@
 // Test-only EstimatorBackend: an IMU-driven SRI filter (gvins::sri::SriFilter) without vision, so
 // that GnssFusion can run GNSS/INS end-to-end on simulated IMU + GNSS before (and independently
 // of) the SRI-SWF estimator. Newest IMU state = pose block (kPose, right perturbation, ImuErr's
-// [δθ, δp]) + extra block (kVector 9, [δv, δbg, δba]); propagation with vio::ImuPropagator's Φ and
-// Q_d (paper eq. (8)); client blocks are placed before the IMU blocks (kParameters) or at the
+// [δθ, δp]) + velocity block (kVector 3) + bias block (kVector 6, [δbg, δba]), all three renewed at
+// every propagation with vio::ImuPropagator's Φ and Q_d (paper eq. (8)); client blocks are placed before the IMU blocks (kParameters) or at the
 // front (kFront).
 #pragma once
 
@@ -34,8 +34,10 @@ class ImuGnssTestBackend final : public vio::EstimatorBackend<Scalar> {
       : prop_(noise, gravity), samples_(samples), t_(initial.t_ns) {
     blocks_.pose = filter_.addBlock(sri::BlockSpec::pose("imu_pose"), poseOf(initial),
                                     sri::Prior<Scalar>::stdDevs(priorSigma.head<6>().template cast<Scalar>()));
-    blocks_.extra = filter_.addBlock(sri::BlockSpec::vector("imu_extra", 9), extraOf(initial),
-                                     sri::Prior<Scalar>::stdDevs(priorSigma.tail<9>().template cast<Scalar>()));
+    blocks_.velocity = filter_.addBlock(sri::BlockSpec::vector("imu_velocity", 3), velocityOf(initial),
+                                        sri::Prior<Scalar>::stdDevs(priorSigma.segment<3>(6).template cast<Scalar>()));
+    blocks_.bias = filter_.addBlock(sri::BlockSpec::vector("imu_bias", 6), biasOf(initial),
+                                    sri::Prior<Scalar>::stdDevs(priorSigma.tail<6>().template cast<Scalar>()));
   }
 
   /// Propagates the newest state to t_ns.
@@ -46,15 +48,18 @@ class ImuGnssTestBackend final : public vio::EstimatorBackend<Scalar> {
     prop_.propagate(s, window(t_, t_ns), t_ns, &Phi, &Qd);
     sri::Propagation<Scalar> step;
     step.addNewBlock(sri::BlockSpec::pose("imu_pose"), poseOf(s));
-    step.addNewBlock(sri::BlockSpec::vector("imu_extra", 9), extraOf(s));
+    step.addNewBlock(sri::BlockSpec::vector("imu_velocity", 3), velocityOf(s));
+    step.addNewBlock(sri::BlockSpec::vector("imu_bias", 6), biasOf(s));
     step.setTransition(blocks_.pose, Phi.leftCols<6>().template cast<Scalar>());
-    step.setTransition(blocks_.extra, Phi.rightCols<9>().template cast<Scalar>());
+    step.setTransition(blocks_.velocity, Phi.middleCols<3>(6).template cast<Scalar>());
+    step.setTransition(blocks_.bias, Phi.rightCols<6>().template cast<Scalar>());
     Qd += 1e-12 * vio::Matrix15d::Identity();
     step.setNoiseCovariance(Qd.template cast<Scalar>());
     step.marginalizeAfter(blocks_.pose);
-    step.marginalizeAfter(blocks_.extra);
+    step.marginalizeAfter(blocks_.velocity);
+    step.marginalizeAfter(blocks_.bias);
     const auto ids = filter_.propagate(step);
-    blocks_ = {ids.at(0), ids.at(1)};
+    blocks_ = {ids.at(0), ids.at(1), ids.at(2)};
     t_ = t_ns;
   }
 
@@ -65,7 +70,7 @@ class ImuGnssTestBackend final : public vio::EstimatorBackend<Scalar> {
   void restart() {
     std::vector<sri::BlockId> clients;
     for (const sri::BlockInfo& b : filter_.layout().blocks()) {
-      if (b.id != blocks_.pose && b.id != blocks_.extra) clients.push_back(b.id);
+      if (b.id != blocks_.pose && b.id != blocks_.velocity && b.id != blocks_.bias) clients.push_back(b.id);
     }
     if (!clients.empty()) filter_.marginalize(clients);
     ++generation_;
@@ -75,13 +80,12 @@ class ImuGnssTestBackend final : public vio::EstimatorBackend<Scalar> {
     vio::ImuState s;
     s.t_ns = t_;
     const auto& p = filter_.estimate(blocks_.pose);
-    const auto& e = filter_.estimate(blocks_.extra);
     s.R_WI = p.rotation.template cast<double>().toRotationMatrix();
     s.p_WI = p.vector.template cast<double>();
-    const Eigen::VectorXd x = e.vector.template cast<double>();
-    s.v_WI = x.segment<3>(0);
-    s.bg = x.segment<3>(3);
-    s.ba = x.segment<3>(6);
+    s.v_WI = filter_.estimate(blocks_.velocity).vector.template cast<double>();
+    const Eigen::VectorXd b = filter_.estimate(blocks_.bias).vector.template cast<double>();
+    s.bg = b.segment<3>(0);
+    s.ba = b.segment<3>(3);
     return s;
   }
   vio::ImuBlocks newestImuBlocks() const override { return blocks_; }
@@ -116,7 +120,7 @@ class ImuGnssTestBackend final : public vio::EstimatorBackend<Scalar> {
   void marginalize(std::span<const sri::BlockId> ids) override { filter_.marginalize(ids); }
   vio::WorldFrameChange reanchorWorld(sri::BlockId frame) override {
     const vio::ReanchoredPose poses[] = {{blocks_.pose, std::nullopt, std::nullopt}};
-    const vio::ReanchoredVelocity velocities[] = {{blocks_.extra, std::nullopt}};
+    const vio::ReanchoredVelocity velocities[] = {{blocks_.velocity, std::nullopt}};
     return vio::reanchorWorld(filter_, frame, poses, velocities);
   }
   bool contains(sri::BlockId id) const override { return filter_.layout().contains(id); }
@@ -148,9 +152,12 @@ class ImuGnssTestBackend final : public vio::EstimatorBackend<Scalar> {
     return sri::BlockEstimate<Scalar>::fromPose(Eigen::Quaterniond(s.R_WI).template cast<Scalar>(),
                                                 s.p_WI.template cast<Scalar>());
   }
-  static sri::BlockEstimate<Scalar> extraOf(const vio::ImuState& s) {
-    Eigen::Matrix<double, 9, 1> x;
-    x << s.v_WI, s.bg, s.ba;
+  static sri::BlockEstimate<Scalar> velocityOf(const vio::ImuState& s) {
+    return sri::BlockEstimate<Scalar>::fromVector(s.v_WI.template cast<Scalar>());
+  }
+  static sri::BlockEstimate<Scalar> biasOf(const vio::ImuState& s) {
+    Eigen::Matrix<double, 6, 1> x;
+    x << s.bg, s.ba;
     return sri::BlockEstimate<Scalar>::fromVector(x.template cast<Scalar>());
   }
   sri::Placement placement(vio::ClientBlockRegion r) const {

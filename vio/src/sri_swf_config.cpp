@@ -44,6 +44,7 @@ void SriSwfConfig::validate() const {
   req(attitude_random_walk >= 0 && std::isfinite(attitude_random_walk), "attitude_random_walk must be >= 0");
   req(zero_velocity_sigma > 0, "zero_velocity_sigma must be positive");
   req(first_estimate_delay >= 0, "first_estimate_delay must not be negative");
+  req(imu_bias_renewal >= 0 && imu_bias_renewal <= 10, "imu_bias_renewal must be in [0, 10] s");
   req(init_window > 0.05 && init_window <= 30, "init.window must be in (0.05, 30] s");
   req(static_max_accel_std > 0 && static_max_gyro_std > 0 && static_max_parallax > 0,
       "init static thresholds must be positive");
@@ -181,6 +182,7 @@ SriSwfConfig parseRoot(const YAML::Node& root, const Ctx& c, const SriSwfConfig*
       {"time_offset_sigma", d(cfg.time_offset_sigma, "time_offset_sigma")},
       {"float_householder", b(cfg.float_householder, "float_householder")},
       {"imu_extra_first", b(cfg.imu_extra_first, "imu_extra_first")},
+      {"imu_bias_renewal", d(cfg.imu_bias_renewal, "imu_bias_renewal")},
       {"precision",
        [&](const YAML::Node& n) {
          const std::string s = str(n, c, "precision");

@@ -101,6 +101,7 @@ struct SriSwfEstimator<Scalar>::Impl {
   bool initialized = false;
   std::int64_t t_newest = 0;
   ImuBlocks newest;
+  std::int64_t t_bias = 0;  // when the bias block was last renewed (SriSwfConfig::imu_bias_renewal)
   std::deque<Clone> clones;
   std::vector<CameraExtrinsic> ext_fixed;  // configured (or carried over a reset) camera extrinsics
   double td_start = 0.0;  // t_d before the time-offset block exists: configured, or carried over a reset
@@ -284,10 +285,10 @@ struct SriSwfEstimator<Scalar>::Impl {
     const PoseEstimate p = poseOf(f.nominal(newest.pose));
     s.R_WI = p.R_WI;
     s.p_WI = p.p_WI;
-    const Eigen::VectorXd x = f.nominal(newest.extra).vector.template cast<double>();
-    s.v_WI = x.segment<3>(0);
-    s.bg = x.segment<3>(3);
-    s.ba = x.segment<3>(6);
+    s.v_WI = f.nominal(newest.velocity).vector.template cast<double>();
+    const Eigen::VectorXd b = f.nominal(newest.bias).vector.template cast<double>();
+    s.bg = b.segment<3>(0);
+    s.ba = b.segment<3>(3);
     return s;
   }
 
@@ -341,16 +342,22 @@ struct SriSwfEstimator<Scalar>::Impl {
                          sri::Prior<Scalar>::stdDevs(sd0));
       setExact(td_id, BlockEstimate<double>::fromVector(Eigen::Matrix<double, 1, 1>(frame_td)));
     }
-    Eigen::Matrix<double, 9, 1> x;
-    x << s.v_WI, s.bg, s.ba;
-    Eigen::Matrix<double, 9, 1> sd;
-    sd << Eigen::Vector3d::Constant(sigma_v), Eigen::Vector3d::Constant(sigma_bg),
-        Eigen::Vector3d::Constant(cfg.init_accel_bias_sigma);
-    const BlockId eid = f.addBlock(BlockSpec::vector("imu_extra", 9),
-                                   BlockEstimate<Scalar>::fromVector(x.cast<Scalar>()),
-                                   sri::Prior<Scalar>::stdDevs(sd.cast<Scalar>()), extraPlacement());
-    setExact(eid, BlockEstimate<double>::fromVector(x));
-    newest = {pid, eid};
+    Eigen::Matrix<double, 6, 1> xb;
+    xb << s.bg, s.ba;
+    Eigen::Matrix<double, 6, 1> sdb;
+    sdb << Eigen::Vector3d::Constant(sigma_bg), Eigen::Vector3d::Constant(cfg.init_accel_bias_sigma);
+    const Eigen::Vector3d sdv = Eigen::Vector3d::Constant(sigma_v);
+    // Bias, then velocity: with the extra last that is their order at the back; first, the
+    // velocity goes in front of the bias.
+    const BlockId bid = f.addBlock(BlockSpec::vector("imu_bias", 6), BlockEstimate<Scalar>::fromVector(xb.cast<Scalar>()),
+                                   sri::Prior<Scalar>::stdDevs(sdb.cast<Scalar>()), extraPlacement());
+    setExact(bid, BlockEstimate<double>::fromVector(xb));
+    const BlockId vid = f.addBlock(BlockSpec::vector("imu_velocity", 3),
+                                   BlockEstimate<Scalar>::fromVector(s.v_WI.cast<Scalar>()),
+                                   sri::Prior<Scalar>::stdDevs(sdv.cast<Scalar>()), extraPlacement());
+    setExact(vid, BlockEstimate<double>::fromVector(s.v_WI));
+    newest = {pid, vid, bid};
+    t_bias = s.t_ns;
     t_newest = s.t_ns;
     clones.push_back({pid, s.t_ns});
     recordCloneMotion(pid, s, frame_td);
@@ -844,20 +851,45 @@ struct SriSwfEstimator<Scalar>::Impl {
     // on the position rows, q·Δt per step, so it does not depend on how the interval is split.
     Qd.diagonal().segment<3>(3).array() += cfg.position_random_walk * cfg.position_random_walk * dt;
     Qd.diagonal().segment<3>(0).array() += cfg.attitude_random_walk * cfg.attitude_random_walk * dt;
+    // The bias block is renewed every imu_bias_renewal seconds (0: at every propagation) with the
+    // random walk of the whole time since the last renewal; in between, the new pose and velocity
+    // rows act on the kept block (SriSwfConfig::imu_bias_renewal).
+    const double since = static_cast<double>(t - t_bias) * 1e-9;
+    const bool renew = cfg.imu_bias_renewal <= 0.0 || since >= cfg.imu_bias_renewal - 1e-3;
+    const int d = renew ? 15 : 9;
+    if (renew && since > dt) {
+      const ImuNoise& q = prop.noise();
+      Qd.block<3, 3>(ImuErr::kBg, ImuErr::kBg).diagonal().array() += q.gyroscope_random_walk * q.gyroscope_random_walk * (since - dt);
+      Qd.block<3, 3>(ImuErr::kBa, ImuErr::kBa).diagonal().array() +=
+          q.accelerometer_random_walk * q.accelerometer_random_walk * (since - dt);
+    }
     sri::Propagation<Scalar> step;
     step.addNewBlock(BlockSpec::pose("imu_pose"), poseEstimate<Scalar>(s.R_WI, s.p_WI), Placement::after(newest.pose));
-    Eigen::Matrix<double, 9, 1> x;
-    x << s.v_WI, s.bg, s.ba;
-    step.addNewBlock(BlockSpec::vector("imu_extra", 9), BlockEstimate<Scalar>::fromVector(x.cast<Scalar>()),
+    step.addNewBlock(BlockSpec::vector("imu_velocity", 3), BlockEstimate<Scalar>::fromVector(s.v_WI.cast<Scalar>()),
                      extraPlacement());
-    step.setTransition(newest.pose, Phi.leftCols<6>().cast<Scalar>());
-    step.setTransition(newest.extra, Phi.rightCols<9>().cast<Scalar>());
-    step.setNoiseCovariance(Qd.cast<Scalar>());
-    step.marginalizeAfter(newest.extra);
+    Eigen::Matrix<double, 6, 1> xb;
+    xb << s.bg, s.ba;
+    if (renew) {
+      // Placed like the velocity: at the back after it, or in front of it.
+      step.addNewBlock(BlockSpec::vector("imu_bias", 6), BlockEstimate<Scalar>::fromVector(xb.cast<Scalar>()),
+                       extraPlacement());
+    }
+    step.setTransition(newest.pose, Phi.topLeftCorner(d, 6).cast<Scalar>());
+    step.setTransition(newest.velocity, Phi.block(0, 6, d, 3).cast<Scalar>());
+    step.setTransition(newest.bias, Phi.topRightCorner(d, 6).cast<Scalar>());
+    step.setNoiseCovariance(Qd.topLeftCorner(d, d).cast<Scalar>());
+    step.marginalizeAfter(newest.velocity);
+    if (renew) step.marginalizeAfter(newest.bias);
     const std::vector<BlockId> ids = f.propagate(step);
     setExact(ids[0], poseEstimate<double>(s.R_WI, s.p_WI));
-    setExact(ids[1], BlockEstimate<double>::fromVector(x));
-    newest = {ids[0], ids[1]};
+    setExact(ids[1], BlockEstimate<double>::fromVector(s.v_WI));
+    if (renew) {
+      setExact(ids[2], BlockEstimate<double>::fromVector(xb));
+      newest.bias = ids[2];
+      t_bias = t;
+    }
+    newest.pose = ids[0];
+    newest.velocity = ids[1];
     t_newest = t;
     clones.push_back({ids[0], t});
     recordCloneMotion(ids[0], s, frame_td);
@@ -917,7 +949,7 @@ struct SriSwfEstimator<Scalar>::Impl {
       poses.push_back(rp);
     }
     const ReanchoredVelocity velocity[] = {
-        {newest.extra, velocityHasFirstEstimate() ? std::optional<Eigen::Vector3d>(fe_v) : std::nullopt}};
+        {newest.velocity, velocityHasFirstEstimate() ? std::optional<Eigen::Vector3d>(fe_v) : std::nullopt}};
     const WorldFrameChange c = vio::reanchorWorld(f, frame, poses, velocity);
     for (auto& [id, P] : fe_pose) {
       P.R_WI = c.attitude(P.R_WI);
@@ -929,13 +961,15 @@ struct SriSwfEstimator<Scalar>::Impl {
     return c;
   }
 
-  /// Where the IMU extra goes (SriSwfConfig::imu_extra_first).
+  /// Where the IMU extra (velocity and bias blocks) goes (SriSwfConfig::imu_extra_first).
   Placement extraPlacement() const { return cfg.imu_extra_first ? Placement::front() : Placement::back(); }
   /// A client's block: kFront in front of everything; parameters after the newest pose, i.e.
-  /// at the back, or before the extra when that is last.
+  /// at the back, or before the extra's blocks when they are last.
   Placement clientPlacement(ClientBlockRegion region) const {
     if (region == ClientBlockRegion::kFront) return Placement::front();
-    return cfg.imu_extra_first ? Placement::back() : Placement::before(newest.extra);
+    if (cfg.imu_extra_first) return Placement::back();
+    const bool biasFirst = f.layout().index(newest.bias) < f.layout().index(newest.velocity);
+    return Placement::before(biasFirst ? newest.bias : newest.velocity);
   }
 
   /// Gauss-Newton triangulation (inverse depth in the first observing camera).
@@ -1317,15 +1351,15 @@ struct SriSwfEstimator<Scalar>::Impl {
   /// The four unobservable directions of VIO (global yaw about the z axis through the origin,
   /// global x, y, z translation) in the current error state, at the linearisation points the
   /// Jacobians use (first estimates where the clones have them): clones δθ = R̂ᵀe_z, δp = e_z × p̂
-  /// (yaw) and δp = e_k (translation); IMU extra δv = e_z × v̂; SLAM features (anchored inverse
-  /// depth), extrinsics and client blocks 0.
+  /// (yaw) and δp = e_k (translation); IMU velocity δv = e_z × v̂; IMU bias, SLAM features
+  /// (anchored inverse depth), extrinsics and client blocks 0.
   Eigen::MatrixXd unobservableDirections() const {
     Eigen::MatrixXd N = Eigen::MatrixXd::Zero(f.dim(), 4);
     if (!initialized) return N;
     const Eigen::Vector3d ez = Eigen::Vector3d::UnitZ();
     const bool fej = cfg.first_estimate_jacobians;
     for (const sri::BlockInfo& b : f.layout().blocks()) {
-      if (b.id == newest.extra) {
+      if (b.id == newest.velocity) {
         const Eigen::Vector3d v = velocityHasFirstEstimate() ? fe_v : Eigen::Vector3d(f.nominal(b.id).vector.head(3));
         N.block<3, 1>(b.offset, 0) = ez.cross(v);
         continue;
@@ -1385,7 +1419,7 @@ struct SriSwfEstimator<Scalar>::Impl {
         Meas z(6);
         const double sv = cfg.zero_velocity_sigma;
         const double sp = sv * static_cast<double>(frame.t_ns - recent[recent.size() - 2].t_ns) * 1e-9;
-        z.jacobian(newest.extra, 9).block(0, 0, 3, 3).setIdentity();
+        z.jacobian(newest.velocity, 3).setIdentity();
         z.jacobian(newest.pose, 6).block(3, 3, 3, 3).setIdentity();
         z.jacobian(previous_pose, 6).block(3, 3, 3, 3) = -Eigen::Matrix<Scalar, 3, 3>::Identity();
         z.residual().head(3) = (-s.v_WI).template cast<Scalar>();
@@ -1709,7 +1743,7 @@ Eigen::Matrix<double, 6, 6> SriSwfEstimator<Scalar>::poseCovariance() const {
 template <typename Scalar>
 Eigen::Matrix<double, 15, 15> SriSwfEstimator<Scalar>::imuCovariance() const {
   if (!impl_->initialized) return Eigen::Matrix<double, 15, 15>::Zero();
-  const std::vector<sri::BlockId> ids{impl_->newest.pose, impl_->newest.extra};
+  const std::vector<sri::BlockId> ids{impl_->newest.pose, impl_->newest.velocity, impl_->newest.bias};
   return impl_->f.covariance(ids).template cast<double>();
 }
 

@@ -11,11 +11,12 @@
 //   - asks for the newest IMU state, its blocks, and the IMU integration terms between an earlier
 //     time and the newest state (for measurements older than the newest state, paper Sec. III-C).
 //
-// The newest IMU state is two blocks (paper eq. (1)): `pose` (kPose, [δθ; δp] with
-// R_WI = R̂_WI·Exp(δθ), p_WI = p̂_WI + δp, i.e. ImuErr's θ and p) and `extra` (kVector, 9 entries
-// [δv; δbg; δba], ImuErr's v, bg, ba). So a Jacobian w.r.t. the 15-dim ImuErr vector splits as
-// columns 0..5 → pose and 6..14 → extra. Both ids change at every propagation: ask for them
-// (newestImuBlocks()) right before building a measurement.
+// The newest IMU state is three blocks (paper eq. (1)): `pose` (kPose, [δθ; δp] with
+// R_WI = R̂_WI·Exp(δθ), p_WI = p̂_WI + δp, i.e. ImuErr's θ and p), `velocity` (kVector, δv_WI) and
+// `bias` (kVector, 6 entries [δbg; δba]). So a Jacobian w.r.t. the 15-dim ImuErr vector splits as
+// columns 0..5 → pose, 6..8 → velocity and 9..14 → bias. The pose and velocity ids change at
+// every propagation, the bias id whenever the bias is renewed (SriSwfConfig::imu_bias_renewal):
+// ask for them (newestImuBlocks()) right before building a measurement.
 //
 // Blocks a client owns keep their id until the client marginalizes or propagates them, or the
 // estimator starts a new state (generation()). Time-varying client blocks (receiver clocks) are
@@ -48,8 +49,9 @@ namespace gvins::vio {
 
 /// Ids of the newest IMU state (see the file comment).
 struct ImuBlocks {
-  sri::BlockId pose;   ///< kPose: [δθ; δp] of R_WI, p_WI.
-  sri::BlockId extra;  ///< kVector(9): [δv_WI; δbg; δba].
+  sri::BlockId pose;      ///< kPose: [δθ; δp] of R_WI, p_WI.
+  sri::BlockId velocity;  ///< kVector(3): δv_WI.
+  sri::BlockId bias;      ///< kVector(6): [δbg; δba].
 };
 
 /// Where a client block goes in the elimination order (sri_filter.hpp explains the trade-off).

@@ -176,6 +176,16 @@ struct SriSwfConfig {
   /// frame): float 1.05–1.08 → 1.00–1.02 ms, double 1.32–1.38 → 1.24–1.26 ms
   /// (docs/vio_estimator.md).
   bool imu_extra_first = true;
+  /// Seconds between renewals of the IMU bias block (gyroscope and accelerometer biases). The
+  /// newest IMU state is a velocity block (replaced at every propagation, with the white noise of
+  /// the interval) and a bias block, which the propagations in between keep: their transition rows
+  /// act on it and its random walk is summed until the next renewal, which adds it at once
+  /// (σ_b²·T over the T since the last renewal; the cross terms of the renewal's own interval are
+  /// kept, the earlier ones, of order σ_b·T^1.5 in velocity, dropped). A replaced block is
+  /// marginalized, which costs O(d n²) when it is not in front (imu_extra_first false: the GNSS
+  /// modes), so renewing the 6 bias columns every 0.2 s instead of every frame moves 4.5 instead
+  /// of 9 columns per frame at 20 Hz. 0 renews at every propagation (the exact discrete model).
+  double imu_bias_renewal = 0.2;
 
   /// Precision the application should instantiate (SriSwfEstimator<float> or <double>).
   bool use_float = false;
@@ -206,7 +216,8 @@ struct SriSwfConfig {
 ///          motion_frames, mono_in_motion, mono_motion_frames, mono_max_scale_sigma, mono_gyro_bias, mono_max_gyro_bias, mono_accel_error, position_sigma, yaw_sigma, tilt_sigma, velocity_sigma,
 ///          gyro_bias_sigma, accel_bias_sigma}, zero_velocity_update, zero_velocity_sigma,
 ///   first_estimate_jacobians, first_estimate_delay, calibrate_extrinsics, extrinsic_rotation_sigma, extrinsic_translation_sigma,
-///   time_offset, calibrate_time_offset, time_offset_sigma, imu_extra_first, precision: double | float, float_householder,
+///   time_offset, calibrate_time_offset, time_offset_sigma, imu_extra_first, imu_bias_renewal, precision: double | float,
+///   float_householder,
 ///   cameras: [<EuRoC camera sensor.yaml path>, ...]  or  camchain: <Kalibr camchain path>
 /// Relative paths are relative to the YAML file's folder. Errors: gvins::ParseError naming the
 /// file, line and field.
