@@ -316,24 +316,21 @@ TEST(SriSwfSimulation, StereoCircleDriftNeesAndFloat) {
   EXPECT_LT(np, 6.0);
 }
 
-// The SRI's result does not depend on the order of the state (any order is an exact
-// factorization of the same information): the IMU extra first (default) or last must give the
-// same poses up to rounding over a whole flight, through propagations, SLAM and MSCKF updates,
-// re-anchoring and marginalizations. (It caught SriFilter::substitute reading the storage below
-// R's diagonal: the orders then parted by 5 cm within 30 s.)
-TEST(SriSwfSimulation, StateOrderDoesNotChangeTheEstimate) {
+/// The 30 s scene (seed 4) on which two estimator settings are compared side by side.
+test::SimScene sideBySideScene() {
   test::SimScene sc;
   sc.duration = 30.0;
   sc.seed = 4;
   sc.build();
-  SriSwfConfig first = sc.config();
-  first.imu_extra_first = true;
-  SriSwfConfig last = first;
-  last.imu_extra_first = false;
-  SriSwfEstimator<double> a(first), b(last);
+  return sc;
+}
+
+/// Feeds the scene's IMU and frames to `a` and `b` in the same order; `compare(ra, rb)` after
+/// every frame.
+template <typename Compare>
+void runSideBySide(const test::SimScene& sc, SriSwfEstimator<double>& a, SriSwfEstimator<double>& b,
+                   Compare&& compare) {
   std::size_t k = 0;
-  double worst = 0;
-  int compared = 0;
   for (const FeatureFrame& fr : sc.frames) {
     while (k < sc.imu.size() && sc.imu[k].t_ns <= fr.t_ns + 20'000'000) {
       a.addImu(sc.imu[k]);
@@ -341,15 +338,34 @@ TEST(SriSwfSimulation, StateOrderDoesNotChangeTheEstimate) {
     }
     const FrameResult ra = a.processFrame(fr);
     const FrameResult rb = b.processFrame(fr);
+    compare(ra, rb);
+  }
+}
+
+// The SRI's result does not depend on the order of the state (any order is an exact
+// factorization of the same information): the IMU extra first (default) or last must give the
+// same poses up to rounding over a whole flight, through propagations, SLAM and MSCKF updates,
+// re-anchoring and marginalizations. (It caught SriFilter::substitute reading the storage below
+// R's diagonal: the orders then parted by 5 cm within 30 s.)
+TEST(SriSwfSimulation, StateOrderDoesNotChangeTheEstimate) {
+  const test::SimScene sc = sideBySideScene();
+  SriSwfConfig first = sc.config();
+  first.imu_extra_first = true;
+  SriSwfConfig last = first;
+  last.imu_extra_first = false;
+  SriSwfEstimator<double> a(first), b(last);
+  double worst = 0;
+  int compared = 0;
+  runSideBySide(sc, a, b, [&](const FrameResult& ra, const FrameResult& rb) {
     ASSERT_EQ(ra.initialized, rb.initialized);
     ASSERT_EQ(ra.slam_features, rb.slam_features);
     ASSERT_EQ(ra.msckf_features, rb.msckf_features);
-    if (!ra.initialized) continue;
+    if (!ra.initialized) return;
     const ImuState ea = a.newestImuState(), eb = b.newestImuState();
     worst = std::max(worst, (ea.p_WI - eb.p_WI).norm());
     worst = std::max(worst, (ea.v_WI - eb.v_WI).norm());
     ++compared;
-  }
+  });
   std::fprintf(stderr, "  extra first vs last: %d frames, largest position/velocity difference %.2e\n", compared, worst);
   EXPECT_GT(compared, 500);
   EXPECT_LT(worst, 1e-6);
@@ -362,28 +378,18 @@ TEST(SriSwfSimulation, StateOrderDoesNotChangeTheEstimate) {
 // well under a millimetre over 30 s (2.9e-5 m when written), and the bias marginal covariance
 // (random walk summed, not dropped) agrees.
 TEST(SriSwfSimulation, BiasRenewalKeepsTheEstimate) {
-  test::SimScene sc;
-  sc.duration = 30.0;
-  sc.seed = 4;
-  sc.build();
+  const test::SimScene sc = sideBySideScene();
   SriSwfConfig exact = sc.config();
   exact.imu_extra_first = false;
   exact.imu_bias_renewal = 0.0;
   SriSwfConfig renewed = exact;
   renewed.imu_bias_renewal = 0.2;
   SriSwfEstimator<double> a(exact), b(renewed);
-  std::size_t k = 0;
   double worstDiff = 0, sigmaRatio = 0;
   int compared = 0, biasIdsA = 0, biasIdsB = 0;
   sri::BlockId lastA, lastB;
-  for (const FeatureFrame& fr : sc.frames) {
-    while (k < sc.imu.size() && sc.imu[k].t_ns <= fr.t_ns + 20'000'000) {
-      a.addImu(sc.imu[k]);
-      b.addImu(sc.imu[k++]);
-    }
-    const FrameResult ra = a.processFrame(fr);
-    b.processFrame(fr);
-    if (!ra.initialized || !b.initialized()) continue;
+  runSideBySide(sc, a, b, [&](const FrameResult& ra, const FrameResult& rb) {
+    if (!ra.initialized || !rb.initialized) return;
     const ImuState ea = a.newestImuState(), eb = b.newestImuState();
     worstDiff = std::max(worstDiff, (ea.p_WI - eb.p_WI).norm());
     if (a.newestImuBlocks().bias != lastA) ++biasIdsA;
@@ -391,7 +397,7 @@ TEST(SriSwfSimulation, BiasRenewalKeepsTheEstimate) {
     lastA = a.newestImuBlocks().bias;
     lastB = b.newestImuBlocks().bias;
     ++compared;
-  }
+  });
   const sri::BlockId ba = a.newestImuBlocks().bias, bb = b.newestImuBlocks().bias;
   const Eigen::MatrixXd Pa = a.covariance(std::span<const sri::BlockId>(&ba, 1));
   const Eigen::MatrixXd Pb = b.covariance(std::span<const sri::BlockId>(&bb, 1));
