@@ -1,6 +1,7 @@
 // The SRI-SWF visual-inertial estimator (paper Sec. II; Wu et al. 2015): a square-root inverse
-// sliding-window filter over [SLAM features | IMU pose clones, oldest first | parameters | IMU
-// extra], built on gvins::sri::SriFilter. docs/vio_estimator.md describes state, order and steps.
+// sliding-window filter over [IMU extra | SLAM features | IMU pose clones, oldest first |
+// parameters] (the extra, velocity and bias blocks, last instead with imu_extra_first false),
+// built on gvins::sri::SriFilter. docs/vio_estimator.md describes state, order and steps.
 //
 // Driver (one thread, time order):
 //   SriSwfEstimator<double> est(config);
@@ -11,7 +12,7 @@
 //
 // Per frame: propagate the newest IMU state to the frame time by appending the paper's block row
 // (eq. (8), Φ and G Q Gᵀ from ImuPropagator) — the new pose block is the frame's clone and the
-// previous extra block is marginalized; SLAM re-observations (anchored inverse depth, gated);
+// previous velocity block (and, every imu_bias_renewal seconds, the bias block) is marginalized; SLAM re-observations (anchored inverse depth, gated);
 // MSCKF updates of lost / window-long tracks (triangulation, null-space projection, χ² gate);
 // delayed SLAM initialisation from window-long tracks; one correction; marginalization of lost
 // SLAM features and of the oldest clone (SLAM features anchored there are re-anchored first).
@@ -166,10 +167,11 @@ struct SriSwfConfig {
   double time_offset_sigma = 0.005;  ///< s, prior 1-σ of t_d around time_offset
 
   // ---- state order
-  /// The IMU extra block (velocity, biases) first in the state instead of last. Every propagation
-  /// marginalizes the old extra right after appending the new one; in front, that is a sweep past
-  /// the 9 columns of the new extra instead of past the whole state (an information-form
-  /// marginalization costs O(d n²) for a block with n columns in front of it), and the visual
+  /// The IMU extra blocks (velocity, biases) first in the state instead of last. Every
+  /// propagation marginalizes the old velocity (and at a renewal the old bias) right after
+  /// appending the new one; in front, that is a sweep past the few columns of the new blocks
+  /// instead of past the whole state (an information-form marginalization costs O(d n²) for a
+  /// block with n columns in front of it), and the visual
   /// updates, which never touch the extra, no longer carry its columns. Rows on the first block
   /// are dense over the whole state, so a backend client whose rows touch the velocity on every
   /// epoch (GNSS Doppler, the fusion sets it) wants it last. bench_vio_estimator /50 (the target
