@@ -182,8 +182,9 @@ struct SriSwfConfig {
   /// newest IMU state is a velocity block (replaced at every propagation, with the white noise of
   /// the interval) and a bias block, which the propagations in between keep: their transition rows
   /// act on it and its random walk is summed until the next renewal, which adds it at once
-  /// (σ_b²·T over the T since the last renewal; the cross terms of the renewal's own interval are
-  /// kept, the earlier ones, of order σ_b·T^1.5 in velocity, dropped). A replaced block is
+  /// (σ_b²·T over the T since the last renewal; left out: the walk's correlation with the
+  /// velocity it drives within the interval, σ_ba²·T³/3, 3 % of σ_a²·T for EuRoC's IMU at
+  /// T = 0.2 s; docs/vio_estimator.md "Bias renewal"). A replaced block is
   /// marginalized, which costs O(d n²) when it is not in front (imu_extra_first false: the GNSS
   /// modes), so renewing the 6 bias columns every 0.2 s instead of every frame moves 4.5 instead
   /// of 9 columns per frame at 20 Hz. 0 renews at every propagation (the exact discrete model).
