@@ -484,6 +484,7 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
   // the back of the state); a row as a vector h over them, in this order.
   std::vector<sri::BlockId> blocks{ib.pose, ib.velocity, ib.bias};
   std::vector<int> dims{6, 3, 6};
+  const std::size_t nImu = blocks.size();  // the client blocks follow
   int dim = 15;
   auto addBlock = [&](sri::BlockId id, int size) {
     blocks.push_back(id);
@@ -606,7 +607,7 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
   sri::Measurement<Scalar> m(static_cast<int>(nk) + (nuisance ? 9 : 0));
   for (std::size_t bi = 0, col = 0; bi < blocks.size(); col += static_cast<std::size_t>(dims[bi]), ++bi) {
     const auto c = static_cast<Eigen::Index>(col);
-    if (bi >= 3 && A.middleCols(c, dims[bi]).isZero(0.0)) continue;  // e.g. the lever arm without excitation
+    if (bi >= nImu && A.middleCols(c, dims[bi]).isZero(0.0)) continue;  // e.g. the lever arm without excitation
     m.jacobian(blocks[bi], dims[bi]).topRows(nk) = A.middleCols(c, dims[bi]).template cast<Scalar>();
   }
   m.residual().head(nk) = A.col(dim + 9).template cast<Scalar>();

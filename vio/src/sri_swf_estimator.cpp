@@ -278,6 +278,12 @@ struct SriSwfEstimator<Scalar>::Impl {
     }
     return pose(id);
   }
+  /// The bias block's value [bg; ba] of an IMU state.
+  static Eigen::Matrix<double, 6, 1> biasVector(const ImuState& s) {
+    Eigen::Matrix<double, 6, 1> b;
+    b << s.bg, s.ba;
+    return b;
+  }
   ImuState newestState() const {
     ImuState s;
     if (!initialized) return s;
@@ -342,8 +348,7 @@ struct SriSwfEstimator<Scalar>::Impl {
                          sri::Prior<Scalar>::stdDevs(sd0));
       setExact(td_id, BlockEstimate<double>::fromVector(Eigen::Matrix<double, 1, 1>(frame_td)));
     }
-    Eigen::Matrix<double, 6, 1> xb;
-    xb << s.bg, s.ba;
+    const Eigen::Matrix<double, 6, 1> xb = biasVector(s);
     Eigen::Matrix<double, 6, 1> sdb;
     sdb << Eigen::Vector3d::Constant(sigma_bg), Eigen::Vector3d::Constant(cfg.init_accel_bias_sigma);
     const Eigen::Vector3d sdv = Eigen::Vector3d::Constant(sigma_v);
@@ -867,8 +872,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     step.addNewBlock(BlockSpec::pose("imu_pose"), poseEstimate<Scalar>(s.R_WI, s.p_WI), Placement::after(newest.pose));
     step.addNewBlock(BlockSpec::vector("imu_velocity", 3), BlockEstimate<Scalar>::fromVector(s.v_WI.cast<Scalar>()),
                      extraPlacement());
-    Eigen::Matrix<double, 6, 1> xb;
-    xb << s.bg, s.ba;
+    const Eigen::Matrix<double, 6, 1> xb = biasVector(s);
     if (renew) {
       // Placed like the velocity: at the back after it, or in front of it.
       step.addNewBlock(BlockSpec::vector("imu_bias", 6), BlockEstimate<Scalar>::fromVector(xb.cast<Scalar>()),
@@ -1360,7 +1364,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     const bool fej = cfg.first_estimate_jacobians;
     for (const sri::BlockInfo& b : f.layout().blocks()) {
       if (b.id == newest.velocity) {
-        const Eigen::Vector3d v = velocityHasFirstEstimate() ? fe_v : Eigen::Vector3d(f.nominal(b.id).vector.head(3));
+        const Eigen::Vector3d v = velocityHasFirstEstimate() ? fe_v : Eigen::Vector3d(f.nominal(b.id).vector);
         N.block<3, 1>(b.offset, 0) = ez.cross(v);
         continue;
       }
