@@ -174,7 +174,7 @@ void Measurement<Scalar>::whitenSqrtInformation(const Matrix& S) {
 }
 
 template <typename Scalar>
-int Measurement<Scalar>::projectNuisance(Measurement* nuisanceRows) {
+int Measurement<Scalar>::projectNuisance(Measurement* nuisanceRows, NuisanceProjection how) {
   if (!whitened_) throw std::logic_error("sri::Measurement::projectNuisance: whiten first");
   if (nuisanceRows == this) throw std::invalid_argument("sri::Measurement::projectNuisance: output is the input");
   const int q = nuisanceDim();
@@ -195,38 +195,71 @@ int Measurement<Scalar>::projectNuisance(Measurement* nuisanceRows) {
     whitened_ = true;
     return m;
   }
-  // Zero the nuisance column j below row j, from the bottom up, with rotations of adjacent rows;
-  // the rows j+1.. of the nuisance columns then span its left null space. H is row-major, so the
-  // rotations run on contiguous rows in place; columns < j of the nuisance are already zero in
-  // both rows and are skipped.
   const int p = static_cast<int>(H_.cols());
-  // First non-zero column of every row of H (an MSCKF row has its clone's columns and the
-  // calibration blocks after them; rows are in observation order): a rotation of rows i − 1 and
-  // i only touches the columns from the smaller of their leads on (zeros in both stay zero), and
-  // both rows then start there.
-  static thread_local std::vector<int> lead;
-  lead.resize(static_cast<std::size_t>(m));
-  for (int i = 0; i < m; ++i) {
-    const Scalar* h = H_.row(i).data();
-    int l = 0;
-    while (l < p && h[l] == Scalar(0)) ++l;
-    lead[static_cast<std::size_t>(i)] = l;
-  }
-  for (int j = 0; j < q; ++j) {
-    for (int i = m - 1; i > j; --i) {
-      const Scalar b = nuisance_(i, j);
-      if (b == Scalar(0)) continue;
-      Scalar c, s;
-      makeGivens(nuisance_(i - 1, j), b, c, s);
-      for (int k = j; k < q; ++k) rotatePair(nuisance_(i - 1, k), nuisance_(i, k), c, s);
-      int& lx = lead[static_cast<std::size_t>(i - 1)];
-      int& ly = lead[static_cast<std::size_t>(i)];
-      const int l = std::min(lx, ly);
-      lx = ly = l;
-      Scalar* x = H_.row(i - 1).data();
-      Scalar* y = H_.row(i).data();
-      for (int col = l; col < p; ++col) rotatePair(x[col], y[col], c, s);
-      rotatePair(residual_(i - 1), residual_(i), c, s);
+  if (how == NuisanceProjection::kHouseholder) {
+    // Column j of the nuisance below row j−1 reflected onto row j (Golub & Van Loan, Matrix
+    // Computations, 4th ed., Alg. 5.1.1), applied to the nuisance columns > j, to H (row-major:
+    // w = Hᵀv and H −= β v wᵀ run along the rows) and to r.
+    Vector v;
+    Eigen::Matrix<Scalar, 1, Eigen::Dynamic> w;
+    for (int j = 0; j < q; ++j) {
+      const int len = m - j;
+      auto x = nuisance_.col(j).tail(len);
+      const Scalar norm = x.norm();
+      if (norm == Scalar(0)) continue;
+      const Scalar alpha = x(0) > Scalar(0) ? -norm : norm;
+      v = x;
+      v(0) -= alpha;
+      const Scalar vv = v.squaredNorm();
+      if (vv == Scalar(0)) continue;
+      const Scalar beta = Scalar(2) / vv;
+      for (int k = j + 1; k < q; ++k) {
+        auto col = nuisance_.col(k).tail(len);
+        col.noalias() -= (beta * v.dot(col)) * v;
+      }
+      if (p > 0) {
+        auto Hj = H_.bottomRows(len);
+        w.noalias() = v.transpose() * Hj;
+        Hj.noalias() -= (beta * v) * w;
+      }
+      auto rj = residual_.tail(len);
+      rj.noalias() -= (beta * v.dot(rj)) * v;
+      x.setZero();
+      x(0) = alpha;
+    }
+  } else {
+    // Zero the nuisance column j below row j, from the bottom up, with rotations of adjacent rows;
+    // the rows j+1.. of the nuisance columns then span its left null space. H is row-major, so the
+    // rotations run on contiguous rows in place; columns < j of the nuisance are already zero in
+    // both rows and are skipped.
+    // First non-zero column of every row of H (an MSCKF row has its clone's columns and the
+    // calibration blocks after them; rows are in observation order): a rotation of rows i − 1 and
+    // i only touches the columns from the smaller of their leads on (zeros in both stay zero), and
+    // both rows then start there.
+    static thread_local std::vector<int> lead;
+    lead.resize(static_cast<std::size_t>(m));
+    for (int i = 0; i < m; ++i) {
+      const Scalar* h = H_.row(i).data();
+      int l = 0;
+      while (l < p && h[l] == Scalar(0)) ++l;
+      lead[static_cast<std::size_t>(i)] = l;
+    }
+    for (int j = 0; j < q; ++j) {
+      for (int i = m - 1; i > j; --i) {
+        const Scalar b = nuisance_(i, j);
+        if (b == Scalar(0)) continue;
+        Scalar c, s;
+        makeGivens(nuisance_(i - 1, j), b, c, s);
+        for (int k = j; k < q; ++k) rotatePair(nuisance_(i - 1, k), nuisance_(i, k), c, s);
+        int& lx = lead[static_cast<std::size_t>(i - 1)];
+        int& ly = lead[static_cast<std::size_t>(i)];
+        const int l = std::min(lx, ly);
+        lx = ly = l;
+        Scalar* x = H_.row(i - 1).data();
+        Scalar* y = H_.row(i).data();
+        for (int col = l; col < p; ++col) rotatePair(x[col], y[col], c, s);
+        rotatePair(residual_(i - 1), residual_(i), c, s);
+      }
     }
   }
   const int keep = m - q;

@@ -150,6 +150,72 @@ TEST(Measurement, NuisanceRowsCompleteTheProjection) {
   EXPECT_THROW(few.projectNuisance(&few), std::invalid_argument);
 }
 
+// The Householder projection (dense rows, e.g. GNSS rows with the 9-dim IMU integration noise as
+// nuisance: [J L_k; I] with prior rows I) keeps the same information as the Givens one: [top;
+// projected] has the Gram matrix of the original [N H r], the nuisance factor is upper
+// triangular, and the projected rows update a filter exactly as the Givens rows do.
+TEST(Measurement, HouseholderProjectionMatchesGivens) {
+  std::mt19937 rng(21);
+  const int nk = 30, q = 9, m = nk + q, p1 = 15, p2 = 6;
+  Md N = Md::Zero(m, q);
+  N.topRows(nk) = randm(rng, nk, q);
+  N.bottomRows(q).setIdentity();
+  Md H1 = Md::Zero(m, p1), H2 = Md::Zero(m, p2);
+  H1.topRows(nk) = randm(rng, nk, p1);
+  H2.topRows(nk) = randm(rng, nk, p2);
+  Vd r = Vd::Zero(m);
+  r.head(nk) = randm(rng, nk, 1);
+  Md A(m, q + p1 + p2 + 1);
+  A << N, H1, H2, r;
+  // Two filters with the same prior on blocks a (p1) and b (p2).
+  auto filter = [&](SriFilter<double>& f) {
+    std::mt19937 r2(5);
+    std::vector<BlockId> ids;
+    ids.push_back(f.addBlock(BlockSpec::vector("a", p1), BlockEstimate<double>::zero(BlockKind::kVector, p1),
+                             Prior<double>::sqrtInformation(randm(r2, p1 + 2, p1))));
+    ids.push_back(f.addBlock(BlockSpec::vector("b", p2), BlockEstimate<double>::zero(BlockKind::kVector, p2),
+                             Prior<double>::sqrtInformation(randm(r2, p2 + 2, p2))));
+    return ids;
+  };
+  SriFilter<double> fg, fh;
+  const std::vector<BlockId> ig = filter(fg), ih = filter(fh);
+  auto make = [&](Measurement<double>& z, const std::vector<BlockId>& ids) {
+    z.reset(m);
+    z.jacobian(ids[0], p1) = H1;
+    z.jacobian(ids[1], p2) = H2;
+    z.nuisance(q) = N;
+    z.residual() = r;
+    z.setWhitened();
+  };
+  Measurement<double> zg, zh, top;
+  make(zg, ig);
+  make(zh, ih);
+  EXPECT_EQ(zg.projectNuisance(), q);
+  EXPECT_EQ(zh.projectNuisance(&top, Measurement<double>::NuisanceProjection::kHouseholder), q);
+  ASSERT_EQ(zh.rows(), nk);
+  ASSERT_EQ(top.rows(), q);
+  const Md Rf = top.nuisanceJacobian();
+  EXPECT_EQ(Md(Rf.triangularView<Eigen::StrictlyLower>()).norm(), 0.0);
+  Md B = Md::Zero(m, A.cols());
+  B.topLeftCorner(q, q) = Rf;
+  B.block(0, q, q, p1 + p2) = top.stackedJacobian();
+  B.block(q, q, nk, p1 + p2) = zh.stackedJacobian();
+  B.block(0, A.cols() - 1, q, 1) = top.residual();
+  B.block(q, A.cols() - 1, nk, 1) = zh.residual();
+  EXPECT_LT((B.transpose() * B - A.transpose() * A).norm(), 1e-12 * (A.transpose() * A).norm());
+  // Both projections: [H r] with the same Gram matrix (the Schur complement of N).
+  Md Gg(nk, p1 + p2 + 1), Gh(nk, p1 + p2 + 1);
+  Gg << zg.stackedJacobian(), zg.residual();
+  Gh << zh.stackedJacobian(), zh.residual();
+  EXPECT_LT((Gg.transpose() * Gg - Gh.transpose() * Gh).norm(), 1e-12 * (Gg.transpose() * Gg).norm());
+  // And the same filter update.
+  const auto ug = fg.update(zg);
+  const auto uh = fh.update(zh);
+  EXPECT_NEAR(ug.chi2, uh.chi2, 1e-10 * ug.chi2);
+  EXPECT_LT((fg.solve() - fh.solve()).norm(), 1e-10 * fg.solve().norm());
+  EXPECT_LT((fg.fullCovariance() - fh.fullCovariance()).norm(), 1e-10 * fg.fullCovariance().norm());
+}
+
 // MSCKF equivalence: updating with the projected rows equals adding the feature as a state with
 // no prior information, updating with the full rows and marginalizing the feature.
 TEST(Measurement, ProjectionEqualsFeatureStateMarginalized) {

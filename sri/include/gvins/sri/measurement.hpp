@@ -97,7 +97,14 @@ class Measurement {
   /// when rows() ≤ q). With them the information about the nuisance is kept: a new state block
   /// for it is initialised by these q rows alone (chain rule onto its parameters), since the
   /// projected rows are orthogonal to every Jacobian in the nuisance's column space.
-  int projectNuisance(Measurement* nuisanceRows = nullptr);
+  ///
+  /// `how`: kGivens (default) rotates adjacent rows and skips the leading zeros of each row, which
+  /// suits sparse rows (MSCKF: each observation on its own clone); kHouseholder reflects all rows
+  /// at once per nuisance column (q reflections instead of about q·m rotations, each a square root
+  /// and divisions that wait for the previous one), for dense rows such as the GNSS rows with the
+  /// IMU integration noise as nuisance. Same information either way (an orthogonal transform).
+  enum class NuisanceProjection { kGivens, kHouseholder };
+  int projectNuisance(Measurement* nuisanceRows = nullptr, NuisanceProjection how = NuisanceProjection::kGivens);
   /// If rows() exceeds the number of state columns p, replaces [H r] by the first p rows of its
   /// QR factorization (Householder): the update is unchanged; the residual of the dropped rows,
   /// which no state can explain, is kept in discardedChiSquare(). Throws std::logic_error if not
