@@ -6,7 +6,6 @@
 #include <cmath>
 
 #include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 
 #include "gvins/base/constants.hpp"
 #include "gvins/base/local_frame.hpp"
@@ -256,6 +255,7 @@ void GnssFusion<Scalar>::forgetState() {
   worldChange_.reset();
   leverBlock_ = {};
   clockBlock_ = {};
+  isbBlock_ = {};
   zwdBlock_ = {};
   clockSystems_.clear();
   lastUpdate_.reset();
@@ -275,7 +275,17 @@ std::optional<Eigen::Vector4d> GnssFusion<Scalar>::frame(const vio::EstimatorBac
 template <typename Scalar>
 std::optional<Eigen::VectorXd> GnssFusion<Scalar>::clocks(const vio::EstimatorBackend<Scalar>& est) const {
   if (!clockBlock_.valid() || !current(est)) return std::nullopt;
-  return Eigen::VectorXd(est.estimate(clockBlock_).vector.template cast<double>());
+  return systemClocks(est);
+}
+
+template <typename Scalar>
+Eigen::VectorXd GnssFusion<Scalar>::systemClocks(const vio::EstimatorBackend<Scalar>& est) const {
+  const int n = static_cast<int>(clockSystems_.size());
+  const Eigen::VectorXd c = est.estimate(clockBlock_).vector.template cast<double>();
+  Eigen::VectorXd out = Eigen::VectorXd::Constant(n + 1, c[0]);
+  out[n] = c[1];
+  if (isbBlock_.valid()) out.segment(1, n - 1) += est.estimate(isbBlock_).vector.template cast<double>();
+  return out;
 }
 
 template <typename Scalar>
@@ -364,16 +374,37 @@ bool GnssFusion<Scalar>::initClocks(vio::EstimatorBackend<Scalar>& est, const st
   }
   const ClockInitResult r = initializeClocksRansac(rows, n + 1, 64, 1, 7);
   if (r.inliers[static_cast<std::size_t>(n)] == 0) return false;  // no drift
-  Eigen::Matrix<Scalar, Eigen::Dynamic, 1> x(n + 1), sigma(n + 1);
+  std::vector<double> x(static_cast<std::size_t>(n + 1)), sigma(x.size());
   for (int i = 0; i <= n; ++i) {
-    x[i] = static_cast<Scalar>(r.x[static_cast<std::size_t>(i)]);
+    const auto u = static_cast<std::size_t>(i);
+    x[u] = r.x[u];
     // The antenna position error (SPP level after the frame initialisation) enters the bias.
-    sigma[i] = static_cast<Scalar>(i < n ? std::max(r.sigma[static_cast<std::size_t>(i)], 5.0)
-                                         : std::max(r.sigma[static_cast<std::size_t>(i)], 0.3));
-    if (r.inliers[static_cast<std::size_t>(i)] == 0) sigma[i] = static_cast<Scalar>(1e3);
+    sigma[u] = i < n ? std::max(r.sigma[u], 5.0) : std::max(r.sigma[u], 0.3);
+    if (r.inliers[u] == 0) sigma[u] = 1e3;
   }
-  clockBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_clock", n + 1), sri::BlockEstimate<Scalar>::fromVector(x),
-                             sri::Prior<Scalar>::stdDevs(sigma));
+  // The prior: b_s ~ N(x_s, σ_s²) independently per system and the drift N(x_n, σ_n²), written
+  // on the receiver clock c = b_0 and the inter-system biases i_s = b_s − b_0: a prior on
+  // [c, ḋ] and, for each other system, the row (c + i_s − x_s)/σ_s on both blocks.
+  using Vec = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
+  Vec xc(2), sc(2);
+  xc << static_cast<Scalar>(x[0]), static_cast<Scalar>(x[static_cast<std::size_t>(n)]);
+  sc << static_cast<Scalar>(sigma[0]), static_cast<Scalar>(sigma[static_cast<std::size_t>(n)]);
+  clockBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_clock", 2), sri::BlockEstimate<Scalar>::fromVector(xc),
+                             sri::Prior<Scalar>::stdDevs(sc));
+  if (n > 1) {
+    Vec xi(n - 1);
+    for (int s = 1; s < n; ++s) xi[s - 1] = static_cast<Scalar>(x[static_cast<std::size_t>(s)] - x[0]);
+    isbBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_isb", n - 1), sri::BlockEstimate<Scalar>::fromVector(xi),
+                             sri::Prior<Scalar>::uninformative());
+    sri::Measurement<Scalar> m(n - 1);
+    Vec w(n - 1);
+    for (int s = 1; s < n; ++s) w[s - 1] = static_cast<Scalar>(1.0 / sigma[static_cast<std::size_t>(s)]);
+    m.jacobian(clockBlock_, 2).col(0) = w;  // (each jacobian() call may move the storage)
+    m.jacobian(isbBlock_, n - 1) = w.asDiagonal();
+    m.residual().setZero();  // at the estimates above, c + i_s = x_s
+    m.setWhitened();
+    est.update(m, 1.0);
+  }
   clockTime_ = t;
   return true;
 }
@@ -382,23 +413,20 @@ template <typename Scalar>
 void GnssFusion<Scalar>::propagateClocks(vio::EstimatorBackend<Scalar>& est, const GpsTime& t) {
   const double dt = t - clockTime_;
   if (!clockBlock_.valid() || dt <= 0.0) return;
-  const int n = static_cast<int>(clockSystems_.size());
   using Mat = typename sri::Propagation<Scalar>::Matrix;
-  Mat phi = Mat::Identity(n + 1, n + 1);
-  phi.col(n).head(n).setConstant(static_cast<Scalar>(dt));
-  // Bias b_j' = b_j + d·dt, drift d' = d: white-noise drift q_d and per-bias q_b over dt
+  Mat phi = Mat::Identity(2, 2);
+  phi(0, 1) = static_cast<Scalar>(dt);
+  // Bias b' = b + d·dt, drift d' = d: white-noise drift q_d and bias random walk q_b over dt
   // (two-state clock model, e.g. Brown & Hwang, "Introduction to Random Signals and Applied
-  // Kalman Filtering", 4th ed., sec. 9.3), the drift part shared by all biases.
+  // Kalman Filtering", 4th ed., sec. 9.3). The inter-system biases are constant: only these two
+  // columns are replaced (and swept past the state) per epoch.
   const double qb = std::pow(config_.clockBiasRandomWalk, 2), qd = std::pow(config_.clockDriftRandomWalk, 2);
-  Eigen::MatrixXd Q = Eigen::MatrixXd::Constant(n + 1, n + 1, qd * dt * dt * dt / 3.0);
-  Q.diagonal().head(n).array() += qb * dt;
-  Q.col(n).setConstant(qd * dt * dt / 2.0);
-  Q.row(n).setConstant(qd * dt * dt / 2.0);
-  Q(n, n) = qd * dt;
+  Eigen::Matrix2d Q;
+  Q << qb * dt + qd * dt * dt * dt / 3.0, qd * dt * dt / 2.0, qd * dt * dt / 2.0, qd * dt;
   const Eigen::VectorXd x = est.estimate(clockBlock_).vector.template cast<double>();
   const Eigen::VectorXd xp = phi.template cast<double>() * x;
   sri::Propagation<Scalar> step;
-  step.addNewBlock(sri::BlockSpec::vector("gnss_clock", n + 1),
+  step.addNewBlock(sri::BlockSpec::vector("gnss_clock", 2),
                    sri::BlockEstimate<Scalar>::fromVector(xp.template cast<Scalar>()));
   step.setTransition(clockBlock_, phi);
   step.setNoiseCovariance(Q.template cast<Scalar>());
@@ -496,7 +524,9 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
   const int leverAt = leverBlock_.valid() ? dim : -1;
   if (leverBlock_.valid()) addBlock(leverBlock_, 3);
   const int clockAt = nc > 0 ? dim : -1;
-  if (nc > 0) addBlock(clockBlock_, nc);
+  if (nc > 0) addBlock(clockBlock_, 2);
+  const int isbAt = nc > 0 && isbBlock_.valid() ? dim : -1;
+  if (isbAt >= 0) addBlock(isbBlock_, nc - 2);
   const int zwdAt = zwdBlock_.valid() ? dim : -1;
   if (zwdBlock_.valid()) addBlock(zwdBlock_, 1);
   const int ambiguityAt = dim;
@@ -507,8 +537,9 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
     if (frameAt >= 0) h.template segment<4>(frameAt) = r.H_frame;
     if (leverAt >= 0) h.template segment<3>(leverAt) = r.H_lever;
     if (clockAt >= 0) {
-      if (r.clockBias >= 0) h[clockAt + r.clockBias] = 1.0;
-      h[clockAt + nc - 1] = r.H_drift;
+      if (r.clockBias >= 0) h[clockAt] = 1.0;                           // b_s = c + i_s
+      if (r.clockBias > 0 && isbAt >= 0) h[isbAt + r.clockBias - 1] = 1.0;
+      h[clockAt + 1] = r.H_drift;
     }
     if (zwdAt >= 0) h[zwdAt] = r.H_tropo;
     if (r.ambiguity >= 0) h[ambiguityAt + r.ambiguity] = 1.0;
@@ -538,8 +569,12 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
   }
   Eigen::VectorXd gateVar(nr);  // σ² + J Σ_k Jᵀ + h P hᵀ per row
   if (haveP) {
-    gateVar = (HJ.leftCols(dim) * P).cwiseProduct(HJ.leftCols(dim)).rowwise().sum() +
-         (HJ.rightCols<9>() * intCov).cwiseProduct(HJ.rightCols<9>()).rowwise().sum() + noise.diagonal();
+    // The products as matrices first: nested in the coefficient-wise expression Eigen would
+    // evaluate them lazily, one scalar dot product per coefficient.
+    const Eigen::MatrixXd HP = HJ.leftCols(dim) * P;
+    const Eigen::Matrix<double, Eigen::Dynamic, 9> JS = HJ.rightCols<9>() * intCov;
+    gateVar = HP.cwiseProduct(HJ.leftCols(dim)).rowwise().sum() + JS.cwiseProduct(HJ.rightCols<9>()).rowwise().sum() +
+              noise.diagonal();
   }
   std::vector<int> keep;
   for (std::size_t i = 0; i < rows.size(); ++i) {
@@ -600,9 +635,12 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
     llt.matrixL().solveInPlace(A.middleRows(a, b - a));
   }
   // L_k of the (positive semi-definite) integration covariance.
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 9, 9>> eig(intCov);
+  // (Pivoted LDLᵀ: Σ_k = Pᵀ L D Lᵀ P, L_k = Pᵀ L D^½; it may be singular. Any L_k with
+  // L_k L_kᵀ = Σ_k gives the same projected rows.)
+  const Eigen::LDLT<Eigen::Matrix<double, 9, 9>> ldlt(intCov);
+  const Eigen::Matrix<double, 9, 9> L = ldlt.matrixL();
   const Eigen::Matrix<double, 9, 9> Lk =
-      eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).cwiseSqrt().asDiagonal();
+      ldlt.transpositionsP().transpose() * (L * ldlt.vectorD().cwiseMax(0.0).cwiseSqrt().asDiagonal());
   const bool nuisance = Lk.norm() > 0.0;
   sri::Measurement<Scalar> m(static_cast<int>(nk) + (nuisance ? 9 : 0));
   for (std::size_t bi = 0, col = 0; bi < blocks.size(); col += static_cast<std::size_t>(dims[bi]), ++bi) {
@@ -617,7 +655,7 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
     N.bottomRows(9).setIdentity();
   }
   m.setWhitened();
-  if (nuisance) m.projectNuisance();
+  if (nuisance) m.projectNuisance(nullptr, sri::Measurement<Scalar>::NuisanceProjection::kHouseholder);
   u = est.update(m, gate ? config_.epochGate : 1.0);
   if (u.applied) {
     for (int i : keep) accepted[static_cast<std::size_t>(i)] = true;
@@ -724,6 +762,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
   // Outage: clocks and ambiguities start again.
   if (lastUpdate_ && rover.time - *lastUpdate_ > config_.outageReset && stage_ == GnssFusionStage::kTight) {
     marginalizeBlock(est, clockBlock_);
+    marginalizeBlock(est, isbBlock_);
     marginalizeBlock(est, zwdBlock_);
     if (rtk_) rtk_->reset();
     while (!ambiguities_.empty()) dropAmbiguity(est, ambiguities_.begin()->first);
@@ -845,7 +884,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
       for (SatelliteModel& m : models) m.troposphere += m.mapWet * zwd;
     }
     Eigen::VectorXd clk;
-    if (clockBlock_.valid()) clk = est.estimate(clockBlock_).vector.template cast<double>();
+    if (clockBlock_.valid()) clk = systemClocks(est);
     const int n = static_cast<int>(clockSystems_.size());
     const bool excited = config_.calibrateLeverArm &&
                          (s.omegaMeasured - s.newest.bg).norm() >= config_.minRotationRate;

@@ -11,8 +11,10 @@
 //      leaves the state, but its information moves into the poses, so the VIO's yaw and position
 //      drift stay observable to the GNSS rows instead of being frozen with the first estimate.
 //   3. Clocks (stage kTight): c·dt per constellation + c·ḋt initialised by RANSAC + least squares
-//      (gnss_clock_init.hpp) at the current antenna estimate, added as one client block and
-//      propagated lazily at each GNSS epoch (bias += drift·Δt, random walks).
+//      (gnss_clock_init.hpp) at the current antenna estimate. In the state as the receiver clock
+//      [c·dt, c·ḋt] of the first clock system (one client block, propagated at each GNSS epoch:
+//      bias += drift·Δt, random walks) and the other systems' inter-system biases (one constant
+//      block): the receiver has one oscillator, the ISBs are hardware delays.
 //   4. Rows of the configured mode (gnss_measurement_models.hpp), each gated by a chi-square test
 //      (robust to NLOS), the accepted rows stacked, whitened with Σ_m + J Σ_g Jᵀ and applied with an
 //      epoch gate. No minimum satellite count once initialised.
@@ -106,7 +108,8 @@ class GnssFusion {
   }
   const GnssAnchor& anchor() const { return anchor_; }
   Eigen::Vector3d leverArm(const vio::EstimatorBackend<Scalar>& est) const;
-  /// Clock estimate [c·dt per clock system..., c·ḋt] and the systems (clock indices).
+  /// Clock estimate [c·dt per clock system..., c·ḋt] (the receiver clock plus each system's
+  /// inter-system bias) and the systems (clock indices).
   std::optional<Eigen::VectorXd> clocks(const vio::EstimatorBackend<Scalar>& est) const;
   const std::vector<System>& clockSystems() const { return clockSystems_; }
   /// Antenna position/velocity (ECEF) at time t_ns from the current estimates (frame needed).
@@ -133,6 +136,8 @@ class GnssFusion {
   bool initClocks(vio::EstimatorBackend<Scalar>& est, const std::vector<SatelliteModel>& models,
                   const AntennaKinematics& k, const GpsTime& t);
   void propagateClocks(vio::EstimatorBackend<Scalar>& est, const GpsTime& t);
+  /// [c·dt per clock system..., c·ḋt] from the clock and ISB blocks (clockBlock_ valid).
+  Eigen::VectorXd systemClocks(const vio::EstimatorBackend<Scalar>& est) const;
   /// Random walk of the zenith wet delay state to time t.
   void propagateZwd(vio::EstimatorBackend<Scalar>& est, const GpsTime& t);
   /// Gates rows one by one, stacks the accepted ones and applies them; returns the update.
@@ -158,7 +163,9 @@ class GnssFusion {
   GnssFusionStage stage_ = GnssFusionStage::kWaitingVio;
   std::uint64_t generation_ = 0;  // estimator generation the ids below belong to
   GnssAnchor anchor_;
-  sri::BlockId frameBlock_, leverBlock_, clockBlock_, zwdBlock_;
+  // clockBlock_: [c·dt, c·ḋt] of clockSystems_[0]; isbBlock_: c·(dt_s − dt_0) of the other
+  // clock systems (none with one system).
+  sri::BlockId frameBlock_, leverBlock_, clockBlock_, isbBlock_, zwdBlock_;
   std::optional<vio::WorldFrameChange> worldChange_;  // set when the estimator was re-anchored in ENU
   Eigen::Vector3d leverStart_;                // lever arm before/at the lever block's creation
   std::optional<Eigen::Vector3d> leverLast_;  // the lever block's estimate after the last epoch

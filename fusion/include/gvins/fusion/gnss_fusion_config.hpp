@@ -35,7 +35,7 @@
 //     zwd_sigma: 0.05                     # m, its prior 1-sigma (about the model's zenith wet delay)
 //     zwd_random_walk: 0.0002             # m/√s
 //     doppler_sigma: 0.1                  # m/s at zenith
-//     clock_bias_random_walk: 0.1         # m/√s per constellation bias
+//     clock_bias_random_walk: 0.1         # m/√s, the receiver clock (inter-system biases constant)
 //     clock_drift_random_walk: 0.5        # m/s/√s
 //     row_gate: 0.999                     # chi-square probability per measurement row
 //     epoch_gate: 0.99999                 # chi-square probability of the stacked rows
