@@ -9,6 +9,10 @@
 #   defaults: 4 rounds, build, "vio+dopp+psr vio+dopp+dpsr vio+dopp+ddcp"
 # DATASET: a gvins-sim flight with GNSS (e.g. bench/fusion/paper_tables.sh's data/uav_60m_1000m_6mps).
 # Needs two cores; with one, the runs go one after the other (then host drift enters the ratios).
+# Each round writes to output directories of another name length: the path's length moves the
+# process's stack, and a replay's estimator time moved by several % with it (memory layout, not
+# work: docs/sri_core.md §10, "Buffer alignment"), so the rounds sample layouts instead of
+# repeating one.
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 DATASET=${1:?usage: gnss_time_share.sh DATASET [ROUNDS] [BUILD_DIR] [MODES]}
@@ -38,12 +42,13 @@ for m in $MODES; do
   ratios=()
   for i in $(seq 1 "$ROUNDS"); do
     a=$((i % 2)); b=$(((i + 1) % 2))
+    pad=$(printf '%*s' "$i" '' | tr ' ' p)
     if [ "$PAIRED" = 1 ]; then
-      run "$a" vio "$TMP/v" & run "$b" "$m" "$TMP/g" & wait
+      run "$a" vio "$TMP/v$pad" & run "$b" "$m" "$TMP/g$pad" & wait
     else
-      run 0 vio "$TMP/v"; run 0 "$m" "$TMP/g"
+      run 0 vio "$TMP/v$pad"; run 0 "$m" "$TMP/g$pad"
     fi
-    v=$(key "$TMP/v" estimator_ms_mean); e=$(key "$TMP/g" estimator_ms_mean); g=$(key "$TMP/g" gnss_ms_per_frame)
+    v=$(key "$TMP/v$pad" estimator_ms_mean); e=$(key "$TMP/g$pad" estimator_ms_mean); g=$(key "$TMP/g$pad" gnss_ms_per_frame)
     r=$(awk -v v="$v" -v e="$e" -v g="$g" 'BEGIN { printf "%.4f", (e + g) / v }')
     ratios+=("$r")
     printf '%-16s %5d %12.4f %12.4f %12.4f %8.4f\n' "$m" "$i" "$v" "$e" "$g" "$r"

@@ -268,6 +268,33 @@ void BM_SweepStride(benchmark::State& state) {
   state.counters["stride_bytes"] = static_cast<double>(ld) * static_cast<double>(sizeof(S));
 }
 
+// The same sweep with d columns (n = 240, the block d columns from the back): what one pass of d
+// columns costs against d passes of one, i.e. whether merging marginalizations pays.
+template <typename S>
+void BM_SweepWidth(benchmark::State& state) {
+  const int n = 240;
+  const int d = static_cast<int>(state.range(0));
+  const int c = n - d;
+  RowMatrix<S> buf = RowMatrix<S>::Zero(n, n);
+  Eigen::Matrix<S, Eigen::Dynamic, 1> r = Eigen::Matrix<S, Eigen::Dynamic, 1>::Ones(n);
+  std::uint32_t seed = 12345;
+  for (int i = 0; i < n; ++i) {
+    for (int j = i; j < n; ++j) {
+      seed = seed * 1664525u + 1013904223u;
+      buf(i, j) = static_cast<S>(static_cast<double>(seed >> 8) / 16777216.0 - 0.5);
+    }
+    buf(i, i) += S(4);
+  }
+  RowMatrixView<S> R(buf.data(), n, n, Eigen::OuterStride<>(n));
+  for (auto _ : state) {
+    sweepColumnsToFront<S>(R, VectorView<S>(r.data(), n), c, d, 0);
+    benchmark::DoNotOptimize(buf.data());
+  }
+  state.counters["us_per_column"] = benchmark::Counter(static_cast<double>(d), benchmark::Counter::kIsIterationInvariantRate |
+                                                                                 benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_SweepWidth<double>)->Arg(1)->Arg(3)->Arg(6)->Arg(9)->Arg(18)->Arg(24)->Unit(benchmark::kMicrosecond);
+
 void strideSizes(benchmark::internal::Benchmark* b) {
   for (int ld : {240, 256, 264, 512, 520, 1024, 1032}) b->Args({ld});
   b->Unit(benchmark::kMicrosecond);
