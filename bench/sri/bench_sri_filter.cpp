@@ -244,14 +244,11 @@ void sizes(benchmark::internal::Benchmark* b) {
     return *std::min_element(v.begin(), v.end());
   });
 }
+// A well-conditioned n × n upper triangle (pseudo-random entries, diagonal + 4) stored with row
+// stride ld, for the sweep benchmarks.
 template <typename S>
-void BM_SweepStride(benchmark::State& state) {
-  const int n = 240;
-  const int ld = static_cast<int>(state.range(0));
-  constexpr int d = 9;
-  const int c = n - 2 * d;
+RowMatrix<S> sweepFactor(int n, int ld) {
   RowMatrix<S> buf = RowMatrix<S>::Zero(n, ld);
-  Eigen::Matrix<S, Eigen::Dynamic, 1> r = Eigen::Matrix<S, Eigen::Dynamic, 1>::Ones(n);
   std::uint32_t seed = 12345;
   for (int i = 0; i < n; ++i) {
     for (int j = i; j < n; ++j) {
@@ -260,6 +257,17 @@ void BM_SweepStride(benchmark::State& state) {
     }
     buf(i, i) += S(4);
   }
+  return buf;
+}
+
+template <typename S>
+void BM_SweepStride(benchmark::State& state) {
+  const int n = 240;
+  const int ld = static_cast<int>(state.range(0));
+  constexpr int d = 9;
+  const int c = n - 2 * d;
+  RowMatrix<S> buf = sweepFactor<S>(n, ld);
+  Eigen::Matrix<S, Eigen::Dynamic, 1> r = Eigen::Matrix<S, Eigen::Dynamic, 1>::Ones(n);
   RowMatrixView<S> R(buf.data(), n, n, Eigen::OuterStride<>(ld));
   for (auto _ : state) {
     sweepColumnsToFront<S>(R, VectorView<S>(r.data(), n), c, d, 0);
@@ -275,16 +283,8 @@ void BM_SweepWidth(benchmark::State& state) {
   const int n = 240;
   const int d = static_cast<int>(state.range(0));
   const int c = n - d;
-  RowMatrix<S> buf = RowMatrix<S>::Zero(n, n);
+  RowMatrix<S> buf = sweepFactor<S>(n, n);
   Eigen::Matrix<S, Eigen::Dynamic, 1> r = Eigen::Matrix<S, Eigen::Dynamic, 1>::Ones(n);
-  std::uint32_t seed = 12345;
-  for (int i = 0; i < n; ++i) {
-    for (int j = i; j < n; ++j) {
-      seed = seed * 1664525u + 1013904223u;
-      buf(i, j) = static_cast<S>(static_cast<double>(seed >> 8) / 16777216.0 - 0.5);
-    }
-    buf(i, i) += S(4);
-  }
   RowMatrixView<S> R(buf.data(), n, n, Eigen::OuterStride<>(n));
   for (auto _ : state) {
     sweepColumnsToFront<S>(R, VectorView<S>(r.data(), n), c, d, 0);
