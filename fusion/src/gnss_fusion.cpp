@@ -506,7 +506,6 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
                                                      std::vector<bool>& accepted, bool gate,
                                                      const std::vector<sri::BlockId>& ambiguities) {
   const vio::ImuBlocks ib = est.newestImuBlocks();
-  const int nc = clockBlock_.valid() ? static_cast<int>(clockSystems_.size()) + 1 : 0;
   accepted.assign(rows.size(), false);
   // The blocks GNSS rows touch: newest pose, velocity and bias, frame, lever arm, clocks (all at
   // the back of the state); a row as a vector h over them, in this order.
@@ -523,10 +522,10 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
   if (frameBlock_.valid()) addBlock(frameBlock_, 4);
   const int leverAt = leverBlock_.valid() ? dim : -1;
   if (leverBlock_.valid()) addBlock(leverBlock_, 3);
-  const int clockAt = nc > 0 ? dim : -1;
-  if (nc > 0) addBlock(clockBlock_, 2);
-  const int isbAt = nc > 0 && isbBlock_.valid() ? dim : -1;
-  if (isbAt >= 0) addBlock(isbBlock_, nc - 2);
+  const int clockAt = clockBlock_.valid() ? dim : -1;
+  if (clockBlock_.valid()) addBlock(clockBlock_, 2);
+  const int isbAt = isbBlock_.valid() ? dim : -1;  // with the clock, one per system after the first
+  if (isbBlock_.valid()) addBlock(isbBlock_, static_cast<int>(clockSystems_.size()) - 1);
   const int zwdAt = zwdBlock_.valid() ? dim : -1;
   if (zwdBlock_.valid()) addBlock(zwdBlock_, 1);
   const int ambiguityAt = dim;
@@ -775,7 +774,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
   double dtr = 0.0;
   if (clockBlock_.valid()) {
     const Eigen::VectorXd c = est.estimate(clockBlock_).vector.template cast<double>();
-    dtr = (c[0] + c[c.size() - 1] * (rover.time - clockTime_)) / kC;
+    dtr = (c[0] + c[1] * (rover.time - clockTime_)) / kC;  // [c·dt, c·ḋt]
   } else if (sppNow().valid()) {
     for (const auto& b : sppNow().clockBias) {
       if (b) {
