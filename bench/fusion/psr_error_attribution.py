@@ -3,7 +3,7 @@
 
     psr_error_attribution.py DATASET [--run OUTDIR] [--bands G:152,J:152]
                              [--ephemeris-error G:0.6,R:5,E:0.3,C:1,J:0.6] [--sigma 0.6] [--mask 10]
-                             [--from S] [--until S]
+                             [--from S] [--until S] [--causal] [--without sisre,...]
 
 DATASET: gvins-sim output simulated with `gnss: error_terms: true` (gnss/truth/rover_errors.csv).
 Each error term (broadcast orbit/clock error, troposphere residual, code multipath, code noise),
@@ -14,6 +14,10 @@ sin^2 el)) + ephemeris_error^2, k the IF noise factor (defaults: the fusion's; a
 --ephemeris-error replaces the whole list, systems not named get 0). With --run (a gvins-replay OUTDIR), the
 epochs start at the first tight epoch and the filter's mean ENU error is printed alongside;
 --from/--until keep only the epochs that many seconds after that start (a window of the flight).
+--causal also solves the offset after every epoch from the epochs so far (what a causal filter
+with a perfect VIO can know then) and prints its RMS over the epochs, to compare with the
+filter's RMSE; its sums also hold the epochs before the first tight one (a perfect VIO from the
+first epoch on). Without --causal, those epochs are left out. --without drops terms from the sums (e.g. sisre for runs with precise products).
 NLOS-affected satellites are left out (the filter's gate rejects them). docs/gnss_fusion.md."""
 import bisect, collections, math, sys
 
@@ -47,7 +51,7 @@ def solve3(n, b):
     return x
 
 
-def filter_error(ds, run):
+def filter_error(ds, run, start):
     truth = []
     for line in open(ds + '/gnss/truth/rover_antenna.csv'):
         if line[0] in '#t':
@@ -59,12 +63,14 @@ def filter_error(ds, run):
     lat = math.atan2(x0[2], math.hypot(x0[0], x0[1]) * (1 - 0.00669438))
     sl, cl, so, co = math.sin(lat), math.cos(lat), math.sin(lon), math.cos(lon)
     ts = [t[0] for t in truth]
-    acc, n = [0.0] * 3, 0
+    acc, sq, n = [0.0] * 3, 0.0, 0
     for line in open(run + '/global_ecef.csv'):
         if line[0] == '#':
             continue
         v = line.split(',')
         t = int(v[0]) * 604800 + float(v[1])
+        if float(v[1]) < start - 1e-6:
+            continue
         i = bisect.bisect_left(ts, t - 1e-4)
         if i >= len(ts) or abs(ts[i] - t) > 1e-3:
             continue
@@ -72,8 +78,9 @@ def filter_error(ds, run):
         enu = (-so * d[0] + co * d[1], -sl * co * d[0] - sl * so * d[1] + cl * d[2],
                cl * co * d[0] + cl * so * d[1] + sl * d[2])
         acc = [acc[k] + enu[k] for k in range(3)]
+        sq += sum(v * v for v in enu)
         n += 1
-    return [a / max(n, 1) for a in acc]
+    return [a / max(n, 1) for a in acc], math.sqrt(sq / max(n, 1))
 
 
 def main(args):
@@ -104,12 +111,17 @@ def main(args):
             continue
         r = dict(zip(hdr, line.strip().split(',')))
         rows[int(r['tag_ns'])][r['sat']][r['signal']] = r
+    causal = '--causal' in args
+    dropped = set(opt(args, '--without', '').split(',')) - {''}
+    kept = [t for t in TERMS if t not in dropped]
     n = [[0.0] * 3 for _ in range(3)]
     b = {t: [0.0] * 3 for t in TERMS}
+    running = [0.0, 0.0, 0]  # sum of |offset|^2, of Up^2, epochs (causal)
     for tag in sorted(rows):
-        if (tag * 1e-9) % 604800 < start - 1e-6:
+        before = (tag * 1e-9) % 604800 < start - 1e-6
+        if before and not causal:
             continue
-        if not start + t_from - 1e-6 <= (tag * 1e-9) % 604800 <= start + t_until + 1e-6:
+        if not before and not start + t_from - 1e-6 <= (tag * 1e-9) % 604800 <= start + t_until + 1e-6:
             continue
         by_clock = collections.defaultdict(list)
         for sat, sig in rows[tag].items():
@@ -151,16 +163,28 @@ def main(args):
                         n[i][j] += w * d[i] * d[j]
                     for t in TERMS:
                         b[t][i] += w * d[i] * (e[t] - eb[t])
+        if causal and not before and sum(len(v) for v in by_clock.values()) > 0:
+            try:
+                x = solve3(n, [sum(b[t][i] for t in kept) for i in range(3)])
+            except ZeroDivisionError:
+                continue
+            running[0] += sum(v * v for v in x)
+            running[1] += x[2] * x[2]
+            running[2] += 1
     total = [0.0] * 3
     print('term         E [m]    N [m]    U [m]   (constant offset, least squares over the flight)')
     for t in TERMS:
         x = solve3(n, b[t])
-        total = [total[i] + x[i] for i in range(3)]
-        print(f'{t:10s} {x[0]:8.3f} {x[1]:8.3f} {x[2]:8.3f}')
-    print(f'{"sum":10s} {total[0]:8.3f} {total[1]:8.3f} {total[2]:8.3f}')
+        if t in kept:
+            total = [total[i] + x[i] for i in range(3)]
+        print(f'{t:10s} {x[0]:8.3f} {x[1]:8.3f} {x[2]:8.3f}' + ('' if t in kept else '   (not in the sum)'))
+    print(f'{"sum":10s} {total[0]:8.3f} {total[1]:8.3f} {total[2]:8.3f}   |sum| {math.sqrt(sum(v * v for v in total)):.3f}')
+    if causal and running[2]:
+        print(f'causal     RMS |offset| {math.sqrt(running[0] / running[2]):.3f}  RMS Up {math.sqrt(running[1] / running[2]):.3f}'
+              f'   (offset solved after every epoch from the epochs so far; {running[2]} epochs)')
     if run:
-        m = filter_error(ds, run)
-        print(f'{"filter":10s} {m[0]:8.3f} {m[1]:8.3f} {m[2]:8.3f}   (mean error of {run}/global_ecef.csv)')
+        m, rms = filter_error(ds, run, start)
+        print(f'{"filter":10s} {m[0]:8.3f} {m[1]:8.3f} {m[2]:8.3f}   (mean error of {run}/global_ecef.csv; RMSE {rms:.3f})')
     return 0
 
 
