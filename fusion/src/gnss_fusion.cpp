@@ -404,6 +404,7 @@ bool GnssFusion<Scalar>::initClocks(vio::EstimatorBackend<Scalar>& est, const st
     m.residual().setZero();  // at the estimates above, c + i_s = x_s
     m.setWhitened();
     est.update(m, 1.0);
+    isbTime_ = t;
   }
   clockTime_ = t;
   return true;
@@ -433,6 +434,19 @@ void GnssFusion<Scalar>::propagateClocks(vio::EstimatorBackend<Scalar>& est, con
   step.marginalizeAfter(clockBlock_);
   clockBlock_ = est.propagate(step, vio::ClientBlockRegion::kParameters).at(0);
   clockTime_ = t;
+  // The inter-system biases: a random walk stepped every isbRenewalInterval seconds with the
+  // variance accumulated since the last step (Brown & Hwang, sec. 9.3: a Wiener process sampled
+  // at those instants; no columns swept in between).
+  const double di = t - isbTime_;
+  if (!isbBlock_.valid() || !(config_.isbRandomWalk > 0.0) || di < config_.isbRenewalInterval) return;
+  const auto ni = static_cast<Eigen::Index>(clockSystems_.size()) - 1;
+  sri::Propagation<Scalar> isb;
+  isb.addNewBlock(sri::BlockSpec::vector("gnss_isb", static_cast<int>(ni)), est.estimate(isbBlock_));
+  isb.setTransition(isbBlock_, Mat::Identity(ni, ni));
+  isb.setNoiseCovariance(Mat::Identity(ni, ni) * static_cast<Scalar>(config_.isbRandomWalk * config_.isbRandomWalk * di));
+  isb.marginalizeAfter(isbBlock_);
+  isbBlock_ = est.propagate(isb, vio::ClientBlockRegion::kParameters).at(0);
+  isbTime_ = t;
 }
 
 template <typename Scalar>

@@ -152,6 +152,10 @@ GnssFusionConfig parseGnssFusionConfig(std::string_view yaml, const std::string&
       c.clockBiasRandomWalk = positive(v, f);
     } else if (key == "clock_drift_random_walk") {
       c.clockDriftRandomWalk = positive(v, f);
+    } else if (key == "isb_random_walk") {
+      c.isbRandomWalk = rd.number(v, f, 0.0, 100.0);
+    } else if (key == "isb_renewal_interval") {
+      c.isbRenewalInterval = positive(v, f);
     } else if (key == "row_gate") {
       c.rowGate = probability(v, f);
     } else if (key == "epoch_gate") {
@@ -179,7 +183,7 @@ GnssFusionConfig parseGnssFusionConfig(std::string_view yaml, const std::string&
       "elevation_mask_deg", "ionosphere", "bands", "ephemeris_error_m", "precise_ephemeris_error_m", "code_sigma",
       "carrier_smoothing", "smoothed_code_factor", "phase_sigma", "ambiguity_sigma", "ambiguity_reset_rejections", "max_ambiguities", "phase_windup", "rtk_hold_fix", "broadcast_ambiguity_random_walk", "broadcast_record_changes", "estimate_zwd", "zwd_sigma", "zwd_random_walk",
       "doppler_sigma",
-      "clock_bias_random_walk", "clock_drift_random_walk", "row_gate", "epoch_gate", "frame_yaw_sigma_deg",
+      "clock_bias_random_walk", "clock_drift_random_walk", "isb_random_walk", "isb_renewal_interval", "row_gate", "epoch_gate", "frame_yaw_sigma_deg",
       "frame_min_speed", "frame_reanchor", "frame_reanchor_position_sigma", "outage_reset", "clock_ransac_threshold", "base_position", "max_base_age"};
   if (const YAML::Node section = root["gnss_fusion"]) {
     if (!section.IsMap()) rd.fail(section, "gnss_fusion", "'gnss_fusion' must be a map");

@@ -96,6 +96,16 @@ TEST(GnssFusionConfig, FloatPppKeys) {
   EXPECT_FALSE(parseGnssFusionConfig("gnss_fusion:\n  mode: vio+dopp+dpsr\n  estimate_zwd: true\n").zwdState());
 }
 
+TEST(GnssFusionConfig, InterSystemBiasRandomWalkKeys) {
+  const GnssFusionConfig c =
+      parseGnssFusionConfig("gnss_fusion:\n  isb_random_walk: 0.01\n  isb_renewal_interval: 5\n");
+  EXPECT_DOUBLE_EQ(c.isbRandomWalk, 0.01);
+  EXPECT_DOUBLE_EQ(c.isbRenewalInterval, 5.0);
+  EXPECT_DOUBLE_EQ(parseGnssFusionConfig("gnss_fusion:\n  isb_random_walk: 0\n").isbRandomWalk, 0.0);  // constant
+  EXPECT_THROW(parseGnssFusionConfig("gnss_fusion:\n  isb_random_walk: -1\n"), ParseError);
+  EXPECT_THROW(parseGnssFusionConfig("gnss_fusion:\n  isb_renewal_interval: 0\n"), ParseError);
+}
+
 TEST(GnssFusionConfig, ModeNamesRoundTrip) {
   for (const char* n : {"vio", "vio+gpsvel", "vio+dopp", "vio+dopp+psr", "vio+dopp+dpsr", "vio+dopp+ddcp",
                         "vio+dopp+psr-nointegration", "vio+dopp+ppp"}) {

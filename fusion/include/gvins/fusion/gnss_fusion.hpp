@@ -172,6 +172,7 @@ class GnssFusion {
   GpsTime zwdTime_;
   std::vector<System> clockSystems_;
   GpsTime clockTime_;
+  GpsTime isbTime_;  // last random-walk step of isbBlock_ (or its creation)
   std::optional<GpsTime> lastUpdate_;
   const EphemerisStore* nav_ = nullptr;
   std::unique_ptr<SppSolver> spp_;

@@ -35,7 +35,9 @@
 //     zwd_sigma: 0.05                     # m, its prior 1-sigma (about the model's zenith wet delay)
 //     zwd_random_walk: 0.0002             # m/√s
 //     doppler_sigma: 0.1                  # m/s at zenith
-//     clock_bias_random_walk: 0.1         # m/√s, the receiver clock (inter-system biases constant)
+//     clock_bias_random_walk: 0.1         # m/√s, the receiver clock
+//     isb_random_walk: 0.001              # m/√s, the inter-system biases (0: constant)
+//     isb_renewal_interval: 30            # s between the inter-system biases' random-walk steps
 //     clock_drift_random_walk: 0.5        # m/s/√s
 //     row_gate: 0.999                     # chi-square probability per measurement row
 //     epoch_gate: 0.99999                 # chi-square probability of the stacked rows
@@ -162,6 +164,13 @@ struct GnssFusionConfig {
   double dopplerSigma = 0.1;
   double clockBiasRandomWalk = 0.1;
   double clockDriftRandomWalk = 0.5;
+  /// Inter-system biases (receiver hardware delays, which drift slowly with temperature): a random
+  /// walk of this strength (m/√s; 0 = constant), applied as one step of the accumulated variance
+  /// q²·Δt every isbRenewalInterval seconds rather than at every epoch, so that their columns are
+  /// swept past the state rarely (the same variance at the step instants; between steps the block
+  /// is held constant).
+  double isbRandomWalk = 0.001;
+  double isbRenewalInterval = 30.0;
   double rowGate = 0.999;
   double epochGate = 0.99999;
   double frameYawSigmaDeg = 3.0;
