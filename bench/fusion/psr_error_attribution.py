@@ -3,7 +3,7 @@
 
     psr_error_attribution.py DATASET [--run OUTDIR] [--bands G:152,J:152]
                              [--ephemeris-error G:0.6,R:5,E:0.3,C:1,J:0.6] [--sigma 0.6] [--mask 10]
-                             [--from S] [--until S] [--causal] [--without sisre,...]
+                             [--from S] [--until S] [--causal [--series CSV]] [--without sisre,...]
 
 DATASET: gvins-sim output simulated with `gnss: error_terms: true` (gnss/truth/rover_errors.csv).
 Each error term (broadcast orbit/clock error, troposphere residual, code multipath, code noise),
@@ -16,7 +16,7 @@ epochs start at the first tight epoch and the filter's mean ENU error is printed
 --from/--until keep only the epochs that many seconds after that start (a window of the flight).
 --causal also solves the offset after every epoch from the epochs so far (what a causal filter
 with a perfect VIO can know then) and prints its RMS over the epochs, to compare with the
-filter's RMSE; its sums also hold the epochs before the first tight one (a perfect VIO from the
+filter's RMSE (--series writes it per epoch); its sums also hold the epochs before the first tight one (a perfect VIO from the
 first epoch on). Without --causal, those epochs are left out. --without drops terms from the sums (e.g. sisre for runs with precise products).
 NLOS-affected satellites are left out (the filter's gate rejects them). docs/gnss_fusion.md."""
 import bisect, collections, math, sys
@@ -117,6 +117,9 @@ def main(args):
     n = [[0.0] * 3 for _ in range(3)]
     b = {t: [0.0] * 3 for t in TERMS}
     running = [0.0, 0.0, 0]  # sum of |offset|^2, of Up^2, epochs (causal)
+    series = open(opt(args, '--series', ''), 'w') if causal and '--series' in args else None
+    if series is not None:
+        series.write('# tow [s],E [m],N [m],U [m]  (causal offset after each epoch)\n')
     for tag in sorted(rows):
         before = (tag * 1e-9) % 604800 < start - 1e-6
         if before and not causal:
@@ -168,6 +171,8 @@ def main(args):
                 x = solve3(n, [sum(b[t][i] for t in kept) for i in range(3)])
             except ZeroDivisionError:
                 continue
+            if series is not None:
+                series.write(f'{(tag * 1e-9) % 604800:.3f},{x[0]:.4f},{x[1]:.4f},{x[2]:.4f}\n')
             running[0] += sum(v * v for v in x)
             running[1] += x[2] * x[2]
             running[2] += 1
