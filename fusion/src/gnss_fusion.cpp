@@ -740,6 +740,10 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
   // (no extrapolated base there) and holds the fix in between (RtkSolver::differencesWithHeldFix,
   // in the tight stage below): the ambiguities are constant along the arcs.
   bool rtkProcessed = false;
+  // Held and nothing new: a new base epoch within rtk_revalidate_interval of the last run takes
+  // the held fix too (in the tight stage below), unless its DD phases differ from that run's
+  // (a new satellite, a slip, another reference): then the module runs there.
+  bool rtkDeferred = false;
   if (rtk_) {
     const bool newBase = base && (!lastBase_ || base->time > *lastBase_);
     if (newBase) {
@@ -752,7 +756,10 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
       }
       lastBase_ = base->time;
     }
-    if (fullRtk && (newBase || !rtk_->hasHeldFix() || !config_.rtkHoldFix)) {
+    const std::optional<GpsTime> lastRun = rtk_->lastProcessTime();
+    rtkDeferred = fullRtk && newBase && config_.rtkHoldFix && rtk_->hasHeldFix() && lastRun &&
+                  rover.time - *lastRun < config_.rtkRevalidateInterval;
+    if (fullRtk && !rtkDeferred && (newBase || !rtk_->hasHeldFix() || !config_.rtkHoldFix)) {
       const RtkSolution rtk = rtk_->process(roverRaw, &states);
       rep.rtkFixed = rtk.quality == SolutionQuality::Fix;
       baseAge = rtk.age;
@@ -1015,6 +1022,12 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
       int heldFixed = 0;
       baseAge = rtk_->differencesWithHeldFix(roverRaw, k.x_E, heldFixed, &states);
       rep.rtkFixed = heldFixed > 0;
+      if (rtkDeferred && !rtk_->phasePairsAsProcessed()) {
+        const RtkSolution rtk = rtk_->process(roverRaw, &states);
+        rep.rtkFixed = rtk.quality == SolutionQuality::Fix;
+        baseAge = rtk.age;
+        rtkProcessed = true;
+      }
     }
     if (baseAge && config_.usesDifferences() && *baseAge <= config_.maxBaseAge) {
       const DdEpoch& e = rtk_->measurements();

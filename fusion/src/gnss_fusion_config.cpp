@@ -138,6 +138,8 @@ GnssFusionConfig parseGnssFusionConfig(std::string_view yaml, const std::string&
       c.phaseWindup = rd.boolean(v, f);
     } else if (key == "rtk_hold_fix") {
       c.rtkHoldFix = rd.boolean(v, f);
+    } else if (key == "rtk_revalidate_interval") {
+      c.rtkRevalidateInterval = rd.number(v, f, 0.0, 3600.0);
     } else if (key == "max_ambiguities") {
       c.maxAmbiguities = static_cast<int>(rd.number(v, f, 0.0, 1000.0));
     } else if (key == "estimate_zwd") {
@@ -181,7 +183,7 @@ GnssFusionConfig parseGnssFusionConfig(std::string_view yaml, const std::string&
   static const std::set<std::string> kKeys = {
       "mode", "lever_arm", "calibrate_lever_arm", "lever_arm_sigma", "min_rotation_rate", "systems",
       "elevation_mask_deg", "ionosphere", "bands", "ephemeris_error_m", "precise_ephemeris_error_m", "code_sigma",
-      "carrier_smoothing", "smoothed_code_factor", "phase_sigma", "ambiguity_sigma", "ambiguity_reset_rejections", "max_ambiguities", "phase_windup", "rtk_hold_fix", "broadcast_ambiguity_random_walk", "broadcast_record_changes", "estimate_zwd", "zwd_sigma", "zwd_random_walk",
+      "carrier_smoothing", "smoothed_code_factor", "phase_sigma", "ambiguity_sigma", "ambiguity_reset_rejections", "max_ambiguities", "phase_windup", "rtk_hold_fix", "rtk_revalidate_interval", "broadcast_ambiguity_random_walk", "broadcast_record_changes", "estimate_zwd", "zwd_sigma", "zwd_random_walk",
       "doppler_sigma",
       "clock_bias_random_walk", "clock_drift_random_walk", "isb_random_walk", "isb_renewal_interval", "row_gate", "epoch_gate", "frame_yaw_sigma_deg",
       "frame_min_speed", "frame_reanchor", "frame_reanchor_position_sigma", "outage_reset", "clock_ransac_threshold", "base_position", "max_base_age"};

@@ -90,6 +90,8 @@ void RtkSolver::reset() {
   filter_ = Filter();
   held_.clear();
   amb_.clear();
+  processedPairs_.clear();
+  lastProcess_.reset();
   initialized_ = false;
   consecutiveFixes_ = 0;
   lastVelocity_.reset();
@@ -392,10 +394,28 @@ std::optional<double> RtkSolver::differencesWithHeldFix(const ObsEpoch& rover, c
   return age;
 }
 
+void RtkSolver::detectSlips(const ObsEpoch& rover, const GlonassChannels& channels) {
+  if (slipEpoch_ && *slipEpoch_ == rover.time) return;
+  roverSlips_.process(rover, channels);
+  slipEpoch_ = rover.time;
+}
+
+bool RtkSolver::phasePairsAsProcessed() const {
+  if (!lastProcess_ || dd_.phase.size() != processedPairs_.size()) return false;
+  for (const DoubleDifference& d : dd_.phase) {
+    const SingleDifference& s = dd_.sd[static_cast<std::size_t>(d.satellite)];
+    const SingleDifference& f = dd_.sd[static_cast<std::size_t>(d.reference)];
+    if (s.halfCycle || f.halfCycle || s.roverSlip || s.baseSlip || f.roverSlip || f.baseSlip) return false;
+    const std::pair<HeldSignal, HeldSignal> p(HeldSignal::of(s), HeldSignal::of(f));
+    if (std::find(processedPairs_.begin(), processedPairs_.end(), p) == processedPairs_.end()) return false;
+  }
+  return true;
+}
+
 std::optional<double> RtkSolver::differences(const ObsEpoch& rover, const Eigen::Vector3d& x, TransmitStates* states) {
   GlonassChannels ch = roverChannels_;
   ch.mergeMissing(nav_.glonassChannels());
-  roverSlips_.process(rover, ch);
+  detectSlips(rover, ch);
   if (base_.snapshot(rover.time, snapshot_) != BaseAvailability::Ok) {
     dd_.clear();
     dd_.time = rover.time;
@@ -418,7 +438,9 @@ RtkSolution RtkSolver::process(const ObsEpoch& rover, TransmitStates* states) {
   }
   GlonassChannels ch = roverChannels_;
   ch.mergeMissing(nav_.glonassChannels());
-  roverSlips_.process(rover, ch);
+  detectSlips(rover, ch);
+  lastProcess_ = rover.time;
+  processedPairs_.clear();
 
   auto single = [&](RtkIssue issue) {
     sol.issue = issue;
@@ -548,6 +570,10 @@ RtkSolution RtkSolver::process(const ObsEpoch& rover, TransmitStates* states) {
     sol.velocityCovariance = filter_.covariance(vid);
   }
   resolve(sol);
+  for (const DoubleDifference& d : dd_.phase) {
+    processedPairs_.emplace_back(HeldSignal::of(dd_.sd[static_cast<std::size_t>(d.satellite)]),
+                                 HeldSignal::of(dd_.sd[static_cast<std::size_t>(d.reference)]));
+  }
   // The fix to hold (differencesWithHeldFix): the DD phases that got an ambiguity.
   if (sol.quality == SolutionQuality::Fix) {
     for (const DoubleDifference& d : dd_.phase) {

@@ -87,6 +87,9 @@ TEST(GnssFusionConfig, FloatPppKeys) {
   EXPECT_TRUE(GnssFusionConfig{}.broadcastRecordChanges);
   EXPECT_FALSE(c.rtkHoldFix);
   EXPECT_TRUE(GnssFusionConfig{}.rtkHoldFix);
+  EXPECT_DOUBLE_EQ(GnssFusionConfig{}.rtkRevalidateInterval, 10.0);
+  EXPECT_DOUBLE_EQ(parseGnssFusionConfig("gnss_fusion:\n  rtk_revalidate_interval: 0\n").rtkRevalidateInterval, 0.0);
+  EXPECT_THROW(parseGnssFusionConfig("gnss_fusion:\n  rtk_revalidate_interval: -2\n"), ParseError);
   // The wet delay state: on by default in vio+dopp+ppp only; estimate_zwd switches it for the
   // other pseudorange modes (never for modes without undifferenced codes).
   EXPECT_TRUE(c.zwdState());

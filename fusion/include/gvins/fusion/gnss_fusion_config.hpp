@@ -29,6 +29,7 @@
 //     phase_windup: true                  # correct the phases for wind-up (vio+dopp+ppp)
 //     rtk_hold_fix: true                  # vio+dopp+ddcp: once fixed, the RTK module runs at the base
 //                                         # epochs only and its fix is held in between (false: every epoch)
+//     rtk_revalidate_interval: 10         # s; held and no new DD phase: the module runs only this often
 //     broadcast_ambiguity_random_walk: 0.005  # m/√s on ambiguities of broadcast-orbit satellites
 //     broadcast_record_changes: true      # carry the modelled-range jump of a new broadcast record over
 //     estimate_zwd: true                  # zenith wet delay residual as a state (default: vio+dopp+ppp only)
@@ -145,6 +146,11 @@ struct GnssFusionConfig {
   /// is measured, not extrapolated) and the DD phases in between take the fix it held
   /// (RtkSolver::differencesWithHeldFix, same arcs only). false: the module runs every epoch.
   bool rtkHoldFix = true;
+  /// With rtkHoldFix: a new base epoch less than this many seconds after the module's last run
+  /// takes the held fix as well when its DD phases are that run's (same satellites, references
+  /// and arcs); the module runs again when they differ or when this interval has passed (0: at
+  /// every base epoch, as before 6 Dec 2026).
+  double rtkRevalidateInterval = 10.0;
   /// vio+dopp+ppp: random walk (m/√s) of the ambiguity states of satellites on broadcast orbits
   /// and clocks (no products, no SSR), whose errors drift by centimetres per minute as the true
   /// orbit departs from the record; 0: constant ambiguities.

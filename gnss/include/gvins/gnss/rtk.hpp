@@ -152,6 +152,13 @@ class RtkSolver {
                                                TransmitStates* states = nullptr);
   /// True when the last process() epoch ended fixed (its fix is held for differencesWithHeldFix).
   bool hasHeldFix() const { return !held_.empty(); }
+  /// Time of the last process() epoch (nullopt before the first and after reset()).
+  std::optional<GpsTime> lastProcessTime() const { return lastProcess_; }
+  /// Whether the DD phases formed by the last differences()/differencesWithHeldFix() are those
+  /// of the last process() epoch: the same satellite and reference signals on the same arcs (no
+  /// new satellite, no slip, no other reference). Then a process() now would resolve nothing
+  /// that the held fix lacks; a caller may skip it until its revalidation is due.
+  bool phasePairsAsProcessed() const;
   /// Forgets the float solution and all ambiguities (base buffer and slip history stay).
   void reset();
 
@@ -218,6 +225,13 @@ class RtkSolver {
     double cycles = 0.0, meters = 0.0;
   };
   std::vector<HeldDd> held_;
+  /// The DD phases (satellite, reference signals) of the last process() epoch and its time.
+  std::vector<std::pair<HeldSignal, HeldSignal>> processedPairs_;
+  std::optional<GpsTime> lastProcess_;
+  /// The rover epoch the slip detector last took: differences() and process() at the same epoch
+  /// must not feed it twice (a zero interval would restart every arc).
+  std::optional<GpsTime> slipEpoch_;
+  void detectSlips(const ObsEpoch& rover, const GlonassChannels& channels);
   int consecutiveFixes_ = 0;
   /// Previous resolution's DD ambiguities (SD block ids of satellite and reference) and its
   /// reduced basis: the next epoch's LAMBDA starts from it (ReductionStart) while none of these
