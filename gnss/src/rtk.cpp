@@ -426,7 +426,17 @@ std::optional<double> RtkSolver::differences(const ObsEpoch& rover, const Eigen:
 }
 
 RtkSolution RtkSolver::process(const ObsEpoch& rover, TransmitStates* states) {
-  held_.clear();  // filled again below if this epoch ends fixed
+  // A run that does not fix keeps the last fix to hold: its integers stay valid on the arcs that
+  // continue (differencesWithHeldFix checks them); a reset drops it.
+  std::vector<HeldDd> previous = std::move(held_);
+  held_.clear();
+  const auto resets = counters_.filterResets;
+  RtkSolution sol = processEpoch(rover, states);
+  if (sol.quality != SolutionQuality::Fix && counters_.filterResets == resets && lastProcess_) held_ = std::move(previous);
+  return sol;
+}
+
+RtkSolution RtkSolver::processEpoch(const ObsEpoch& rover, TransmitStates* states) {
   RtkSolution sol;
   sol.time = rover.time;
   const SppSolution spp = spp_.solve(rover);

@@ -560,6 +560,44 @@ TEST(RtkHeldFix, PhasePairsAsProcessedTellsWhatIsNew) {
   EXPECT_EQ(*a->lastProcessTime(), d.rover[13].time);
 }
 
+// A run that does not fix (here: three satellites left at epoch 6) keeps the held fix: the
+// next epoch's continuing arcs still take its integers. A reset drops it.
+TEST(RtkHeldFix, RunWithoutFixKeepsTheHeldFix) {
+  const Dataset& d = nagoya();
+  RtkSolver s(d.nav, nagoyaConfig());
+  s.setRoverGlonassChannels(d.roverHeader.glonassChannels);
+  s.setBaseGlonassChannels(d.baseHeader.glonassChannels);
+  s.setBasePosition(d.basePosition);
+  std::size_t k = 0;
+  auto feedBase = [&](const ObsEpoch& e) {
+    while (k < d.base.size() && (k == 0 || d.base[k - 1].time - e.time <= BaseStation::kSyncTolerance)) {
+      s.addBaseEpoch(d.base[k]);
+      ++k;
+    }
+  };
+  for (int i = 0; i < 6; ++i) {
+    feedBase(d.rover[static_cast<std::size_t>(i)]);
+    (void)s.process(d.rover[static_cast<std::size_t>(i)]);
+  }
+  ASSERT_TRUE(s.hasHeldFix());
+  ObsEpoch few = d.rover[6];
+  few.sats.resize(3);
+  feedBase(few);
+  EXPECT_NE(s.process(few).quality, SolutionQuality::Fix);
+  EXPECT_TRUE(s.hasHeldFix());
+  feedBase(d.rover[7]);
+  int fixed = 0;
+  ASSERT_TRUE(s.differencesWithHeldFix(d.rover[7], d.truth, fixed).has_value());
+  EXPECT_GT(fixed, 10);
+  for (const DoubleDifference& dd : s.measurements().phase) {
+    if (dd.ambiguityMeters) {
+      EXPECT_LT(std::abs(ddPhaseResidual(s.measurements(), dd, d.truth).residual), 0.03);
+    }
+  }
+  s.reset();
+  EXPECT_FALSE(s.hasHeldFix());
+}
+
 TEST(CycleSlips, DetectorTests) {
   const Dataset& d = nagoya();
   CycleSlipDetector det;

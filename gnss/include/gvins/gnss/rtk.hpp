@@ -150,7 +150,8 @@ class RtkSolver {
   /// that got an ambiguity.
   std::optional<double> differencesWithHeldFix(const ObsEpoch& rover, const Eigen::Vector3d& x, int& fixed,
                                                TransmitStates* states = nullptr);
-  /// True when the last process() epoch ended fixed (its fix is held for differencesWithHeldFix).
+  /// True when a process() epoch ended fixed since the last reset: the fix of the last such epoch
+  /// is held for differencesWithHeldFix (a run that does not fix keeps it; a reset drops it).
   bool hasHeldFix() const { return !held_.empty(); }
   /// Time of the last process() epoch (nullopt before the first and after reset()).
   std::optional<GpsTime> lastProcessTime() const { return lastProcess_; }
@@ -232,6 +233,7 @@ class RtkSolver {
   /// must not feed it twice (a zero interval would restart every arc).
   std::optional<GpsTime> slipEpoch_;
   void detectSlips(const ObsEpoch& rover, const GlonassChannels& channels);
+  RtkSolution processEpoch(const ObsEpoch& rover, TransmitStates* states);
   int consecutiveFixes_ = 0;
   /// Previous resolution's DD ambiguities (SD block ids of satellite and reference) and its
   /// reduced basis: the next epoch's LAMBDA starts from it (ReductionStart) while none of these
