@@ -439,14 +439,21 @@ void GnssFusion<Scalar>::propagateClocks(vio::EstimatorBackend<Scalar>& est, con
   // at those instants; no columns swept in between).
   const double di = t - isbTime_;
   if (!isbBlock_.valid() || !(config_.isbRandomWalk > 0.0) || di < config_.isbRenewalInterval) return;
-  const auto ni = static_cast<Eigen::Index>(clockSystems_.size()) - 1;
-  sri::Propagation<Scalar> isb;
-  isb.addNewBlock(sri::BlockSpec::vector("gnss_isb", static_cast<int>(ni)), est.estimate(isbBlock_));
-  isb.setTransition(isbBlock_, Mat::Identity(ni, ni));
-  isb.setNoiseCovariance(Mat::Identity(ni, ni) * static_cast<Scalar>(config_.isbRandomWalk * config_.isbRandomWalk * di));
-  isb.marginalizeAfter(isbBlock_);
-  isbBlock_ = est.propagate(isb, vio::ClientBlockRegion::kParameters).at(0);
+  isbBlock_ = randomWalkStep(est, isbBlock_, "gnss_isb", static_cast<int>(clockSystems_.size()) - 1,
+                             config_.isbRandomWalk * config_.isbRandomWalk * di);
   isbTime_ = t;
+}
+
+template <typename Scalar>
+sri::BlockId GnssFusion<Scalar>::randomWalkStep(vio::EstimatorBackend<Scalar>& est, sri::BlockId id, const char* name,
+                                                int size, double variance) {
+  using Mat = typename sri::Propagation<Scalar>::Matrix;
+  sri::Propagation<Scalar> step;
+  step.addNewBlock(sri::BlockSpec::vector(name, size), est.estimate(id));
+  step.setTransition(id, Mat::Identity(size, size));
+  step.setNoiseCovariance(Mat::Identity(size, size) * static_cast<Scalar>(variance));
+  step.marginalizeAfter(id);
+  return est.propagate(step, vio::ClientBlockRegion::kParameters).at(0);
 }
 
 template <typename Scalar>
@@ -467,13 +474,7 @@ template <typename Scalar>
 void GnssFusion<Scalar>::propagateZwd(vio::EstimatorBackend<Scalar>& est, const GpsTime& t) {
   const double dt = t - zwdTime_;
   if (!zwdBlock_.valid() || dt <= 0.0) return;
-  using Mat = typename sri::Propagation<Scalar>::Matrix;
-  sri::Propagation<Scalar> step;
-  step.addNewBlock(sri::BlockSpec::vector("gnss_zwd", 1), est.estimate(zwdBlock_));
-  step.setTransition(zwdBlock_, Mat::Identity(1, 1));
-  step.setNoiseCovariance(Mat::Constant(1, 1, static_cast<Scalar>(config_.zwdRandomWalk * config_.zwdRandomWalk * dt)));
-  step.marginalizeAfter(zwdBlock_);
-  zwdBlock_ = est.propagate(step, vio::ClientBlockRegion::kParameters).at(0);
+  zwdBlock_ = randomWalkStep(est, zwdBlock_, "gnss_zwd", 1, config_.zwdRandomWalk * config_.zwdRandomWalk * dt);
   zwdTime_ = t;
 }
 
@@ -744,6 +745,12 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
   // the held fix too (in the tight stage below), unless its DD phases differ from that run's
   // (a new satellite, a slip, another reference): then the module runs there.
   bool rtkDeferred = false;
+  auto runRtk = [&] {
+    const RtkSolution rtk = rtk_->process(roverRaw, &states);
+    rep.rtkFixed = rtk.quality == SolutionQuality::Fix;
+    baseAge = rtk.age;
+    rtkProcessed = true;
+  };
   if (rtk_) {
     const bool newBase = base && (!lastBase_ || base->time > *lastBase_);
     if (newBase) {
@@ -759,12 +766,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
     const std::optional<GpsTime> lastRun = rtk_->lastProcessTime();
     rtkDeferred = fullRtk && newBase && config_.rtkHoldFix && rtk_->hasHeldFix() && lastRun &&
                   rover.time - *lastRun < config_.rtkRevalidateInterval;
-    if (fullRtk && !rtkDeferred && (newBase || !rtk_->hasHeldFix() || !config_.rtkHoldFix)) {
-      const RtkSolution rtk = rtk_->process(roverRaw, &states);
-      rep.rtkFixed = rtk.quality == SolutionQuality::Fix;
-      baseAge = rtk.age;
-      rtkProcessed = true;
-    }
+    if (fullRtk && !rtkDeferred && (newBase || !rtk_->hasHeldFix() || !config_.rtkHoldFix)) runRtk();
   }
   // A new estimator state (the VIO started again, EstimatorBackend::generation): the client
   // blocks are gone; frame, clocks, lever arm and ambiguities start again.
@@ -1022,12 +1024,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
       int heldFixed = 0;
       baseAge = rtk_->differencesWithHeldFix(roverRaw, k.x_E, heldFixed, &states);
       rep.rtkFixed = heldFixed > 0;
-      if (rtkDeferred && !rtk_->phasePairsAsProcessed()) {
-        const RtkSolution rtk = rtk_->process(roverRaw, &states);
-        rep.rtkFixed = rtk.quality == SolutionQuality::Fix;
-        baseAge = rtk.age;
-        rtkProcessed = true;
-      }
+      if (rtkDeferred && !rtk_->phasePairsAsProcessed()) runRtk();
     }
     if (baseAge && config_.usesDifferences() && *baseAge <= config_.maxBaseAge) {
       const DdEpoch& e = rtk_->measurements();

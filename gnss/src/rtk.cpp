@@ -378,12 +378,10 @@ std::optional<double> RtkSolver::differencesWithHeldFix(const ObsEpoch& rover, c
   const std::optional<double> age = differences(rover, x, states);
   if (!age || held_.empty()) return age;
   for (DoubleDifference& d : dd_.phase) {
-    const SingleDifference& s = dd_.sd[static_cast<std::size_t>(d.satellite)];
-    const SingleDifference& f = dd_.sd[static_cast<std::size_t>(d.reference)];
-    if (s.halfCycle || f.halfCycle || s.roverSlip || s.baseSlip || f.roverSlip || f.baseSlip) continue;
-    const HeldSignal sat = HeldSignal::of(s), ref = HeldSignal::of(f);
+    if (flagged(d)) continue;
+    const HeldPair p = pairOf(d);
     for (const HeldDd& h : held_) {
-      if (h.satellite == sat && h.reference == ref) {
+      if (h.satellite == p.first && h.reference == p.second) {
         d.fixedCycles = h.cycles;
         d.ambiguityMeters = h.meters;
         ++fixed;
@@ -400,14 +398,22 @@ void RtkSolver::detectSlips(const ObsEpoch& rover, const GlonassChannels& channe
   slipEpoch_ = rover.time;
 }
 
+RtkSolver::HeldPair RtkSolver::pairOf(const DoubleDifference& d) const {
+  return {HeldSignal::of(dd_.sd[static_cast<std::size_t>(d.satellite)]),
+          HeldSignal::of(dd_.sd[static_cast<std::size_t>(d.reference)])};
+}
+
+bool RtkSolver::flagged(const DoubleDifference& d) const {
+  const SingleDifference& s = dd_.sd[static_cast<std::size_t>(d.satellite)];
+  const SingleDifference& f = dd_.sd[static_cast<std::size_t>(d.reference)];
+  return s.halfCycle || f.halfCycle || s.roverSlip || s.baseSlip || f.roverSlip || f.baseSlip;
+}
+
 bool RtkSolver::phasePairsAsProcessed() const {
   if (!lastProcess_ || dd_.phase.size() != processedPairs_.size()) return false;
   for (const DoubleDifference& d : dd_.phase) {
-    const SingleDifference& s = dd_.sd[static_cast<std::size_t>(d.satellite)];
-    const SingleDifference& f = dd_.sd[static_cast<std::size_t>(d.reference)];
-    if (s.halfCycle || f.halfCycle || s.roverSlip || s.baseSlip || f.roverSlip || f.baseSlip) return false;
-    const std::pair<HeldSignal, HeldSignal> p(HeldSignal::of(s), HeldSignal::of(f));
-    if (std::find(processedPairs_.begin(), processedPairs_.end(), p) == processedPairs_.end()) return false;
+    if (flagged(d) || std::find(processedPairs_.begin(), processedPairs_.end(), pairOf(d)) == processedPairs_.end())
+      return false;
   }
   return true;
 }
@@ -428,11 +434,12 @@ std::optional<double> RtkSolver::differences(const ObsEpoch& rover, const Eigen:
 RtkSolution RtkSolver::process(const ObsEpoch& rover, TransmitStates* states) {
   // A run that does not fix keeps the last fix to hold: its integers stay valid on the arcs that
   // continue (differencesWithHeldFix checks them); a reset drops it.
+  // (processEpoch sets lastProcess_ before any return; only a reset, also the one initialize()
+  // starts with, clears it again.)
   std::vector<HeldDd> previous = std::move(held_);
   held_.clear();
-  const auto resets = counters_.filterResets;
   RtkSolution sol = processEpoch(rover, states);
-  if (sol.quality != SolutionQuality::Fix && counters_.filterResets == resets && lastProcess_) held_ = std::move(previous);
+  if (sol.quality != SolutionQuality::Fix && lastProcess_) held_ = std::move(previous);
   return sol;
 }
 
@@ -580,17 +587,13 @@ RtkSolution RtkSolver::processEpoch(const ObsEpoch& rover, TransmitStates* state
     sol.velocityCovariance = filter_.covariance(vid);
   }
   resolve(sol);
-  for (const DoubleDifference& d : dd_.phase) {
-    processedPairs_.emplace_back(HeldSignal::of(dd_.sd[static_cast<std::size_t>(d.satellite)]),
-                                 HeldSignal::of(dd_.sd[static_cast<std::size_t>(d.reference)]));
-  }
+  for (const DoubleDifference& d : dd_.phase) processedPairs_.push_back(pairOf(d));
   // The fix to hold (differencesWithHeldFix): the DD phases that got an ambiguity.
   if (sol.quality == SolutionQuality::Fix) {
     for (const DoubleDifference& d : dd_.phase) {
       if (!d.ambiguityMeters || !d.fixedCycles) continue;
-      const SingleDifference& s = dd_.sd[static_cast<std::size_t>(d.satellite)];
-      const SingleDifference& f = dd_.sd[static_cast<std::size_t>(d.reference)];
-      held_.push_back({HeldSignal::of(s), HeldSignal::of(f), *d.fixedCycles, *d.ambiguityMeters});
+      const HeldPair p = pairOf(d);
+      held_.push_back({p.first, p.second, *d.fixedCycles, *d.ambiguityMeters});
     }
   }
   return sol;

@@ -96,24 +96,33 @@ struct RunResult {
 
 /// Runs the solver over rover epochs [first, last) with the given base epochs, feeding base epochs
 /// up to each rover time and one beyond (as gvins-rtk does).
+/// The dataset's GLONASS channels of both receivers and its base position (or basePos).
+void setUp(RtkSolver& s, const Dataset& d, std::optional<Eigen::Vector3d> basePos = std::nullopt) {
+  s.setRoverGlonassChannels(d.roverHeader.glonassChannels);
+  s.setBaseGlonassChannels(d.baseHeader.glonassChannels);
+  s.setBasePosition(basePos.value_or(d.basePosition));
+}
+
+/// Base epochs from `next` up to rover time t and the first one after it (never more).
+void addBaseUpTo(RtkSolver& s, const std::vector<ObsEpoch>& base, std::size_t& next, const GpsTime& t) {
+  while (next < base.size() && (next == 0 || base[next - 1].time - t <= BaseStation::kSyncTolerance)) {
+    s.addBaseEpoch(base[next]);
+    ++next;
+  }
+}
+
 RunResult runRtk(const Dataset& d, const RtkConfig& cfg, const std::vector<ObsEpoch>& base, int first, int last,
            bool keepDd = false, std::optional<Eigen::Vector3d> basePos = std::nullopt,
            const std::function<void(ObsEpoch&, int)>& doctorRover = {}) {
   RtkSolver s(d.nav, cfg);
-  s.setRoverGlonassChannels(d.roverHeader.glonassChannels);
-  s.setBaseGlonassChannels(d.baseHeader.glonassChannels);
-  s.setBasePosition(basePos.value_or(d.basePosition));
+  setUp(s, d, basePos);
   std::size_t b = 0;
   RunResult r;
   last = std::min(last, static_cast<int>(d.rover.size()));
   for (int i = first; i < last; ++i) {
     ObsEpoch e = d.rover[static_cast<std::size_t>(i)];
     if (doctorRover) doctorRover(e, i);
-    // Base epochs up to the rover time and the first one after it (never more).
-    while (b < base.size() && (b == 0 || base[b - 1].time - e.time <= BaseStation::kSyncTolerance)) {
-      s.addBaseEpoch(base[b]);
-      ++b;
-    }
+    addBaseUpTo(s, base, b, e.time);
     r.sol.push_back(s.process(e));
     if (keepDd) r.dd.push_back(s.measurements());
   }
@@ -458,18 +467,13 @@ TEST(RtkHeldFix, EpochsBetweenRunsTakeTheSameIntegers) {
   for (const bool slipped : {false, true}) {
     const auto doctor = slip(g, '1', 5, 32);  // between the runs at 30 and 35
     RtkSolver s(d.nav, nagoyaConfig());
-    s.setRoverGlonassChannels(d.roverHeader.glonassChannels);
-    s.setBaseGlonassChannels(d.baseHeader.glonassChannels);
-    s.setBasePosition(d.basePosition);
+    setUp(s, d);
     std::size_t b = 0;
     int held = 0, compared = 0, slippedHeld = 0;
     for (int i = 0; i < 60; ++i) {
       ObsEpoch e = d.rover[static_cast<std::size_t>(i)];
       if (slipped) doctor(e, i);
-      while (b < d.base.size() && (b == 0 || d.base[b - 1].time - e.time <= BaseStation::kSyncTolerance)) {
-        s.addBaseEpoch(d.base[b]);
-        ++b;
-      }
+      addBaseUpTo(s, d.base, b, e.time);
       if (i % 5 == 0) {
         (void)s.process(e);
         continue;
@@ -521,22 +525,17 @@ TEST(RtkHeldFix, PhasePairsAsProcessedTellsWhatIsNew) {
   const auto doctor = slip(g, '1', 5, 12);
   auto solver = [&] {
     auto s = std::make_unique<RtkSolver>(d.nav, nagoyaConfig());
-    s->setRoverGlonassChannels(d.roverHeader.glonassChannels);
-    s->setBaseGlonassChannels(d.baseHeader.glonassChannels);
-    s->setBasePosition(d.basePosition);
+    setUp(*s, d);
     return s;
   };
   auto a = solver(), b = solver();  // b forms the differences before each of its runs
-  std::size_t k = 0;
+  std::size_t ka = 0, kb = 0;
   std::vector<int> asProcessed;
   for (int i = 0; i < 20; ++i) {
     ObsEpoch e = d.rover[static_cast<std::size_t>(i)];
     doctor(e, i);
-    while (k < d.base.size() && (k == 0 || d.base[k - 1].time - e.time <= BaseStation::kSyncTolerance)) {
-      a->addBaseEpoch(d.base[k]);
-      b->addBaseEpoch(d.base[k]);
-      ++k;
-    }
+    addBaseUpTo(*a, d.base, ka, e.time);
+    addBaseUpTo(*b, d.base, kb, e.time);
     int fixed = 0;
     if (i == 0 || i == 5 || i == 13) {
       if (i > 0) {
@@ -565,27 +564,19 @@ TEST(RtkHeldFix, PhasePairsAsProcessedTellsWhatIsNew) {
 TEST(RtkHeldFix, RunWithoutFixKeepsTheHeldFix) {
   const Dataset& d = nagoya();
   RtkSolver s(d.nav, nagoyaConfig());
-  s.setRoverGlonassChannels(d.roverHeader.glonassChannels);
-  s.setBaseGlonassChannels(d.baseHeader.glonassChannels);
-  s.setBasePosition(d.basePosition);
+  setUp(s, d);
   std::size_t k = 0;
-  auto feedBase = [&](const ObsEpoch& e) {
-    while (k < d.base.size() && (k == 0 || d.base[k - 1].time - e.time <= BaseStation::kSyncTolerance)) {
-      s.addBaseEpoch(d.base[k]);
-      ++k;
-    }
-  };
   for (int i = 0; i < 6; ++i) {
-    feedBase(d.rover[static_cast<std::size_t>(i)]);
+    addBaseUpTo(s, d.base, k, d.rover[static_cast<std::size_t>(i)].time);
     (void)s.process(d.rover[static_cast<std::size_t>(i)]);
   }
   ASSERT_TRUE(s.hasHeldFix());
   ObsEpoch few = d.rover[6];
   few.sats.resize(3);
-  feedBase(few);
+  addBaseUpTo(s, d.base, k, few.time);
   EXPECT_NE(s.process(few).quality, SolutionQuality::Fix);
   EXPECT_TRUE(s.hasHeldFix());
-  feedBase(d.rover[7]);
+  addBaseUpTo(s, d.base, k, d.rover[7].time);
   int fixed = 0;
   ASSERT_TRUE(s.differencesWithHeldFix(d.rover[7], d.truth, fixed).has_value());
   EXPECT_GT(fixed, 10);
@@ -701,18 +692,14 @@ TEST(RtkBadInput, RoverTimeGaps) {
   const Dataset& d = nagoya();
   for (const int gap : {100, 20}) {
     RtkSolver s(d.nav, nagoyaConfig());
-    s.setRoverGlonassChannels(d.roverHeader.glonassChannels);
-    s.setBaseGlonassChannels(d.baseHeader.glonassChannels);
-    s.setBasePosition(d.basePosition);
+    setUp(s, d);
     std::size_t b = 0;
     std::vector<RtkSolution> after;
     std::int64_t addedBefore = 0;
     for (int i = 0; i < 50 + gap + 30; ++i) {
       if (i >= 50 && i < 50 + gap) continue;  // rover epochs missing
       const ObsEpoch& e = d.rover[static_cast<std::size_t>(i)];
-      while (b < d.base.size() && (b == 0 || d.base[b - 1].time - e.time <= BaseStation::kSyncTolerance)) {
-        s.addBaseEpoch(d.base[b++]);
-      }
+      addBaseUpTo(s, d.base, b, e.time);
       const RtkSolution sol = s.process(e);
       if (i == 49) addedBefore = s.counters().ambiguitiesAdded;
       if (i >= 50 + gap) after.push_back(sol);
@@ -827,14 +814,12 @@ TEST(TransmitStatesShared, SameStatesAndTheSameRtkSolution) {
   // RTK over 120 epochs, with and without states filled first from the second code.
   const RunResult plain = runRtk(d, nagoyaConfig(), d.base, 0, 120);
   RtkSolver s(d.nav, nagoyaConfig());
-  s.setRoverGlonassChannels(d.roverHeader.glonassChannels);
-  s.setBaseGlonassChannels(d.baseHeader.glonassChannels);
-  s.setBasePosition(d.basePosition);
+  setUp(s, d);
   std::size_t b = 0;
   int compared = 0;
   for (int i = 0; i < 120; ++i) {
     const ObsEpoch& e = d.rover[static_cast<std::size_t>(i)];
-    while (b < d.base.size() && (b == 0 || d.base[b - 1].time - e.time <= BaseStation::kSyncTolerance)) s.addBaseEpoch(d.base[b++]);
+    addBaseUpTo(s, d.base, b, e.time);
     TransmitStates states(d.nav, e.time);
     for (const SatObs& so : e.sats) {
       for (auto it = so.signals.rbegin(); it != so.signals.rend(); ++it) {

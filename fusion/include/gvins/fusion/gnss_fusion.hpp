@@ -140,6 +140,10 @@ class GnssFusion {
   Eigen::VectorXd systemClocks(const vio::EstimatorBackend<Scalar>& est) const;
   /// Random walk of the zenith wet delay state to time t.
   void propagateZwd(vio::EstimatorBackend<Scalar>& est, const GpsTime& t);
+  /// One random-walk step of a vector block of `size` (parameter region): the same estimate,
+  /// `variance` added to each component; returns the new block's id.
+  sri::BlockId randomWalkStep(vio::EstimatorBackend<Scalar>& est, sri::BlockId id, const char* name, int size,
+                              double variance);
   /// Gates rows one by one, stacks the accepted ones and applies them; returns the update.
   /// `ambiguities`: the blocks that rows' `ambiguity` indices refer to.
   vio::BackendUpdate<Scalar> apply(vio::EstimatorBackend<Scalar>& est, std::vector<GnssRow>& rows,

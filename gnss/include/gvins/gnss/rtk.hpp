@@ -226,8 +226,14 @@ class RtkSolver {
     double cycles = 0.0, meters = 0.0;
   };
   std::vector<HeldDd> held_;
-  /// The DD phases (satellite, reference signals) of the last process() epoch and its time.
-  std::vector<std::pair<HeldSignal, HeldSignal>> processedPairs_;
+  /// A DD phase of dd_ as its (satellite, reference) signals on their arcs.
+  using HeldPair = std::pair<HeldSignal, HeldSignal>;
+  HeldPair pairOf(const DoubleDifference& d) const;
+  /// Whether either signal of a DD phase of dd_ is flagged in this epoch (slip, half cycle): its
+  /// arc may not continue, so no held integer applies.
+  bool flagged(const DoubleDifference& d) const;
+  /// The DD phases of the last process() epoch and its time.
+  std::vector<HeldPair> processedPairs_;
   std::optional<GpsTime> lastProcess_;
   /// The rover epoch the slip detector last took: differences() and process() at the same epoch
   /// must not feed it twice (a zero interval would restart every arc).
