@@ -52,7 +52,10 @@ const char* kUsage =
     "  --dynamics D          random-walk | constant-velocity (kinematic; default random-walk)\n"
     "  --armode M            off | continuous | instantaneous | fix-and-hold (default continuous)\n"
     "  --ratio R             ratio-test threshold (default 3)\n"
-    "  --validation V        ratio | success-rate | ratio+success-rate (default ratio)\n"
+    "  --validation V        fixed-failure-rate | ratio | success-rate | ratio+success-rate\n"
+    "                        (default fixed-failure-rate: the ratio's critical value bounds the\n"
+    "                        probability of a wrong fix by --max-failure-rate)\n"
+    "  --max-failure-rate P  bound on the wrong-fix probability (default 0.001)\n"
     "  --no-partial          no partial ambiguity resolution\n"
     "  --systems GRECJ       systems used (default GRECJ)\n"
     "  --ar-systems GECJ     systems whose ambiguities are fixed (default GECJ: GLONASS float)\n"
@@ -75,7 +78,7 @@ struct Args {
   std::vector<std::string> inputs;
   std::optional<Eigen::Vector3d> baseXyz, truth;
   std::optional<std::string> mode, dynamics, armode, systems, arSystems, validation;
-  std::optional<double> ratio, elmask, maxAge;
+  std::optional<double> ratio, elmask, maxAge, maxFailureRate;
   std::optional<int> freq;
   bool noPartial = false, noInterpolation = false, xyz = false, noVelocity = false, strict = false, quiet = false;
   int timeDecimals = 3;
@@ -137,6 +140,8 @@ Args parseArgs(int argc, char** argv) {
       a.armode = value(i, o);
     } else if (o == "--ratio") {
       a.ratio = parseNumber(o, value(i, o));
+    } else if (o == "--max-failure-rate") {
+      a.maxFailureRate = parseNumber(o, value(i, o));
       if (*a.ratio < 1.0) usageError("--ratio must be at least 1");
     } else if (o == "--validation") {
       a.validation = value(i, o);
@@ -235,12 +240,14 @@ int main(int argc, char** argv) {
     else usageError("--armode must be off, continuous, instantaneous or fix-and-hold");
   }
   if (args.validation) {
-    if (*args.validation == "ratio") cfg.ar.validation = AmbiguityValidation::Ratio;
-    else if (*args.validation == "success-rate") cfg.ar.validation = AmbiguityValidation::SuccessRate;
-    else if (*args.validation == "ratio+success-rate") cfg.ar.validation = AmbiguityValidation::RatioAndSuccessRate;
-    else usageError("--validation must be ratio, success-rate or ratio+success-rate");
+    if (const auto v = parseAmbiguityValidation(*args.validation)) cfg.ar.validation = *v;
+    else usageError("--validation must be fixed-failure-rate, ratio, success-rate or ratio+success-rate");
   }
   if (args.ratio) cfg.ar.ratioThreshold = *args.ratio;
+  if (args.maxFailureRate) {
+    if (!(*args.maxFailureRate > 0.0 && *args.maxFailureRate <= 0.5)) usageError("--max-failure-rate must be in (0, 0.5]");
+    cfg.ar.maxFailureRate = *args.maxFailureRate;
+  }
   if (args.noPartial) cfg.ar.partial = false;
   try {
     if (args.systems) {
@@ -323,17 +330,17 @@ int main(int argc, char** argv) {
   std::snprintf(buf, sizeof buf, "%.1f deg", cfg.elevationMask * constants::kRadToDeg);
   popt.headerFields.emplace_back("elev mask", buf);
   popt.headerFields.emplace_back("navi sys", systemsText(cfg.systems));
-  std::snprintf(buf, sizeof buf, "%s, systems %s, ratio %.1f, %s%s", toString(cfg.ambiguityMode), systemsText(cfg.arSystems).c_str(),
-                cfg.ar.ratioThreshold,
-                cfg.ar.validation == AmbiguityValidation::Ratio ? "ratio test"
-                : cfg.ar.validation == AmbiguityValidation::SuccessRate ? "success-rate test"
-                                                                          : "ratio and success-rate tests",
-                cfg.ar.partial ? ", partial" : "");
+  std::snprintf(buf, sizeof buf, "%s, systems %s, ratio %.1f, %s validation, failure rate %g%s", toString(cfg.ambiguityMode),
+                systemsText(cfg.arSystems).c_str(), cfg.ar.ratioThreshold, toString(cfg.ar.validation),
+                cfg.ar.maxFailureRate, cfg.ar.partial ? ", partial" : "");
   popt.headerFields.emplace_back("amb res", buf);
   // The base position line is added once known (before the first row is written).
   std::unique_ptr<PosWriter> writer;
 
   std::optional<AccuracyStatistics> fixStats, rtkStats;
+  // A fixed epoch farther than this from --truth counts as a wrong fix (3-D, m).
+  constexpr double kWrongFix = 0.10;
+  long wrongFixes = 0;
   if (args.truth) {
     fixStats.emplace(*args.truth);
     rtkStats.emplace(*args.truth);
@@ -431,7 +438,10 @@ int main(int argc, char** argv) {
       writer->write(sol.toPositionSolution());
       satSum += sol.numSatellites;
       if (sol.quality != SolutionQuality::Single) ageMax = std::max(ageMax, sol.age);
-      if (fixStats && sol.quality == SolutionQuality::Fix) fixStats->addPosition(sol.position);
+      if (fixStats && sol.quality == SolutionQuality::Fix) {
+        fixStats->addPosition(sol.position);
+        if ((sol.position - *args.truth).norm() > kWrongFix) ++wrongFixes;
+      }
       if (rtkStats && sol.quality != SolutionQuality::Single) rtkStats->addPosition(sol.position);
     }
     if (!args.quiet) {
@@ -504,6 +514,11 @@ int main(int argc, char** argv) {
   std::fprintf(stderr, "  ambiguities            %lld added, %lld slip resets, %lld outlier resets, %lld removed\n",
                static_cast<long long>(c.ambiguitiesAdded), static_cast<long long>(c.slipResets),
                static_cast<long long>(c.phaseOutliers), static_cast<long long>(c.ambiguitiesRemoved));
+  if (c.impreciseFixes || c.inconsistentFixes || c.unconfirmedFixes) {
+    std::fprintf(stderr, "  fixes not used         %lld imprecise (sigma > %.2f m), %lld inconsistent with float, %lld awaiting confirmation\n",
+                 static_cast<long long>(c.impreciseFixes), cfg.maxFixedSigma, static_cast<long long>(c.inconsistentFixes),
+                 static_cast<long long>(c.unconfirmedFixes));
+  }
   if (c.codeOutliers || c.filterResets || c.rejectedFixes) {
     std::fprintf(stderr, "  rejected               %lld code DDs, %lld fixes by residual check, %lld filter resets\n",
                  static_cast<long long>(c.codeOutliers), static_cast<long long>(c.rejectedFixes),
@@ -534,6 +549,10 @@ int main(int argc, char** argv) {
     for (const auto& m : rs.messages) std::fprintf(stderr, "    %s\n", m.c_str());
   }
   std::fprintf(stderr, "  time                   %8.3f s (%.0f epochs/s)\n", wall, wall > 0 ? epochs / wall : 0.0);
+  if (fixStats) {
+    std::fprintf(stderr, "  wrong fixes            %8ld of %ld fixed epochs more than %.2f m from the truth\n", wrongFixes, fixed,
+                 kWrongFix);
+  }
   if (fixStats && fixStats->position().count > 0) {
     std::fputs("  fixed solutions vs truth:\n", stderr);
     std::fputs(fixStats->table().c_str(), stderr);

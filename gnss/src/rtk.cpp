@@ -36,8 +36,11 @@ const char* toString(ArStatus s) {
   switch (s) {
     case ArStatus::Off: return "off";
     case ArStatus::TooFewAmbiguities: return "too few ambiguities";
-    case ArStatus::NotValidated: return "ratio/success-rate test failed";
+    case ArStatus::NotValidated: return "validation failed (ratio below its critical value)";
     case ArStatus::Rejected: return "fix rejected by residual check";
+    case ArStatus::Imprecise: return "fix leaves the position imprecise";
+    case ArStatus::Inconsistent: return "fix inconsistent with the float position";
+    case ArStatus::Unconfirmed: return "marginal first fix awaiting confirmation";
     case ArStatus::Fixed: return "fixed";
     case ArStatus::PartialFixed: return "partially fixed";
   }
@@ -444,6 +447,8 @@ RtkSolution RtkSolver::process(const ObsEpoch& rover, TransmitStates* states) {
 }
 
 RtkSolution RtkSolver::processEpoch(const ObsEpoch& rover, TransmitStates* states) {
+  fixBefore_ = std::move(fixNow_);
+  fixNow_.clear();
   RtkSolution sol;
   sol.time = rover.time;
   const SppSolution spp = spp_.solve(rover);
@@ -597,234 +602,6 @@ RtkSolution RtkSolver::processEpoch(const ObsEpoch& rover, TransmitStates* state
     }
   }
   return sol;
-}
-
-namespace {
-
-/// Start basis for this epoch's LAMBDA from the previous epoch's reduced basis (of the DD pairs
-/// `before`), when every one of those pairs is still among `now`: the old basis on the old pairs'
-/// rows and a unit column for each new pair (unimodular, and its inverse likewise). nullopt if a
-/// pair has gone (or there is no previous basis): the reduction starts cold.
-std::optional<ReductionStart> embedBasis(const std::vector<std::pair<sri::BlockId, sri::BlockId>>& before,
-                                         const ReductionStart& basis,
-                                         const std::vector<std::pair<sri::BlockId, sri::BlockId>>& now) {
-  const int m0 = static_cast<int>(before.size());
-  const int m = static_cast<int>(now.size());
-  if (m0 == 0 || m0 > m || !basis.fits(m0)) return std::nullopt;
-  std::vector<int> where(static_cast<std::size_t>(m0));
-  for (int i = 0; i < m0; ++i) {
-    const auto it = std::find(now.begin(), now.end(), before[static_cast<std::size_t>(i)]);
-    if (it == now.end()) return std::nullopt;
-    where[static_cast<std::size_t>(i)] = static_cast<int>(it - now.begin());
-  }
-  ReductionStart start{Eigen::MatrixXd::Zero(m, m), Eigen::MatrixXd::Zero(m, m)};
-  std::vector<char> old(static_cast<std::size_t>(m), 0);
-  for (int i = 0; i < m0; ++i) {
-    const int r = where[static_cast<std::size_t>(i)];
-    old[static_cast<std::size_t>(r)] = 1;
-    for (int j = 0; j < m0; ++j) {
-      start.Z(r, j) = basis.Z(i, j);
-      start.Zinv(j, r) = basis.Zinv(j, i);
-    }
-  }
-  for (int r = 0, c = m0; r < m; ++r) {
-    if (old[static_cast<std::size_t>(r)]) continue;
-    start.Z(r, c) = 1.0;
-    start.Zinv(c, r) = 1.0;
-    ++c;
-  }
-  return start;
-}
-
-}  // namespace
-
-void RtkSolver::resolve(RtkSolution& sol) {
-  if (cfg_.ambiguityMode == AmbiguityMode::Off) {
-    sol.ar = ArStatus::Off;
-    return;
-  }
-  // Eligible SDs per group and the DD pairs (AR reference, satellite).
-  std::vector<char> inPhase(dd_.sd.size(), 0);
-  for (const DoubleDifference& d : dd_.phase) {
-    inPhase[static_cast<std::size_t>(d.reference)] = 1;
-    inPhase[static_cast<std::size_t>(d.satellite)] = 1;
-  }
-  struct Pair {
-    int ref, sat;
-    sri::BlockId refId, satId;
-  };
-  std::vector<Pair> pairs;
-  std::vector<int> arRef(dd_.groups.size(), -1);
-  for (std::size_t g = 0; g < dd_.groups.size(); ++g) {
-    std::vector<int> members;
-    for (std::size_t i = 0; i < dd_.sd.size(); ++i) {
-      const SingleDifference& s = dd_.sd[i];
-      if (s.group != static_cast<int>(g) || !inPhase[i] || !s.hasPhase || s.halfCycle) continue;
-      if (!cfg_.fixSystem(s.sat.system) || s.elevation < cfg_.arElevationMask) continue;
-      const auto it = amb_.find(key(s.sat, s.code));
-      if (it == amb_.end() || it->second.lock < cfg_.arMinLock) continue;
-      members.push_back(static_cast<int>(i));
-    }
-    if (members.size() < 2) continue;
-    int ref = dd_.groups[g].phaseReference;
-    if (std::find(members.begin(), members.end(), ref) == members.end()) {
-      ref = members[0];
-      for (int i : members) {
-        if (dd_.sd[static_cast<std::size_t>(i)].elevation > dd_.sd[static_cast<std::size_t>(ref)].elevation) ref = i;
-      }
-    }
-    arRef[g] = ref;
-    const SingleDifference& f = dd_.sd[static_cast<std::size_t>(ref)];
-    const sri::BlockId rid = amb_.at(key(f.sat, f.code)).id;
-    for (int i : members) {
-      if (i == ref) continue;
-      const SingleDifference& s = dd_.sd[static_cast<std::size_t>(i)];
-      pairs.push_back(Pair{ref, i, rid, amb_.at(key(s.sat, s.code)).id});
-    }
-  }
-  const int m = static_cast<int>(pairs.size());
-  sol.numAmbiguities = m;
-  if (m < std::max(1, cfg_.ar.minFixed)) {
-    sol.ar = ArStatus::TooFewAmbiguities;
-    consecutiveFixes_ = 0;
-    return;
-  }
-  ++counters_.arAttempts;
-  // Joint covariance of [position; DD ambiguities] from the square-root factor: with F the rows
-  // of R⁻¹ of the position and of the SD ambiguities (SriFilter::covarianceFactor, ~n³/6), a DD's
-  // row is F_sat − F_ref and Q = Y Yᵀ over Y = [F_pos; F_sat − F_ref] (the earlier R⁻ᵀ Mᵀ solve
-  // with 3 + m right-hand sides cost about three times as much).
-  std::vector<sri::BlockId> ids{pos_};
-  std::unordered_map<std::uint64_t, int> rowOf;  // SD ambiguity block → row of F
-  auto listed = [&](sri::BlockId id) {
-    if (rowOf.emplace(id.value, 3 + static_cast<int>(ids.size()) - 1).second) ids.push_back(id);
-  };
-  Eigen::VectorXd a(m);
-  for (int k = 0; k < m; ++k) {
-    const Pair& p = pairs[static_cast<std::size_t>(k)];
-    listed(p.satId);
-    listed(p.refId);
-    a[k] = filter_.estimate(p.satId).vector[0] - filter_.estimate(p.refId).vector[0];
-  }
-  Eigen::MatrixXd F;
-  try {
-    F = filter_.covarianceFactor(ids);
-  } catch (const std::domain_error&) {
-    F.resize(0, 0);
-  }
-  if (F.rows() != static_cast<Eigen::Index>(ids.size()) + 2) {  // a block without information
-    sol.ar = ArStatus::NotValidated;
-    consecutiveFixes_ = 0;
-    return;
-  }
-  Eigen::MatrixXd Y(3 + m, F.cols());
-  Y.topRows(3) = F.topRows(3);
-  for (int k = 0; k < m; ++k) {
-    const Pair& p = pairs[static_cast<std::size_t>(k)];
-    Y.row(3 + k) = F.row(rowOf.at(p.satId.value)) - F.row(rowOf.at(p.refId.value));
-  }
-  Eigen::MatrixXd Q = Eigen::MatrixXd::Zero(3 + m, 3 + m);
-  Q.selfadjointView<Eigen::Lower>().rankUpdate(Y);
-  Q = Q.selfadjointView<Eigen::Lower>();
-  const Eigen::MatrixXd Qaa = Q.bottomRightCorner(m, m);
-  const Eigen::MatrixXd Qxa = Q.topRightCorner(3, m);
-  std::vector<std::pair<sri::BlockId, sri::BlockId>> now(static_cast<std::size_t>(m));
-  for (int k = 0; k < m; ++k) now[static_cast<std::size_t>(k)] = {pairs[static_cast<std::size_t>(k)].satId, pairs[static_cast<std::size_t>(k)].refId};
-  const std::optional<ReductionStart> start = embedBasis(arPairs_, arBasis_, now);
-  arPairs_ = std::move(now);
-  const AmbiguityFix fix = resolveAmbiguities(a, Qaa, cfg_.ar, start ? &*start : nullptr);
-  arBasis_ = fix.basis;
-  if (!arBasis_.fits(m)) arPairs_.clear();
-  sol.ratio = fix.fixed ? fix.ratio : fix.fullRatio;
-  sol.successRate = fix.fixed ? fix.successRate : fix.fullSuccessRate;
-  if (!fix.fixed) {
-    sol.ar = ArStatus::NotValidated;
-    consecutiveFixes_ = 0;
-    return;
-  }
-  // Condition the float solution on the fixed combinations y = T a = t (T = I for a full fix).
-  Eigen::VectorXd ac;
-  Eigen::Vector3d xfix;
-  Eigen::Matrix3d Pfix;
-  {
-    const bool full = !fix.partial;
-    const Eigen::VectorXd dy = full ? Eigen::VectorXd(a - fix.values) : Eigen::VectorXd(fix.T * a - fix.values);
-    const Eigen::MatrixXd QaT = full ? Qaa : Eigen::MatrixXd(Qaa * fix.T.transpose());  // Q_ay
-    const Eigen::MatrixXd Qyy = full ? Qaa : Eigen::MatrixXd(fix.T * QaT);
-    const Eigen::MatrixXd QxT = full ? Qxa : Eigen::MatrixXd(Qxa * fix.T.transpose());  // Q_xy
-    const Eigen::LLT<Eigen::MatrixXd> llt(Qyy);
-    if (llt.info() != Eigen::Success) {
-      sol.ar = ArStatus::NotValidated;
-      consecutiveFixes_ = 0;
-      return;
-    }
-    const Eigen::VectorXd w = llt.solve(dy);
-    xfix = sol.floatPosition - QxT * w;
-    Pfix = sol.floatCovariance - QxT * llt.solve(QxT.transpose());
-    ac = full ? Eigen::VectorXd(fix.values) : Eigen::VectorXd(a - QaT * w);
-  }
-  // Residual check of every DD in the AR set at the fixed position.
-  for (int k = 0; k < m; ++k) {
-    const Pair& p = pairs[static_cast<std::size_t>(k)];
-    const SingleDifference& s = dd_.sd[static_cast<std::size_t>(p.sat)];
-    const SingleDifference& f = dd_.sd[static_cast<std::size_t>(p.ref)];
-    const double nref = filter_.estimate(p.refId).vector[0];
-    const double v = sdPhaseResidual(s, xfix) - sdPhaseResidual(f, xfix) -
-                     (s.wavelength * ac[k] + (s.wavelength - f.wavelength) * nref);
-    if (std::abs(v) > cfg_.fixValidationSigmas * std::sqrt(s.phaseVariance + f.phaseVariance)) {
-      sol.ar = ArStatus::Rejected;
-      ++counters_.rejectedFixes;
-      consecutiveFixes_ = 0;
-      return;
-    }
-  }
-  sol.quality = SolutionQuality::Fix;
-  sol.position = xfix;
-  sol.positionCovariance = 0.5 * (Pfix + Pfix.transpose());
-  sol.ar = fix.partial ? ArStatus::PartialFixed : ArStatus::Fixed;
-  sol.numFixed = fix.numFixed();
-  if (fix.partial) ++counters_.partialFixes;
-
-  // Fixed ambiguities of the DD phases (values relative to each group's AR reference).
-  std::vector<double> rel(dd_.sd.size(), std::numeric_limits<double>::quiet_NaN());
-  for (std::size_t g = 0; g < arRef.size(); ++g) {
-    if (arRef[g] >= 0) rel[static_cast<std::size_t>(arRef[g])] = 0.0;
-  }
-  for (int k = 0; k < m; ++k) rel[static_cast<std::size_t>(pairs[static_cast<std::size_t>(k)].sat)] = ac[k];
-  for (DoubleDifference& d : dd_.phase) {
-    const double vs = rel[static_cast<std::size_t>(d.satellite)], vr = rel[static_cast<std::size_t>(d.reference)];
-    if (!std::isfinite(vs) || !std::isfinite(vr)) continue;
-    const double val = vs - vr;
-    if (std::abs(val - std::round(val)) > 1e-3) continue;
-    const SingleDifference& s = dd_.sd[static_cast<std::size_t>(d.satellite)];
-    const SingleDifference& f = dd_.sd[static_cast<std::size_t>(d.reference)];
-    d.fixedCycles = std::round(val);
-    d.ambiguityMeters = s.wavelength * *d.fixedCycles + (s.wavelength - f.wavelength) * ambiguityEstimate(f);
-  }
-
-  ++consecutiveFixes_;
-  if (cfg_.ambiguityMode == AmbiguityMode::FixAndHold && consecutiveFixes_ >= cfg_.holdMinFixes) {
-    // Fixed combinations as constraints on the SD ambiguity states.
-    const Eigen::MatrixXd& T = fix.T;
-    Meas h(static_cast<int>(T.rows()));
-    for (int r = 0; r < T.rows(); ++r) {
-      double cur = 0.0;
-      for (int k = 0; k < m; ++k) {
-        const double c = T(r, k);
-        if (c == 0.0) continue;
-        const Pair& p = pairs[static_cast<std::size_t>(k)];
-        h.jacobian(p.satId, 1)(r, 0) += c;
-        h.jacobian(p.refId, 1)(r, 0) -= c;
-        cur += c * a[k];
-      }
-      h.residual()[r] = fix.values[r] - cur;
-    }
-    h.whitenStdDev(cfg_.holdSigmaCycles);
-    filter_.update(h);
-    filter_.correct();
-    sol.held = true;
-    ++counters_.holdUpdates;
-  }
 }
 
 }  // namespace gvins

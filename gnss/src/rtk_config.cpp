@@ -35,17 +35,16 @@ void applyAr(const Reader& r, const YAML::Node& v, const std::string& where, Rtk
   static const std::set<std::string> kKeys = {
       "systems", "elevation_mask_deg", "min_lock", "validation", "ratio_threshold", "max_failure_rate", "partial",
       "partial_success_rate", "min_fixed", "max_partial_attempts", "max_search_nodes", "hold_min_fixes",
-      "hold_sigma_cycles", "validation_sigmas"};
+      "hold_sigma_cycles", "validation_sigmas", "ffrt_samples", "max_fixed_sigma_m", "position_test_alpha",
+      "code_validation_sigmas", "confirm_ratio_factor"};
   r.map(v, where, kKeys, [&](const std::string& k, const std::string& f, const YAML::Node& x) {
     if (k == "systems") c.arSystems = r.systems(x, f);
     else if (k == "elevation_mask_deg") c.arElevationMask = r.number(x, f, 0.0, 90.0) * constants::kDegToRad;
     else if (k == "min_lock") c.arMinLock = r.integer(x, f, 0, 100000);
     else if (k == "validation") {
       const std::string t = r.text(x, f);
-      if (t == "ratio") c.ar.validation = AmbiguityValidation::Ratio;
-      else if (t == "success-rate") c.ar.validation = AmbiguityValidation::SuccessRate;
-      else if (t == "ratio+success-rate") c.ar.validation = AmbiguityValidation::RatioAndSuccessRate;
-      else r.fail(x, f, "'" + f + "' must be ratio, success-rate or ratio+success-rate, not '" + t + "'");
+      if (const auto rule = parseAmbiguityValidation(t)) c.ar.validation = *rule;
+      else r.fail(x, f, "'" + f + "' must be ratio, success-rate, ratio+success-rate or fixed-failure-rate, not '" + t + "'");
     } else if (k == "ratio_threshold") c.ar.ratioThreshold = r.number(x, f, 1.0, 1000.0);
     else if (k == "max_failure_rate") c.ar.maxFailureRate = r.number(x, f, 1e-9, 0.5);
     else if (k == "partial") c.ar.partial = r.boolean(x, f);
@@ -55,7 +54,12 @@ void applyAr(const Reader& r, const YAML::Node& v, const std::string& where, Rtk
     else if (k == "max_search_nodes") c.ar.maxNodes = r.integer(x, f, 100, 100000000);
     else if (k == "hold_min_fixes") c.holdMinFixes = r.integer(x, f, 1, 100000);
     else if (k == "hold_sigma_cycles") c.holdSigmaCycles = r.number(x, f, 1e-6, 1.0);
-    else c.fixValidationSigmas = r.number(x, f, 1.0, 100.0);
+    else if (k == "validation_sigmas") c.fixValidationSigmas = r.number(x, f, 1.0, 100.0);
+    else if (k == "ffrt_samples") c.ar.ffrtSamples = r.integer(x, f, 100, 1000000);
+    else if (k == "max_fixed_sigma_m") c.maxFixedSigma = r.number(x, f, 1e-4, 100.0);
+    else if (k == "position_test_alpha") c.fixPositionTestAlpha = r.number(x, f, 0.0, 0.5);
+    else if (k == "code_validation_sigmas") c.fixCodeValidationSigmas = r.number(x, f, 1.0, 1000.0);
+    else c.confirmRatioFactor = r.number(x, f, 1.0, 1000.0);
   });
 }
 

@@ -534,5 +534,60 @@ TEST(AmbiguityResolution, PartialFixRecoversTheWellDeterminedSubset) {
   EXPECT_EQ(partialOk, fixedCount);
 }
 
+/// Fixed-failure-rate ratio test: the simulated critical value bounds the failure rate of a weak
+/// model, checked against an independent Monte Carlo run (other seed, other integer vectors),
+/// where the fixed ratio threshold 3 fails far more often; a strong model needs no more than 1.
+TEST(AmbiguityResolution, FixedFailureRateCriticalRatioBoundsTheFailures) {
+  std::mt19937 rng(2024);
+  std::normal_distribution<double> g(0.0, 1.0);
+  // Five DD ambiguities of a single-epoch, single-frequency model: the three position directions
+  // (metre-level code) dominate, the phase-only directions are precise.
+  const int n = 5;
+  Eigen::MatrixXd G(n, 3);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < 3; ++j) G(i, j) = g(rng);
+  const Eigen::MatrixXd Q = (G * (0.6 * 0.6) * G.transpose() + 0.01 * (Eigen::MatrixXd::Identity(n, n) +
+                                                                         Eigen::MatrixXd::Ones(n, n))) / (0.19 * 0.19);
+  AmbiguityResolutionOptions o;
+  o.partial = false;
+  o.maxFailureRate = 0.01;
+  const LambdaResult probe = lambda(Eigen::VectorXd::Zero(n), Q);
+  ASSERT_TRUE(probe.ok);
+  ASSERT_LT(probe.successRate, 0.9);  // weak
+  const double critical = fixedFailureRateCriticalRatio(probe.reduction.factor, o);
+  EXPECT_GT(critical, 3.0);
+  EXPECT_EQ(critical, fixedFailureRateCriticalRatio(probe.reduction.factor, o));  // deterministic
+  const Eigen::MatrixXd L = Q.llt().matrixL();
+  const int trials = 4000;
+  int wrongFfrt = 0, wrongRatio = 0, acceptedFfrt = 0;
+  for (int t = 0; t < trials; ++t) {
+    Eigen::VectorXd truth(n), w(n);
+    for (int i = 0; i < n; ++i) {
+      truth[i] = std::round(50.0 * g(rng));
+      w[i] = g(rng);
+    }
+    const LambdaResult r = lambda(truth + L * w, Q);
+    ASSERT_TRUE(r.ok);
+    const bool right = (r.fixed[0] - truth).cwiseAbs().maxCoeff() < 0.5;
+    if (r.ratio >= 3.0 && !right) ++wrongRatio;
+    if (r.ratio >= std::max(3.0, critical)) {
+      ++acceptedFfrt;
+      if (!right) ++wrongFfrt;
+    }
+  }
+  // Binomial bound: 1 % of 4000 = 40 expected at most; 3 sigma above.
+  EXPECT_LE(wrongFfrt, 40 + 3 * std::sqrt(40.0));
+  EXPECT_GT(wrongRatio, 3 * 40);
+  EXPECT_GT(acceptedFfrt, 0);
+  // resolveAmbiguities applies the same critical value.
+  const AmbiguityFix fx = resolveAmbiguities(L * Eigen::VectorXd::Constant(n, 0.1), Q, o);
+  EXPECT_DOUBLE_EQ(fx.criticalRatio, std::max(o.ratioThreshold, fx.fullRatio >= 3.0 ? critical : 0.0));
+  // A strong model: success rate above 1 - Pf, critical value 1.
+  const Eigen::MatrixXd Qs = 1e-3 * (Eigen::MatrixXd::Identity(n, n) + Eigen::MatrixXd::Ones(n, n));
+  const LambdaResult strong = lambda(Eigen::VectorXd::Zero(n), Qs);
+  ASSERT_GT(strong.successRate, 0.999);
+  EXPECT_EQ(fixedFailureRateCriticalRatio(strong.reduction.factor, o), 1.0);
+}
+
 }  // namespace
 }  // namespace gvins

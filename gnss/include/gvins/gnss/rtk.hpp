@@ -12,12 +12,16 @@
 //   6. measurement update of the square-root information filter (gvins::sri) with the DD phase and
 //      code of each group, whitened with their exact correlation (shared reference); post-fit
 //      outliers re-initialise the ambiguity (phase) or drop the code, and the update is redone;
-//   7. ambiguity resolution: the float DD ambiguities of the eligible signals (system enabled for
-//      AR, above the AR mask, locked long enough, no half-cycle flag) and their covariance, taken
-//      from the square-root factor by triangular solves, go to LAMBDA with the ratio test and
-//      partial fixing (resolveAmbiguities); the fixed position is the float one conditioned on the
-//      fixed integer combinations, and is accepted only if every DD phase residual at it is within
-//      `fixValidationSigmas`; in fix-and-hold mode validated fixes are fed back as constraints.
+//   7. ambiguity resolution (rtk_ambiguity.cpp): the float DD ambiguities of the eligible signals
+//      (system enabled for AR, above the AR mask, locked long enough, no half-cycle flag) and their
+//      covariance, taken from the square-root factor, go to LAMBDA with the fixed-failure-rate
+//      ratio test and partial fixing (resolveAmbiguities); the fixed position is the float one
+//      conditioned on the fixed integer combinations. It is a fix only if it passes every check
+//      of the fixed solution: its 3-D sigma is at most `maxFixedSigma` (a partial fix must
+//      determine the position), it agrees with the float position in the float covariance
+//      (χ²(3) test), every DD phase of the AR set and every DD code fits it; a marginal first fix
+//      waits for the next epoch's fix of the same integers. In fix-and-hold mode only such
+//      validated, confirmed fixes are fed back as constraints.
 //
 // The float state is [SD ambiguities (cycles)..., position (, velocity)] in ECEF; ambiguities sit in
 // front so the position block stays at the back, where the filter updates and reads it cheaply.
@@ -62,6 +66,9 @@ enum class ArStatus : std::uint8_t {
   TooFewAmbiguities,  ///< fewer eligible DD ambiguities than `ar.minFixed`
   NotValidated,       ///< no (partial) integer solution passed the ratio / success-rate test
   Rejected,           ///< an accepted solution failed the residual check at the fixed position
+  Imprecise,          ///< the fixed position's sigma exceeds maxFixedSigma (fix not used)
+  Inconsistent,       ///< the fixed position disagrees with the float one (position-domain test)
+  Unconfirmed,        ///< a marginal first fix, reported as float until the next epoch confirms it
   Fixed,              ///< the whole eligible set
   PartialFixed,       ///< a subset (decorrelated combinations)
 };
@@ -80,6 +87,7 @@ struct RtkSolution {
   double age = 0.0;        ///< s, age of the base data
   double ratio = 0.0;      ///< ratio-test value of the accepted set, else of the full set
   double successRate = 0.0;  ///< bootstrapped success rate of the accepted (or full) set
+  double criticalRatio = 0.0;  ///< ratio the accepted (or full) set had to reach (fixed-failure-rate test)
   int numAmbiguities = 0;  ///< eligible DD ambiguities
   int numFixed = 0;        ///< integer combinations fixed
   bool held = false;       ///< fix-and-hold constraints applied after this epoch
@@ -106,7 +114,10 @@ struct RtkCounters {
   std::int64_t holdUpdates = 0;
   std::int64_t arAttempts = 0;
   std::int64_t partialFixes = 0;
-  std::int64_t rejectedFixes = 0;
+  std::int64_t rejectedFixes = 0;       ///< by the residual checks at the fixed position
+  std::int64_t impreciseFixes = 0;      ///< fixes that left the position sigma above maxFixedSigma
+  std::int64_t inconsistentFixes = 0;   ///< by the position-domain test
+  std::int64_t unconfirmedFixes = 0;    ///< marginal first fixes held back one epoch
 };
 
 class RtkSolver {
@@ -179,6 +190,18 @@ class RtkSolver {
     int lock = 0;
   };
   struct Group;  // per-epoch bookkeeping of the update (rtk.cpp)
+  /// A DD ambiguity of the AR set: SD indices of the AR reference and the satellite in dd_, and
+  /// their ambiguity blocks.
+  struct ArPair {
+    int ref, sat;
+    sri::BlockId refId, satId;
+  };
+  /// The float solution conditioned on a (partial) integer fix.
+  struct ConditionedFix {
+    Eigen::VectorXd ambiguities;  ///< conditioned DD ambiguities of the AR set, cycles
+    Eigen::Vector3d position;
+    Eigen::Matrix3d covariance;
+  };
 
   static std::uint32_t key(SatId s, ObsCode c) {
     return static_cast<std::uint32_t>(satIndex(s)) << 16 | static_cast<std::uint32_t>(c.band) << 8 |
@@ -194,6 +217,18 @@ class RtkSolver {
   /// something (the update must then be redone).
   bool rejectOutlier(RtkSolution& sol);
   void resolve(RtkSolution& sol);
+  // Steps of resolve() (rtk_ambiguity.cpp).
+  std::vector<ArPair> arPairs(std::vector<int>& arReference) const;
+  /// Float DD ambiguities `a` of the pairs, their covariance and cross-covariance with the
+  /// position; false when a block has no information.
+  bool arCovariance(const std::vector<ArPair>& pairs, Eigen::VectorXd& a, Eigen::MatrixXd& Qaa,
+                    Eigen::MatrixXd& Qxa) const;
+  /// Checks of the fixed solution (precision, position domain, phase and code residuals).
+  ArStatus checkFix(const std::vector<ArPair>& pairs, const RtkSolution& sol, const ConditionedFix& f);
+  /// Integer DD phases of dd_ implied by the conditioned AR ambiguities (NaN where not integer).
+  std::vector<double> ddIntegers(const std::vector<ArPair>& pairs, const std::vector<int>& arReference,
+                                 const ConditionedFix& f) const;
+  void hold(const std::vector<ArPair>& pairs, const AmbiguityFix& fix, const Eigen::VectorXd& a);
   Eigen::Vector3d positionEstimate() const;
   double ambiguityEstimate(const SingleDifference& sd) const;
 
@@ -241,6 +276,10 @@ class RtkSolver {
   void detectSlips(const ObsEpoch& rover, const GlonassChannels& channels);
   RtkSolution processEpoch(const ObsEpoch& rover, TransmitStates* states);
   int consecutiveFixes_ = 0;
+  /// DD integers of the validated fix of the previous and of this process() epoch (empty when
+  /// that epoch had none): what a marginal first fix is confirmed by. Kept across resets (the
+  /// integer of a DD on the same arcs does not depend on the filter).
+  std::vector<std::pair<HeldPair, double>> fixBefore_, fixNow_;
   /// Previous resolution's DD ambiguities (SD block ids of satellite and reference) and its
   /// reduced basis: the next epoch's LAMBDA starts from it (ReductionStart) while none of these
   /// pairs has gone (new pairs enter with unit vectors).

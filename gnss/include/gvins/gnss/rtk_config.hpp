@@ -55,6 +55,21 @@ struct RtkConfig {
   /// A fixed solution is accepted only if every double-differenced phase residual at the fixed
   /// position is within this many standard deviations (and the code within `codeOutlierSigmas`).
   double fixValidationSigmas = 4.0;
+  /// ... and every DD code residual at the fixed position within this many standard deviations.
+  double fixCodeValidationSigmas = 8.0;
+  /// A (partial) fix is a fix only if it determines the position: 3-D standard deviation (m) of
+  /// the fixed position at most this (a partial fix of combinations that leave the position
+  /// float-like is reported as float).
+  double maxFixedSigma = 0.10;
+  /// Position-domain test of the fixed against the float solution: with correct integers
+  /// x_fix − x_float ~ N(0, P_float − P_fix); rejected when its χ²(3) statistic exceeds the
+  /// 1 − alpha quantile (0 = off, the default: on real data the float covariance of a filter
+  /// that has run for minutes is optimistic, its error correlated in time — Nagoya, continuous
+  /// AR: float 0.17 m from the correct fix with sigma 0.03 m — so the test rejects right fixes).
+  double fixPositionTestAlpha = 0.0;
+  /// A first fix (no validated fix in the previous epoch) whose ratio is below this factor times
+  /// its critical ratio is reported as float until the next epoch's fix confirms its integers.
+  double confirmRatioFactor = 2.0;
 
   // --- Measurement model.
   /// Carrier-phase standard deviation per receiver: σ² = a² + b² / sin²(el), metres.
@@ -114,10 +129,13 @@ const char* toString(RtkDynamics d);
 ///     bands: {G: "125", E: "157", C: "276"}
 ///     elevation_mask_deg: 15
 ///     snr_mask_dbhz: 0
-///     ar: {systems: GECJ, elevation_mask_deg: 15, min_lock: 0, validation: ratio,
+///     ar: {systems: GECJ, elevation_mask_deg: 15, min_lock: 0, validation: fixed-failure-rate,
 ///          ratio_threshold: 3, max_failure_rate: 0.001, partial: true,
 ///          partial_success_rate: 0.999, min_fixed: 4, hold_min_fixes: 10,
-///          hold_sigma_cycles: 0.01, validation_sigmas: 4}
+///          hold_sigma_cycles: 0.01, validation_sigmas: 4, ffrt_samples: 4000,
+///          max_fixed_sigma_m: 0.1, position_test_alpha: 0, code_validation_sigmas: 8,
+///          confirm_ratio_factor: 2}   # validation: fixed-failure-rate | ratio | success-rate |
+///                                     #             ratio+success-rate
 ///     phase_sigma_m: {a: 0.003, b: 0.003}
 ///     code_phase_ratio: 100
 ///     code_system_factor: {R: 1.5}
