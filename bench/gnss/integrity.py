@@ -4,6 +4,7 @@ against RTKLIB's rnx2rtkp on the same inputs.
 
     bench/gnss/integrity.py [--build DIR] [--data DIR] [--out DIR] [--quick] [--cases a,b]
                             [--modes continuous,instantaneous,...] [--markdown FILE]
+                            [--no-sim] [--sim-seeds N] [--ours-args "GVINS-RTK OPTIONS"]
 
 Pairs (tests/data/gnss, provenance in tests/data/README.md):
   nagoya  Septentrio rover/base 0.99 m apart, 301 epochs at 1 Hz, five systems; truth: the
@@ -15,6 +16,8 @@ Variants (each alone on top of the base setting L1+L2, 15 deg, all systems): sin
 elevation masks 25 and 35 deg, one system at a time, the reported Galileo-only single-frequency
 case at 25 deg, arcs cut to 30 s (every 30 s piece processed from a cold start), the rover's
 Doppler sign flipped in a copy, the base's codes rewritten to other tracking modes of their band.
+Simulated flights (gvins-sim, bench/gnss/harsh_flight.yaml): NLOS, blockages and slips on the
+rover, base 5 and 10 km away, seeds 1..N (4); truth: the simulated antenna track.
 AR modes: continuous, instantaneous, fix-and-hold, each with and without partial AR (RTKLIB
 2.4.3 has no partial AR: its figures stand in both rows).
 
@@ -215,15 +218,20 @@ def run_rtklib(conf_template, rover, base, base_xyz, navs, out, mode, freq, mask
 
 
 def score(pos_path, truth):
+    """Fixed epochs, wrong fixes, worst wrong error. `truth`: one ECEF point (static), or a
+    function of the .pos time string giving the ECEF point (None: no truth, not counted)."""
     fixed = wrong = 0
     worst = 0.0
     if not os.path.exists(pos_path):
         return 0, 0, 0.0
-    for _, x, q in read_pos(pos_path):
+    for t, x, q in read_pos(pos_path):
         if q != 1:
             continue
+        ref = truth(t) if callable(truth) else truth
+        if ref is None:
+            continue
         fixed += 1
-        d = math.dist(x, truth)
+        d = math.dist(x, ref)
         if d > WRONG_M:
             wrong += 1
             worst = max(worst, d)
@@ -260,8 +268,74 @@ def datasets(data, tmp):
     }
 
 
+def gpst_seconds(text):
+    """Seconds of GPS time (from 1980-01-06) of a .pos time 'YYYY/MM/DD hh:mm:ss.sss'."""
+    import datetime
+    d, t = text.split()
+    y, mo, da = (int(v) for v in d.split('/'))
+    h, mi, se = t.split(':')
+    base = datetime.datetime(y, mo, da) - datetime.datetime(1980, 1, 6)
+    return base.days * 86400.0 + int(h) * 3600 + int(mi) * 60 + float(se)
+
+
+def antenna_truth(csv_path):
+    """The simulator's rover antenna truth as a function of the .pos time (nearest epoch within
+    5 ms of true GPST)."""
+    rows = []
+    with open(csv_path) as f:
+        for line in f:
+            if line[0] in '#t':
+                continue
+            p = line.split(',')
+            rows.append((int(p[1]) * 1e-9, (float(p[2]), float(p[3]), float(p[4]))))
+    rows.sort()
+    times = [r[0] for r in rows]
+    import bisect
+
+    def at(text):
+        t = gpst_seconds(text)
+        i = bisect.bisect_left(times, t)
+        best = None
+        for j in (i - 1, i):
+            if 0 <= j < len(rows) and abs(rows[j][0] - t) < 0.005:
+                best = rows[j][1]
+        return best
+    return at
+
+
+def simulated(build, tmp, seeds, distances):
+    """Harsh simulated flights (bench/gnss/harsh_flight.yaml) per base distance and seed."""
+    scenario = os.path.join(ROOT, 'bench', 'gnss', 'harsh_flight.yaml')
+    text = open(scenario).read().replace('../../tests/data', os.path.join(ROOT, 'tests', 'data'))
+    out = {}
+    for dist in distances:
+        for seed in seeds:
+            name = 'sim %d km seed %d' % (dist // 1000, seed)
+            d = os.path.join(tmp, 'sim_%d_%d' % (dist, seed))
+            if not os.path.exists(os.path.join(d, 'gnss', 'rover.obs')):
+                y = os.path.join(tmp, 'harsh_%d.yaml' % dist)
+                with open(y, 'w') as f:
+                    f.write(text.replace('distance_m: 5000', 'distance_m: %d' % dist))
+                subprocess.run([os.path.join(build, 'bin', 'gvins-sim'), '--config', y, '--seed', str(seed),
+                                '--features-only', '-o', d], check=True, stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)
+            g = os.path.join(d, 'gnss')
+            base_xyz = None
+            with open(os.path.join(g, 'base.obs')) as f:
+                for line in f:
+                    if 'APPROX POSITION XYZ' in line:
+                        base_xyz = tuple(float(v) for v in line.split()[:3])
+                        break
+            out[name] = dict(rover=os.path.join(g, 'rover.obs'), base=os.path.join(g, 'base.obs'),
+                             navs=[os.path.join(g, 'nav.rnx')], truth=antenna_truth(os.path.join(g, 'truth', 'rover_antenna.csv')),
+                             base_xyz=base_xyz, systems='GREJC', rinex3=False, simulated=True)
+    return out
+
+
 def variants(ds):
     """(name, settings) of each stressed variant of a data set."""
+    if ds.get('simulated'):
+        return [('base', {})]
     v = [('base', {}), ('L1 only', {'freq': 1}), ('mask 25', {'mask': 25}), ('mask 35', {'mask': 35})]
     if len(ds['systems']) > 1:
         for s in ds['systems']:
@@ -288,7 +362,11 @@ def main(args):
     os.makedirs(tmp_root, exist_ok=True)
     rows = []
     t_start = time.time()
-    for dname, ds in datasets(data, tmp_root).items():
+    sets = datasets(data, tmp_root)
+    if '--no-sim' not in args:
+        seeds = range(1, int(opt(args, '--sim-seeds', '4')) + 1)
+        sets.update(simulated(build, tmp_root, seeds, (5000, 10000)))
+    for dname, ds in sets.items():
         for vname, s in variants(ds):
             case = '%s: %s' % (dname, vname)
             if only and not any(c in case for c in only.split(',')):
