@@ -525,7 +525,7 @@ int main(int argc, char** argv) {
                  static_cast<long long>(ds.noEphemeris), static_cast<long long>(ds.belowMask));
   }
   if (ds.crossMode || ds.crossModeRefused) {
-    std::fprintf(stderr, "  signal pairs           %lld across tracking modes (%s matching), %lld refused (phase alignment unknown)\n",
+    std::fprintf(stderr, "  signal pairs           %lld across tracking modes (%s matching), %lld refused (strict, or phase alignment unknown)\n",
                  static_cast<long long>(ds.crossMode), toString(cfg.signalMatching),
                  static_cast<long long>(ds.crossModeRefused));
   }
