@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
@@ -28,8 +29,10 @@
 #include "gvins/base/phase_alignment.hpp"
 #include "gvins/base/rinex_obs_reader.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
+#include "gvins/gnss/base_reader.hpp"
 #include "gvins/gnss/rtk.hpp"
 #include "gvins/gnss/rtk_config.hpp"
+#include "gvins/rtcm/encoder.hpp"
 
 using namespace gvins;
 
@@ -307,4 +310,42 @@ TEST(SignalMatching, RawTrackingPhasesAreAligned) {
   const Outcome ignored = run(raw, rover, phaseAlignmentOf(p.baseHeader), SignalMatching::Band, n);
   EXPECT_TRUE(ignored.fixed() < orig.fixed() || maxDifference(ignored, orig) > 3e-3)
       << ignored.fixed() << " fixed, " << maxDifference(ignored, orig) << " m";
+}
+
+// The rewritten base streamed as RTCM 3 MSM7 (the project's encoder): MSM phases are aligned
+// (RTCM 10403.3), the reader says so for every system it decoded MSM of, and the solution is the
+// original pair's (MSM7 resolution: within 2 mm, as RtkNagoya.RtcmBaseStreamGivesTheSameSolution).
+TEST(SignalMatching, RtcmMsmBaseOfOtherTrackingModes) {
+  const Pair& p = nagoya();
+  const int n = 40;
+  const auto path = std::filesystem::temp_directory_path() / "gvins_test_signal_matching.rtcm3";
+  {
+    std::ofstream out(path, std::ios::binary);
+    rtcm::Encoder enc(7);
+    enc.setGlonassChannels(p.baseHeader.glonassChannels);
+    for (int i = 0; i < n; ++i) {
+      const auto f = enc.msm(p.rewritten[static_cast<std::size_t>(i)], 7);
+      out.write(reinterpret_cast<const char*>(f.data()), static_cast<std::streamsize>(f.size()));
+    }
+  }
+  EphemerisStore nav = p.nav;
+  auto reader = BaseReader::open(path.string(), p.rover.front().time, &nav);
+  EXPECT_EQ(reader->phaseAlignment().get(System::Galileo), PhaseAlignment::Unknown);  // nothing decoded yet
+  std::vector<ObsEpoch> base;
+  ObsEpoch e;
+  while (reader->next(e)) base.push_back(e);
+  std::filesystem::remove(path);
+  ASSERT_EQ(base.size(), static_cast<std::size_t>(n));
+  const PhaseAlignments a = reader->phaseAlignment();
+  for (System s : {System::Gps, System::Glonass, System::Galileo, System::BeiDou, System::Qzss}) {
+    EXPECT_EQ(a.get(s), PhaseAlignment::Aligned) << systemName(s);
+  }
+  EXPECT_EQ(a.get(System::Sbas), PhaseAlignment::Unknown);
+  const PhaseAlignments rover = phaseAlignmentOf(p.roverHeader);
+  const Outcome orig = run(p.base, rover, phaseAlignmentOf(p.baseHeader), SignalMatching::Band, n);
+  const Outcome msm = run(base, rover, a, SignalMatching::Band, n);
+  EXPECT_EQ(msm.fixed(), n);
+  EXPECT_EQ(msm.phaseSats, orig.phaseSats);
+  EXPECT_GT(msm.stats.crossMode, 1000);
+  EXPECT_LT(maxDifference(msm, orig), 0.002);
 }
