@@ -21,9 +21,9 @@
 //     1001-1012 state nothing that a decoder can rely on (Unknown).
 //   - A source that delivers the receiver's tracking phases (Raw) is aligned here by adding the
 //     Table A23 correction of its signal (alignmentShift).
-// Same-code single differences never need a correction (the shift is a property of the signal
-// and cancels between the receivers); single differences across modes are formed with phase only
-// when both sides are Aligned or Raw.
+// Same-code single differences need no correction (the shift is a property of the signal and
+// cancels between the receivers; Raw phases are corrected anyway, which is harmless); single
+// differences across modes are formed only when both sides are Aligned or Raw.
 #pragma once
 
 #include <array>
