@@ -300,6 +300,7 @@ int main(int argc, char** argv) {
 
   RtkSolver solver(nav, cfg, sppCfg);
   solver.setRoverGlonassChannels(hdr.glonassChannels);
+  const PhaseAlignments roverAlignment = phaseAlignmentOf(hdr);
   if (hdr.station.approxPosition && hdr.station.approxPosition->norm() > 1e6) {
     solver.setRoverInitialPosition(*hdr.station.approxPosition);
   }
@@ -389,6 +390,7 @@ int main(int argc, char** argv) {
           }
         }
         solver.setBaseGlonassChannels(base->glonassChannels());
+        solver.setPhaseAlignment(roverAlignment, base->phaseAlignment());
         solver.addBaseEpoch(baseEpoch);
         lastBaseTime = baseEpoch.time;
         basePending = false;
@@ -536,6 +538,11 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "  satellite-epochs       %lld not at base, %lld signal mismatches, %lld no ephemeris, %lld below mask\n",
                  static_cast<long long>(ds.notAtBase), static_cast<long long>(ds.signalMismatch),
                  static_cast<long long>(ds.noEphemeris), static_cast<long long>(ds.belowMask));
+  }
+  if (ds.crossMode || ds.crossModeRefused) {
+    std::fprintf(stderr, "  signal pairs           %lld across tracking modes (%s matching), %lld refused (strict, or phase alignment unknown)\n",
+                 static_cast<long long>(ds.crossMode), toString(cfg.signalMatching),
+                 static_cast<long long>(ds.crossModeRefused));
   }
   const BaseStationStats& bs = solver.base().stats();
   if (bs.outOfOrder || bs.positionChanges) {

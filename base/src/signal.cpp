@@ -1,5 +1,6 @@
 #include "gvins/base/signal.hpp"
 
+#include <algorithm>
 #include <cctype>
 
 #include "gvins/base/constants.hpp"
@@ -129,6 +130,59 @@ std::string_view attributePriority(System sys, char band) {
       return "ABCX";
   }
   return "";
+}
+
+namespace {
+
+// Attributes of a band grouped by transmitted signal, groups separated by '|'.
+std::string_view signalGroups(System sys, char band) {
+  switch (sys) {
+    case System::Gps:
+      if (band == '1') return "C|SLX|PWYND|M";
+      if (band == '2') return "C|SLX|PWYND|M";
+      if (band == '5') return "IQX";
+      break;
+    case System::Glonass:
+      if (band == '1' || band == '2') return "C|P";
+      if (band == '3') return "IQX";
+      if (band == '4' || band == '6') return "ABX";
+      break;
+    case System::Galileo:
+      if (band == '1' || band == '6') return "BCX|AZ";
+      if (band == '5' || band == '7' || band == '8') return "IQX";
+      break;
+    case System::BeiDou:
+      if (band == '2') return "IQX";
+      if (band == '1') return "DPX|SLZ";
+      if (band == '5' || band == '8') return "DPX";
+      if (band == '7' || band == '6') return "IQX|DPZ";
+      break;
+    case System::Qzss:
+      if (band == '1') return "C|SLX|Z|EB";
+      if (band == '2') return "SLX";
+      if (band == '5') return "IQX|DPZ";
+      if (band == '6') return "SLX|EZ";
+      break;
+    case System::Sbas:
+      if (band == '1') return "C";
+      if (band == '5') return "IQX";
+      break;
+    case System::Navic:
+      return "A|BCX";
+  }
+  return "";
+}
+
+}  // namespace
+
+bool sameSignal(System sys, ObsCode a, ObsCode b) {
+  if (a.band != b.band) return false;
+  if (a.attr == b.attr) return true;
+  const std::string_view g = signalGroups(sys, a.band);
+  const auto pa = g.find(a.attr), pb = g.find(b.attr);
+  if (pa == std::string_view::npos || pb == std::string_view::npos) return false;
+  const auto lo = std::min(pa, pb), hi = std::max(pa, pb);
+  return g.substr(lo, hi - lo).find('|') == std::string_view::npos;
 }
 
 char primaryBand(System sys) {

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -31,6 +32,7 @@ class RinexBase final : public BaseReader {
   }
   GlonassChannels glonassChannels() const override { return reader_.header().glonassChannels; }
   BaseFormat format() const override { return BaseFormat::Rinex; }
+  PhaseAlignments phaseAlignment() const override { return phaseAlignmentOf(reader_.header()); }
   std::string describe() const override {
     char buf[160];
     std::snprintf(buf, sizeof buf, "RINEX %.2f, marker '%s'", reader_.header().version,
@@ -85,6 +87,27 @@ class RtcmBase final : public BaseReader {
   }
   GlonassChannels glonassChannels() const override { return decoder_.glonassChannels(); }
   BaseFormat format() const override { return BaseFormat::Rtcm; }
+  PhaseAlignments phaseAlignment() const override {
+    // MSM numbers 1071-1077 (GPS), 1081- (GLONASS), 1091- (Galileo), 1101- (SBAS), 1111- (QZSS),
+    // 1121- (BeiDou), 1131- (NavIC): RTCM 10403.3 table 3.5-1.
+    static constexpr std::pair<int, System> kMsm[] = {{1070, System::Gps},    {1080, System::Glonass},
+                                                      {1090, System::Galileo}, {1100, System::Sbas},
+                                                      {1110, System::Qzss},    {1120, System::BeiDou},
+                                                      {1130, System::Navic}};
+    const auto& m = decoder_.stats().messages;
+    auto any = [&](int lo, int hi) {
+      for (auto it = m.lower_bound(lo); it != m.end() && it->first <= hi; ++it) {
+        if (it->second > 0) return true;
+      }
+      return false;
+    };
+    PhaseAlignments a;
+    for (const auto& [first, sys] : kMsm) {
+      const bool legacy = (sys == System::Gps && any(1001, 1004)) || (sys == System::Glonass && any(1009, 1012));
+      if (any(first + 1, first + 7) && !legacy) a.set(sys, PhaseAlignment::Aligned);
+    }
+    return a;
+  }
   std::string describe() const override {
     const auto& s = decoder_.stats();
     char buf[200];

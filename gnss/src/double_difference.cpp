@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <set>
+#include <tuple>
 
 #include "gvins/base/geodetic.hpp"
 #include "gvins/base/local_frame.hpp"
@@ -86,6 +88,72 @@ DoubleDifferenceBuilder::DoubleDifferenceBuilder(const EphemerisStore& nav, cons
 
 void DoubleDifferenceBuilder::setGlonassChannels(const GlonassChannels& channels) { channels_ = channels; }
 
+void DoubleDifferenceBuilder::setPhaseAlignment(const PhaseAlignments& rover, const PhaseAlignments& base) {
+  roverAlignment_ = rover;
+  baseAlignment_ = base;
+}
+
+double DoubleDifferenceBuilder::alignedShift(const PhaseAlignments& a, System sys, ObsCode code) {
+  return a.get(sys) == PhaseAlignment::Raw ? alignmentShift(sys, code) : 0.0;
+}
+
+std::pair<const BaseSignal*, const BaseSignal*> DoubleDifferenceBuilder::baseSignalsOf(const BaseSnapshot& base,
+                                                                                       SatId sat) {
+  const auto less = [](const BaseSignal& b, SatId s) { return b.sat < s; };
+  const BaseSignal* first = base.signals.data();
+  const BaseSignal* last = first + base.signals.size();
+  const BaseSignal* b = std::lower_bound(first, last, sat, less);
+  const BaseSignal* e = b;
+  while (e != last && e->sat == sat) ++e;
+  return {b, e};
+}
+
+std::optional<DoubleDifferenceBuilder::Pick> DoubleDifferenceBuilder::pickPair(const SatObs& so, char band,
+                                                                               const BaseSignal* baseBegin,
+                                                                               const BaseSignal* baseEnd) {
+  const System sys = so.sat.system;
+  // Pairs across tracking modes only when both receivers' phases refer to the band's reference.
+  const bool crossAllowed = config_.signalMatching == SignalMatching::Band &&
+                            roverAlignment_.get(sys) != PhaseAlignment::Unknown &&
+                            baseAlignment_.get(sys) != PhaseAlignment::Unknown;
+  const std::string_view pri = attributePriority(sys, band);
+  const auto rank = [&](ObsCode r, ObsCode b) {
+    const int kind = r == b ? 0 : sameSignal(sys, r, b) ? 1 : 2;
+    const auto pr = std::min(pri.find(r.attr), pri.size()), pb = std::min(pri.find(b.attr), pri.size());
+    return std::tuple<int, std::size_t, std::size_t>(kind, pr, pb);
+  };
+  bool roverHasBand = false, baseHasBand = false, crossSeen = false;
+  for (const BaseSignal* b = baseBegin; b != baseEnd; ++b) baseHasBand = baseHasBand || b->code.band == band;
+  // Prefer a pair with phase at both receivers, then one with code at both.
+  for (int pass = 0; pass < 2; ++pass) {
+    std::optional<Pick> best;
+    std::tuple<int, std::size_t, std::size_t> bestRank;
+    for (const SignalObs& s : so.signals) {
+      if (s.code.band != band) continue;
+      roverHasBand = true;
+      for (const BaseSignal* b = baseBegin; b != baseEnd; ++b) {
+        if (b->code.band != band) continue;
+        const bool both = pass == 0 ? s.hasPhase() && b->hasPhase : s.hasCode() && b->hasCode;
+        if (!both) continue;
+        if (!(s.code == b->code) && !crossAllowed) {
+          crossSeen = true;
+          continue;
+        }
+        const auto r = rank(s.code, b->code);
+        if (best && !(r < bestRank)) continue;
+        best = Pick{&s, b};
+        bestRank = r;
+      }
+    }
+    if (best) return best;
+  }
+  if (roverHasBand && baseHasBand) {
+    ++stats_.signalMismatch;
+    if (crossSeen) ++stats_.crossModeRefused;
+  }
+  return std::nullopt;
+}
+
 void DoubleDifferenceBuilder::reset() {
   phaseRef_.clear();
   arcs_.clear();
@@ -125,48 +193,15 @@ void DoubleDifferenceBuilder::form(const ObsEpoch& rover, const CycleSlipDetecto
     }
     std::optional<int> channel;
     if (sys == System::Glonass) channel = ch.get(so.sat.prn);
-    // Common signals, one per band, the first `frequencies` bands of the preference list.
-    struct Pick {
-      const SignalObs* rover;
-      const BaseSignal* base;
-    };
+    // One signal pair per band, the first `frequencies` bands of the preference list.
     Pick picks[3];
     int np = 0;
+    const auto [baseBegin, baseEnd] = baseSignalsOf(base, so.sat);
     const std::string& bands = config_.bands[static_cast<std::size_t>(systemIndex(sys))];
     for (char band : bands) {
       if (np >= std::clamp(config_.frequencies, 1, 3)) break;
-      const SignalObs* rs = nullptr;
-      const BaseSignal* bs = nullptr;
-      bool roverHasBand = false, baseHasBand = false;
-      // Prefer a code with phase at both receivers, then one with code at both.
-      for (int pass = 0; pass < 2 && !rs; ++pass) {
-        for (const SignalObs& s : so.signals) {
-          if (s.code.band != band) continue;
-          roverHasBand = true;
-          const BaseSignal* b = base.find(so.sat, s.code);
-          if (!b) continue;
-          const bool phaseBoth = s.hasPhase() && b->hasPhase;
-          const bool codeBoth = s.hasCode() && b->hasCode;
-          if (pass == 0 ? !phaseBoth : !codeBoth) continue;
-          // Among several common codes take the one the attribute priority prefers.
-          if (rs) {
-            const std::string_view pri = attributePriority(sys, band);
-            const auto pOld = pri.find(rs->code.attr), pNew = pri.find(s.code.attr);
-            if (pNew >= pOld) continue;
-          }
-          rs = &s;
-          bs = b;
-        }
-      }
-      if (!rs) {
-        // Is the band at the base at all (with another code)?
-        for (const BaseSignal& b : base.signals) {
-          if (b.sat == so.sat && b.code.band == band) baseHasBand = true;
-        }
-        if (roverHasBand && baseHasBand) ++stats_.signalMismatch;
-        continue;
-      }
-      picks[np++] = {rs, bs};
+      const auto pick = pickPair(so, band, baseBegin, baseEnd);
+      if (pick) picks[np++] = *pick;
     }
     if (np == 0) continue;
     // Satellite state at the rover transmit time.
@@ -209,6 +244,7 @@ void DoubleDifferenceBuilder::form(const ObsEpoch& rover, const CycleSlipDetecto
       SingleDifference d;
       d.sat = so.sat;
       d.code = rs.code;
+      d.baseCode = bs.code;
       d.elevation = azel.elevation;
       d.azimuth = azel.azimuth;
       d.snr = rs.hasSnr() ? rs.snr : 0.0;
@@ -220,9 +256,11 @@ void DoubleDifferenceBuilder::form(const ObsEpoch& rover, const CycleSlipDetecto
       d.hasPhase = lam && rs.hasPhase() && bs.hasPhase && rs.carrierPhase != 0.0 && std::isfinite(rs.carrierPhase);
       d.hasCode = rs.hasCode() && bs.hasCode && rs.pseudorange > 1e6 && rs.pseudorange < 1e8;
       if (!d.hasPhase && !d.hasCode) continue;
+      if (!(rs.code == bs.code)) ++stats_.crossMode;
       if (d.hasPhase) {
-        d.roverPhase = *lam * rs.carrierPhase;
-        d.basePhaseOmc = bs.phaseOmc;
+        // Raw tracking phases are referred to the band's reference signal (alignedShift).
+        d.roverPhase = *lam * (rs.carrierPhase + alignedShift(roverAlignment_, sys, rs.code));
+        d.basePhaseOmc = bs.phaseOmc + *lam * alignedShift(baseAlignment_, sys, bs.code);
         d.roverSlip = roverSlips.flags(so.sat, rs.code);
         d.roverArc = roverSlips.arcStart(so.sat, rs.code).value_or(rover.time);
         d.baseSlip = bs.slipFlags;
@@ -231,8 +269,8 @@ void DoubleDifferenceBuilder::form(const ObsEpoch& rover, const CycleSlipDetecto
         const auto key = signalKey(so.sat, rs.code);
         auto it = arcs_.find(key);
         d.continuous = prevOk && it != arcs_.end() && it->second.epoch == prevEpoch && it->second.rover == d.roverArc &&
-                       it->second.base == d.baseArc;
-        arcs_[key] = Arcs{d.roverArc, d.baseArc, rover.time};
+                       it->second.base == d.baseArc && it->second.baseCode == d.baseCode;
+        arcs_[key] = Arcs{d.roverArc, d.baseArc, rover.time, d.baseCode};
       }
       if (d.hasCode) {
         d.roverCode = rs.pseudorange;

@@ -85,6 +85,10 @@ void RtkSolver::setRoverGlonassChannels(const GlonassChannels& channels) {
   builder_.setGlonassChannels(channels);
 }
 
+void RtkSolver::setPhaseAlignment(const PhaseAlignments& rover, const PhaseAlignments& base) {
+  builder_.setPhaseAlignment(rover, base);
+}
+
 void RtkSolver::setRoverInitialPosition(const Eigen::Vector3d& ecef) { spp_.setInitialPosition(ecef); }
 
 void RtkSolver::addBaseEpoch(const ObsEpoch& epoch) { base_.addEpoch(epoch); }
@@ -205,7 +209,10 @@ void RtkSolver::manageAmbiguities(const Eigen::Vector3d& x0, RtkSolution& sol) {
     const std::uint32_t k = key(sd.sat, sd.code);
     const auto it = amb_.find(k);
     if (it != amb_.end()) {
-      if (it->second.roverArc == sd.roverArc && it->second.baseArc == sd.baseArc && !forced_.count(k)) {
+      // Keyed by the rover signal: a change of the base signal (another tracking mode of the
+      // band) is a new arc too.
+      if (it->second.roverArc == sd.roverArc && it->second.baseArc == sd.baseArc &&
+          it->second.baseCode == sd.baseCode && !forced_.count(k)) {
         it->second.lastSeen = dd_.time;
         continue;
       }
@@ -228,6 +235,7 @@ void RtkSolver::manageAmbiguities(const Eigen::Vector3d& x0, RtkSolution& sol) {
                             sri::Prior<double>::stdDev(1, sigma), sri::Placement::before(pos_));
     a.sat = sd.sat;
     a.code = sd.code;
+    a.baseCode = sd.baseCode;
     a.wavelength = sd.wavelength;
     a.roverArc = sd.roverArc;
     a.baseArc = sd.baseArc;

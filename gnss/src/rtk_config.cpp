@@ -27,6 +27,8 @@ const char* toString(AmbiguityMode m) {
 
 const char* toString(RtkDynamics d) { return d == RtkDynamics::RandomWalk ? "random-walk" : "constant-velocity"; }
 
+const char* toString(SignalMatching m) { return m == SignalMatching::Strict ? "strict" : "band"; }
+
 namespace {
 
 using Reader = YamlReader;  // base/yaml_reader.hpp
@@ -65,7 +67,7 @@ void applyAr(const Reader& r, const YAML::Node& v, const std::string& where, Rtk
 
 void apply(const Reader& r, const YAML::Node& rtk, RtkConfig& c) {
   static const std::set<std::string> kKeys = {
-      "mode", "dynamics", "ambiguity_mode", "systems", "frequencies", "bands", "elevation_mask_deg",
+      "mode", "dynamics", "ambiguity_mode", "systems", "frequencies", "bands", "signal_matching", "elevation_mask_deg",
       "snr_mask_dbhz", "ar", "phase_sigma_m", "code_phase_ratio", "code_system_factor", "troposphere", "base",
       "cycle_slip", "ambiguity_outage_s", "outliers", "filter"};
   r.map(rtk, "rtk", kKeys, [&](const std::string& k, const std::string& full, const YAML::Node& v) {
@@ -102,6 +104,11 @@ void apply(const Reader& r, const YAML::Node& rtk, RtkConfig& c) {
         }
         c.bands[systemIndex(s)] = bands;
       });
+    } else if (k == "signal_matching") {
+      const std::string t = r.text(v, full);
+      if (t == "strict") c.signalMatching = SignalMatching::Strict;
+      else if (t == "band") c.signalMatching = SignalMatching::Band;
+      else r.fail(v, full, "'" + full + "' must be band or strict, not '" + t + "'");
     } else if (k == "elevation_mask_deg") {
       c.elevationMask = r.number(v, full, -10.0, 90.0) * constants::kDegToRad;
     } else if (k == "snr_mask_dbhz") {

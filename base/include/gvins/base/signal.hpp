@@ -52,6 +52,12 @@ ObsCode normalizeObsCode(System sys, ObsCode code, double rinexVersion);
 /// band when a receiver reports several, e.g. GPS L1: C before W/P/X/L/S).
 std::string_view attributePriority(System sys, char band);
 
+/// Whether two codes of one band denote the same transmitted signal (its data or pilot component
+/// or their combination, e.g. GPS L2C "2S"/"2L"/"2X", Galileo E1 OS "1B"/"1C"/"1X", E5a "5I"/"5Q"/
+/// "5X") rather than different signals sharing the carrier (GPS L1 C/A "1C" against P(Y) "1W" or
+/// L1C "1X"). Grouping from the RINEX 3.05 observation code tables 4-10. False for different bands.
+bool sameSignal(System sys, ObsCode a, ObsCode b);
+
 /// The usual primary frequency band per system for single-frequency processing:
 /// GPS/QZSS/SBAS/Galileo '1', GLONASS '1', BeiDou '2' (B1I), NavIC '5'.
 char primaryBand(System sys);

@@ -12,6 +12,7 @@
 
 #include "gvins/base/gnss_time.hpp"
 #include "gvins/base/observation.hpp"
+#include "gvins/base/phase_alignment.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
 
 namespace gvins {
@@ -41,6 +42,11 @@ class BaseReader {
   /// GLONASS channels known so far (RINEX header, RTCM 1020/MSM extended information).
   virtual GlonassChannels glonassChannels() const = 0;
   virtual BaseFormat format() const = 0;
+  /// What the data state about the alignment of their phases across tracking modes
+  /// (base/phase_alignment.hpp): RINEX from the header (phaseAlignmentOf); RTCM per system
+  /// Aligned once MSM observations of the system were decoded and no legacy ones (1001-1004,
+  /// 1009-1012), which state nothing.
+  virtual PhaseAlignments phaseAlignment() const = 0;
   /// One-line description for logs ("RINEX 2.10, marker 3040" / "RTCM 3, 1234 frames, ...").
   virtual std::string describe() const = 0;
   /// Malformed epochs or frames skipped so far.

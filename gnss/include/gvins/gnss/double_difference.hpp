@@ -1,9 +1,22 @@
 // Single and double differences between a rover and a base receiver: the measurement model that
 // RTK and the GNSS fusion share.
 //
-// Single differences (SD, rover minus base) are formed per satellite and signal when both
-// receivers track the same RINEX signal code (a tracking-attribute mismatch, e.g. L2W at the rover
-// and L2L at the base, is not differenced: the two can differ by a fraction of a cycle). In metres,
+// Single differences (SD, rover minus base) are formed per satellite and band, one rover signal
+// against one base signal of that band. Matching (RtkConfig::signalMatching):
+//   - strict: the same RINEX code at both receivers only;
+//   - band (default): the same code when both receivers have one; otherwise another tracking mode
+//     of the band (receivers of different brands track different modes: Galileo E1 C against X,
+//     GPS L2 L against X or W, ...), provided both receivers' phases are known to refer to the
+//     band's reference signal (PhaseAlignment of each receiver, see base/phase_alignment.hpp:
+//     RINEX 3.01+ with SYS / PHASE SHIFT records, RTCM MSM; raw tracking phases are aligned here
+//     with the RINEX 3.04 Table A23 shift). Without that knowledge a quarter-cycle offset could
+//     enter the double differences, so the pair is not formed (as strict; counted).
+//   Among several pairs with phase (else with code) at both receivers: the same code first, then
+//   two modes of one transmitted signal (sameSignal: L2L and L2X, E1C and E1X), then different
+//   signals of the band (GPS L1 C/A and P(Y)); ties by the attribute priority of the rover, then of
+//   the base. Code biases between different signals (e.g. GPS P1-C1) do not cancel in such a
+//   double difference; they stay within the code noise model of short baselines.
+// In metres,
 //   SD phase:  λφ_r − λφ_b = ρ_r − ρ_b + c(dt_r − dt_b) + λN_rb + ε
 //   SD code:   P_r − P_b   = ρ_r − ρ_b + c(dt_r − dt_b) + ε
 // with ρ the geometric range with Sagnac term, minus the satellite clock, plus the modelled
@@ -26,11 +39,13 @@
 #include <cstdint>
 #include <optional>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "gvins/base/observation.hpp"
+#include "gvins/base/phase_alignment.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/gnss/base_station.hpp"
 #include "gvins/gnss/cycle_slip_detector.hpp"
@@ -42,7 +57,8 @@ namespace gvins {
 /// Rover-minus-base single difference of one satellite signal.
 struct SingleDifference {
   SatId sat;
-  ObsCode code;          ///< signal tracked by both receivers
+  ObsCode code;          ///< rover signal
+  ObsCode baseCode;      ///< base signal (another tracking mode of the band when matched across modes)
   int group = -1;        ///< index into DdEpoch::groups
   double wavelength = 0.0;  ///< m (0: unknown, phase unusable)
   double elevation = 0.0;   ///< rad, at the rover
@@ -134,7 +150,11 @@ struct DdFormationStats {
   std::int64_t belowMask = 0;
   std::int64_t lowSnr = 0;
   std::int64_t notAtBase = 0;        ///< satellite absent from the base data
-  std::int64_t signalMismatch = 0;   ///< a band seen by both receivers without a common signal code
+  std::int64_t signalMismatch = 0;   ///< a band seen by both receivers without a signal pair formed
+  /// Of signalMismatch: a pair across tracking modes existed, but a receiver's phase alignment is
+  /// unknown (or matching is strict).
+  std::int64_t crossModeRefused = 0;
+  std::int64_t crossMode = 0;        ///< signal-epochs differenced across tracking modes
   std::int64_t used = 0;             ///< satellite-epochs with at least one SD
 };
 
@@ -144,6 +164,9 @@ class DoubleDifferenceBuilder {
   DoubleDifferenceBuilder(const EphemerisStore& nav, const RtkConfig& config);
   /// Rover GLONASS channels (header); the navigation data fill gaps.
   void setGlonassChannels(const GlonassChannels& channels);
+  /// What rover and base data state about their phase alignment (default: Unknown, i.e. only
+  /// the same codes are differenced).
+  void setPhaseAlignment(const PhaseAlignments& rover, const PhaseAlignments& base);
 
   /// Forms the SDs and DDs of a rover epoch at the rover position `x` (linearisation point for
   /// elevations and the troposphere; residuals can be evaluated anywhere later). `roverSlips` must
@@ -167,13 +190,27 @@ class DoubleDifferenceBuilder {
            static_cast<std::uint32_t>(static_cast<unsigned char>(c.attr));
   }
 
+  struct Pick {
+    const SignalObs* rover = nullptr;
+    const BaseSignal* base = nullptr;
+  };
+  /// The rover and base signals of a band to difference (see the file comment), or nullopt
+  /// (counted in the statistics).
+  std::optional<Pick> pickPair(const SatObs& so, char band, const BaseSignal* baseBegin, const BaseSignal* baseEnd);
+  /// The base signals of a satellite (`base.signals` is sorted by satellite).
+  static std::pair<const BaseSignal*, const BaseSignal*> baseSignalsOf(const BaseSnapshot& base, SatId sat);
+  /// Cycles to add to a phase of a receiver with alignment `a` to refer it to the band's reference.
+  static double alignedShift(const PhaseAlignments& a, System sys, ObsCode code);
+
   const EphemerisStore& nav_;
   RtkConfig config_;
   GlonassChannels channels_;
+  PhaseAlignments roverAlignment_, baseAlignment_;
   DdFormationStats stats_;
   std::unordered_map<int, SatId> phaseRef_;  // by groupKey
   struct Arcs {
     GpsTime rover, base, epoch;
+    ObsCode baseCode;
   };
   std::unordered_map<std::uint32_t, Arcs> arcs_;  // by signalKey
   GpsTime lastEpoch_;

@@ -134,6 +134,10 @@ class RtkSolver {
   const std::optional<Eigen::Vector3d>& basePosition() const { return base_.position(); }
   void setBaseGlonassChannels(const GlonassChannels& channels);
   void setRoverGlonassChannels(const GlonassChannels& channels);
+  /// Whether the rover's and the base's phases refer to the reference signal of each band
+  /// (phaseAlignmentOf a RINEX header, RTCM MSM: Aligned). Default Unknown: only signals with the
+  /// same code at both receivers are differenced, whatever RtkConfig::signalMatching says.
+  void setPhaseAlignment(const PhaseAlignments& rover, const PhaseAlignments& base);
   /// A-priori rover position for the first SPP iteration (e.g. RINEX header).
   void setRoverInitialPosition(const Eigen::Vector3d& ecef);
 
@@ -185,6 +189,7 @@ class RtkSolver {
     sri::BlockId id;
     SatId sat;
     ObsCode code;
+    ObsCode baseCode;
     double wavelength = 0.0;
     GpsTime roverArc, baseArc, lastSeen;
     int lock = 0;
@@ -251,9 +256,9 @@ class RtkSolver {
   /// The fixed DD phases of the last process() epoch that ended fixed (differencesWithHeldFix).
   struct HeldSignal {
     SatId sat;
-    ObsCode code;
+    ObsCode code, baseCode;
     GpsTime roverArc, baseArc;
-    static HeldSignal of(const SingleDifference& sd) { return {sd.sat, sd.code, sd.roverArc, sd.baseArc}; }
+    static HeldSignal of(const SingleDifference& sd) { return {sd.sat, sd.code, sd.baseCode, sd.roverArc, sd.baseArc}; }
     bool operator==(const HeldSignal&) const = default;
   };
   struct HeldDd {

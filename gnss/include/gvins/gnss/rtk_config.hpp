@@ -29,6 +29,12 @@ enum class AmbiguityMode {
   FixAndHold,     ///< as Continuous, and validated fixes constrain the float ambiguities
 };
 
+/// Which rover and base signals of one band are differenced (see double_difference.hpp).
+enum class SignalMatching {
+  Strict,  ///< the same RINEX code at both receivers only
+  Band,    ///< the same code if both have one, else another tracking mode of the same band
+};
+
 struct RtkConfig {
   RtkMode mode = RtkMode::Kinematic;
   RtkDynamics dynamics = RtkDynamics::RandomWalk;
@@ -40,6 +46,9 @@ struct RtkConfig {
   /// available at both receivers are used. One double-difference group per system and band.
   std::array<std::string, kNumSystems> bands{"125", "12", "157", "276", "125", "15", "59"};
   int frequencies = 2;
+  /// Rover and base signals of a band: the same code only, or any tracking mode of the band
+  /// (receivers of different brands track different modes, e.g. Galileo E1 C against X).
+  SignalMatching signalMatching = SignalMatching::Band;
   double elevationMask = 15.0 * constants::kDegToRad;  ///< rad, at the rover
   double snrMask = 0.0;                                ///< dB-Hz, 0 = off
 
@@ -114,6 +123,7 @@ struct RtkConfig {
 const char* toString(RtkMode m);
 const char* toString(AmbiguityMode m);
 const char* toString(RtkDynamics d);
+const char* toString(SignalMatching m);
 
 /// Reads options from the `rtk:` map of a YAML file (yaml-cpp); other top-level keys (e.g. the
 /// `spp:` section used for the single-point solutions) are left to their readers. Every key under
@@ -127,6 +137,7 @@ const char* toString(RtkDynamics d);
 ///     systems: GRECJ
 ///     frequencies: 2                # 1..3
 ///     bands: {G: "125", E: "157", C: "276"}
+///     signal_matching: band         # band (any tracking mode of the band) | strict (same code)
 ///     elevation_mask_deg: 15
 ///     snr_mask_dbhz: 0
 ///     ar: {systems: GECJ, elevation_mask_deg: 15, min_lock: 0, validation: fixed-failure-rate,
