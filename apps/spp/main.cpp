@@ -63,7 +63,9 @@ const char* kUsage =
     "                     the config's carrier_smoothing_s, 0 = raw codes); with --freq 2 --iono\n"
     "                     dual-frequency free of divergence\n"
     "  --no-fde           no fault detection and exclusion\n"
-    "  --no-velocity      no Doppler velocity (velocity columns are zeros)\n"
+    "  --no-velocity      no Doppler velocity (no velocity columns)\n"
+    "  --drop-failed      omit the epochs whose residual (RAIM) test failed even after fault\n"
+    "                     exclusion (by default they are written with test = 1 in the last column)\n"
     "  --xyz              ECEF x/y/z columns instead of latitude/longitude/height\n"
     "  --time-decimals N  decimals of the time column (default 3)\n"
     "  --truth X,Y,Z      true antenna position (ECEF, m): adds an accuracy table (east/north/up\n"
@@ -87,7 +89,7 @@ struct Args {
   std::optional<std::string> iono, tropo;
   std::optional<double> smooth;
   std::vector<std::string> ssr;
-  bool noFde = false, noVelocity = false, xyz = false, strict = false, quiet = false;
+  bool noFde = false, noVelocity = false, xyz = false, strict = false, quiet = false, dropFailed = false;
   int timeDecimals = 3;
   std::optional<Eigen::Vector3d> truth;
 };
@@ -149,6 +151,8 @@ Args parseArgs(int argc, char** argv) {
       a.noFde = true;
     } else if (o == "--no-velocity") {
       a.noVelocity = true;
+    } else if (o == "--drop-failed") {
+      a.dropFailed = true;
     } else if (o == "--xyz") {
       a.xyz = true;
     } else if (o == "--time-decimals") {
@@ -342,7 +346,16 @@ int main(int argc, char** argv) {
   }
   PosWriterOptions popt;
   popt.coordinates = args.xyz ? PosCoordinates::Xyz : PosCoordinates::Llh;
-  popt.velocity = true;
+  // Velocity columns when a velocity can exist: Doppler observations in the file and asked for.
+  bool hasDoppler = false;
+  for (int i = 0; i < kNumSystems; ++i) {
+    if (!cfg.systems[i]) continue;
+    for (const ObsDescriptor& d : hdr.obsTypes[i]) hasDoppler = hasDoppler || d.type == ObsType::Doppler;
+  }
+  popt.velocity = cfg.velocity && hasDoppler;
+  if (!cfg.velocity) popt.notes.emplace_back("no velocity columns: velocity not estimated (--no-velocity)");
+  else if (!hasDoppler) popt.notes.emplace_back("no velocity columns: no Doppler observations in the input");
+  popt.testColumn = true;
   popt.timeDecimals = args.timeDecimals;
   popt.program = "SRI-GVINS gvins-spp";
   for (const auto& f : args.inputs) popt.headerFields.emplace_back("inp file", f);
@@ -355,6 +368,7 @@ int main(int argc, char** argv) {
   popt.headerFields.emplace_back("navi sys", systemsText(cfg));
   std::snprintf(buf, sizeof buf, "%d", cfg.frequencies);
   popt.headerFields.emplace_back("freqs", buf);
+  if (args.dropFailed) popt.headerFields.emplace_back("failed", "epochs failing the residual test omitted");
   std::optional<CarrierSmoother> smoother;
   if (args.smooth) cfg.carrierSmoothing = *args.smooth;
   if (cfg.carrierSmoothing > 0.0) {
@@ -374,7 +388,7 @@ int main(int argc, char** argv) {
   std::map<SppStatus, long> statusCount;
   std::map<SatId, long> excludedCount;
   std::array<long, 8> useCount{};
-  long epochs = 0, solutions = 0, velocities = 0, testFailed = 0;
+  long epochs = 0, solutions = 0, velocities = 0, testFailed = 0, untestable = 0, written = 0;
   double satSum = 0.0;
   const bool tty = isatty(fileno(stderr));
   auto lastProgress = wall0;
@@ -397,10 +411,14 @@ int main(int argc, char** argv) {
     for (const auto& s : sol.excluded) ++excludedCount[s];
     if (sol.valid()) {
       ++solutions;
-      if (sol.status == SppStatus::TestFailed) ++testFailed;
+      const PositionSolution ps = sol.toPositionSolution();
+      if (ps.residualTest == ResidualTest::Failed) ++testFailed;
+      if (ps.residualTest == ResidualTest::Untestable) ++untestable;
       satSum += sol.numSatellites;
       if (sol.velocity.valid) ++velocities;
-      writer.write(sol.toPositionSolution());
+      if (args.dropFailed && ps.residualTest == ResidualTest::Failed) continue;
+      ++written;
+      writer.write(ps);
       if (stats) {
         stats->addPosition(sol.position);
         if (sol.velocity.valid) stats->addVelocity(sol.velocity.velocity);
@@ -437,7 +455,10 @@ int main(int argc, char** argv) {
   std::fprintf(stderr, "gvins-spp summary (%s)\n", args.inputs[0].c_str());
   std::fprintf(stderr, "  epochs read            %8ld\n", epochs);
   std::fprintf(stderr, "  solutions              %8ld (%.1f %%)\n", solutions, epochs ? 100.0 * solutions / epochs : 0.0);
-  std::fprintf(stderr, "    residual test failed %8ld (kept, flagged)\n", testFailed);
+  std::fprintf(stderr, "    residual test failed %8ld (%s)\n", testFailed,
+               args.dropFailed ? "omitted: --drop-failed" : "written with test = 1");
+  std::fprintf(stderr, "    not testable         %8ld (no redundancy; test = 2)\n", untestable);
+  std::fprintf(stderr, "  rows written           %8ld\n", written);
   std::fprintf(stderr, "  velocity solutions     %8ld\n", velocities);
   std::fprintf(stderr, "  mean satellites used   %8.1f\n", solutions ? satSum / solutions : 0.0);
   for (const auto& [st, n] : statusCount) {

@@ -240,6 +240,41 @@ Eigen::Vector3d GnssFusion<Scalar>::leverArm(const vio::EstimatorBackend<Scalar>
 }
 
 template <typename Scalar>
+std::optional<Eigen::Matrix3d> GnssFusion<Scalar>::antennaCovariance(const vio::EstimatorBackend<Scalar>& est,
+                                                                     std::int64_t t_ns) const {
+  if (!current(est) || !est.initialized() || (!frameBlock_.valid() && !worldChange_)) return std::nullopt;
+  GnssStateValues s;
+  if (!buildState(est, t_ns, s)) return std::nullopt;
+  const AntennaKinematics k = antennaKinematics(s);
+  // Rows 0..2 of the kinematics' Jacobians (p_N) over the blocks, in the order listed.
+  const vio::ImuBlocks ib = est.newestImuBlocks();
+  std::vector<sri::BlockId> blocks{ib.pose, ib.velocity, ib.bias};
+  Eigen::Matrix<double, 3, Eigen::Dynamic> J(3, 22);
+  J.leftCols<15>() = k.J_imu.template topRows<3>();
+  Eigen::Index n = 15;
+  if (frameBlock_.valid()) {
+    blocks.push_back(frameBlock_);
+    J.middleCols<4>(n) = k.J_frame.template topRows<3>();
+    n += 4;
+  }
+  if (leverBlock_.valid()) {
+    blocks.push_back(leverBlock_);
+    J.middleCols<3>(n) = k.J_lever.template topRows<3>();
+    n += 3;
+  }
+  Eigen::MatrixXd P;
+  try {
+    P = est.covariance(std::span<const sri::BlockId>(blocks)).template cast<double>();
+  } catch (const std::exception&) {
+    return std::nullopt;  // a block without information yet (sri_filter.hpp)
+  }
+  const auto Jb = J.leftCols(n);
+  const Eigen::Matrix<double, 3, 9> Je = k.J_earlier.template topRows<3>();
+  const Eigen::Matrix3d C_N = Jb * P * Jb.transpose() + Je * k.integrationCovariance * Je.transpose();
+  return Eigen::Matrix3d(k.R_EN * C_N * k.R_EN.transpose());
+}
+
+template <typename Scalar>
 Eigen::Vector3d GnssFusion<Scalar>::carriedLever() const {
   if (leverLast_ && ((*leverLast_ - config_.leverArm).cwiseAbs().array() <= 3.0 * config_.leverArmSigma).all()) {
     return *leverLast_;

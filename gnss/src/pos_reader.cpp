@@ -2,6 +2,8 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
+#include <optional>
 
 #include "gvins/base/constants.hpp"
 #include "gvins/base/geodetic.hpp"
@@ -27,6 +29,12 @@ std::vector<std::string_view> splitBlanks(std::string_view s) {
   return out;
 }
 
+/// "nan" or "-nan" (printf's spelling), the writer's mark of an absent velocity.
+bool isNanToken(std::string_view t) {
+  if (!t.empty() && (t[0] == '-' || t[0] == '+')) t.remove_prefix(1);
+  return t.size() == 3 && (t[0] == 'n' || t[0] == 'N') && (t[1] == 'a' || t[1] == 'A') && (t[2] == 'n' || t[2] == 'N');
+}
+
 enum class Layout { Unknown, Ecef, Llh };
 enum class TimeScale { Gpst, Utc };
 
@@ -34,6 +42,7 @@ PosFile parse(LineReader& in) {
   PosFile out;
   Layout layout = Layout::Unknown;
   TimeScale scale = TimeScale::Gpst;
+  bool testColumn = false;  // the column titles end with "test" (our residual-test column)
   std::string line;
   while (in.next(line)) {
     const std::string_view l = trim(line);
@@ -50,12 +59,22 @@ PosFile parse(LineReader& in) {
         if (l.find("latitude(d'\")") != std::string_view::npos) {
           throwParseError(w, "latitude", "degree-minute-second coordinates are not supported");
         }
+        const auto titles = splitBlanks(l);
+        testColumn = !titles.empty() && titles.back() == "test";
       }
       continue;
     }
-    const auto tok = splitBlanks(l);
+    auto tok = splitBlanks(l);
+    std::optional<ResidualTest> residualTest;
+    if (testColumn && tok.size() >= 8) {
+      const long t = parseInt(tok.back(), w, "test");
+      if (t < 0 || t > 2) throwParseError(w, "test", "residual test flag outside 0-2");
+      residualTest = static_cast<ResidualTest>(t);
+      tok.pop_back();
+    }
     if (tok.size() < 7) throwParseError(w, "row", "expected at least time, 3 coordinates, Q and ns");
     PositionSolution s;
+    s.residualTest = residualTest;
     // Time: "yyyy/mm/dd hh:mm:ss.sss" or "week tow".
     if (tok[0].find('/') != std::string_view::npos) {
       CalendarTime c;
@@ -91,6 +110,10 @@ PosFile parse(LineReader& in) {
     if (ns < 0 || ns > 999) throwParseError(w, "ns", "number of satellites out of range");
     s.numSatellites = static_cast<int>(ns);
     auto val = [&](std::size_t i, const char* name) { return parseDouble(tok[i], w, name); };
+    // Velocity columns may be nan (no velocity in that epoch).
+    auto velVal = [&](std::size_t i, const char* name) {
+      return isNanToken(tok[i]) ? std::numeric_limits<double>::quiet_NaN() : parseDouble(tok[i], w, name);
+    };
     Eigen::Matrix3d P = Eigen::Matrix3d::Zero();
     if (tok.size() >= 13) {
       const double sd[3] = {val(7, "sd1"), val(8, "sd2"), val(9, "sd3")};
@@ -109,11 +132,11 @@ PosFile parse(LineReader& in) {
     Eigen::Vector3d vel = Eigen::Vector3d::Zero();
     bool hasVel = false;
     if (tok.size() >= 18) {
-      vel = {val(15, "v1"), val(16, "v2"), val(17, "v3")};
+      vel = {velVal(15, "v1"), velVal(16, "v2"), velVal(17, "v3")};
       hasVel = true;
       if (tok.size() >= 24) {
-        const double sd[3] = {val(18, "sdv1"), val(19, "sdv2"), val(20, "sdv3")};
-        const double cr[3] = {val(21, "sdv12"), val(22, "sdv23"), val(23, "sdv31")};
+        const double sd[3] = {velVal(18, "sdv1"), velVal(19, "sdv2"), velVal(20, "sdv3")};
+        const double cr[3] = {velVal(21, "sdv12"), velVal(22, "sdv23"), velVal(23, "sdv31")};
         for (int i = 0; i < 3; ++i) V(i, i) = sd[i] * sd[i];
         auto sq = [](double v) { return v < 0 ? -v * v : v * v; };
         V(0, 1) = V(1, 0) = sq(cr[0]);
@@ -121,7 +144,12 @@ PosFile parse(LineReader& in) {
         V(2, 0) = V(0, 2) = sq(cr[2]);
       }
     }
-    // RTKLIB (and our writer) print zeros in the velocity columns of epochs without a velocity.
+    // Our writer prints nan in the velocity columns of epochs without a velocity, RTKLIB zeros.
+    if (hasVel && vel.array().isNaN().all() && (V.array().isNaN().all() || tok.size() < 24)) {
+      hasVel = false;
+      vel.setZero();
+      V.setZero();
+    }
     if (hasVel && vel.isZero(0.0) && V.isZero(0.0)) hasVel = false;
     if (!std::isfinite(P.sum()) || !std::isfinite(V.sum()) || !vel.allFinite()) {
       throwParseError(w, "row", "non-finite value");

@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <ostream>
 
 #include "gvins/base/constants.hpp"
@@ -21,9 +22,12 @@ namespace {
 // without printf's format parsing and multi-precision arithmetic; the padding is added here.
 
 /// Right-aligned in `width` characters; with `zeros`, padded with '0' after the sign (printf's
-/// '0' flag) instead of blanks.
+/// '0' flag) instead of blanks. A blank-padded value that fills its field or is wider gets one
+/// leading blank more, so that it never runs into the field before it (readers split on blanks;
+/// RTKLIB's printf layout would write "0.0-1475.85308" for a ratio followed by a wide velocity).
 void appendPadded(std::string& out, const char* first, const char* last, int width, bool zeros) {
   const int len = static_cast<int>(last - first);
+  if (!zeros && len >= width) out += ' ';
   const int pad = std::max(width - len, 0);
   if (zeros && pad > 0 && first < last && *first == '-') {
     out += '-';
@@ -38,8 +42,8 @@ void appendFixed(std::string& out, double v, int width, int precision, bool zero
   char buf[400];  // any double in %.9f: at most 309 integer digits, sign, point, 9 decimals
   if (!std::isfinite(v)) {
     // inf/nan are spelled by the C library itself.
-    const int n = std::snprintf(buf, sizeof buf, "%*.*f", width, precision, v);
-    out.append(buf, static_cast<std::size_t>(std::max(n, 0)));
+    const int n = std::snprintf(buf, sizeof buf, "%.*f", precision, v);
+    appendPadded(out, buf, buf + std::max(n, 0), width, false);
     return;
   }
   const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::fixed, precision);
@@ -72,6 +76,14 @@ void PosWriter::writeHeader() {
   const bool xyz = opt_.coordinates == PosCoordinates::Xyz;
   h += xyz ? "% (x/y/z-ecef=WGS84,Q=1:fix,2:float,3:sbas,4:dgps,5:single,6:ppp,ns=# of satellites)\n"
            : "% (lat/lon/height=WGS84/ellipsoidal,Q=1:fix,2:float,3:sbas,4:dgps,5:single,6:ppp,ns=# of satellites)\n";
+  // Legends of our additions (docs/pos_format.md). RTKLIB's readers take the time system and the
+  // layout from header lines naming them, so these lines name neither.
+  if (opt_.velocity) h += "% (velocity columns nan: no velocity in that epoch)\n";
+  if (opt_.testColumn) {
+    h += "% (test=residual/RAIM test of the epoch: 0:passed,1:failed after fault exclusion (solution kept, "
+         "not trustworthy),2:not testable (no redundancy))\n";
+  }
+  for (const std::string& note : opt_.notes) h += "% (" + note + ")\n";
   // Column titles aligned with the row layout below.
   std::string t = "%  GPST";
   t.resize(static_cast<std::size_t>(19 + (opt_.timeDecimals > 0 ? opt_.timeDecimals + 1 : 0) + 2), ' ');
@@ -96,6 +108,7 @@ void PosWriter::writeHeader() {
     }
     t += buf;
   }
+  if (opt_.testColumn) t += " test";
   h += t + "\n";
   out_ << h;
 }
@@ -123,7 +136,10 @@ void PosWriter::write(const PositionSolution& s) {
   const bool xyz = opt_.coordinates == PosCoordinates::Xyz;
   Eigen::Matrix3d P = s.positionCovariance;
   Eigen::Matrix3d V = s.velocityCovariance;
-  Eigen::Vector3d vel = s.velocity.value_or(Eigen::Vector3d::Zero());
+  // An epoch without velocity gets nan in the velocity columns (RTKLIB writes zeros there, which
+  // read as a measured standstill with zero uncertainty).
+  constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+  Eigen::Vector3d vel = s.velocity.value_or(Eigen::Vector3d::Constant(kNan));
   if (xyz) {
     // "%15.4f%15.4f%15.4f"
     for (int i = 0; i < 3; ++i) appendFixed(buf_, s.position[i], 15, 4);
@@ -152,7 +168,7 @@ void PosWriter::write(const PositionSolution& s) {
   appendFixed(buf_, s.age, 7, 2);
   appendFixed(buf_, s.ratio, 7, 1);
   if (opt_.velocity) {
-    if (!s.velocity) V.setZero();
+    if (!s.velocity) V.setConstant(kNan);
     // "%11.5f%11.5f%11.5f %9.5f%9.5f%9.5f%9.5f%9.5f%9.5f"
     for (int i = 0; i < 3; ++i) appendFixed(buf_, vel[i], 11, 5);
     buf_ += ' ';
@@ -161,6 +177,7 @@ void PosWriter::write(const PositionSolution& s) {
     appendFixed(buf_, signedSqrt(V(1, 2)), 9, 5);
     appendFixed(buf_, signedSqrt(V(2, 0)), 9, 5);
   }
+  if (opt_.testColumn) appendInt(buf_, static_cast<int>(s.residualTest.value_or(ResidualTest::Untestable)), 5);
   buf_ += '\n';
   out_ << buf_;
 }

@@ -54,6 +54,10 @@ PositionSolution SppSolution::toPositionSolution() const {
   p.position = position;
   p.positionCovariance = positionCovariance;
   p.numSatellites = numSatellites;
+  if (valid()) {
+    p.residualTest = status == SppStatus::TestFailed ? ResidualTest::Failed
+                                                     : (dof < 1 ? ResidualTest::Untestable : ResidualTest::Passed);
+  }
   if (velocity.valid) {
     p.velocity = velocity.velocity;
     p.velocityCovariance = velocity.covariance;
@@ -670,12 +674,20 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
     }
   }
 
-  // Outputs.
+  // Outputs. The reported covariance is scaled by the a-posteriori variance factor of the
+  // residual test's statistic (after fault exclusion, before the robust weights, which shrink it
+  // by down-weighting the very residuals that show the weights to be optimistic;
+  // CovarianceScaling); the inter-system bias priors below keep the a-priori covariance.
   sol.position = x;
-  sol.positionCovariance = last.cov.topLeftCorner<3, 3>();
+  const CovarianceScaling& cs = cfg.covarianceScaling;
+  if (cs.enabled) {
+    const double k = sol.dof >= 1 ? (sol.chi2 + cs.priorDof) / (sol.dof + cs.priorDof) : 1.0;
+    sol.varianceFactor = std::max(k, 1.0);
+  }
+  sol.positionCovariance = sol.varianceFactor * last.cov.topLeftCorner<3, 3>();
   for (std::size_t c = 0; c < colSystems.size(); ++c) {
     sol.clockBias[colSystems[c]] = clk[static_cast<int>(c)];
-    sol.clockBiasVariance[colSystems[c]] = last.cov(3 + static_cast<int>(c), 3 + static_cast<int>(c));
+    sol.clockBiasVariance[colSystems[c]] = sol.varianceFactor * last.cov(3 + static_cast<int>(c), 3 + static_cast<int>(c));
   }
   const int gi = systemIndex(System::Gps), ji = systemIndex(System::Qzss);
   if (cfg.qzssUsesGpsClock && sol.clockBias[gi]) {

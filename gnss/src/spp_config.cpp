@@ -30,7 +30,7 @@ void apply(const Reader& r, const YAML::Node& spp, SppConfig& c) {
   static const std::set<std::string> kKeys = {
       "systems", "elevation_mask_deg", "snr_mask_dbhz", "frequencies", "bands", "ionosphere", "troposphere",
       "relative_humidity", "meteo", "weighting", "ionosphere_model_error", "troposphere_zenith_error_m",
-      "ephemeris_error_m", "ephemeris_alarm_accuracy_m", "precise_ephemeris_error_m", "fault_exclusion", "robust", "ionosphere_estimation", "max_gdop", "isb_prior_sigma_m", "isb_random_walk_m2ps", "qzss_gps_clock",
+      "ephemeris_error_m", "ephemeris_alarm_accuracy_m", "precise_ephemeris_error_m", "fault_exclusion", "robust", "ionosphere_estimation", "covariance_scaling", "max_gdop", "isb_prior_sigma_m", "isb_random_walk_m2ps", "qzss_gps_clock",
       "max_iterations", "velocity", "carrier_smoothing_s", "allow_unhealthy"};
   r.map(spp, "spp", kKeys, [&](const std::string& k, const std::string& full, const YAML::Node& v) {
     if (k == "systems") {
@@ -130,6 +130,12 @@ void apply(const Reader& r, const YAML::Node& spp, SppConfig& c) {
         if (ik == "enabled") c.ionosphereEstimation.enabled = r.boolean(iv, iff);
         else if (ik == "prior_fraction") c.ionosphereEstimation.priorFraction = r.number(iv, iff, 0.0, 10.0);
         else c.ionosphereEstimation.minPriorSigma = r.number(iv, iff, 0.001, 100.0);
+      });
+    } else if (k == "covariance_scaling") {
+      static const std::set<std::string> kC = {"enabled", "prior_dof"};
+      r.map(v, full, kC, [&](const std::string& ck, const std::string& cf, const YAML::Node& cv) {
+        if (ck == "enabled") c.covarianceScaling.enabled = r.boolean(cv, cf);
+        else c.covarianceScaling.priorDof = r.number(cv, cf, 0.0, 1000.0);
       });
     } else if (k == "max_gdop") {
       c.maxGdop = r.number(v, full, 1.0, 1e6);

@@ -6,15 +6,20 @@
 // lever-arm calibration from a 0.3 m wrong start, and float against double.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "gvins/base/local_frame.hpp"
+#include "gvins/base/geodetic.hpp"
+#include "gvins/gnss/pos_reader.hpp"
 #include "gvins/fusion/replay_pipeline.hpp"
 #include "gvins/fusion/replay_sri_swf.hpp"
 #include "gvins/fusion/sim_dataset_info.hpp"
@@ -284,6 +289,82 @@ TEST(ReplaySim, LockOutResetsVioButNotWhileGnssHoldsTheState) {
   EXPECT_LT(vio.summary.local.positionRmse, 0.3);
   EXPECT_EQ(ddcp.summary.estimatorResets, 0u);
   EXPECT_LT(ddcp.summary.global.positionRmse, 0.1);
+}
+
+// global.pos carries the estimator's antenna position covariance (the joint marginal covariance
+// of the blocks the antenna position depends on, GnssFusion::antennaCovariance): nonzero in every
+// row, growing over the 60 s outage (VIO alone), and compared per east/north/up axis with the
+// actual error against the simulation's truth of each rover epoch.
+TEST(ReplaySim, GlobalPosCovarianceDescribesTheError) {
+  const ReplayRun r = replay<double>("cov", config(GnssFusionMode::kDoppDpsr));
+  const PosFile f = readPosFile((r.out / "global.pos").string());
+  // The true antenna at the true time of each rover epoch (the rows are at the receiver's time
+  // tag; the estimate is at the tag minus the estimated receiver clock), by tag.
+  std::map<std::int64_t, Eigen::Vector3d> truth;
+  {
+    std::ifstream in(dataset() / "gnss" / "truth" / "rover_antenna.csv");
+    std::string line;
+    while (std::getline(in, line)) {
+      if (line.empty() || line[0] == '#' || line[0] == 't') continue;
+      long long tag = 0, gpst = 0;
+      double x, y, z;
+      if (std::sscanf(line.c_str(), "%lld,%lld,%lf,%lf,%lf", &tag, &gpst, &x, &y, &z) == 5) truth[tag] = {x, y, z};
+    }
+  }
+  ASSERT_GT(truth.size(), 400u);
+  ASSERT_GT(f.solutions.size(), 200u);
+  const Geodetic g0 = ecefToGeodetic(truth.begin()->second);
+  const Eigen::Matrix3d R = ecefToEnuRotation(g0.lat, g0.lon);
+  std::array<std::array<int, 3>, 3> within{};
+  std::array<std::vector<double>, 3> ratio;
+  Eigen::Vector3d sum2 = Eigen::Vector3d::Zero(), var = Eigen::Vector3d::Zero();
+  int n = 0, zero = 0;
+  double sigmaBefore = 0.0, sigmaBack = 0.0;  // east sigma at the last epoch before / first after the outage
+  std::int64_t lastTag = 0;
+  for (const PositionSolution& s : f.solutions) {
+    const std::int64_t tag = static_cast<std::int64_t>(s.time.week()) * 604800'000'000'000LL + std::llround(s.time.tow() * 1e3) * 1'000'000;
+    const auto it = truth.find(tag);
+    if (it == truth.end()) continue;
+    const Eigen::Vector3d e = R * (s.position - it->second);
+    const Eigen::Matrix3d C = R * s.positionCovariance * R.transpose();
+    if (C.diagonal().minCoeff() <= 0.0) {
+      ++zero;
+      continue;
+    }
+    if (lastTag > 0 && tag - lastTag > 30'000'000'000LL) sigmaBack = std::sqrt(C(0, 0));
+    else if (sigmaBack == 0.0) sigmaBefore = std::sqrt(C(0, 0));
+    lastTag = tag;
+    ++n;
+    sum2 += e.cwiseAbs2();
+    var += C.diagonal();
+    for (int a = 0; a < 3; ++a) {
+      const double q = std::abs(e[a]) / std::sqrt(C(a, a));
+      ratio[a].push_back(q);
+      for (int k = 0; k < 3; ++k) within[a][k] += q <= k + 1;
+    }
+  }
+  ASSERT_GT(n, 200);
+  EXPECT_EQ(zero, 0);
+  for (int a = 0; a < 3; ++a) {
+    std::sort(ratio[a].begin(), ratio[a].end());
+    const double median = ratio[a][ratio[a].size() / 2];
+    std::fprintf(stderr,
+                 "global.pos %c: %d epochs, error RMS %.4f m, sigma RMS %.4f m, within 1/2/3 sigma %.1f / %.1f / %.1f %%, "
+                 "median |e|/sigma %.2f\n",
+                 "ENU"[a], n, std::sqrt(sum2[a] / n), std::sqrt(var[a] / n), 100.0 * within[a][0] / n,
+                 100.0 * within[a][1] / n, 100.0 * within[a][2] / n, median);
+    // A Gaussian error with an honest sigma: 68 / 95 / 99.7 %, median 0.67. Measured (Dpsr,
+    // 7 Dec 2026): E 58/81/100 % (median 0.41), N 16/29/48 % (3.04), U 28/79/100 % (1.33): the
+    // filter's own covariance is up to 3x optimistic in north on this flight, whose slowly
+    // varying north error of 0.1-0.15 m it does not know of (VIO+Dopp+Ddcp: 2-5x, mm-level
+    // sigma against 1-2 cm errors). The bounds hold the sigma to within a factor 4 of the error.
+    EXPECT_GT(within[a][2], n * 4 / 10) << "ENU"[a];
+    EXPECT_GT(median, 0.2) << "ENU"[a];  // not uselessly pessimistic
+    EXPECT_LT(median, 4.0) << "ENU"[a];
+  }
+  // 60 s of VIO alone: the first epoch back has a larger sigma than the last before the outage.
+  std::fprintf(stderr, "east sigma: %.4f m before the outage, %.4f m at the first epoch after it\n", sigmaBefore, sigmaBack);
+  EXPECT_GT(sigmaBack, 2.0 * sigmaBefore);
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 #include <sstream>
 
@@ -110,22 +111,133 @@ TEST(PosIo, RowsAreCharacterForCharacterPrintf) {
       std::snprintf(buf, sizeof buf, "%04d/%02d/%02d %02d:%02d:%0*.*f", t.year, t.month, t.day, t.hour, t.minute,
                     decimals > 0 ? decimals + 3 : 2, decimals, std::floor(t.second * scale + 0.5) / scale);
       expected += buf;
+      // printf's "%<w>.<p>f", with one blank more before a value that fills its field (the writer
+      // keeps a separator there).
+      auto f = [&](double x, int width, int p) {
+        if (std::snprintf(nullptr, 0, "%.*f", p, x) >= width) expected += ' ';
+        std::snprintf(buf, sizeof buf, "%*.*f", width, p, x);
+        expected += buf;
+      };
       const Eigen::Matrix3d& P = s.positionCovariance;
-      std::snprintf(buf, sizeof buf, "%15.4f%15.4f%15.4f%4d%4d%9.4f%9.4f%9.4f%9.4f%9.4f%9.4f%7.2f%7.1f", s.position.x(),
-                    s.position.y(), s.position.z(), 5, s.numSatellites, std::sqrt(std::max(P(0, 0), 0.0)),
-                    std::sqrt(std::max(P(1, 1), 0.0)), std::sqrt(std::max(P(2, 2), 0.0)), signedSqrt(P(0, 1)),
-                    signedSqrt(P(1, 2)), signedSqrt(P(2, 0)), s.age, s.ratio);
+      for (int k = 0; k < 3; ++k) f(s.position[k], 15, 4);
+      std::snprintf(buf, sizeof buf, "%4d%4d", 5, s.numSatellites);
       expected += buf;
-      const Eigen::Vector3d v = s.velocity.value_or(Eigen::Vector3d::Zero());
-      const Eigen::Matrix3d V = s.velocity ? s.velocityCovariance : Eigen::Matrix3d::Zero();
-      std::snprintf(buf, sizeof buf, "%11.5f%11.5f%11.5f %9.5f%9.5f%9.5f%9.5f%9.5f%9.5f\n", v.x(), v.y(), v.z(),
-                    std::sqrt(std::max(V(0, 0), 0.0)), std::sqrt(std::max(V(1, 1), 0.0)),
-                    std::sqrt(std::max(V(2, 2), 0.0)), signedSqrt(V(0, 1)), signedSqrt(V(1, 2)), signedSqrt(V(2, 0)));
-      expected += buf;
+      for (int k = 0; k < 3; ++k) f(std::sqrt(std::max(P(k, k), 0.0)), 9, 4);
+      f(signedSqrt(P(0, 1)), 9, 4);
+      f(signedSqrt(P(1, 2)), 9, 4);
+      f(signedSqrt(P(2, 0)), 9, 4);
+      f(s.age, 7, 2);
+      f(s.ratio, 7, 1);
+      // No velocity: nan in all six columns.
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      const Eigen::Vector3d v = s.velocity.value_or(Eigen::Vector3d::Constant(nan));
+      const Eigen::Matrix3d V = s.velocity ? s.velocityCovariance : Eigen::Matrix3d::Constant(nan);
+      for (int k = 0; k < 3; ++k) f(v[k], 11, 5);
+      expected += ' ';
+      for (int k = 0; k < 3; ++k) f(std::sqrt(std::max(V(k, k), 0.0)), 9, 5);
+      f(signedSqrt(V(0, 1)), 9, 5);
+      f(signedSqrt(V(1, 2)), 9, 5);
+      f(signedSqrt(V(2, 0)), 9, 5);
+      expected += '\n';
     }
     w.finish();
     EXPECT_EQ(os.str(), expected) << "time decimals " << decimals;
   }
+}
+
+/// The whitespace-separated fields of the data rows of a .pos text.
+std::vector<std::vector<std::string>> dataRows(const std::string& text) {
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '%') continue;
+    std::istringstream ls(line);
+    std::vector<std::string> f;
+    for (std::string t; ls >> t;) f.push_back(t);
+    rows.push_back(f);
+  }
+  return rows;
+}
+
+TEST(PosIo, WideValuesStaySeparatedAndRoundTrip) {
+  // Values as wide as their fields or wider (a diverged velocity, a huge sd, a negative ratio):
+  // printf's layout runs them into the field before ("0.0-1475.85308"); ours keeps a blank.
+  PositionSolution s = sample(0);
+  s.position = Eigen::Vector3d(-3817679.8533, 3562838.2326, 3650159.8842);
+  s.ratio = -123456.7;
+  s.age = 99999.99;
+  s.positionCovariance = Eigen::Matrix3d::Identity() * 1e10;  // sd 100000.0000: 11 characters in %9.4f
+  s.velocity = Eigen::Vector3d(-1475.85308, 582.16883, -3156.54187);
+  s.velocityCovariance = Eigen::Matrix3d::Identity() * 1e6;  // sd 1000.00000 in %9.5f
+  s.residualTest = ResidualTest::Failed;
+  for (PosCoordinates layout : {PosCoordinates::Xyz, PosCoordinates::Llh}) {
+    std::ostringstream os;
+    PosWriterOptions o;
+    o.coordinates = layout;
+    o.testColumn = true;
+    {
+      PosWriter w(os, o);
+      w.write(s);
+      w.write(sample(2));
+    }
+    const auto rows = dataRows(os.str());
+    ASSERT_EQ(rows.size(), 2u);
+    // date time, 3 coordinates, Q ns, 6 sd, age ratio, 3 velocities, 6 sd, test
+    EXPECT_EQ(rows[0].size(), 25u) << os.str();
+    EXPECT_EQ(rows[1].size(), 25u) << os.str();
+    if (layout == PosCoordinates::Xyz) {
+      EXPECT_EQ(rows[0][14], "-123456.7");
+      EXPECT_EQ(rows[0][15], "-1475.85308");
+      EXPECT_EQ(rows[0][16], "582.16883");
+      EXPECT_EQ(rows[0][17], "-3156.54187");
+    }
+    const PosFile f = parsePosText(os.str(), "wide.pos");
+    ASSERT_EQ(f.solutions.size(), 2u);
+    const PositionSolution& b = f.solutions[0];
+    EXPECT_DOUBLE_EQ(b.ratio, s.ratio);
+    EXPECT_DOUBLE_EQ(b.age, s.age);
+    EXPECT_NEAR(std::sqrt(b.positionCovariance(2, 2)), 1e5, 1e-3);
+    ASSERT_TRUE(b.velocity);
+    EXPECT_LT((*b.velocity - *s.velocity).norm(), 2e-5);
+    EXPECT_NEAR(std::sqrt(b.velocityCovariance(1, 1)), 1e3, 1e-4);
+    EXPECT_EQ(b.residualTest, ResidualTest::Failed);
+    EXPECT_EQ(f.solutions[1].residualTest, ResidualTest::Untestable);  // not set: written as 2
+  }
+}
+
+TEST(PosIo, AbsentVelocityIsNanAndReadsBackAbsent) {
+  // An epoch without velocity: nan in the six velocity columns (not 0 with sd 0, a measured
+  // standstill), read back as no velocity; the header says what nan means.
+  PositionSolution s = sample(1);
+  ASSERT_FALSE(s.velocity);
+  std::ostringstream os;
+  PosWriterOptions o;
+  o.coordinates = PosCoordinates::Xyz;
+  {
+    PosWriter w(os, o);
+    w.write(s);
+    w.write(sample(0));
+  }
+  EXPECT_NE(os.str().find("% (velocity columns nan: no velocity in that epoch)"), std::string::npos) << os.str();
+  const auto rows = dataRows(os.str());
+  ASSERT_EQ(rows.size(), 2u);
+  ASSERT_EQ(rows[0].size(), 24u);
+  for (int i = 15; i < 24; ++i) EXPECT_EQ(rows[0][i], "nan") << i;
+  EXPECT_NE(rows[1][15], "nan");
+  const PosFile f = parsePosText(os.str(), "nan.pos");
+  ASSERT_EQ(f.solutions.size(), 2u);
+  EXPECT_FALSE(f.solutions[0].velocity.has_value());
+  EXPECT_TRUE(f.solutions[0].velocityCovariance.isZero(0.0));
+  ASSERT_TRUE(f.solutions[1].velocity.has_value());
+  EXPECT_FALSE(f.solutions[0].residualTest.has_value());  // no test column
+  // A velocity that is nan on one axis only is malformed.
+  std::string text = os.str();
+  const std::size_t at = text.rfind('\n', text.size() - 2) + 1;
+  std::string row = text.substr(at);
+  const auto nrow = dataRows(row)[0];
+  std::string broken;
+  for (std::size_t i = 0; i < nrow.size(); ++i) broken += (i ? " " : "") + (i == 16 ? std::string("nan") : nrow[i]);
+  EXPECT_THROW(parsePosText(text.substr(0, at) + broken + "\n", "partial.pos"), ParseError);
 }
 
 TEST(PosIo, ReadsRtklibSolutionFiles) {

@@ -272,6 +272,48 @@ TEST(Spp, CovarianceIsConsistentWithSimulatedNoise) {
   EXPECT_NEAR(nees, 3.0, 0.5);
 }
 
+TEST(Spp, VarianceFactorScalesTheCovarianceWhenTheWeightsAreOptimistic) {
+  // The noise is 3x the weighting model's sigma (1 m against 0.3 m): the least-squares covariance
+  // is 9x too small (NEES ~27); scaled by the a-posteriori variance factor it describes the error
+  // again (NEES ~3). The solution itself does not change.
+  SppConfig c = plainConfig();
+  c.weighting.a = 0.3;
+  c.weighting.b = 0.0;
+  c.ephemerisError.fill(0.0);
+  c.faultExclusion.enabled = false;
+  c.robust.enabled = false;
+  c.isbPriorSigma = 0.0;
+  c.velocity = false;
+  SppConfig raw = c;
+  raw.covarianceScaling.enabled = false;
+  SimOptions o;
+  o.position = kNagoyaRover;
+  o.noise = 1.0;
+  std::mt19937 rng(7);
+  o.rng = &rng;
+  const int trials = 300;
+  double nees = 0.0, neesRaw = 0.0;
+  for (int i = 0; i < trials; ++i) {
+    const ObsEpoch e = simulate(nagoyaNav(), kNagoyaTime + i * 10.0, o);
+    SppSolver solver(nagoyaNav(), c), rawSolver(nagoyaNav(), raw);
+    solver.setInitialPosition(kNagoyaRover);
+    rawSolver.setInitialPosition(kNagoyaRover);
+    const SppSolution s = solver.solve(e), r = rawSolver.solve(e);
+    ASSERT_TRUE(s.valid());
+    ASSERT_TRUE(r.valid());
+    EXPECT_EQ(s.position, r.position);
+    EXPECT_DOUBLE_EQ(r.varianceFactor, 1.0);
+    EXPECT_NEAR(s.varianceFactor, (s.chi2 + 2.0) / (s.dof + 2.0), 1e-12);
+    const Eigen::Vector3d d = s.position - o.position;
+    nees += d.dot(s.positionCovariance.ldlt().solve(d));
+    neesRaw += d.dot(r.positionCovariance.ldlt().solve(d));
+  }
+  nees /= trials;
+  neesRaw /= trials;
+  EXPECT_GT(neesRaw, 15.0);
+  EXPECT_NEAR(nees, 3.0, 0.6);
+}
+
 TEST(Spp, DopplerVelocityAndClockDriftFromFiniteDifferenceRanges) {
   SimOptions o;
   o.position = kNagoyaRover;

@@ -9,6 +9,8 @@
 #include <sstream>
 
 #include "gvins/base/geodetic.hpp"
+#include "gvins/base/rinex_obs_reader.hpp"
+#include "gvins/base/rinex_obs_writer.hpp"
 #include "gvins/ephemeris/broadcast_sp3.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
@@ -85,7 +87,9 @@ TEST(SppCli, XyzLayoutOptionsAndConfig) {
   }
   EXPECT_EQ(rows, 900);
   EXPECT_NE(header.find("x-ecef(m)"), std::string::npos);
-  EXPECT_NE(header.find("vx(m/s)"), std::string::npos);
+  // Velocity disabled: no velocity columns, and the header says why.
+  EXPECT_EQ(header.find("vx(m/s)"), std::string::npos);
+  EXPECT_NE(header.find(" test"), std::string::npos);
   std::filesystem::remove(out);
   std::filesystem::remove(cfg);
 }
@@ -295,4 +299,102 @@ TEST(SppCli, SsrCorrectionsFromARecordedStream) {
   EXPECT_NE(missing.err.find(missingFile), std::string::npos) << missing.err;
   EXPECT_FALSE(std::filesystem::exists(tmp("m.pos")));
   for (const std::string& f : {ssr, cfg, a, b}) std::filesystem::remove(f);
+}
+
+// Epochs whose residual test fails even after fault exclusion are written with test = 1 in the
+// last column (Q stays 5, RTKLIB's "single"), told apart from the good ones, and --drop-failed
+// omits them. Real Nagoya epochs; in five of them the pseudoranges of every third satellite are
+// moved by +-100 m, more faults than fault exclusion removes (at most six per epoch).
+TEST(SppCli, FailedResidualTestIsFlaggedAndDropFailedOmitsIt) {
+  const std::string obs = tmp("fault.obs"), out = tmp("fault.pos"), dropped = tmp("fault_drop.pos");
+  std::vector<gvins::GpsTime> faulty;
+  {
+    gvins::RinexObsReader in(kData + "/gnss/nagoya_static_2024/rover.obs.gz");
+    std::ofstream f(obs);
+    gvins::RinexObsWriter w(f, in.header());
+    gvins::ObsEpoch e;
+    for (int i = 0; i < 60 && in.next(e); ++i) {
+      if (i >= 30 && i < 35) {
+        ASSERT_GE(e.sats.size(), 20u);
+        // Every third satellite (14 of 42, about 11 of them above the mask with ephemerides).
+        for (std::size_t k = 0; k < e.sats.size(); k += 3) {
+          for (auto& sig : e.sats[k].signals) {
+            if (sig.hasCode()) sig.pseudorange += k % 2 ? 100.0 : -100.0;
+          }
+        }
+        faulty.push_back(e.time);
+      }
+      w.write(e);
+    }
+    w.finish();
+  }
+  const std::string nav = kData + "/gnss/nagoya_static_2024/base.nav.gz";
+  const CliRun r = run("-q -o " + out + " " + obs + " " + nav);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("written with test = 1"), std::string::npos) << r.err;
+  const gvins::PosFile f = gvins::readPosFile(out);
+  ASSERT_EQ(f.solutions.size(), 60u);
+  int failed = 0, passed = 0;
+  for (const auto& s : f.solutions) {
+    ASSERT_TRUE(s.residualTest.has_value());
+    EXPECT_EQ(s.quality, gvins::SolutionQuality::Single);
+    // Solution time = tag minus the receiver clock (< 1 ms here).
+    bool isFaulty = false;
+    for (const auto& t : faulty) isFaulty = isFaulty || std::abs(s.time - t) < 0.01;
+    if (isFaulty) {
+      EXPECT_EQ(*s.residualTest, gvins::ResidualTest::Failed);
+    }
+    failed += *s.residualTest == gvins::ResidualTest::Failed;
+    passed += *s.residualTest == gvins::ResidualTest::Passed;
+  }
+  // The clean epochs of this recording pass (RTKLIB solves all of them too).
+  EXPECT_EQ(failed, 5);
+  EXPECT_EQ(passed, 55);
+  // The flag as text: the last field of the rows.
+  {
+    std::ifstream in(out);
+    std::string line, title;
+    int ones = 0;
+    while (std::getline(in, line)) {
+      if (line.rfind("%  GPST", 0) == 0) title = line;
+      if (line.empty() || line[0] == '%') continue;
+      ones += line.substr(line.find_last_not_of(' ') - 1) == " 1";
+    }
+    EXPECT_EQ(title.substr(title.size() - 5), " test");
+    EXPECT_EQ(ones, 5);
+  }
+  const CliRun d = run("-q --drop-failed -o " + dropped + " " + obs + " " + nav);
+  ASSERT_EQ(d.code, 0) << d.err;
+  EXPECT_NE(d.err.find("omitted: --drop-failed"), std::string::npos) << d.err;
+  const gvins::PosFile g = gvins::readPosFile(dropped);
+  ASSERT_EQ(g.solutions.size(), 55u);
+  for (const auto& s : g.solutions) {
+    EXPECT_EQ(*s.residualTest, gvins::ResidualTest::Passed);
+    for (const auto& t : faulty) EXPECT_GT(std::abs(s.time - t), 0.5);
+  }
+  if (!::testing::Test::HasFailure()) std::filesystem::remove(obs);
+  std::filesystem::remove(out);
+  std::filesystem::remove(dropped);
+}
+
+// A rover without Doppler (Kamakura) has no velocity columns and says so; one with Doppler has
+// them, with a velocity in every epoch here.
+TEST(SppCli, VelocityColumnsOnlyWithDoppler) {
+  const std::string out = tmp("nodopp.pos");
+  const CliRun r = run("-q -o " + out + " " + kData + "/gnss/kamakura_static_2021/SEPT078M.21O.gz " + kData +
+                       "/gnss/kamakura_static_2021/SEPT078M.21P.gz");
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream in(out);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string text = ss.str();
+  EXPECT_NE(text.find("% (no velocity columns: no Doppler observations in the input)"), std::string::npos);
+  EXPECT_EQ(text.find("vn(m/s)"), std::string::npos);
+  const gvins::PosFile f = gvins::readPosFile(out);
+  ASSERT_EQ(f.solutions.size(), 900u);
+  for (const auto& s : f.solutions) {
+    EXPECT_FALSE(s.velocity.has_value());
+    EXPECT_TRUE(s.residualTest.has_value());
+  }
+  std::filesystem::remove(out);
 }

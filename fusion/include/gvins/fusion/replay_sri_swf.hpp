@@ -65,6 +65,9 @@ class GnssFusionReplayClient final : public ReplayGnss {
     o.chi2 = r.chi2, o.dof = r.dof;
     o.antennaEcef = r.antennaEcef;
     o.antennaVelocityEcef = r.antennaVelocityEcef;
+    if (r.antennaEcef) {
+      if (const auto c = fusion_.antennaCovariance(est_, r.t_ns)) o.antennaCovarianceEcef = *c;
+    }
     return o;
   }
   std::optional<Eigen::Vector3d> leverArm() const override { return fusion_.leverArm(est_); }

@@ -1,7 +1,8 @@
 // Reader of RTKLIB-compatible solution files (.pos) in either coordinate layout: geodetic
 // ("latitude(deg) longitude(deg) height(m)" with optional n/e/u sd and velocity columns) or ECEF
 // ("x-ecef(m) ..."), GPST times as "yyyy/mm/dd hh:mm:ss.sss" or "week tow". Velocity columns that
-// are all zero, values and sd alike, mean "no velocity" (RTKLIB's convention). Used to compare our
+// are nan (our writer) or all zero, values and sd alike (RTKLIB's convention), mean "no velocity".
+// A last column titled "test" is our residual-test flag (PositionSolution::residualTest). Used to compare our
 // solutions with RTKLIB's and to evaluate any stored result against a truth.
 #pragma once
 

@@ -1,7 +1,10 @@
 // Writer of RTKLIB-compatible solution files (.pos): header lines starting with '%', then one
 // row per epoch with GPST time, position (geodetic degrees/height or ECEF), quality, number of
 // satellites, standard deviations with signed square roots of the covariances, age, ratio and,
-// optionally, velocity with its standard deviations (RTKLIB's "out-outvel" columns).
+// optionally, velocity with its standard deviations (RTKLIB's "out-outvel" columns; nan where an
+// epoch has no velocity) and the residual-test column. Fields keep printf's widths; a value that
+// fills or overflows its field is preceded by one blank more, so columns never run together.
+// The layout and its additions: docs/pos_format.md.
 #pragma once
 
 #include <iosfwd>
@@ -19,12 +22,17 @@ enum class PosCoordinates {
 
 struct PosWriterOptions {
   PosCoordinates coordinates = PosCoordinates::Llh;
-  bool velocity = true;    ///< velocity columns (zeros for epochs without a velocity)
+  bool velocity = true;    ///< velocity columns (nan for epochs without a velocity)
+  /// A last column "test": the epoch's residual (RAIM) test, PositionSolution::residualTest
+  /// (0 passed, 1 failed, 2 not testable; 2 when not set). RTKLIB's readers ignore it.
+  bool testColumn = false;
   int timeDecimals = 3;    ///< decimals of the seconds, 0-9
   bool header = true;
   std::string program = "SRI-GVINS";
   /// Extra "% key : value" header lines (input files, options), written after the program line.
   std::vector<std::pair<std::string, std::string>> headerFields;
+  /// Extra "% (note)" lines after the column legend (e.g. why the velocity is absent).
+  std::vector<std::string> notes;
 };
 
 class PosWriter {

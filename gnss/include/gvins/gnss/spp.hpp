@@ -57,6 +57,8 @@ struct SppSolution {
   SppStatus status = SppStatus::NoObservations;
   Eigen::Vector3d position = Eigen::Vector3d::Zero();            ///< ECEF, m
   Eigen::Matrix3d positionCovariance = Eigen::Matrix3d::Zero();  ///< ECEF, m^2
+  /// Factor the least-squares covariance was scaled by (SppConfig::covarianceScaling; 1: none).
+  double varianceFactor = 1.0;
   /// Receiver clock bias per system (m), present for the systems estimated.
   std::array<std::optional<double>, kNumSystems> clockBias;
   std::array<double, kNumSystems> clockBiasVariance{};

@@ -32,6 +32,21 @@ struct RobustEstimation {
   int maxIterations = 3;
 };
 
+/// Scaling of the reported covariance (position, clocks) by the a-posteriori variance factor of
+/// the fit when the residuals say the a-priori weights are optimistic:
+///   k = max(1, (chi2 + nu0) / (dof + nu0)),
+/// the posterior of the unit variance with a prior of nu0 degrees of freedom at 1 (with few
+/// degrees of freedom chi2/dof alone is too noisy to scale by; cf. Koch 1999, Parameter
+/// Estimation and Hypothesis Testing in Linear Models, ch. 3). Never below 1: on open-sky data the
+/// a-priori covariance is already conservative while the residuals are far smaller than the
+/// weights say, so a factor below 1 would shrink it where the errors common to all satellites
+/// (which residuals cannot show) dominate. Only the reported covariance changes, never the
+/// solution. Measured on real and simulated data: bench/spp/sigma_calibration.py, docs/spp.md.
+struct CovarianceScaling {
+  bool enabled = true;
+  double priorDof = 2.0;
+};
+
 /// A common correction to the broadcast ionosphere model's zenith delay, estimated with the
 /// position from the elevation dependence of the residuals (partial: the model's obliquity
 /// factor), constrained by a prior of `priorFraction` of the modelled zenith delay.
@@ -80,6 +95,7 @@ struct SppConfig {
   FaultExclusionOptions faultExclusion;
   RobustEstimation robust;
   IonosphereEstimation ionosphereEstimation;
+  CovarianceScaling covarianceScaling;
   double maxGdop = 30.0;
   /// Inter-system clock biases: a prior from earlier epochs keeps systems with one or two
   /// satellites useful; sigma of the prior (m) and random-walk noise (m^2/s). 0 disables.
@@ -125,6 +141,7 @@ struct SppConfig {
 ///                       max_candidates: 10, min_redundancy: 1}
 ///     robust: {enabled: true, k0: 2.0, k1: 5.0, min_scale: 0.5, max_iterations: 3}
 ///     ionosphere_estimation: {enabled: true, prior_fraction: 1.0, min_prior_sigma_m: 0.3}
+///     covariance_scaling: {enabled: true, prior_dof: 2}
 ///     max_gdop: 30
 ///     isb_prior_sigma_m: 2
 ///     isb_random_walk_m2ps: 0.01
