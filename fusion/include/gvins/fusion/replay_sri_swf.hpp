@@ -65,6 +65,7 @@ class GnssFusionReplayClient final : public ReplayGnss {
     o.chi2 = r.chi2, o.dof = r.dof;
     o.antennaEcef = r.antennaEcef;
     o.antennaVelocityEcef = r.antennaVelocityEcef;
+    o.warnings = r.warnings;
     return o;
   }
   std::optional<Eigen::Vector3d> leverArm() const override { return fusion_.leverArm(est_); }
