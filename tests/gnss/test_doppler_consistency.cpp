@@ -18,6 +18,7 @@
 #include "gvins/base/geodetic.hpp"
 #include "gvins/base/rinex_obs_reader.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
+#include "gvins/gnss/base_reader.hpp"
 #include "gvins/gnss/doppler_consistency.hpp"
 #include "gvins/gnss/rtk.hpp"
 #include "gvins/gnss/spp.hpp"
@@ -157,6 +158,31 @@ TEST(DopplerConsistency, RecordedFilesAreConsistent) {
     EXPECT_TRUE(c.warnings().empty()) << f;
     EXPECT_EQ(c.counts().withheld + c.counts().dropped + c.counts().passed, 0) << f;
   }
+}
+
+TEST(DopplerConsistency, RtcmMsm7StreamIsConsistent) {
+  // IGS station GMSD as RTCM 3 MSM7 (GPS, GLONASS, QZSS, BeiDou): the decoder's Doppler (from the
+  // MSM phase-range rate) agrees with its phase rate on every signal.
+  EphemerisStore nav;
+  auto reader = BaseReader::open(kData + "/rtcm/rtklib_GMSD7_20121014.rtcm3",
+                                 GpsTime::fromCalendar({2012, 10, 13, 12, 0, 0.0}), &nav);
+  std::vector<ObsEpoch> epochs;
+  for (ObsEpoch e; reader->next(e);) epochs.push_back(e);
+  ASSERT_GT(epochs.size(), 200u);
+  const DopplerConsistency c = judge(epochs, reader->glonassChannels(), "base");
+  const auto signals = c.signals();
+  ASSERT_EQ(signals.size(), 4u);  // G L1C, R L1C, J L1C (one satellite), C L2I
+  for (const DopplerSignalReport& r : signals) {
+    EXPECT_EQ(r.verdict, DopplerVerdict::Consistent) << r.name();
+    EXPECT_LT(r.medianConsistent, 0.05) << r.name();
+    EXPECT_GT(r.medianFlipped, 50.0) << r.name();
+  }
+  EXPECT_TRUE(c.warnings().empty());
+  EXPECT_EQ(c.counts().dropped + c.counts().corrected, 0);
+  // The same stream with the receiver quirk of a flipped MSM Doppler: every signal corrected.
+  const DopplerConsistency f = judge(doctored(epochs, flipAll), reader->glonassChannels(), "base");
+  EXPECT_EQ(countVerdict(f, DopplerVerdict::SignFlipped), 4);
+  EXPECT_EQ(f.warnings().size(), 4u);
 }
 
 TEST(DopplerConsistency, FlippedSignIsCorrectedAndSppVelocitiesAreTheOriginal) {
