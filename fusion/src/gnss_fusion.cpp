@@ -726,6 +726,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
     spp_ = std::make_unique<SppSolver>(nav);
     if (config_.usesDifferences()) {
       rtk_ = std::make_unique<RtkSolver>(nav);
+      baseWarned_ = 0;
       if (config_.basePosition) rtk_->setBasePosition(*config_.basePosition);
     }
   }
@@ -769,6 +770,8 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
         rtk_->addBaseEpoch(*base);
       }
       lastBase_ = base->time;
+      const std::vector<std::string>& w = rtk_->base().doppler().warnings();  // the base's Doppler check
+      for (; baseWarned_ < w.size(); ++baseWarned_) rep.warnings.push_back(w[baseWarned_]);
     }
     const std::optional<GpsTime> lastRun = rtk_->lastProcessTime();
     rtkDeferred = fullRtk && newBase && config_.rtkHoldFix && rtk_->hasHeldFix() && lastRun &&

@@ -172,6 +172,7 @@ RunResult run(GnssFusionConfig cfg, const SatelliteCut& cut = {}, const Ephemeri
   cfg.basePosition = sc.basePosition;
   GnssFusion<Scalar> fusion(cfg);
   const ObsEpoch* base = nullptr;
+  ObsEpoch flippedBase;
   RunResult out;
   double p2 = 0, h2 = 0, v2 = 0, c2 = 0, isb2 = 0, micros = 0;
   int n = 0, nAll = 0;
@@ -179,6 +180,13 @@ RunResult run(GnssFusionConfig cfg, const SatelliteCut& cut = {}, const Ephemeri
   for (const sim::GnssSimEpoch& e : sc.epochs) {
     if (e.role == sim::GnssReceiverRole::Base) {
       base = &e.obs;
+      if (flipDoppler) {
+        flippedBase = e.obs;
+        for (SatObs& so : flippedBase.sats) {
+          for (SignalObs& sig : so.signals) sig.doppler = -sig.doppler;
+        }
+        base = &flippedBase;
+      }
       continue;
     }
     const double tf = sc.frame.flightTime(e.obs.time);
@@ -780,8 +788,8 @@ TEST(GnssFusionSim, DriftingInterSystemBiasIsFollowed) {
 }
 
 // The simulated rover (moving, with its own clock drift) passes the fusion's Doppler check
-// unchanged; with its Doppler sign flipped at the input, the check corrects every signal, names
-// each once, and the fused solution is the same to the last bit.
+// unchanged; with its Doppler sign flipped at the input (rover and base), the checks correct every
+// signal, name each once, and the fused solution is the same to the last bit.
 TEST(GnssFusionSim, FlippedDopplerIsCorrectedAtTheInput) {
   const RunResult a = run<double>(mode(GnssFusionMode::kDoppPsr));
   const RunResult b = run<double>(mode(GnssFusionMode::kDoppPsr), {}, nullptr, -1.0, {}, true);
@@ -798,6 +806,19 @@ TEST(GnssFusionSim, FlippedDopplerIsCorrectedAtTheInput) {
   EXPECT_EQ(b.dopp.used, a.dopp.used);
   EXPECT_EQ(b.posRms, a.posRms);
   EXPECT_EQ(b.velRms, a.velRms);
+  // Ddcp: the base's Doppler (checked in the RTK module) flipped as well.
+  const RunResult c = run<double>(mode(GnssFusionMode::kDoppDdcp));
+  const RunResult d = run<double>(mode(GnssFusionMode::kDoppDdcp), {}, nullptr, -1.0, {}, true);
+  EXPECT_TRUE(c.dopplerWarnings.empty());
+  const auto baseWarnings = std::count_if(d.dopplerWarnings.begin(), d.dopplerWarnings.end(), [](const std::string& w) {
+    return w.rfind("base: Doppler sign flipped on ", 0) == 0;
+  });
+  EXPECT_GT(baseWarnings, 0);
+  EXPECT_EQ(d.dopplerWarnings.size(), b.dopplerWarnings.size() + static_cast<std::size_t>(baseWarnings));
+  ASSERT_GT(c.fixedEpochs, 50);
+  EXPECT_EQ(d.fixedEpochs, c.fixedEpochs);
+  EXPECT_EQ(d.ddcp.used, c.ddcp.used);
+  EXPECT_EQ(d.posRms, c.posRms);
 }
 
 }  // namespace

@@ -79,7 +79,7 @@ struct GnssEpochReport {
   double chi2 = 0.0;
   int dof = 0;
   double elapsedMicroseconds = 0.0;
-  std::vector<std::string> warnings;  ///< new this epoch (Doppler sanity of the rover)
+  std::vector<std::string> warnings;  ///< new this epoch (Doppler check of the rover and the base)
 };
 
 template <typename Scalar>
@@ -187,7 +187,8 @@ class GnssFusion {
   std::unique_ptr<SppSolver> spp_;
   std::unique_ptr<RtkSolver> rtk_;
   DopplerConsistency roverDoppler_{"rover"};
-  ObsEpoch checkedRover_;  // the rover epoch after the Doppler check
+  ObsEpoch checkedRover_;      // the rover epoch after the Doppler check
+  std::size_t baseWarned_ = 0;  // warnings of rtk_'s base Doppler check already reported
   std::optional<GpsTime> lastBase_;
   std::unique_ptr<CarrierSmoother> smoother_, baseSmoother_;  // carrierSmoothing > 0: psr, dpsr
   ObsEpoch smoothed_;
