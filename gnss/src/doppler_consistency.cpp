@@ -111,7 +111,7 @@ void DopplerConsistency::sample(const ObsEpoch& epoch, const GlonassChannels& ch
             ok = true;
           } else if (!hasPhase && hasCode && tr->hasCode) {
             // Signals without phase only: a phase-less interval of a phase signal is a slip.
-            vl = (s.pseudorange - tr->code_) / dt;
+            vl = (s.pseudorange - tr->pseudorange) / dt;
             tol = 2.0 * std::sqrt(2.0) * options_.codeSigma / dt + options_.phaseTolerance +
                   options_.dopplerJerk * dt * dt / 12.0;
             ok = true;
@@ -138,7 +138,7 @@ void DopplerConsistency::sample(const ObsEpoch& epoch, const GlonassChannels& ch
       tr->hasPhase = hasPhase;
       tr->hasCode = hasCode;
       tr->phase = s.carrierPhase;
-      tr->code_ = s.pseudorange;
+      tr->pseudorange = s.pseudorange;
       tr->doppler = s.doppler;
     }
   }
@@ -158,7 +158,53 @@ void DopplerConsistency::decide(SignalState& s) {
     f.push_back(x.flipped);
   }
   const double mc = median(c), mf = median(f);
+  // One hypothesis within its tolerance and the other clearly rejected (a signal whose range
+  // rates are all small, e.g. one satellite near its closest approach, cannot tell them apart yet).
+  constexpr double kRejected = 3.0;
+  DopplerVerdict verdict = DopplerVerdict::Pending;
+  double factor = 1.0;
+  if (mc <= 1.0 && mf > kRejected) {
+    verdict = DopplerVerdict::Consistent;
+  } else if (mf <= 1.0 && mc > kRejected) {
+    verdict = DopplerVerdict::SignFlipped;
+    factor = -1.0;
+  } else if (mc > kRejected && mf > kRejected) {
+    // A scale error: the ratio v_D / v_L from the samples with a well-determined ratio (|v_L|
+    // far above the tolerance), then the residual about that line.
+    verdict = DopplerVerdict::Inconsistent;
+    std::vector<double> k;
+    for (const Sample& x : s.samples) {
+      if (std::abs(x.vl) > 20.0 * x.tolerance) k.push_back(x.vd / x.vl);
+    }
+    if (static_cast<int>(k.size()) * 2 >= n) {
+      const double ratio = median(k);
+      std::vector<double> res;
+      for (const Sample& x : s.samples) res.push_back(std::abs(x.vd - ratio * x.vl) / x.tolerance);
+      if (median(res) <= 1.0 && std::abs(ratio - 1.0) > options_.scaleTolerance &&
+          std::abs(ratio + 1.0) > options_.scaleTolerance) {
+        verdict = DopplerVerdict::Scaled;
+        factor = ratio;
+      }
+    }
+  } else if (s.intervals >= options_.maxPendingIntervals) {
+    // Never clearly apart (e.g. only geostationary satellites): the hypothesis within tolerance
+    // that fits better (the RINEX convention on a tie); neither within tolerance: not trusted.
+    if (mc <= 1.0 && mc <= mf) {
+      verdict = DopplerVerdict::Consistent;
+    } else if (mf <= 1.0) {
+      verdict = DopplerVerdict::SignFlipped;
+      factor = -1.0;
+    } else {
+      verdict = DopplerVerdict::Inconsistent;
+    }
+  }
+  if (verdict == DopplerVerdict::Pending) {
+    if (s.samples.size() > 1000) s.samples.erase(s.samples.begin(), s.samples.begin() + 500);
+    return;
+  }
   DopplerSignalReport& r = s.report;
+  r.verdict = verdict;
+  r.factor = factor;
   r.samples = n;
   r.fromPhase = 2 * std::count_if(s.samples.begin(), s.samples.end(), [](const Sample& x) { return x.phase; }) >= n;
   r.satellites = static_cast<int>(s.satellites.size());
@@ -170,30 +216,6 @@ void DopplerConsistency::decide(SignalState& s) {
   }
   r.medianConsistent = median(cm);
   r.medianFlipped = median(fm);
-  if (mc <= 1.0 && mc <= mf) {
-    r.verdict = DopplerVerdict::Consistent;
-  } else if (mf <= 1.0 && mf < mc) {
-    r.verdict = DopplerVerdict::SignFlipped;
-    r.factor = -1.0;
-  } else {
-    // A scale error: the ratio v_D / v_L from the samples with a well-determined ratio (|v_L|
-    // far above the tolerance), then the residual about that line.
-    std::vector<double> k;
-    for (const Sample& x : s.samples) {
-      if (std::abs(x.vl) > 20.0 * x.tolerance) k.push_back(x.vd / x.vl);
-    }
-    r.verdict = DopplerVerdict::Inconsistent;
-    if (static_cast<int>(k.size()) * 2 >= n) {
-      const double factor = median(k);
-      std::vector<double> res;
-      for (const Sample& x : s.samples) res.push_back(std::abs(x.vd - factor * x.vl) / x.tolerance);
-      if (median(res) <= 1.0 && std::abs(factor - 1.0) > options_.scaleTolerance &&
-          std::abs(factor + 1.0) > options_.scaleTolerance) {
-        r.verdict = DopplerVerdict::Scaled;
-        r.factor = factor;
-      }
-    }
-  }
   s.samples.clear();
   s.samples.shrink_to_fit();
   if (r.verdict != DopplerVerdict::Consistent) warn(r);

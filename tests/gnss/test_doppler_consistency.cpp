@@ -340,3 +340,35 @@ TEST(DopplerConsistency, ClockDriftJumpsAndSlipsDoNotMoveTheVerdict) {
   const DopplerConsistency bad = judge(doctored(drifting, flipAll), d.roverHeader.glonassChannels, "rover");
   EXPECT_EQ(countVerdict(bad, DopplerVerdict::SignFlipped), 15);
 }
+
+TEST(DopplerConsistency, SmallRangeRatesWaitThenTakeTheConvention) {
+  // One satellite at a constant range rate (exact RINEX-convention data: L(t) = L0 − D·t): at
+  // 500 Hz (95 m/s) the two hypotheses are far apart and the verdict comes once enough intervals
+  // are in (patientIntervals waives the satellite count); at 1 Hz (0.19 m/s, a geostationary
+  // satellite) both fit, the Doppler is withheld until maxPendingIntervals, then the convention.
+  for (const double dopplerHz : {500.0, 1.0}) {
+    DopplerConsistency dc("rover");
+    const GpsTime t0 = GpsTime::fromWeekTow(2000, 0.0);
+    int decidedAt = -1;
+    for (int i = 0; i <= 70; ++i) {
+      ObsEpoch e;
+      e.time = t0 + static_cast<double>(i);
+      SignalObs s;
+      s.code = ObsCode('1', 'C');
+      s.setCode(2.2e7 - 0.19029367 * dopplerHz * i);
+      s.setPhase(1.1e8 - dopplerHz * i);
+      s.setDoppler(dopplerHz);
+      e.add(SatId{System::Gps, 1}).signals.push_back(s);
+      dc.apply(e);
+      if (decidedAt < 0 && dc.verdict(System::Gps, s.code) != DopplerVerdict::Pending) decidedAt = i;
+      const SignalObs& out = e.sats[0].signals[0];
+      EXPECT_EQ(out.hasDoppler(), decidedAt >= 0) << i;
+      if (out.hasDoppler()) {
+        EXPECT_EQ(out.doppler, dopplerHz);
+      }
+    }
+    EXPECT_EQ(dc.verdict(System::Gps, ObsCode('1', 'C')), DopplerVerdict::Consistent) << dopplerHz;
+    EXPECT_EQ(decidedAt, dopplerHz > 100.0 ? 12 : dc.options().maxPendingIntervals) << dopplerHz;
+    EXPECT_TRUE(dc.warnings().empty());
+  }
+}

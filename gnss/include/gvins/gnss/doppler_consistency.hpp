@@ -19,11 +19,14 @@
 // the signal (several satellites, a few epochs), so cycle slips and receiver clock jumps that
 // reach the phase or code but not the Doppler (single intervals of a few satellites or epochs)
 // cannot move it:
-//   - Consistent:   median |r_consistent| ≤ 1 (and below the flipped one) — Doppler kept;
-//   - SignFlipped:  median |r_flipped| ≤ 1 — Doppler negated from then on;
-//   - Scaled:       v_D = k·v_L within tolerance for the median ratio k (a wrong wavelength or
-//                   unit) — Doppler dropped;
-//   - Inconsistent: none of these — Doppler dropped.
+//   - Consistent:   median |r_consistent| ≤ 1 and median |r_flipped| > 3 — Doppler kept;
+//   - SignFlipped:  median |r_flipped| ≤ 1 and median |r_consistent| > 3 — Doppler negated;
+//   - Scaled:       both > 3, but v_D = k·v_L within tolerance for the median ratio k (a wrong
+//                   wavelength or unit) — Doppler dropped;
+//   - Inconsistent: both > 3 otherwise — Doppler dropped.
+// While neither hypothesis is clearly rejected (small range rates) the signal stays undecided;
+// after maxPendingIntervals it takes the better one within tolerance (geostationary satellites:
+// their range rates stay small, and so does the error of a wrong choice), else Inconsistent.
 // Until a signal is decided its Doppler is withheld (absent), so no user ever sees an unchecked
 // value; a verdict is final for the stream. Each verdict other than Consistent produces one
 // warning naming the receiver label and the signal (e.g. "rover: Doppler sign flipped on G L1C
@@ -50,6 +53,8 @@ struct DopplerConsistencyOptions {
   int minIntervals = 3;            ///< ... over at least this many epoch intervals (one
                                    ///< interval with a receiver clock jump stays a minority)
   int patientIntervals = 10;       ///< after this many intervals minSatellites is waived
+  int maxPendingIntervals = 60;    ///< still undecided after this many: the better-fitting
+                                   ///< hypothesis within tolerance, else inconsistent
   double maxGap = 60.0;            ///< s, longest interval used
   double phaseTolerance = 0.5;     ///< m/s, |v_D − v_L| allowed (noise, Doppler time tag)
   double dopplerJerk = 1.0;        ///< m/s³, range jerk allowance: + jerk·Δt²/12
@@ -127,7 +132,7 @@ class DopplerConsistency {
     ObsCode code;
     GpsTime time;
     bool hasPhase = false, hasCode = false;
-    double phase = 0.0, code_ = 0.0, doppler = 0.0;
+    double phase = 0.0, pseudorange = 0.0, doppler = 0.0;
   };
   SignalState& state(System sys, ObsCode code);
   void sample(const ObsEpoch& epoch, const GlonassChannels& channels);
