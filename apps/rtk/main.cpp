@@ -360,6 +360,13 @@ int main(int argc, char** argv) {
   auto lastProgress = wall0;
   const double span = hdr.firstObs && hdr.lastObs ? *hdr.lastObs - *hdr.firstObs : 0.0;
   std::optional<GpsTime> first;
+  // Doppler verdicts other than "consistent" (doppler_consistency.hpp), printed when made.
+  std::size_t roverWarned = 0, baseWarned = 0;
+  auto showDopplerWarnings = [&](const DopplerConsistency& d, std::size_t& shown) {
+    for (; shown < d.warnings().size(); ++shown) {
+      std::fprintf(stderr, "%sgvins-rtk: warning: %s\n", tty ? "\r" : "", d.warnings()[shown].c_str());
+    }
+  };
 
   ObsEpoch baseEpoch;
   bool baseDone = false, basePending = false;
@@ -409,6 +416,8 @@ int main(int argc, char** argv) {
     }
 
     const RtkSolution sol = solver.process(roverEpoch);
+    showDopplerWarnings(solver.roverDoppler(), roverWarned);
+    showDopplerWarnings(solver.base().doppler(), baseWarned);
     if (sol.issue != RtkIssue::None) ++issues[sol.issue];
     if (sol.quality == SolutionQuality::Fix || sol.quality == SolutionQuality::Float) {
       ++arStatus[sol.ar];
@@ -533,6 +542,10 @@ int main(int argc, char** argv) {
   };
   slipLine("rover", solver.roverSlipCounts());
   slipLine("base ", solver.base().slipCounts());
+  for (const DopplerConsistency* d : {&solver.roverDoppler(), &solver.base().doppler()}) {
+    std::fprintf(stderr, "  %-5s Doppler           %s\n", d->label().c_str(), d->countsText().c_str());
+    for (const std::string& line : d->summary()) std::fprintf(stderr, "    %s\n", line.c_str());
+  }
   const DdFormationStats& ds = solver.differenceStats();
   if (ds.notAtBase || ds.signalMismatch || ds.noEphemeris || ds.systemDisabled) {
     std::fprintf(stderr, "  satellite-epochs       %lld not at base, %lld signal mismatches, %lld no ephemeris, %lld below mask\n",

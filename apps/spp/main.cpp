@@ -23,6 +23,7 @@
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "gvins/gnss/accuracy_statistics.hpp"
 #include "gvins/gnss/carrier_smoothing.hpp"
+#include "gvins/gnss/doppler_consistency.hpp"
 #include "gvins/gnss/pos_reader.hpp"
 #include "gvins/gnss/pos_writer.hpp"
 #include "gvins/gnss/spp.hpp"
@@ -394,6 +395,10 @@ int main(int argc, char** argv) {
   auto lastProgress = wall0;
   const double span = hdr.firstObs && hdr.lastObs ? *hdr.lastObs - *hdr.firstObs : 0.0;
   int exitCode = 0;
+  // Doppler sanity of the receiver (doppler_consistency.hpp): a flipped sign is corrected, a
+  // Doppler that disagrees with the phase/code rate is dropped, each with one warning.
+  DopplerConsistency doppler("rover");
+  std::size_t dopplerWarned = 0;
   ObsEpoch epoch;
   for (;;) {
     try {
@@ -404,6 +409,10 @@ int main(int argc, char** argv) {
       break;
     }
     ++epochs;
+    doppler.apply(epoch, channels);
+    for (; dopplerWarned < doppler.warnings().size(); ++dopplerWarned) {
+      std::fprintf(stderr, "%sgvins-spp: warning: %s\n", tty ? "\r" : "", doppler.warnings()[dopplerWarned].c_str());
+    }
     if (smoother) smoother->apply(epoch, channels);
     const SppSolution sol = solver.solve(epoch);
     ++statusCount[sol.status];
@@ -461,6 +470,8 @@ int main(int argc, char** argv) {
   std::fprintf(stderr, "  rows written           %8ld\n", written);
   std::fprintf(stderr, "  velocity solutions     %8ld\n", velocities);
   std::fprintf(stderr, "  mean satellites used   %8.1f\n", solutions ? satSum / solutions : 0.0);
+  std::fprintf(stderr, "  Doppler                %s\n", doppler.countsText().c_str());
+  for (const std::string& line : doppler.summary()) std::fprintf(stderr, "    %s\n", line.c_str());
   for (const auto& [st, n] : statusCount) {
     if (st != SppStatus::Ok && st != SppStatus::TestFailed) std::fprintf(stderr, "  no solution: %-22s %6ld\n", toString(st), n);
   }

@@ -713,11 +713,11 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
 }
 
 template <typename Scalar>
-GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& est, const ObsEpoch& roverRaw,
+GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& est, const ObsEpoch& roverInput,
                                                  const ObsEpoch* base, const EphemerisStore& nav) {
   const auto wall0 = std::chrono::steady_clock::now();
   GnssEpochReport rep;
-  rep.time = roverRaw.time;
+  rep.time = roverInput.time;
   auto finish = [&]() {
     if (leverBlock_.valid() && current(est)) leverLast_ = est.estimate(leverBlock_).vector.template cast<double>();
     rep.stage = stage_;
@@ -726,6 +726,13 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
     return rep;
   };
   if (config_.mode == GnssFusionMode::kVio) return finish();
+  // Doppler sanity of the rover stream before any user (doppler_consistency.hpp): flipped signs
+  // corrected, bad Dopplers dropped; the base's is checked inside the RTK module.
+  checkedRover_ = roverInput;
+  const std::size_t warned = roverDoppler_.warnings().size();
+  roverDoppler_.apply(checkedRover_, nav.glonassChannels());
+  rep.warnings.assign(roverDoppler_.warnings().begin() + static_cast<std::ptrdiff_t>(warned), roverDoppler_.warnings().end());
+  const ObsEpoch& roverRaw = checkedRover_;
   // Carrier-smoothed codes for the psr rows, and for the dpsr rows on both receivers (every epoch,
   // also before the VIO is ready, so that the arcs are long when the rows start). Ddcp keeps the
   // raw codes: its RTK filter estimates the ambiguities from phase minus code, which smoothing
@@ -754,6 +761,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
     spp_ = std::make_unique<SppSolver>(nav);
     if (config_.usesDifferences()) {
       rtk_ = std::make_unique<RtkSolver>(nav);
+      baseWarned_ = 0;
       if (config_.basePosition) rtk_->setBasePosition(*config_.basePosition);
     }
   }
@@ -797,6 +805,8 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
         rtk_->addBaseEpoch(*base);
       }
       lastBase_ = base->time;
+      const std::vector<std::string>& w = rtk_->base().doppler().warnings();  // the base's Doppler check
+      for (; baseWarned_ < w.size(); ++baseWarned_) rep.warnings.push_back(w[baseWarned_]);
     }
     const std::optional<GpsTime> lastRun = rtk_->lastProcessTime();
     rtkDeferred = fullRtk && newBase && config_.rtkHoldFix && rtk_->hasHeldFix() && lastRun &&

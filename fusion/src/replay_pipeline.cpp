@@ -681,6 +681,7 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
           const auto t0 = Clock::now();
           const ReplayGnssOutcome o = gnss->processEpoch(g.nextRover, g.haveCurrentBase ? &g.currentBase : nullptr, g.nav);
           const double ms = msSince(t0);
+          for (const std::string& w : o.warnings) std::fprintf(stderr, "\n[gvins-replay] warning: %s\n", w.c_str());
           gnssMs += ms;
           ++gnssCount;
           ++sum.gnssEpochs;

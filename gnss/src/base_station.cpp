@@ -83,10 +83,11 @@ void BaseStation::addEpoch(const ObsEpoch& epoch) {
   ++stats_.epochs;
   GlonassChannels ch = channels_;
   ch.mergeMissing(nav_.glonassChannels());
-  slips_.process(epoch, ch);
   Epoch e;
   e.time = epoch.time;
   e.raw = epoch;
+  doppler_.apply(e.raw, ch);  // sign-flipped / bad Doppler never reaches the slip detector
+  slips_.process(e.raw, ch);
   epochs_.push_back(std::move(e));
   // Keep what alignment can still use: the newest epoch may be one past the rover time, the one
   // held up to maxAge older, and the rate window of extrapolation up to maxInterpolationGap before

@@ -429,7 +429,17 @@ bool RtkSolver::phasePairsAsProcessed() const {
   return true;
 }
 
-std::optional<double> RtkSolver::differences(const ObsEpoch& rover, const Eigen::Vector3d& x, TransmitStates* states) {
+const ObsEpoch& RtkSolver::checkedRover(const ObsEpoch& rover) {
+  if (&rover == &roverChecked_) return rover;
+  roverChecked_ = rover;
+  GlonassChannels ch = roverChannels_;
+  ch.mergeMissing(nav_.glonassChannels());
+  roverDoppler_.apply(roverChecked_, ch);
+  return roverChecked_;
+}
+
+std::optional<double> RtkSolver::differences(const ObsEpoch& roverIn, const Eigen::Vector3d& x, TransmitStates* states) {
+  const ObsEpoch& rover = checkedRover(roverIn);
   GlonassChannels ch = roverChannels_;
   ch.mergeMissing(nav_.glonassChannels());
   detectSlips(rover, ch);
@@ -449,7 +459,7 @@ RtkSolution RtkSolver::process(const ObsEpoch& rover, TransmitStates* states) {
   // starts with, clears it again.)
   std::vector<HeldDd> previous = std::move(held_);
   held_.clear();
-  RtkSolution sol = processEpoch(rover, states);
+  RtkSolution sol = processEpoch(checkedRover(rover), states);
   if (sol.quality != SolutionQuality::Fix && lastProcess_) held_ = std::move(previous);
   return sol;
 }

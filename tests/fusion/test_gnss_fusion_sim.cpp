@@ -15,6 +15,8 @@
 #include <memory>
 #include <optional>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "gvins/base/constants.hpp"
 #include "gvins/base/signal.hpp"
@@ -25,6 +27,7 @@
 #include "gvins/ephemeris/sp3.hpp"
 #include "gvins/ephemeris/ssr_from_products.hpp"
 #include "gvins/fusion/gnss_fusion.hpp"
+#include "gvins/gnss/doppler_consistency.hpp"
 #include "gvins/gnss/phase_windup.hpp"
 #include "gvins/sim/flight_pattern.hpp"
 #include "gvins/sim/gnss_epoch_generator.hpp"
@@ -135,6 +138,8 @@ struct RunResult {
   double tightAgainAfter = -1.0;  // s of flight when the frame converged again after a restart
   Vector3d leverBeforeRestart = Vector3d::Zero(), leverAfterRestart = Vector3d::Zero();
   double isbErr = 0.0;  // RMS error of the drifting system's inter-system bias (IsbDrift), m
+  std::vector<std::string> dopplerWarnings;  // the fusion's rover Doppler check (all epochs)
+  DopplerConsistencyCounts doppler;
 };
 
 /// An inter-system bias that drifts: from flight time `from` on, `rate` (m/s) times the elapsed
@@ -155,7 +160,7 @@ struct SatelliteCut {
 
 template <typename Scalar>
 RunResult run(GnssFusionConfig cfg, const SatelliteCut& cut = {}, const EphemerisStore* store = nullptr,
-              double restartAt = -1.0, const IsbDrift& drift = {}) {
+              double restartAt = -1.0, const IsbDrift& drift = {}, bool flipDoppler = false) {
   const Scenario& sc = scenario();
   const EphemerisStore& nav = store ? *store : sc.nav;
   Eigen::Matrix<double, 15, 1> sigma;
@@ -167,6 +172,7 @@ RunResult run(GnssFusionConfig cfg, const SatelliteCut& cut = {}, const Ephemeri
   cfg.basePosition = sc.basePosition;
   GnssFusion<Scalar> fusion(cfg);
   const ObsEpoch* base = nullptr;
+  ObsEpoch flippedBase;
   RunResult out;
   double p2 = 0, h2 = 0, v2 = 0, c2 = 0, isb2 = 0, micros = 0;
   int n = 0, nAll = 0;
@@ -174,6 +180,13 @@ RunResult run(GnssFusionConfig cfg, const SatelliteCut& cut = {}, const Ephemeri
   for (const sim::GnssSimEpoch& e : sc.epochs) {
     if (e.role == sim::GnssReceiverRole::Base) {
       base = &e.obs;
+      if (flipDoppler) {
+        flippedBase = e.obs;
+        for (SatObs& so : flippedBase.sats) {
+          for (SignalObs& sig : so.signals) sig.doppler = -sig.doppler;
+        }
+        base = &flippedBase;
+      }
       continue;
     }
     const double tf = sc.frame.flightTime(e.obs.time);
@@ -204,12 +217,18 @@ RunResult run(GnssFusionConfig cfg, const SatelliteCut& cut = {}, const Ephemeri
         }
       }
     }
+    if (flipDoppler) {  // a receiver with the opposite Doppler sign (e.g. u-blox M8P MSM7)
+      for (SatObs& so : obs.sats) {
+        for (SignalObs& sig : so.signals) sig.doppler = -sig.doppler;
+      }
+    }
     if (tf > cut.after) {
       std::erase_if(obs.sats, [&](const SatObs& so) {
         return std::find(cut.keep.begin(), cut.keep.end(), so.sat) == cut.keep.end();
       });
     }
     const GnssEpochReport r = fusion.processEpoch(be, obs, base, nav);
+    out.dopplerWarnings.insert(out.dopplerWarnings.end(), r.warnings.begin(), r.warnings.end());
     out.resets += r.reset;
     out.last = &e;
     micros += r.elapsedMicroseconds;
@@ -258,6 +277,7 @@ RunResult run(GnssFusionConfig cfg, const SatelliteCut& cut = {}, const Ephemeri
     out.clockErr = std::sqrt(c2 / n);
     out.isbErr = std::sqrt(isb2 / n);
   }
+  out.doppler = fusion.roverDoppler().counts();
   out.lever = fusion.leverArm(be);
   out.ambiguities = fusion.ambiguities(be);
   out.zwd = fusion.zenithWetDelay(be);
@@ -765,6 +785,40 @@ TEST(GnssFusionSim, DriftingInterSystemBiasIsFollowed) {
   EXPECT_LT(w.isbErr, 0.3);
   EXPECT_LT(w.posRms, c.posRms);
   EXPECT_LT(w.posRms, ref.posRms + 0.05);  // measured 0.603 against 0.601 m without the drift
+}
+
+// The simulated rover (moving, with its own clock drift) passes the fusion's Doppler check
+// unchanged; with its Doppler sign flipped at the input (rover and base), the checks correct every
+// signal, name each once, and the fused solution is the same to the last bit.
+TEST(GnssFusionSim, FlippedDopplerIsCorrectedAtTheInput) {
+  const RunResult a = run<double>(mode(GnssFusionMode::kDoppPsr));
+  const RunResult b = run<double>(mode(GnssFusionMode::kDoppPsr), {}, nullptr, -1.0, {}, true);
+  EXPECT_TRUE(a.dopplerWarnings.empty());
+  EXPECT_EQ(a.doppler.corrected + a.doppler.dropped, 0);
+  EXPECT_GT(a.doppler.passed, 1000);
+  ASSERT_FALSE(b.dopplerWarnings.empty());
+  for (const std::string& w : b.dopplerWarnings) {
+    EXPECT_EQ(w.rfind("rover: Doppler sign flipped on ", 0), 0u) << w;
+  }
+  EXPECT_EQ(b.doppler.corrected, a.doppler.passed);
+  EXPECT_EQ(b.doppler.withheld, a.doppler.withheld);
+  ASSERT_GT(a.dopp.used, 100);
+  EXPECT_EQ(b.dopp.used, a.dopp.used);
+  EXPECT_EQ(b.posRms, a.posRms);
+  EXPECT_EQ(b.velRms, a.velRms);
+  // Ddcp: the base's Doppler (checked in the RTK module) flipped as well.
+  const RunResult c = run<double>(mode(GnssFusionMode::kDoppDdcp));
+  const RunResult d = run<double>(mode(GnssFusionMode::kDoppDdcp), {}, nullptr, -1.0, {}, true);
+  EXPECT_TRUE(c.dopplerWarnings.empty());
+  const auto baseWarnings = std::count_if(d.dopplerWarnings.begin(), d.dopplerWarnings.end(), [](const std::string& w) {
+    return w.rfind("base: Doppler sign flipped on ", 0) == 0;
+  });
+  EXPECT_GT(baseWarnings, 0);
+  EXPECT_EQ(d.dopplerWarnings.size(), b.dopplerWarnings.size() + static_cast<std::size_t>(baseWarnings));
+  ASSERT_GT(c.fixedEpochs, 50);
+  EXPECT_EQ(d.fixedEpochs, c.fixedEpochs);
+  EXPECT_EQ(d.ddcp.used, c.ddcp.used);
+  EXPECT_EQ(d.posRms, c.posRms);
 }
 
 }  // namespace

@@ -26,6 +26,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -37,6 +38,7 @@
 #include "gvins/fusion/gnss_measurement_models.hpp"
 #include "gvins/gnss/broadcast_record_change.hpp"
 #include "gvins/gnss/carrier_smoothing.hpp"
+#include "gvins/gnss/doppler_consistency.hpp"
 #include "gvins/gnss/rtk.hpp"
 #include "gvins/gnss/spp.hpp"
 #include "gvins/gnss/transmit_states.hpp"
@@ -77,6 +79,7 @@ struct GnssEpochReport {
   double chi2 = 0.0;
   int dof = 0;
   double elapsedMicroseconds = 0.0;
+  std::vector<std::string> warnings;  ///< new this epoch (Doppler check of the rover and the base)
 };
 
 template <typename Scalar>
@@ -107,6 +110,8 @@ class GnssFusion {
     return current(est) ? worldChange_ : std::nullopt;
   }
   const GnssAnchor& anchor() const { return anchor_; }
+  /// Doppler sanity of the rover epochs (verdicts, warnings, counters).
+  const DopplerConsistency& roverDoppler() const { return roverDoppler_; }
   Eigen::Vector3d leverArm(const vio::EstimatorBackend<Scalar>& est) const;
   /// Clock estimate [c·dt per clock system..., c·ḋt] (the receiver clock plus each system's
   /// inter-system bias) and the systems (clock indices).
@@ -187,6 +192,9 @@ class GnssFusion {
   const EphemerisStore* nav_ = nullptr;
   std::unique_ptr<SppSolver> spp_;
   std::unique_ptr<RtkSolver> rtk_;
+  DopplerConsistency roverDoppler_{"rover"};
+  ObsEpoch checkedRover_;      // the rover epoch after the Doppler check
+  std::size_t baseWarned_ = 0;  // warnings of rtk_'s base Doppler check already reported
   std::optional<GpsTime> lastBase_;
   std::unique_ptr<CarrierSmoother> smoother_, baseSmoother_;  // carrierSmoothing > 0: psr, dpsr
   ObsEpoch smoothed_;

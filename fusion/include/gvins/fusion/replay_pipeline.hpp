@@ -89,6 +89,7 @@ struct ReplayGnssOutcome {
   int dof = 0;
   std::optional<Eigen::Vector3d> antennaEcef, antennaVelocityEcef;
   Eigen::Matrix3d antennaCovarianceEcef = Eigen::Matrix3d::Zero();  ///< zero if unknown
+  std::vector<std::string> warnings;  ///< new this epoch (e.g. a Doppler sign flip), for stderr
 };
 
 /// What the pipeline needs from the GNSS fusion.

@@ -68,6 +68,7 @@ class GnssFusionReplayClient final : public ReplayGnss {
     if (r.antennaEcef) {
       if (const auto c = fusion_.antennaCovariance(est_, r.t_ns)) o.antennaCovarianceEcef = *c;
     }
+    o.warnings = r.warnings;
     return o;
   }
   std::optional<Eigen::Vector3d> leverArm() const override { return fusion_.leverArm(est_); }

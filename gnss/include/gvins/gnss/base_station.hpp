@@ -39,6 +39,7 @@
 #include "gvins/base/observation.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/gnss/cycle_slip_detector.hpp"
+#include "gvins/gnss/doppler_consistency.hpp"
 #include "gvins/gnss/rtk_config.hpp"
 
 namespace gvins {
@@ -115,6 +116,8 @@ class BaseStation {
 
   const BaseStationStats& stats() const { return stats_; }
   const CycleSlipCounts& slipCounts() const { return slips_.counts(); }
+  /// Doppler sanity of the base stream (applied to every added epoch before slip detection).
+  const DopplerConsistency& doppler() const { return doppler_; }
 
  private:
   struct Epoch {
@@ -140,6 +143,7 @@ class BaseStation {
   std::optional<Eigen::Vector3d> position_;
   GlonassChannels channels_;
   CycleSlipDetector slips_;
+  DopplerConsistency doppler_{"base"};
   std::deque<Epoch> epochs_;
   BaseStationStats stats_;
 };

@@ -40,6 +40,7 @@
 #include "gvins/gnss/base_station.hpp"
 #include "gvins/gnss/cycle_slip_detector.hpp"
 #include "gvins/gnss/double_difference.hpp"
+#include "gvins/gnss/doppler_consistency.hpp"
 #include "gvins/gnss/position_solution.hpp"
 #include "gvins/gnss/rtk_config.hpp"
 #include "gvins/gnss/spp.hpp"
@@ -183,6 +184,9 @@ class RtkSolver {
   const BaseStation& base() const { return base_; }
   const DdFormationStats& differenceStats() const { return builder_.stats(); }
   const CycleSlipCounts& roverSlipCounts() const { return roverSlips_.counts(); }
+  /// Doppler sanity of the rover stream (every rover epoch passes it before SPP and the slip
+  /// detector; the base's is base().doppler()).
+  const DopplerConsistency& roverDoppler() const { return roverDoppler_; }
 
  private:
   struct Ambiguity {
@@ -242,6 +246,9 @@ class RtkSolver {
   SppSolver spp_;
   BaseStation base_;
   CycleSlipDetector roverSlips_;
+  DopplerConsistency roverDoppler_{"rover"};
+  ObsEpoch roverChecked_;  // the rover epoch with its Doppler checked (checkedRover)
+  const ObsEpoch& checkedRover(const ObsEpoch& rover);
   DoubleDifferenceBuilder builder_;
   GlonassChannels roverChannels_;
   sri::SriFilter<double> filter_;
