@@ -1,5 +1,7 @@
 #include "gvins/base/yaml_reader.hpp"
 
+#include <filesystem>
+
 #include <cctype>
 #include <cmath>
 #include <fstream>
@@ -89,13 +91,37 @@ YAML::Node YamlReader::loadText(const std::string& text, const std::string& name
   }
 }
 
-YAML::Node YamlReader::loadFile(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw ParseError(path, 0, "", "cannot open file");
-  std::ostringstream ss;
-  ss << f.rdbuf();
-  return loadText(ss.str(), path);
+void YamlReader::sections(const YAML::Node& root, const std::set<std::string>& known) const {
+  if (!root.IsMap()) return;
+  for (auto it = root.begin(); it != root.end(); ++it) {
+    const std::string k = key(it->first, "");
+    if (known.count(k)) continue;
+    std::string list;
+    for (const std::string& s : known) list += (list.empty() ? "" : ", ") + s;
+    fail(it->first, k, "unknown section '" + k + "' (expected " + list + ")");
+  }
 }
+
+std::string YamlReader::readFile(const std::string& path, std::size_t maxBytes) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw ParseError(path, 0, "", "is a directory, not a configuration file");
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw ParseError(path, 0, "", "cannot open the configuration file");
+  const auto size = std::filesystem::file_size(path, ec);
+  if (!ec && size > maxBytes)
+    throw ParseError(path, 0, "", "configuration file of " + std::to_string(size) + " bytes, larger than the limit of " +
+                                       std::to_string(maxBytes));
+  std::string text;
+  char buf[65536];
+  while (f.read(buf, sizeof buf) || f.gcount() > 0) {
+    text.append(buf, static_cast<std::size_t>(f.gcount()));
+    if (text.size() > maxBytes)
+      throw ParseError(path, 0, "", "configuration larger than the limit of " + std::to_string(maxBytes) + " bytes");
+  }
+  return text;
+}
+
+YAML::Node YamlReader::loadFile(const std::string& path) { return loadText(readFile(path), path); }
 
 std::array<bool, kNumSystems> parseSystemLetters(std::string_view letters) {
   std::array<bool, kNumSystems> out{};

@@ -80,6 +80,16 @@ class YamlReader {
     }
   }
 
+  /// Rejects top-level keys of a configuration file that are not one of the `known` sections (a
+  /// misspelled section, "sp:" for "spp:", would otherwise be ignored silently).
+  void sections(const YAML::Node& root, const std::set<std::string>& known) const;
+
+  /// The text of a configuration file: ParseError (line 0) for a missing or unreadable file, a
+  /// directory, or a file larger than `maxBytes` (checked before reading: a configuration is
+  /// small, and yaml-cpp needs about 200 bytes of memory per byte of a long list).
+  static std::string readFile(const std::string& path, std::size_t maxBytes = kMaxFileBytes);
+  static constexpr std::size_t kMaxFileBytes = 1 << 20;
+
   /// Loads a YAML document from a file (ParseError with yaml-cpp's line on a syntax error, or on a
   /// missing/unreadable file) or from text (`name` used in errors).
   static YAML::Node loadFile(const std::string& path);
