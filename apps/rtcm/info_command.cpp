@@ -11,7 +11,8 @@ int runInfo(const std::vector<std::string>& args) {
   std::string path;
   std::optional<GpsTime> date;
   for (std::size_t i = 0; i < args.size(); ++i) {
-    if (args[i] == "--date" && i + 1 < args.size()) date = parseDate(args[++i]);
+    requireValue(args, i, {"-o", "--date", "--interval"});
+    if (args[i] == "--date") date = parseDate(args[++i]);
     else if (args[i].size() > 1 && args[i][0] == '-') throw UsageError("info: unknown option '" + args[i] + "'");
     else if (path.empty()) path = args[i];
     else throw UsageError("info: more than one input");
@@ -25,6 +26,11 @@ int runInfo(const std::vector<std::string>& args) {
   decodeAll(in, dec, [](const rtcm::Decoded&) {});
   if (in != stdin) std::fclose(in);
   printSummary(std::cout, dec, path == "-" ? "<stdin>" : path);
+  if (dec.stats().framing.frames == 0) {
+    std::cerr << "gvins-rtcm: info: " << (path == "-" ? "<stdin>" : path) << ": no RTCM 3 frame with a good CRC in "
+              << dec.stats().framing.bytes << " bytes\n";
+    return 1;
+  }
   return 0;
 }
 
