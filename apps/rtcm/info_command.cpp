@@ -26,11 +26,6 @@ int runInfo(const std::vector<std::string>& args) {
   decodeAll(in, dec, [](const rtcm::Decoded&) {});
   if (in != stdin) std::fclose(in);
   printSummary(std::cout, dec, path == "-" ? "<stdin>" : path);
-  if (dec.stats().framing.frames == 0) {
-    std::cerr << "gvins-rtcm: info: " << (path == "-" ? "<stdin>" : path) << ": no RTCM 3 frame with a good CRC in "
-              << dec.stats().framing.bytes << " bytes\n";
-    return 1;
-  }
   return 0;
 }
 

@@ -1,6 +1,8 @@
 #include "gvins/base/yaml_reader.hpp"
 
+#include <algorithm>
 #include <filesystem>
+#include <vector>
 
 #include <cctype>
 #include <cmath>
@@ -91,14 +93,44 @@ YAML::Node YamlReader::loadText(const std::string& text, const std::string& name
   }
 }
 
+namespace {
+/// Levenshtein distance of two short keys.
+std::size_t editDistance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diag = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diag = up;
+    }
+  }
+  return row[b.size()];
+}
+}  // namespace
+
 void YamlReader::sections(const YAML::Node& root, const std::set<std::string>& known) const {
-  if (!root.IsMap()) return;
+  if (!root.IsMap() || root.size() == 0) return;
+  std::string list;
+  for (const std::string& s : known) list += (list.empty() ? "" : ", ") + s;
+  bool any = false;
   for (auto it = root.begin(); it != root.end(); ++it) {
     const std::string k = key(it->first, "");
-    if (known.count(k)) continue;
-    std::string list;
-    for (const std::string& s : known) list += (list.empty() ? "" : ", ") + s;
-    fail(it->first, k, "unknown section '" + k + "' (expected " + list + ")");
+    if (known.count(k)) {
+      any = true;
+      continue;
+    }
+    // Other tools' sections may share the file; a near miss of a known name is a typo.
+    for (const std::string& s : known) {
+      if (k.size() <= 64 && editDistance(k, s) <= 2)
+        fail(it->first, k, "unknown section '" + k + "' (did you mean '" + s + "'? expected " + list + ")");
+    }
+  }
+  if (!any) {
+    const std::string first = key(root.begin()->first, "");
+    fail(root.begin()->first, first, "unknown section '" + first + "': the file has none of the sections " + list);
   }
 }
 

@@ -107,8 +107,14 @@ TEST(YamlReader, ConfigFilesMustBeSmallFilesWithKnownSections) {
     ADD_FAILURE() << "section 'sp' accepted";
   } catch (const ParseError& e) {
     EXPECT_EQ(e.line(), 2);
-    EXPECT_NE(e.reason().find("unknown section 'sp' (expected rtk, spp)"), std::string::npos) << e.what();
+    EXPECT_NE(e.reason().find("unknown section 'sp' (did you mean 'spp'? expected rtk, spp)"), std::string::npos)
+        << e.what();
   }
+  // A near miss next to a valid section, and a file with only other tools' sections.
+  EXPECT_THROW(r.sections(YamlReader::loadText("spp:\n  a: 1\nrkt:\n  b: 2\n", "c.yaml"), {"spp", "rtk"}), ParseError);
+  EXPECT_THROW(r.sections(YamlReader::loadText("replay:\n  a: 1\n", "c.yaml"), {"spp", "rtk"}), ParseError);
+  // Sections of other tools beside a known one are theirs.
+  EXPECT_NO_THROW(r.sections(YamlReader::loadText("rtk:\n  a: 1\nother_tool: [1, 2]\n", "c.yaml"), {"spp", "rtk"}));
   fs::remove_all(dir);
 }
 

@@ -80,8 +80,10 @@ class YamlReader {
     }
   }
 
-  /// Rejects top-level keys of a configuration file that are not one of the `known` sections (a
-  /// misspelled section, "sp:" for "spp:", would otherwise be ignored silently).
+  /// Checks the top-level keys of a configuration file against the `known` sections of a tool: a
+  /// non-empty file without any of them, or a key within two edits of a known name ("sp:",
+  /// "rkt:"), is an error (a misspelled section would otherwise be ignored silently). Other keys
+  /// are sections of other tools sharing the file and are left alone.
   void sections(const YAML::Node& root, const std::set<std::string>& known) const;
 
   /// The text of a configuration file: ParseError (line 0) for a missing or unreadable file, a
