@@ -187,6 +187,8 @@ spp_cases() {
   reject spp config-misspelled-section "typo.yaml:1|unknown section 'sp'" -- "$S" -q --config "$d/typo.yaml" -o "$d/x.pos" "$ROVER" "$NAV"
   reject spp elmask-nan "--elmask" -- "$S" -q --elmask nan -o "$d/x.pos" "$ROVER" "$NAV"
   reject spp elmask-1e999 "--elmask" -- "$S" -q --elmask 1e999 -o "$d/x.pos" "$ROVER" "$NAV"
+  reject spp elmask-200-digits "--elmask" -- "$S" -q --elmask "$(printf '9%.0s' $(seq 200))" -o "$d/x.pos" "$ROVER" "$NAV"
+  reject spp elmask-inf "--elmask" -- "$S" -q --elmask inf -o "$d/x.pos" "$ROVER" "$NAV"
   reject spp o-without-value "-o|needs a value" -- "$S" -q "$ROVER" "$NAV" -o
 }
 
@@ -200,6 +202,8 @@ rtk_cases() {
   same rtk crlf-rover "$d/ref.pos" "$d/crlf.pos" -- "$R" -q --base-llh "$BASE_LLH" -o "$d/crlf.pos" "$d/crlf.obs" "$BASE" "$NAV"
   rinex_epochs "$d/rover.obs" "$d/swap.obs" swap 10 11
   reject rtk epochs-swapped-strict "swap.obs:|epoch time" -- "$R" -q --strict --base-llh "$BASE_LLH" -o "$d/x.pos" "$d/swap.obs" "$BASE" "$NAV"
+  rinex_epochs "$d/rover.obs" "$d/repeat.obs" repeat 10 0
+  reject rtk epoch-repeated-strict "repeat.obs:|epoch time|repeat" -- "$R" -q --strict --base-llh "$BASE_LLH" -o "$d/x.pos" "$d/repeat.obs" "$BASE" "$NAV"
   rinex_epochs "$d/rover.obs" "$d/past.obs" past 5 40
   reject rtk epoch-restamped-strict "past.obs:|epoch time" -- "$R" -q --strict --base-llh "$BASE_LLH" -o "$d/x.pos" "$d/past.obs" "$BASE" "$NAV"
   run rtk epochs-restamped-skipped "$R" -q --base-llh "$BASE_LLH" -o "$d/past.pos" "$d/past.obs" "$BASE" "$NAV" && {
@@ -373,6 +377,8 @@ replay_cases() {
   reject replay duration-negative "--duration" -- "$R" "$DS" -q --duration -1 -o "$d/x"
   reject replay start-negative "--start" -- "$R" "$DS" -q --start -5 -o "$d/x"
   reject replay start-nan "--start" -- "$R" "$DS" -q --start nan -o "$d/x"
+  reject replay start-inf "--start" -- "$R" "$DS" -q --start inf -o "$d/x"
+  reject replay duration-200-digits "--duration" -- "$R" "$DS" -q --duration "$(printf '9%.0s' $(seq 200))" -o "$d/x"
   reject replay lever-arm-1e6 "--lever-arm" -- "$R" "$DS" -q --mode vio+dopp+psr --lever-arm 1e6,0,0 -o "$d/x"
   reject replay base-position-zero "--base-position|Earth's surface" -- "$R" "$DS" -q --base-position 0,0,0 -o "$d/x"
   reject replay base-position-1e7 "--base-position|Earth's surface" -- "$R" "$DS" -q --base-position 1e7,1e7,1e7 -o "$d/x"
