@@ -3,9 +3,11 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <filesystem>
 #include <string>
 #include <vector>
 
+#include "gvins/base/atomic_output_file.hpp"
 #include "gvins/base/parse_error.hpp"
 #include "gvins/fusion/rosbag_dataset.hpp"
 
@@ -123,6 +125,23 @@ int main(int argc, char** argv) {
     }
     if (cmd == "to-dataset") {
       if (positional.size() != 1 || out.empty()) return usageError("to-dataset needs BAG and -o DIR");
+      if (!calib.empty()) {
+        // A folder to copy from that holds nothing to copy is a mistake, not a dataset without calibration.
+        namespace fs = std::filesystem;
+        std::error_code ec;
+        const fs::path from = fs::exists(fs::path(calib) / "mav0", ec) ? fs::path(calib) / "mav0" : fs::path(calib);
+        bool any = fs::exists(from / "body.yaml", ec);
+        for (const char* sensor : {"imu0", "cam0", "cam1"}) any = any || fs::exists(from / sensor / "sensor.yaml", ec);
+        if (!fs::is_directory(calib, ec)) {
+          std::fprintf(stderr, "gvins-bag: --calib-from %s: no such dataset folder\n", calib.c_str());
+          return 1;
+        }
+        if (!any) {
+          std::fprintf(stderr, "gvins-bag: --calib-from %s: no imu0/cam0/cam1 sensor.yaml or body.yaml to copy\n",
+                       calib.c_str());
+          return 1;
+        }
+      }
       gvins::fusion::BagToDatasetOptions o;
       o.calibrationFrom = calib;
       const auto s = gvins::fusion::bagToDataset(positional[0], out, o);
@@ -135,7 +154,10 @@ int main(int argc, char** argv) {
       o.gnssObs = obs;
       o.gnssNav = nav;
       o.compression = compression;
-      const auto s = gvins::fusion::datasetToBag(positional[0], out, o);
+      // Written under a temporary name: a failed conversion leaves no bag that reads as valid.
+      gvins::AtomicOutputFile bagFile(out);
+      const auto s = gvins::fusion::datasetToBag(positional[0], bagFile.tempPath(), o);
+      bagFile.commit();
       std::printf("gvins-bag from-dataset %s -> %s\n%s", positional[0].c_str(), out.c_str(), s.text().c_str());
       return 0;
     }

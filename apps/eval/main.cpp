@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "gvins/base/line_reader.hpp"
+#include "gvins/base/option_values.hpp"
 #include "gvins/base/parse_error.hpp"
 #include "gvins/vio/euroc_csv.hpp"
 #include "gvins/vio/pose_covariance_csv.hpp"
@@ -57,14 +58,11 @@ const char* kUsage =
   std::exit(2);
 }
 
-double parseNumber(const std::string& s, const char* opt) {
+double parseNumber(const std::string& s, const char* opt, double lo, double hi) {
   try {
-    std::size_t pos = 0;
-    const double v = std::stod(s, &pos);
-    if (pos != s.size()) throw std::invalid_argument("trailing");
-    return v;
-  } catch (const std::exception&) {
-    usageError(std::string("bad number '") + s + "' for " + opt);
+    return gvins::optionNumber(opt, s, lo, hi);
+  } catch (const gvins::OptionError& e) {
+    usageError(e.what());
   }
 }
 
@@ -111,8 +109,7 @@ int main(int argc, char** argv) {
       gtFormat = value();
       if (gtFormat != "auto" && gtFormat != "asl" && gtFormat != "tum") usageError("unknown --gt-format '" + gtFormat + "'");
     } else if (a == "--tolerance") {
-      const double ms = parseNumber(value(), "--tolerance");
-      if (!(ms >= 0.0 && ms < 1e6)) usageError("--tolerance must be in [0, 1e6) ms");
+      const double ms = parseNumber(value(), "--tolerance", 0.0, 1e6);
       opt.tolerance_ns = static_cast<std::int64_t>(ms * 1e6);
     } else if (a == "--segments") {
       opt.segmentLengths.clear();
@@ -121,15 +118,13 @@ int main(int argc, char** argv) {
       while (start <= v.size()) {
         const auto c = v.find(',', start);
         tok = v.substr(start, c == std::string::npos ? std::string::npos : c - start);
-        const double L = parseNumber(tok, "--segments");
-        if (!(L > 0.0)) usageError("segment lengths must be positive");
+        const double L = parseNumber(tok, "--segments", 1e-3, 1e7);
         opt.segmentLengths.push_back(L);
         if (c == std::string::npos) break;
         start = c + 1;
       }
     } else if (a == "--align-first") {
-      const double n = parseNumber(value(), "--align-first");
-      if (!(n >= 2.0)) usageError("--align-first needs at least 2");
+      const double n = parseNumber(value(), "--align-first", 2.0, 1e9);
       opt.alignFirst = static_cast<std::size_t>(n);
     } else if (a == "--cov") {
       covPath = value();
@@ -168,8 +163,10 @@ int main(int argc, char** argv) {
                   estPath.c_str(), marks.size(), est.size() - from);
       est.erase(est.begin(), est.begin() + static_cast<std::ptrdiff_t>(from));
     }
+    if (est.empty()) throw std::runtime_error(estPath + ": no poses to evaluate (empty trajectory file)");
     const bool asl = gtFormat == "asl" || (gtFormat == "auto" && looksLikeAsl(gtPath));
     const auto gt = asl ? toTrajectorySamples(readGroundTruthCsv(gtPath)) : toTrajectorySamples(readTumTrajectory(gtPath));
+    if (gt.empty()) throw std::runtime_error(gtPath + ": no reference poses (empty ground-truth file)");
     std::vector<PoseCovariance> cov;
     if (!noCov) {
       if (covPath.empty()) {

@@ -181,7 +181,6 @@ int main(int argc, char** argv) {
     gvins::EphemerisStore preciseStore;  // the products with the antenna offsets, if any
     preciseStore.setPrecise(precise);
     if (antennas) preciseStore.setSatelliteAntennas(antennas);
-    std::printf("gpst,sat,radial_m,along_m,cross_m,clock_m,sisre_m\n");
     int epochs = 0;
     for (double dt = 0.0; dt <= duration + 1e-9; dt += step) {
       const gvins::GpsTime te = t + dt;
@@ -198,6 +197,7 @@ int main(int argc, char** argv) {
         ++cnt[gvins::systemIndex(sat.system)];
       }
       for (const auto& [sat, d] : rows) {
+        if (acc.empty()) std::printf("gpst,sat,radial_m,along_m,cross_m,clock_m,sisre_m\n");  // with the first row
         const int si = gvins::systemIndex(sat.system);
         const double mean = sum[si] / cnt[si];
         const double e = gvins::sisre(sat, d, mean);
@@ -223,15 +223,33 @@ int main(int argc, char** argv) {
                    std::string(gvins::systemName(static_cast<gvins::System>(si))).c_str(), a.n, rms(a.r2), rms(a.a2),
                    rms(a.c2), rms(a.k2), rms(a.s2));
     }
-    return acc.empty() ? 3 : 0;
+    if (acc.empty()) {
+      std::fprintf(stderr,
+                   "gvins-orbit: --compare: no satellite has both a broadcast ephemeris and a precise state at %s GPST%s "
+                   "(the navigation files and the products do not overlap there)\n",
+                   t.toString(3).c_str(), duration > 0.0 ? " or later in --duration" : "");
+      return 1;
+    }
+    return 0;
   }
   if (precise) store.setPrecise(precise);
   if (antennas) store.setSatelliteAntennas(antennas);
   int perSystem[gvins::kNumSystems] = {};
-  std::printf("sat,x,y,z,vx,vy,vz,clock_s,drift_s_per_s\n");
+  std::vector<std::pair<gvins::SatId, gvins::SatelliteState>> states;
   for (const gvins::SatId sat : store.satellites()) {
-    const auto st = store.satelliteState(sat, t, policy);
-    if (!st) continue;
+    if (const auto st = store.satelliteState(sat, t, policy)) states.emplace_back(sat, *st);
+  }
+  if (states.empty()) {
+    // A header alone would look like a valid answer for an empty sky.
+    std::fprintf(stderr,
+                 "gvins-orbit: --time %s GPST: no satellite has a usable ephemeris at that time in %zu record(s) of "
+                 "%zu file(s) (time outside the files' validity windows%s)\n",
+                 t.toString(6).c_str(), store.size(), files.size(), unhealthy ? "" : ", or all unhealthy");
+    return 1;
+  }
+  std::printf("sat,x,y,z,vx,vy,vz,clock_s,drift_s_per_s\n");
+  for (const auto& [sat, state] : states) {
+    const gvins::SatelliteState* st = &state;
     std::printf("%s,%.4f,%.4f,%.4f,%.6f,%.6f,%.6f,%.12e,%.6e\n", sat.str().c_str(), st->position.x(),
                 st->position.y(), st->position.z(), st->velocity.x(), st->velocity.y(), st->velocity.z(),
                 st->clockBias, st->clockDrift);

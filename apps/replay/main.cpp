@@ -13,6 +13,7 @@
 #include <vector>
 #include <string>
 
+#include "gvins/base/option_values.hpp"
 #include "gvins/base/parse_error.hpp"
 #include "gvins/fusion/gnss_fusion_config.hpp"
 #include "gvins/fusion/replay_config.hpp"
@@ -93,6 +94,19 @@ const char* kUsage =
   std::exit(2);
 }
 
+/// Largest lever-arm component accepted from --lever-arm, m.
+constexpr double kMaxLeverArm = 10.0;
+
+/// The value of a checked option (base/option_values.hpp), or a usage error naming it.
+template <class F>
+auto optionValue(F&& parse) {
+  try {
+    return parse();
+  } catch (const OptionError& e) {
+    usageError(e.what());
+  }
+}
+
 double toNumber(const std::string& s, const std::string& opt) {
   try {
     std::size_t p = 0;
@@ -161,22 +175,11 @@ int main(int argc, char** argv) {
       carrierSmoothing = toNumber(value(), a);
       if (!(*carrierSmoothing >= 0.0 && *carrierSmoothing <= 3600.0)) usageError("--carrier-smoothing must be within 0..3600 s");
     }
-    else if (a == "--base-position") {
-      std::string s = value();
-      for (char& c : s)
-        if (c == ',') c = ' ';
-      std::istringstream is(s);
-      Eigen::Vector3d v;
-      if (!(is >> v.x() >> v.y() >> v.z())) usageError("--base-position needs X,Y,Z");
-      basePos = v;
-    } else if (a == "--lever-arm") {
-      std::string s = value();
-      for (char& c : s)
-        if (c == ',') c = ' ';
-      std::istringstream is(s);
-      Eigen::Vector3d v;
-      if (!(is >> v.x() >> v.y() >> v.z()) || !v.allFinite()) usageError("--lever-arm needs X,Y,Z");
-      leverArm = v;
+    else if (a == "--base-position") basePos = optionValue([&] { return optionStationEcef(a, value()); });
+    else if (a == "--lever-arm") {
+      // A GNSS antenna a few metres from the IMU at most on the vehicles this estimator is for;
+      // a larger value is a unit or sign mistake that would only show as a km-level error.
+      leverArm = optionValue([&] { return optionVector3(a, value(), -kMaxLeverArm, kMaxLeverArm, "m"); });
     } else if (a == "--sensor-to-gpst") {
       const std::string v = value();
       try {
@@ -186,9 +189,9 @@ int main(int argc, char** argv) {
       } catch (const std::exception&) {
         usageError("bad integer '" + v + "' for --sensor-to-gpst");
       }
-    } else if (a == "--start") start = toNumber(value(), a);
-    else if (a == "--duration") duration = toNumber(value(), a);
-    else if (a == "--max-imu-gap") maxGap = toNumber(value(), a);
+    } else if (a == "--start") start = optionValue([&] { return optionNumber(a, value(), 0.0, 1e7, "s"); });
+    else if (a == "--duration") duration = optionValue([&] { return optionNumber(a, value(), 0.0, 1e7, "s (0: to the end)"); });
+    else if (a == "--max-imu-gap") maxGap = optionValue([&] { return optionNumber(a, value(), 1e-4, 3600.0, "s"); });
     else if (a == "--imu-gaps") {
       gapPolicy = value();
       if (*gapPolicy != "error" && *gapPolicy != "warn") usageError("--imu-gaps takes error or warn");
@@ -203,6 +206,15 @@ int main(int argc, char** argv) {
     else usageError("more than one dataset given");
   }
   if (dataset.empty()) usageError("no dataset folder given");
+  {
+    std::error_code ec;
+    if (!fs::is_directory(dataset, ec)) {
+      std::fprintf(stderr, "gvins-replay: dataset %s: %s\n", dataset.c_str(),
+                   fs::exists(dataset, ec) ? "not a folder (give the dataset folder, e.g. as gvins-sim writes it)"
+                                           : "no such folder");
+      return 1;
+    }
+  }
   if (outDir.empty()) usageError("no output folder given (-o)");
   const auto gnssMode = gnssFusionModeFromString(mode);
   if (!gnssMode) usageError("unknown mode '" + mode + "'");
@@ -275,6 +287,14 @@ int main(int argc, char** argv) {
     const ReplaySummary s = ec.use_float ? run<float>(dataset, ec, gc, opt) : run<double>(dataset, ec, gc, opt);
     s.print(std::cout);
     for (const auto& f : s.files) std::cout << "wrote " << f << "\n";
+    if (s.framesProcessed == 0) {
+      // Output files of a run without a single frame would look like a result.
+      std::fprintf(stderr,
+                   "gvins-replay: %s: no frame was processed (%zu frames in the dataset): empty or unreadable "
+                   "cam0 data (features.csv / data.csv), or a --start/--duration window without frames\n",
+                   dataset.c_str(), s.frames);
+      return 1;
+    }
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "gvins-replay: %s\n", e.what());

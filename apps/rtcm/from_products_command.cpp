@@ -4,6 +4,7 @@
 // the broadcast records a receiver holds into the products' states (gvins/ephemeris/
 // ssr_from_products.hpp). For testing a real-time (SSR) processing chain against the products
 // it is made from, e.g. `gvins-replay D --broadcast --ssr FILE` against `gvins-replay D`.
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -11,6 +12,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "gvins/base/atomic_output_file.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/ephemeris/precise_product_files.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
@@ -25,9 +27,10 @@ int runFromProducts(const std::vector<std::string>& args) {
   double interval = 5.0;
   std::vector<std::string> inputs;
   for (std::size_t i = 0; i < args.size(); ++i) {
-    if (args[i] == "-o" && i + 1 < args.size()) {
+    requireValue(args, i, {"-o", "--date", "--interval"});
+    if (args[i] == "-o") {
       out = args[++i];
-    } else if (args[i] == "--interval" && i + 1 < args.size()) {
+    } else if (args[i] == "--interval") {
       const std::string v = args[++i];
       char* end = nullptr;
       interval = std::strtod(v.c_str(), &end);
@@ -57,10 +60,22 @@ int runFromProducts(const std::vector<std::string>& args) {
   SsrServiceConfig service;
   service.interval = interval;
   const std::vector<SsrMessage> messages = ssrFromProducts(nav, productStore, first, last, service);
+  if (messages.empty()) {
+    std::string navFiles;
+    for (const std::string& f : inputs)
+      if (std::find(products.orbits.begin(), products.orbits.end(), f) == products.orbits.end() &&
+          std::find(products.clocks.begin(), products.clocks.end(), f) == products.clocks.end() &&
+          std::find(products.antennas.begin(), products.antennas.end(), f) == products.antennas.end() &&
+          std::find(products.biases.begin(), products.biases.end(), f) == products.biases.end())
+        navFiles += (navFiles.empty() ? "" : ", ") + f;
+    throw std::runtime_error("from-products: no SSR correction: no satellite of the navigation file(s) " + navFiles +
+                             " has a broadcast record usable in the products' span " + first.toString(0) + " to " +
+                             last.toString(0) + " GPST (navigation and products of different days?)");
+  }
   const std::vector<std::uint8_t> bytes = rtcm::encodeSsrFrames(messages);
-  std::ofstream f(out, std::ios::binary);
-  f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-  if (!f) throw std::runtime_error("cannot write '" + out + "'");
+  AtomicOutputFile file(out);
+  file.stream().write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  file.commit();
   std::map<int, int> perType;
   std::size_t corrections = 0;
   for (const SsrMessage& m : messages) {

@@ -11,7 +11,8 @@ int runInfo(const std::vector<std::string>& args) {
   std::string path;
   std::optional<GpsTime> date;
   for (std::size_t i = 0; i < args.size(); ++i) {
-    if (args[i] == "--date" && i + 1 < args.size()) date = parseDate(args[++i]);
+    requireValue(args, i, {"-o", "--date", "--interval"});
+    if (args[i] == "--date") date = parseDate(args[++i]);
     else if (args[i].size() > 1 && args[i][0] == '-') throw UsageError("info: unknown option '" + args[i] + "'");
     else if (path.empty()) path = args[i];
     else throw UsageError("info: more than one input");

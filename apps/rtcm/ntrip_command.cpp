@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "gvins/base/option_values.hpp"
 #include "gvins/rtcm/framer.hpp"
 #include "gvins/rtcm/ntrip_client.hpp"
 #include "stream_summary.hpp"
@@ -26,14 +27,16 @@ int runNtrip(const std::vector<std::string>& args) {
     };
     try {
       if (a == "-o") outPath = value();
-      else if (a == "--duration") duration = std::stod(value());
-      else if (a == "--frames") maxFrames = std::stoll(value());
-      else if (a == "--version") nopt.version = std::stoi(value());
-      else if (a == "--timeout") nopt.readTimeout = nopt.connectTimeout = std::stod(value());
+      else if (a == "--duration") duration = optionNumber(a, value(), 0.0, 1e8, "s");
+      else if (a == "--frames") maxFrames = static_cast<long long>(optionNumber(a, value(), 0.0, 1e15));
+      else if (a == "--version") nopt.version = static_cast<int>(optionNumber(a, value(), 1.0, 2.0));
+      else if (a == "--timeout") nopt.readTimeout = nopt.connectTimeout = optionNumber(a, value(), 0.1, 3600.0, "s");
       else if (a == "--gga") nopt.gga = value();
       else if (a.size() > 1 && a[0] == '-') throw UsageError("ntrip: unknown option '" + a + "'");
       else if (url.empty()) url = a;
       else throw UsageError("ntrip: more than one URL");
+    } catch (const OptionError& e) {
+      throw UsageError(std::string("ntrip: ") + e.what());
     } catch (const std::logic_error&) {
       throw UsageError("ntrip: bad number for " + a);
     }

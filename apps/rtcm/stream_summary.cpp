@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -14,11 +15,22 @@
 
 namespace gvins::rtcm_app {
 
+void requireValue(const std::vector<std::string>& args, std::size_t i, std::initializer_list<const char*> withValue) {
+  if (i + 1 < args.size()) return;
+  for (const char* o : withValue)
+    if (args[i] == o) throw UsageError(args[i] + " needs a value");
+}
+
 GpsTime parseDate(const std::string& text) {
   CalendarTime c;
   char extra = 0;
   if (std::sscanf(text.c_str(), "%d-%d-%d%c", &c.year, &c.month, &c.day, &extra) != 3 || !isValidCalendar(c)) {
     throw UsageError("--date must be YYYY-MM-DD, got '" + text + "'");
+  }
+  // GPS time starts on 1980-01-06 (IS-GPS-200 section 3.3.4); RTCM 3 carries times of week only,
+  // so a date outside GPS time would place every epoch before the start of GPS time.
+  if (c.year < 1980 || (c.year == 1980 && (c.month == 1 && c.day < 6)) || c.year > 2099) {
+    throw UsageError("--date " + text + " is outside GPS time (1980-01-06 to 2099-12-31)");
   }
   c.hour = 12;
   return GpsTime::fromCalendar(c);
@@ -26,6 +38,8 @@ GpsTime parseDate(const std::string& text) {
 
 std::FILE* openInput(const std::string& path) {
   if (path == "-") return stdin;
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw std::runtime_error("'" + path + "' is a directory, not an RTCM 3 file");
   std::FILE* f = std::fopen(path.c_str(), "rb");
   if (!f) throw std::runtime_error("cannot open '" + path + "': " + std::strerror(errno));
   return f;

@@ -4,7 +4,9 @@
 #include <cstdio>
 #include <optional>
 #include <ostream>
+#include <initializer_list>
 #include <string>
+#include <vector>
 
 #include "gvins/base/gnss_time.hpp"
 #include "gvins/rtcm/decoder.hpp"
@@ -15,6 +17,10 @@ namespace gvins::rtcm_app {
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+/// Throws UsageError when args[i] is one of `withValue` and no value follows it (rather than
+/// reporting it as an unknown option).
+void requireValue(const std::vector<std::string>& args, std::size_t i, std::initializer_list<const char*> withValue);
 
 /// "YYYY-MM-DD" to 12:00 GPST of that day; throws UsageError.
 GpsTime parseDate(const std::string& text);

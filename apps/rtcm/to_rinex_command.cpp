@@ -12,6 +12,7 @@
 #include <tuple>
 
 #include "commands.hpp"
+#include "gvins/base/atomic_output_file.hpp"
 #include "gvins/base/rinex_obs_writer.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "stream_summary.hpp"
@@ -57,8 +58,9 @@ int runToRinex(const std::vector<std::string>& args) {
   std::string path, prefix;
   std::optional<GpsTime> date;
   for (std::size_t i = 0; i < args.size(); ++i) {
-    if (args[i] == "--date" && i + 1 < args.size()) date = parseDate(args[++i]);
-    else if (args[i] == "-o" && i + 1 < args.size()) prefix = args[++i];
+    requireValue(args, i, {"-o", "--date", "--interval"});
+    if (args[i] == "--date") date = parseDate(args[++i]);
+    else if (args[i] == "-o") prefix = args[++i];
     else if (args[i].size() > 1 && args[i][0] == '-') throw UsageError("to-rinex: unknown option '" + args[i] + "'");
     else if (path.empty()) path = args[i];
     else throw UsageError("to-rinex: more than one input");
@@ -98,6 +100,17 @@ int runToRinex(const std::vector<std::string>& args) {
       seen[key] = true;
     }
   });
+  const std::string name = path == "-" ? "<stdin>" : path;
+  if (scan.stats().framing.frames == 0) {
+    if (in != stdin) std::fclose(in);
+    throw std::runtime_error("to-rinex: " + name + ": no RTCM 3 frame with a good CRC in " +
+                             std::to_string(scan.stats().framing.bytes) + " bytes; nothing to convert");
+  }
+  if (epochs == 0 && nav.kepler.empty() && nav.glonass.empty()) {
+    if (in != stdin) std::fclose(in);
+    throw std::runtime_error("to-rinex: " + name + ": " + std::to_string(scan.stats().framing.frames) +
+                             " RTCM 3 frames but no observation epoch and no ephemeris; nothing to convert");
+  }
   sortTypes(header);
   header.station = scan.station();
   if (header.station.markerName.empty()) header.station.markerName = std::filesystem::path(path == "-" ? "RTCM" : path).stem().string();
@@ -123,8 +136,8 @@ int runToRinex(const std::vector<std::string>& args) {
   // Pass 2: observations.
   std::rewind(in);
   const std::string obsPath = prefix + ".obs";
-  std::ofstream obs(obsPath);
-  if (!obs) throw std::runtime_error("cannot create '" + obsPath + "'");
+  AtomicOutputFile obsFile(obsPath);  // renamed into place only when both files are complete
+  std::ofstream& obs = obsFile.stream();
   RinexObsWriter writer(obs, header, "gvins-rtcm");
   rtcm::Decoder dec(opt);
   std::optional<ObsEpoch> pending;
@@ -140,7 +153,6 @@ int runToRinex(const std::vector<std::string>& args) {
   });
   if (pending) writer.write(*pending);
   writer.finish();
-  obs.close();
   if (in != stdin) std::fclose(in);
 
   // Navigation file.
@@ -152,9 +164,10 @@ int runToRinex(const std::vector<std::string>& args) {
   });
   if (first) nav.leapSeconds = leapSecondsAtGpst(*first);
   const std::string navPath = prefix + ".nav";
-  std::ofstream navOut(navPath);
-  if (!navOut) throw std::runtime_error("cannot create '" + navPath + "'");
-  writeRinexNav(navOut, nav, "gvins-rtcm");
+  AtomicOutputFile navFile(navPath);
+  writeRinexNav(navFile.stream(), nav, "gvins-rtcm");
+  obsFile.commit();
+  navFile.commit();
 
   std::cerr << "wrote " << obsPath << " (" << writer.epochsWritten() << " epochs";
   if (writer.droppedValues() > 0) std::cerr << ", " << writer.droppedValues() << " values not representable";

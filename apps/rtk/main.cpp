@@ -19,6 +19,7 @@
 
 #include "gvins/base/constants.hpp"
 #include "gvins/base/geodetic.hpp"
+#include "gvins/base/option_values.hpp"
 #include "gvins/base/heap_pages.hpp"
 #include "gvins/base/parse_error.hpp"
 #include "gvins/base/rinex_obs_reader.hpp"
@@ -89,12 +90,6 @@ struct Args {
   std::exit(2);
 }
 
-bool parseTriple(const std::string& s, double v[3]) {
-  char extra = 0;
-  return std::sscanf(s.c_str(), "%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &extra) == 3 && std::isfinite(v[0]) &&
-         std::isfinite(v[1]) && std::isfinite(v[2]);
-}
-
 double parseNumber(const std::string& opt, const std::string& s) {
   char* end = nullptr;
   const double v = std::strtod(s.c_str(), &end);
@@ -103,14 +98,12 @@ double parseNumber(const std::string& opt, const std::string& s) {
 }
 
 Eigen::Vector3d parsePosition(const std::string& opt, const std::string& s, bool llh) {
-  double v[3];
-  if (!parseTriple(s, v)) usageError(opt + " needs three comma-separated numbers, not '" + s + "'");
-  if (!llh) {
-    if (Eigen::Vector3d(v[0], v[1], v[2]).norm() < 1e6) usageError(opt + " is not a position near the Earth's surface");
-    return {v[0], v[1], v[2]};
+  // A base station near the Earth's surface (base/option_values.hpp).
+  try {
+    return llh ? gvins::optionStationLlh(opt, s) : gvins::optionStationEcef(opt, s);
+  } catch (const gvins::OptionError& e) {
+    usageError(e.what());
   }
-  if (std::abs(v[0]) > 90.0 || std::abs(v[1]) > 360.0) usageError(opt + " latitude/longitude out of range");
-  return gvins::geodeticToEcef(gvins::geodeticFromDegrees(v[0], v[1], v[2]));
 }
 
 Args parseArgs(int argc, char** argv) {

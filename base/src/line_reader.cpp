@@ -1,6 +1,7 @@
 #include "gvins/base/line_reader.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <zlib.h>
 
@@ -29,6 +30,8 @@ LineReader::LineReader(const std::string& path, std::size_t maxLineLength)
     : gz_(std::make_unique<GzFile>()), name_(path), maxLen_(maxLineLength) {
   gz_->fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (gz_->fd < 0) throw ParseError(path, 0, "", std::string("cannot open file: ") + std::strerror(errno));
+  struct stat st {};
+  if (::fstat(gz_->fd, &st) == 0 && S_ISDIR(st.st_mode)) throw ParseError(path, 0, "", "is a directory, not a file");
   // Compression is detected from the content (the gzip magic bytes), as zlib does. A file that
   // cannot be peeked at (a pipe) is left to zlib, which reads either kind sequentially.
   unsigned char magic[2] = {0, 0};
@@ -61,6 +64,15 @@ bool LineReader::fill() {
       int err = 0;
       const char* msg = gzerror(gz_->f, &err);
       throw ParseError(name_, line_ + 1, "", std::string("read error: ") + (msg ? msg : "unknown"));
+    }
+    if (n == 0) {
+      // zlib reports a stream that ends before its trailer (CRC-32 and length, RFC 1952 section
+      // 2.3) as a non-fatal Z_BUF_ERROR: a cut-off file would otherwise read as complete.
+      int err = 0;
+      gzerror(gz_->f, &err);
+      if (err == Z_BUF_ERROR)
+        throw ParseError(name_, line_ + 1, "gzip stream",
+                         "truncated gzip file: the compressed stream ends before its end (no CRC/length trailer)");
     }
   } else {
     // Fill the buffer as gzread does (short reads are continued) so that refills fall at the

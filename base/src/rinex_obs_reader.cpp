@@ -147,6 +147,10 @@ struct RinexObsReader::Impl {
   std::vector<std::string> satLines;  // RINEX 2 satellite list
   GpsTime lastTime;
   bool haveTime = false;
+  // The last observation epoch returned (epochs must increase) and the line of the epoch last read.
+  GpsTime lastObsTime;
+  bool haveObsTime = false;
+  std::int64_t epochLine = 0;
   // Scratch per signal: SSI of each of the four types.
   std::vector<std::array<std::uint8_t, 4>> ssiScratch;
 
@@ -599,6 +603,7 @@ bool RinexObsReader::Impl::readEpoch(ObsEpoch& e) {
     if (isBlank(line)) continue;  // stray blank lines between epochs
     break;
   }
+  epochLine = in.lineNumber();
   const std::string_view l = line;
   const bool r2 = rinex2();
   if (!r2 && l[0] != '>') fail("epoch record", "expected an epoch line starting with '>'");
@@ -795,6 +800,21 @@ bool RinexObsReader::next(ObsEpoch& epoch) {
       if (!m.opt.returnSpecialRecords) continue;
       return true;
     }
+    if (m.haveObsTime && !(epoch.time > m.lastObsTime)) {
+      // Out of order, duplicated or restamped into the past: a solution for such an epoch would
+      // come out of time order (RINEX epochs increase; RINEX 3.05 section 5.4).
+      const std::string what = "epoch " + epoch.time.toString(3) + " GPST is " +
+                               (epoch.time == m.lastObsTime ? "a repeat of" : "before") + " the previous epoch " +
+                               m.lastObsTime.toString(3) + " (epochs must increase)";
+      if (!m.opt.skipBadEpochs) throwParseError({m.in.name(), m.epochLine}, "epoch time", what);
+      ++m.stats.skippedEpochs;
+      ++m.stats.outOfOrderEpochs;
+      if (m.stats.messages.size() < m.opt.maxMessages)
+        m.stats.messages.push_back(m.in.name() + ":" + std::to_string(m.epochLine) + ": epoch time: " + what + "; skipped");
+      continue;
+    }
+    m.lastObsTime = epoch.time;
+    m.haveObsTime = true;
     ++m.stats.epochs;
     if (epoch.sats.empty()) ++m.stats.emptyEpochs;
     return true;

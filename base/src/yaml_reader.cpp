@@ -1,5 +1,9 @@
 #include "gvins/base/yaml_reader.hpp"
 
+#include <algorithm>
+#include <filesystem>
+#include <vector>
+
 #include <cctype>
 #include <cmath>
 #include <fstream>
@@ -89,13 +93,67 @@ YAML::Node YamlReader::loadText(const std::string& text, const std::string& name
   }
 }
 
-YAML::Node YamlReader::loadFile(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw ParseError(path, 0, "", "cannot open file");
-  std::ostringstream ss;
-  ss << f.rdbuf();
-  return loadText(ss.str(), path);
+namespace {
+/// Levenshtein distance of two short keys.
+std::size_t editDistance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diag = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diag = up;
+    }
+  }
+  return row[b.size()];
 }
+}  // namespace
+
+void YamlReader::sections(const YAML::Node& root, const std::set<std::string>& known) const {
+  if (!root.IsMap() || root.size() == 0) return;
+  std::string list;
+  for (const std::string& s : known) list += (list.empty() ? "" : ", ") + s;
+  bool any = false;
+  for (auto it = root.begin(); it != root.end(); ++it) {
+    const std::string k = key(it->first, "");
+    if (known.count(k)) {
+      any = true;
+      continue;
+    }
+    // Other tools' sections may share the file; a near miss of a known name is a typo.
+    for (const std::string& s : known) {
+      if (k.size() <= 64 && editDistance(k, s) <= 2)
+        fail(it->first, k, "unknown section '" + k + "' (did you mean '" + s + "'? expected " + list + ")");
+    }
+  }
+  if (!any) {
+    const std::string first = key(root.begin()->first, "");
+    fail(root.begin()->first, first, "unknown section '" + first + "': the file has none of the sections " + list);
+  }
+}
+
+std::string YamlReader::readFile(const std::string& path, std::size_t maxBytes) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw ParseError(path, 0, "", "is a directory, not a configuration file");
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw ParseError(path, 0, "", "cannot open the configuration file");
+  const auto size = std::filesystem::file_size(path, ec);
+  if (!ec && size > maxBytes)
+    throw ParseError(path, 0, "", "configuration file of " + std::to_string(size) + " bytes, larger than the limit of " +
+                                       std::to_string(maxBytes));
+  std::string text;
+  char buf[65536];
+  while (f.read(buf, sizeof buf) || f.gcount() > 0) {
+    text.append(buf, static_cast<std::size_t>(f.gcount()));
+    if (text.size() > maxBytes)
+      throw ParseError(path, 0, "", "configuration larger than the limit of " + std::to_string(maxBytes) + " bytes");
+  }
+  return text;
+}
+
+YAML::Node YamlReader::loadFile(const std::string& path) { return loadText(readFile(path), path); }
 
 std::array<bool, kNumSystems> parseSystemLetters(std::string_view letters) {
   std::array<bool, kNumSystems> out{};

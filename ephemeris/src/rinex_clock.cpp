@@ -102,6 +102,23 @@ void ClockReader::readHeader() {
   }
 }
 
+// Data values are E19.12 / E20.12 (RINEX clock 3.04, section 5 and table A5: "-0.123456789012E-03").
+// A value without its exponent of at least two digits has lost characters (a file cut inside a
+// number) and must not be read as a different number (-7.670588 s for -7.670588E-05 s).
+double clockValue(std::string_view tok, const TextLocation& where, std::string_view field) {
+  const std::size_t e = tok.find_first_of("EeDd");
+  std::size_t digits = 0;
+  if (e != std::string_view::npos) {
+    std::size_t k = e + 1;
+    if (k < tok.size() && (tok[k] == '+' || tok[k] == '-')) ++k;
+    digits = tok.size() - k;
+  }
+  if (digits < 2) {
+    throwParseError(where, field, "'" + std::string(tok) + "' is not a complete E19.12 value (exponent missing or cut off)");
+  }
+  return parseFiniteDouble(tok, where, field);
+}
+
 void ClockReader::readRecord() {
   const std::string_view type = column(line_, 0, 2);
   const bool sat = type == "AS";
@@ -142,7 +159,7 @@ void ClockReader::readRecord() {
   }
   double values[kMaxValues] = {};
   for (std::size_t k = 0; k < onFirst; ++k)
-    values[k] = parseFiniteDouble(tok[7 + k], here(), k == 0 ? "clock bias" : "bias sigma");
+    values[k] = clockValue(tok[7 + k], here(), k == 0 ? "clock bias" : "bias sigma");
   if (count > 2) {
     if (!in_.next(line_)) throwParseError(here(), "data values", "unexpected end of file in a continuation line");
     std::string_view more[5];
@@ -150,7 +167,7 @@ void ClockReader::readRecord() {
     if (m != static_cast<std::size_t>(count - 2)) {
       throwParseError(here(), "data values", std::to_string(count - 2) + " values expected on the continuation line");
     }
-    for (std::size_t k = 0; k < m; ++k) values[2 + k] = parseFiniteDouble(more[k], here(), "data values");
+    for (std::size_t k = 0; k < m; ++k) values[2 + k] = clockValue(more[k], here(), "data values");
   }
   if (!sat) {
     ++d_.skippedRecords;

@@ -1,5 +1,7 @@
 #include "gvins/fusion/replay_config.hpp"
 
+#include "gvins/base/yaml_reader.hpp"
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -138,12 +140,9 @@ ReplayConfig parseReplayConfig(std::string_view text, const std::string& file, c
 }
 
 ReplayConfig loadReplayConfig(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw ParseError(path, 0, "", "cannot open the configuration file");
-  std::ostringstream ss;
-  ss << f.rdbuf();
+  const std::string text = YamlReader::readFile(path);
   const std::filesystem::path p(path);
-  return parseReplayConfig(ss.str(), path, p.has_parent_path() ? p.parent_path().string() : ".");
+  return parseReplayConfig(text, path, p.has_parent_path() ? p.parent_path().string() : ".");
 }
 
 }  // namespace gvins::fusion

@@ -759,6 +759,13 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
   cov.close();
   timing.close();
   sum.files = {(out / "trajectory.tum").string(), (out / "trajectory.cov.csv").string(), timing.path()};
+  if (gnss && g.rover && g.rover->stats().skippedEpochs > 0) {
+    // Malformed or out-of-order rover epochs were skipped: say which (file:line: reason).
+    const RinexObsReaderStats& rs = g.rover->stats();
+    std::fprintf(stderr, "[gvins-replay] warning: %lld rover epochs skipped (%lld out of order or repeated):\n",
+                 static_cast<long long>(rs.skippedEpochs), static_cast<long long>(rs.outOfOrderEpochs));
+    for (const std::string& m : rs.messages) std::fprintf(stderr, "  %s\n", m.c_str());
+  }
   if (gnss) {
     posWriter->finish();
     posFile->close();

@@ -79,6 +79,7 @@ struct BagReader::Impl {
 
 BagReader::BagReader(const std::string& path) : path_(path), impl_(std::make_unique<Impl>()) {
   std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw ParseError(path, 0, "file", "is a directory, not a bag file");
   if (!std::filesystem::is_regular_file(path, ec)) throw ParseError(path, 0, "file", "no such bag file");
   // The library reads the version line itself; check it first for a clear message.
   {

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <utility>
 #include <variant>
@@ -152,6 +153,8 @@ std::optional<BaseFormat> BaseReader::detect(const std::string& path) {
 
 std::unique_ptr<BaseReader> BaseReader::open(const std::string& path, const GpsTime& referenceTime,
                                              EphemerisStore* nav, bool skipBadEpochs) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw ParseError(path, 0, "", "is a directory, not a base station file");
   const auto f = detect(path);
   if (!f) {
     std::ifstream probe(path, std::ios::binary);

@@ -197,6 +197,8 @@ RtkConfig parseRtkConfig(std::string_view yaml, std::string_view name, const Rtk
   if (root.IsNull()) return c;
   if (!root.IsMap()) r.fail(root, "", "the configuration must be a map with an 'rtk' section");
   try {
+    // spp: and rtk: share files (gvins-rtk reads both); anything else is a mistake.
+    r.sections(root, {"spp", "rtk"});
     const YAML::Node rtk = root["rtk"];
     if (!rtk || rtk.IsNull()) return c;
     apply(r, rtk, c);
@@ -207,11 +209,7 @@ RtkConfig parseRtkConfig(std::string_view yaml, std::string_view name, const Rtk
 }
 
 RtkConfig loadRtkConfig(const std::string& path, const RtkConfig& base) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw ParseError(path, 0, "", "cannot open configuration file");
-  std::ostringstream ss;
-  ss << f.rdbuf();
-  return parseRtkConfig(ss.str(), path, base);
+  return parseRtkConfig(YamlReader::readFile(path), path, base);
 }
 
 }  // namespace gvins

@@ -166,6 +166,8 @@ SppConfig parseSppConfig(std::string_view yaml, std::string_view name, const Spp
   if (root.IsNull()) return c;  // empty file: defaults
   if (!root.IsMap()) r.fail(root, "", "the configuration must be a map with an 'spp' section");
   try {
+    // spp: and rtk: share files (gvins-rtk reads both); anything else is a mistake.
+    r.sections(root, {"spp", "rtk"});
     const YAML::Node spp = root["spp"];
     if (!spp || spp.IsNull()) return c;
     apply(r, spp, c);
@@ -177,11 +179,7 @@ SppConfig parseSppConfig(std::string_view yaml, std::string_view name, const Spp
 }
 
 SppConfig loadSppConfig(const std::string& path, const SppConfig& base) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw ParseError(path, 0, "", "cannot open configuration file");
-  std::ostringstream ss;
-  ss << f.rdbuf();
-  return parseSppConfig(ss.str(), path, base);
+  return parseSppConfig(YamlReader::readFile(path), path, base);
 }
 
 }  // namespace gvins

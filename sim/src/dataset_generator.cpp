@@ -120,6 +120,45 @@ void GenerationSummary::print(std::ostream& os) const {
   if (!gnssSummary.empty()) os << gnssSummary;
 }
 
+namespace {
+/// A lower bound of a flight's duration from its spec alone (path at cruise speed, hovers): the
+/// route is built as a polyline of 0.5 m steps, so a spec of legs 1000 km long must be refused
+/// before it is built.
+double nominalFlightDuration(const FlightSpec& f) {
+  double path = f.length;
+  if (f.pattern == FlightPattern::Waypoints) {
+    path = 0.0;
+    Eigen::Vector3d prev = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& w : f.waypoints) {
+      path += (w - prev).norm();
+      prev = w;
+    }
+  }
+  return path / f.speed + f.hoverStart + f.hoverEnd;
+}
+
+void checkResourceLimits(const Scenario& sc, double duration, const GenerationOptions& opt) {
+  const GenerationLimits lim;
+  const auto fail = [&](const std::string& what) {
+    throw std::invalid_argument("scenario '" + sc.name + "' asks for " + what + " (trajectory " + std::to_string(duration) +
+                                " s); shorten the trajectory or lower the rates");
+  };
+  if (!(duration <= lim.maxDuration))
+    fail("a trajectory longer than the limit of " + std::to_string(lim.maxDuration) + " s");
+  const double imuSamples = duration * sc.imu.rateHz;
+  if (imuSamples > lim.maxImuSamples)
+    fail(std::to_string(static_cast<long long>(imuSamples)) + " IMU samples, more than the limit of " +
+         std::to_string(static_cast<long long>(lim.maxImuSamples)));
+  const bool images = !(opt.featuresOnly || sc.output == CameraOutput::Features);
+  double pixels = 0.0;
+  for (const auto& c : sc.cameras) pixels += static_cast<double>(c.intrinsics.width) * c.intrinsics.height;
+  const double imageBytes = images ? duration * sc.cameraRate * pixels : 0.0;  // 8-bit, before PNG compression
+  if (imageBytes > lim.maxImageBytes)
+    fail(std::to_string(static_cast<long long>(imageBytes / 1e6)) + " MB of images, more than the limit of " +
+         std::to_string(static_cast<long long>(lim.maxImageBytes / 1e6)) + " MB");
+}
+}  // namespace
+
 GenerationSummary generateDataset(const Scenario& sc, const fs::path& dir, const GenerationOptions& opt) {
   const auto tStart = Clock::now();
   GenerationSummary sum;
@@ -133,9 +172,11 @@ GenerationSummary generateDataset(const Scenario& sc, const fs::path& dir, const
 
   // ---- trajectory and IMU
   if (log) *log << "[gvins-sim] scenario '" << sc.name << "', seed " << seed << " -> " << dir.string() << "\n";
+  if (sc.trajectory == TrajectoryKind::Flight) checkResourceLimits(sc, nominalFlightDuration(sc.flight), opt);
   const std::unique_ptr<Trajectory> traj = buildTrajectory(sc, seed);
   const double duration = traj->duration();
   sum.duration = duration;
+  checkResourceLimits(sc, duration, opt);
   const fs::path mav0 = dir / "mav0";
   const fs::path truthDir = dir / "truth";
   fs::create_directories(mav0 / "imu0");

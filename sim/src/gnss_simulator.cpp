@@ -88,6 +88,19 @@ GnssSimSummary GnssSimulator::run(const NavData& nav, const Trajectory& trajecto
   std::filesystem::create_directories(dir);
   GnssEpochGenerator gen(config_, nav, trajectory, frame, leverArmBody, seed);
   const GnssSimWorld& world = gen.world();
+  // A start outside the navigation data would give observation files without a single epoch.
+  bool covered = false;
+  for (const SatId sat : world.store().satellites()) {
+    if (world.store().satelliteState(sat, frame.startTime)) {
+      covered = true;
+      break;
+    }
+  }
+  if (!covered) {
+    throw std::invalid_argument("gnss.navigation " + config_.navigationFile.string() +
+                                ": no satellite has a usable ephemeris at the scenario start " +
+                                frame.startTime.toString(0) + " GPST (start_gpst outside the navigation file)");
+  }
   const bool withBase = gen.base() != nullptr;
 
   GnssSimSummary sum;

@@ -536,6 +536,8 @@ Scenario parseScenario(const std::string& text, const std::string& file) {
 }
 
 Scenario loadScenario(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw ParseError(path, 0, "", "is a directory, not a scenario file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ParseError(path, 0, "", "cannot open scenario file");
   std::string text;

@@ -73,6 +73,48 @@ TEST(LineReader, PlainAndGzipFilesReadTheSame) {
   std::remove(gz.c_str());
 }
 
+TEST(LineReader, TruncatedGzipAndDirectoriesAreErrors) {
+  // A gzip file cut anywhere - inside the deflate data or only its 8-byte trailer (CRC-32 and
+  // length, RFC 1952 section 2.3) - is an error naming the file, not a shorter file (`gzip -t`
+  // rejects these too). The complete file reads to the end.
+  const auto dir = std::filesystem::temp_directory_path();
+  const std::string gz = (dir / "gvins_lr_cut.txt.gz").string();
+  std::string content;
+  for (int i = 0; i < 5000; ++i) content += "row " + std::to_string(i * 7919 % 10007) + "\n";
+  {
+    gzFile f = gzopen(gz.c_str(), "wb");
+    ASSERT_NE(f, nullptr);
+    gzwrite(f, content.data(), static_cast<unsigned>(content.size()));
+    gzclose(f);
+  }
+  const auto full = std::filesystem::file_size(gz);
+  auto countLines = [&](const std::string& p) {
+    LineReader r(p);
+    std::string l;
+    int n = 0;
+    while (r.next(l)) ++n;
+    return n;
+  };
+  EXPECT_EQ(countLines(gz), 5000);
+  for (const std::uintmax_t cut : {std::uintmax_t{1}, std::uintmax_t{4}, std::uintmax_t{8}, full / 2}) {
+    std::filesystem::resize_file(gz, full - cut);
+    try {
+      countLines(gz);
+      ADD_FAILURE() << "cut " << cut << " bytes: read without error";
+    } catch (const ParseError& e) {
+      EXPECT_EQ(e.file(), gz);
+      EXPECT_NE(std::string(e.what()).find("truncated gzip"), std::string::npos) << e.what();
+    }
+  }
+  std::remove(gz.c_str());
+  try {
+    LineReader r(dir.string());
+    ADD_FAILURE() << "a directory opened as a file";
+  } catch (const ParseError& e) {
+    EXPECT_NE(std::string(e.what()).find("is a directory"), std::string::npos) << e.what();
+  }
+}
+
 TEST(LineReader, ViewsAcrossBufferRefillsWithUnreadEverywhere) {
   // Lines of many lengths (0 to 3000 characters, about 70 of them across the 64 KiB refills), CRLF
   // and LF, no final newline: the string_view interface returns the lines, and unread() after any

@@ -721,6 +721,48 @@ TEST(RinexObs, SkipBadEpochsResynchronisesAndCounts) {
   EXPECT_FALSE(r.stats().messages.empty());
 }
 
+TEST(RinexObs, EpochsOutOfOrderOrRepeatedAreErrorsOrSkipped) {
+  // Epochs must increase: one repeated (at 1 s) or restamped into the past (0.5 s) is an error at
+  // its epoch line; with skipBadEpochs it is dropped, counted and reported with its line.
+  const std::string t = header3(kG2) +
+                        "> 2020 01 01 00 00  0.0000000  0  1\nG05  21000000.000\n"
+                        "> 2020 01 01 00 00  1.0000000  0  1\nG05  21000001.000\n"
+                        "> 2020 01 01 00 00  1.0000000  0  1\nG05  21000009.000\n"
+                        "> 2020 01 01 00 00  0.5000000  0  1\nG05  21000009.000\n"
+                        "> 2020 01 01 00 00  2.0000000  0  1\nG05  21000002.000\n";
+  {
+    RinexObsReader r(std::string_view(t), "order.obs");
+    ObsEpoch e;
+    ASSERT_TRUE(r.next(e));
+    ASSERT_TRUE(r.next(e));
+    try {
+      r.next(e);
+      ADD_FAILURE() << "repeated epoch accepted";
+    } catch (const ParseError& err) {
+      EXPECT_EQ(err.file(), "order.obs");
+      EXPECT_EQ(err.line(), 8) << err.what();
+      EXPECT_EQ(err.field(), "epoch time");
+      EXPECT_NE(err.reason().find("repeat"), std::string::npos) << err.what();
+    }
+  }
+  RinexObsReaderOptions opt;
+  opt.skipBadEpochs = true;
+  RinexObsReader r(std::string_view(t), "order.obs", opt);
+  ObsEpoch e;
+  std::vector<double> secs, ranges;
+  while (r.next(e)) {
+    secs.push_back(e.time.toCalendar().second);
+    ranges.push_back(e.sats.at(0).signals.at(0).pseudorange);
+  }
+  EXPECT_EQ(secs, (std::vector<double>{0.0, 1.0, 2.0}));
+  EXPECT_EQ(ranges, (std::vector<double>{21000000.0, 21000001.0, 21000002.0}));
+  EXPECT_EQ(r.stats().skippedEpochs, 2);
+  EXPECT_EQ(r.stats().outOfOrderEpochs, 2);
+  ASSERT_EQ(r.stats().messages.size(), 2u);
+  EXPECT_NE(r.stats().messages[0].find("order.obs:8: epoch time"), std::string::npos) << r.stats().messages[0];
+  EXPECT_NE(r.stats().messages[1].find("order.obs:10: epoch time"), std::string::npos) << r.stats().messages[1];
+}
+
 // The writer's output is stable (byte-identical to the stored file) and RTKLIB accepts it:
 // rnx2rtkp single-point solutions on the rewritten file equal those on the original file.
 // Stored files: reference/rtklib-2.4.3/nagoya_rover_gvins_written_30s.obs.gz (first 30 epochs of

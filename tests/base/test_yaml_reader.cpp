@@ -3,7 +3,11 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <string>
+
+#include <unistd.h>
 
 namespace gvins {
 namespace {
@@ -64,6 +68,54 @@ TEST(YamlReader, SyntaxErrorsAndMissingFilesNameTheFile) {
   EXPECT_GE(syntax.line(), 1);
   const ParseError missing = errorOf([] { YamlReader::loadFile("/nonexistent/dir/x.yaml"); });
   EXPECT_EQ(missing.file(), "/nonexistent/dir/x.yaml");
+}
+
+TEST(YamlReader, ConfigFilesMustBeSmallFilesWithKnownSections) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("gvins_yaml_cfg_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  // A folder given as a configuration file is named as such.
+  try {
+    YamlReader::readFile(dir.string());
+    ADD_FAILURE() << "a directory read as a configuration";
+  } catch (const ParseError& e) {
+    EXPECT_EQ(e.file(), dir.string());
+    EXPECT_NE(std::string(e.what()).find("is a directory"), std::string::npos) << e.what();
+  }
+  // Larger than the limit: rejected before yaml-cpp parses it.
+  const fs::path big = dir / "big.yaml";
+  {
+    std::ofstream f(big);
+    f << "spp:\n  list: [";
+    for (int i = 0; i < 300000; ++i) f << i << ",";
+    f << "0]\n";
+  }
+  try {
+    YamlReader::readFile(big.string());
+    ADD_FAILURE() << "a 2 MB configuration accepted";
+  } catch (const ParseError& e) {
+    EXPECT_NE(std::string(e.what()).find("limit"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(YamlReader::readFile(big.string(), 4u << 20).size(), fs::file_size(big));
+  // Sections: a misspelled one is named with its line.
+  const YamlReader r("c.yaml");
+  const YAML::Node good = YamlReader::loadText("spp:\n  a: 1\nrtk:\n  b: 2\n", "c.yaml");
+  EXPECT_NO_THROW(r.sections(good, {"spp", "rtk"}));
+  const YAML::Node bad = YamlReader::loadText("# comment\nsp:\n  a: 1\n", "c.yaml");
+  try {
+    r.sections(bad, {"spp", "rtk"});
+    ADD_FAILURE() << "section 'sp' accepted";
+  } catch (const ParseError& e) {
+    EXPECT_EQ(e.line(), 2);
+    EXPECT_NE(e.reason().find("unknown section 'sp' (did you mean 'spp'? expected rtk, spp)"), std::string::npos)
+        << e.what();
+  }
+  // A near miss next to a valid section, and a file with only other tools' sections.
+  EXPECT_THROW(r.sections(YamlReader::loadText("spp:\n  a: 1\nrkt:\n  b: 2\n", "c.yaml"), {"spp", "rtk"}), ParseError);
+  EXPECT_THROW(r.sections(YamlReader::loadText("replay:\n  a: 1\n", "c.yaml"), {"spp", "rtk"}), ParseError);
+  // Sections of other tools beside a known one are theirs.
+  EXPECT_NO_THROW(r.sections(YamlReader::loadText("rtk:\n  a: 1\nother_tool: [1, 2]\n", "c.yaml"), {"spp", "rtk"}));
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -135,3 +135,24 @@ TEST(RinexClock, RoundTripBothLayouts) {
     }
   }
 }
+
+TEST(RinexClock, ValueCutInsideItsExponentIsAnError) {
+  // A file cut inside its last value ("-0.123456789012E-03" -> "-0.1234567890") must not read as
+  // a clock 1000 times larger: the record is rejected with its line and field.
+  std::string text = v300("GPS");
+  const std::string full = "-0.123456789012E-03";
+  const std::size_t at = text.find(full);
+  ASSERT_NE(at, std::string::npos);
+  for (const std::size_t keep : {std::size_t{12}, std::size_t{16}, std::size_t{17}, std::size_t{18}}) {
+    std::string cut = text.substr(0, at) + full.substr(0, keep) + "  0.123456789012E-10\n";
+    try {
+      parseRinexClock(cut, "cut.clk");
+      ADD_FAILURE() << "accepted " << full.substr(0, keep);
+    } catch (const ParseError& e) {
+      EXPECT_EQ(e.line(), 11) << e.what();  // 8 header lines, AR and its continuation, then AS G16
+      EXPECT_EQ(e.field(), "clock bias") << e.what();
+    }
+  }
+  // The complete value still reads.
+  EXPECT_DOUBLE_EQ(parseRinexClock(text, "full.clk").find(SatId(System::Gps, 16))->back().bias, -0.123456789012e-3);
+}

@@ -131,6 +131,9 @@ TEST(EurocImuCsv, MalformedInputNamesLineAndField) {
   expectParseError([&] { parseImu(h + "1005000000,0,x,0,0,0,9.81\n"); }, 3, "w_y", "not a number");
   expectParseError([&] { parseImu(h + "1005000000,0,0,0,nan,0,9.81\n"); }, 3, "a_x");
   expectParseError([&] { parseImu(h + "1005000000,0,0,0,1e999,0,9.81\n"); }, 3, "a_x", "range");
+  // Finite but physically impossible values (a corrupt file) are named here, not by the filter.
+  expectParseError([&] { parseImu(h + "1005000000,0,0,0,1e30,0,9.81\n"); }, 3, "a_x", "beyond");
+  expectParseError([&] { parseImu(h + "1005000000,0,-250,0,0,0,9.81\n"); }, 3, "w_y", "beyond");
   expectParseError([&] { parseImu(h + "1005000000,0,0,,0,0,9.81\n"); }, 3, "w_z", "missing");
   expectParseError([&] { parseImu(h + "-1005000000,0,0,0,0,0,9.81\n"); }, 3, "timestamp");
   expectParseError([&] { parseImu(h + "99999999999999999999,0,0,0,0,0,9.81\n"); }, 3, "timestamp", "range");

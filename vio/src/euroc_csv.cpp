@@ -19,6 +19,9 @@ std::int64_t periodFromRate(double rateHz) {
   return static_cast<std::int64_t>(std::llround(1e9 / rateHz));
 }
 
+constexpr double kMaxAngularRate = 200.0;     // rad/s
+constexpr double kMaxSpecificForce = 2000.0;  // m/s^2, about 200 g
+
 void checkIncreasing(std::int64_t t, std::int64_t last, const TextLocation& where) {
   if (last < 0) return;
   if (t == last) throwParseError(where, "timestamp", "duplicate time stamp " + std::to_string(t));
@@ -52,8 +55,17 @@ bool ImuCsvReader::next(ImuSample& s) {
     }
     s.t_ns = detail::parseNanoseconds(fields_[0], where, "timestamp");
     for (int k = 0; k < 3; ++k) {
-      s.gyro[k] = parseDouble(fields_[1 + k], where, kImuFields[1 + k]);
-      s.accel[k] = parseDouble(fields_[4 + k], where, kImuFields[4 + k]);
+      s.gyro[k] = parseFiniteDouble(fields_[1 + k], where, kImuFields[1 + k]);
+      s.accel[k] = parseFiniteDouble(fields_[4 + k], where, kImuFields[4 + k]);
+      // Physical limits well beyond the full scale of navigation IMUs (MEMS data sheets give
+      // +-2000 deg/s = 35 rad/s and +-16 g; shock-rated parts +-200 g): anything larger is a
+      // corrupt value that would only surface later as a numerical failure of the filter.
+      if (std::abs(s.gyro[k]) > kMaxAngularRate)
+        throwParseError(where, kImuFields[1 + k], "angular rate " + std::string(fields_[1 + k]) + " rad/s beyond +-" +
+                                                      std::to_string(static_cast<int>(kMaxAngularRate)) + " rad/s");
+      if (std::abs(s.accel[k]) > kMaxSpecificForce)
+        throwParseError(where, kImuFields[4 + k], "specific force " + std::string(fields_[4 + k]) + " m/s^2 beyond +-" +
+                                                      std::to_string(static_cast<int>(kMaxSpecificForce)) + " m/s^2");
     }
     checkIncreasing(s.t_ns, last_, where);
     if (last_ >= 0 && gaps_.nominalPeriod_ns > 0) {

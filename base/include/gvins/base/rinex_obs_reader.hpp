@@ -11,7 +11,8 @@
 //
 // Errors: malformed content throws ParseError naming file, line and field. With
 // `skipBadEpochs` the reader instead drops a malformed epoch, resynchronises at the next epoch
-// line and counts it in stats(); header errors always throw. Satellites of unknown systems or
+// line and counts it in stats(); header errors always throw. Observation epochs must increase:
+// one at or before the previous one is an error too (skipped and counted with `skipBadEpochs`). Satellites of unknown systems or
 // with out-of-range numbers, and satellites of systems without observation types, are skipped and
 // counted, never fatal.
 #pragma once
@@ -43,6 +44,8 @@ struct RinexObsReaderStats {
   std::int64_t epochs = 0;             ///< observation epochs (flag 0/1) returned
   std::int64_t specialRecords = 0;     ///< epochs with flags 2-6 read
   std::int64_t skippedEpochs = 0;      ///< malformed epochs dropped (skipBadEpochs)
+  std::int64_t outOfOrderEpochs = 0;   ///< of those, epochs not after the previous one (out of
+                                       ///< order, repeated); without skipBadEpochs a ParseError
   std::int64_t skippedSatellites = 0;  ///< satellite records dropped (unknown system/number/types)
   std::int64_t emptyEpochs = 0;        ///< observation epochs without any satellite
   std::vector<std::string> messages;   ///< first few reasons, with file and line

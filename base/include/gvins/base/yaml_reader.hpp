@@ -80,6 +80,18 @@ class YamlReader {
     }
   }
 
+  /// Checks the top-level keys of a configuration file against the `known` sections of a tool: a
+  /// non-empty file without any of them, or a key within two edits of a known name ("sp:",
+  /// "rkt:"), is an error (a misspelled section would otherwise be ignored silently). Other keys
+  /// are sections of other tools sharing the file and are left alone.
+  void sections(const YAML::Node& root, const std::set<std::string>& known) const;
+
+  /// The text of a configuration file: ParseError (line 0) for a missing or unreadable file, a
+  /// directory, or a file larger than `maxBytes` (checked before reading: a configuration is
+  /// small, and yaml-cpp needs about 200 bytes of memory per byte of a long list).
+  static std::string readFile(const std::string& path, std::size_t maxBytes = kMaxFileBytes);
+  static constexpr std::size_t kMaxFileBytes = 1 << 20;
+
   /// Loads a YAML document from a file (ParseError with yaml-cpp's line on a syntax error, or on a
   /// missing/unreadable file) or from text (`name` used in errors).
   static YAML::Node loadFile(const std::string& path);

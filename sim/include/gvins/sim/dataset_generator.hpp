@@ -50,12 +50,22 @@ struct GenerationSummary {
   void print(std::ostream& os) const;
 };
 
+/// What one dataset may ask for, checked before anything is written (a scenario of 10,000
+/// far-apart waypoints would otherwise fill a disk): trajectory length, IMU samples, and the raw
+/// size of the rendered images (8-bit pixels of every camera and frame).
+struct GenerationLimits {
+  double maxDuration = 6.0 * 3600.0;  ///< s
+  double maxImuSamples = 2e7;
+  double maxImageBytes = 20e9;        ///< before PNG compression
+};
+
 /// The scenario's trajectory (flight from its spec and the seed, or the recorded one).
 std::unique_ptr<Trajectory> buildTrajectory(const Scenario& scenario, std::uint64_t seed);
 
 /// Writes the dataset into `dir` (created; existing files of the same names are overwritten).
 /// Throws ParseError for bad input files (recorded trajectory, navigation file),
-/// std::invalid_argument for inconsistent scenarios, std::runtime_error for write errors.
+/// std::invalid_argument for inconsistent scenarios or ones beyond GenerationLimits (before
+/// writing anything), std::runtime_error for write errors.
 GenerationSummary generateDataset(const Scenario& scenario, const std::filesystem::path& dir,
                                   const GenerationOptions& options);
 

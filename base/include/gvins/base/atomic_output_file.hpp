@@ -1,0 +1,36 @@
+// An output file written under a temporary name in its destination folder and renamed over the
+// destination only when complete (rename(2) is atomic within a file system): a run that fails or
+// is interrupted leaves no file that looks valid, and an older file of that name stays intact.
+#pragma once
+
+#include <fstream>
+#include <string>
+
+namespace gvins {
+
+class AtomicOutputFile {
+ public:
+  /// Reserves `path`; nothing is created until stream() or the caller writes tempPath().
+  explicit AtomicOutputFile(std::string path);
+  /// Removes the temporary file unless commit() succeeded.
+  ~AtomicOutputFile();
+  AtomicOutputFile(const AtomicOutputFile&) = delete;
+  AtomicOutputFile& operator=(const AtomicOutputFile&) = delete;
+
+  const std::string& path() const { return path_; }
+  /// "<path>.part-<pid>" (same folder, so the final rename does not cross file systems).
+  const std::string& tempPath() const { return temp_; }
+  /// The temporary file opened for writing (binary); throws std::runtime_error naming path()
+  /// if it cannot be created.
+  std::ofstream& stream();
+  /// Flushes and closes the stream (if opened) and renames the temporary file to path();
+  /// throws std::runtime_error naming path() on a write or rename failure.
+  void commit();
+
+ private:
+  std::string path_, temp_;
+  std::ofstream out_;
+  bool opened_ = false, committed_ = false;
+};
+
+}  // namespace gvins

@@ -1,0 +1,43 @@
+#include "gvins/base/atomic_output_file.hpp"
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <stdexcept>
+
+namespace gvins {
+
+AtomicOutputFile::AtomicOutputFile(std::string path)
+    : path_(std::move(path)), temp_(path_ + ".part-" + std::to_string(::getpid())) {}
+
+AtomicOutputFile::~AtomicOutputFile() {
+  if (committed_) return;
+  if (out_.is_open()) out_.close();
+  std::remove(temp_.c_str());
+}
+
+std::ofstream& AtomicOutputFile::stream() {
+  if (!opened_) {
+    out_.open(temp_, std::ios::binary | std::ios::trunc);
+    if (!out_) throw std::runtime_error("cannot create '" + path_ + "': " + std::strerror(errno));
+    opened_ = true;
+  }
+  return out_;
+}
+
+void AtomicOutputFile::commit() {
+  if (committed_) return;
+  if (opened_) {
+    out_.flush();
+    const bool good = static_cast<bool>(out_);
+    out_.close();
+    if (!good || out_.fail()) throw std::runtime_error("cannot write '" + path_ + "' (disk full?)");
+  }
+  if (std::rename(temp_.c_str(), path_.c_str()) != 0)
+    throw std::runtime_error("cannot write '" + path_ + "': " + std::strerror(errno));
+  committed_ = true;
+}
+
+}  // namespace gvins
