@@ -440,6 +440,12 @@ def main(args):
     if md:
         with open(md, 'w') as f:
             f.write('<!-- written by bench/gnss/integrity.py; do not edit by hand -->\n')
+            f.write('# RTK integrity: fix rate and wrong fixes, ours and RTKLIB 2.4.3\n\n')
+            f.write('`bench/gnss/integrity.py --markdown docs/rtk_integrity.md` (docstring of the script: pairs, '
+                    'truth, stressed variants, simulated flights). A wrong fix is a fixed epoch more than %.2f m '
+                    '(3-D) from the truth; fix %% is of all rover epochs. "no-PAR": `--no-partial`. RTKLIB '
+                    '(rnx2rtkp, same elevation mask, frequencies, systems and AR mode, ratio 3) has no partial '
+                    'fixing. Model of the fix: docs/rtk.md, "Integrity of the fix".\n\n' % WRONG_M)
             f.write('| ' + ' | '.join(head) + ' |\n|' + '---|' * len(head) + '\n')
             for r in table:
                 f.write('| ' + ' | '.join(r) + ' |\n')
