@@ -22,6 +22,7 @@
 #include "gvins/gnss/doppler_consistency.hpp"
 #include "gvins/gnss/rtk.hpp"
 #include "gvins/gnss/spp.hpp"
+#include "nagoya_pair.hpp"
 
 using namespace gvins;
 
@@ -29,28 +30,8 @@ namespace {
 
 const std::string kData = GVINS_TEST_DATA;
 
-struct Nagoya {
-  std::vector<ObsEpoch> rover, base;
-  RinexObsHeader roverHeader, baseHeader;
-  EphemerisStore nav;
-  Eigen::Vector3d basePosition = Eigen::Vector3d::Zero();
-};
-
-const Nagoya& nagoya() {
-  static const Nagoya d = [] {
-    Nagoya s;
-    const std::string dir = kData + "/gnss/nagoya_static_2024/";
-    s.rover = readRinexObs(dir + "rover.obs.gz", &s.roverHeader);
-    s.base = readRinexObs(dir + "base.obs.gz", &s.baseHeader);
-    s.nav.add(readRinexNav(dir + "base.nav.gz"));
-    std::ifstream f(dir + "base_position.txt");
-    double lat = 0, lon = 0, h = 0;
-    f >> lat >> lon >> h;
-    s.basePosition = geodeticToEcef(geodeticFromDegrees(lat, lon, h));
-    return s;
-  }();
-  return d;
-}
+using Nagoya = test::RecordedPair;
+const Nagoya& nagoya() { return test::nagoyaPair(); }
 
 using Doctor = std::function<void(SatId, SignalObs&, const ObsEpoch&)>;
 

@@ -29,6 +29,7 @@
 #include "gvins/gnss/rtk.hpp"
 #include "gvins/gnss/transmit_states.hpp"
 #include "gvins/rtcm/encoder.hpp"
+#include "nagoya_pair.hpp"
 
 using namespace gvins;
 
@@ -36,34 +37,9 @@ namespace {
 
 const std::string kData = GVINS_TEST_DATA;
 
-struct Dataset {
-  std::vector<ObsEpoch> rover, base;
-  RinexObsHeader roverHeader, baseHeader;
-  EphemerisStore nav;
-  Eigen::Vector3d basePosition = Eigen::Vector3d::Zero();
-  Eigen::Vector3d truth = Eigen::Vector3d::Zero();  // rover (Nagoya); unused for GEONET
-};
+using Dataset = test::RecordedPair;
 
-Eigen::Vector3d readLlh(const std::string& path) {
-  std::ifstream f(path);
-  double lat = 0, lon = 0, h = 0;
-  f >> lat >> lon >> h;
-  return geodeticToEcef(geodeticFromDegrees(lat, lon, h));
-}
-
-const Dataset& nagoya() {
-  static const Dataset d = [] {
-    Dataset s;
-    const std::string dir = kData + "/gnss/nagoya_static_2024/";
-    s.rover = readRinexObs(dir + "rover.obs.gz", &s.roverHeader);
-    s.base = readRinexObs(dir + "base.obs.gz", &s.baseHeader);
-    s.nav.add(readRinexNav(dir + "base.nav.gz"));
-    s.basePosition = readLlh(dir + "base_position.txt");
-    s.truth = readLlh(dir + "rover_position.txt");
-    return s;
-  }();
-  return d;
-}
+const Dataset& nagoya() { return test::nagoyaPair(); }
 
 const Dataset& geonet() {
   static const Dataset d = [] {

@@ -33,6 +33,7 @@
 #include "gvins/gnss/rtk.hpp"
 #include "gvins/gnss/rtk_config.hpp"
 #include "gvins/rtcm/encoder.hpp"
+#include "nagoya_pair.hpp"
 
 using namespace gvins;
 
@@ -90,23 +91,23 @@ struct Pair {
   RinexObsHeader roverHeader, baseHeader, rewrittenHeader;
   EphemerisStore nav;
   Eigen::Vector3d basePosition = Eigen::Vector3d::Zero();
-};
+};  // the recorded pair (tests/support/nagoya_pair.hpp) and the base rewritten
 
 const Pair& nagoya() {
   static const Pair p = [] {
     Pair s;
-    s.rover = readRinexObs(kDir + "rover.obs.gz", &s.roverHeader);
-    s.base = readRinexObs(kDir + "base.obs.gz", &s.baseHeader);
+    const test::RecordedPair& d = test::nagoyaPair();
+    s.rover = d.rover;
+    s.roverHeader = d.roverHeader;
+    s.base = d.base;
+    s.baseHeader = d.baseHeader;
     const std::string text = rewrittenBaseText();  // the reader keeps a view of it
     RinexObsReader r(text, "base.obs (rewritten)");
     ObsEpoch e;
     while (r.next(e)) s.rewritten.push_back(e);
     s.rewrittenHeader = r.header();
-    s.nav.add(readRinexNav(kDir + "base.nav.gz"));
-    std::ifstream f(kDir + "base_position.txt");
-    double lat = 0, lon = 0, h = 0;
-    f >> lat >> lon >> h;
-    s.basePosition = geodeticToEcef(geodeticFromDegrees(lat, lon, h));
+    s.nav = d.nav;
+    s.basePosition = d.basePosition;
     return s;
   }();
   return p;

@@ -240,9 +240,9 @@ TEST(Spp, RobustWeightingSurvivesSeveralMultipathLikeErrors) {
   EXPECT_GT((plain.position - o.position).norm(), 1.5 * (s.position - o.position).norm());
 }
 
-TEST(Spp, CovarianceIsConsistentWithSimulatedNoise) {
-  // With the noise model equal to the simulation (sigma 0.3 m, GLONASS x1.5, no other error
-  // terms) the normalised estimation error squared averages to 3 (chi-square, 3 dof).
+/// Plain weighted least squares with the simulation's own noise model (sigma 0.3 m, GLONASS x1.5,
+/// no other error terms, no exclusion or robust weights): what the covariance tests compare with.
+SppConfig simulationNoiseConfig() {
   SppConfig c = plainConfig();
   c.weighting.a = 0.3;
   c.weighting.b = 0.0;
@@ -251,6 +251,13 @@ TEST(Spp, CovarianceIsConsistentWithSimulatedNoise) {
   c.robust.enabled = false;
   c.isbPriorSigma = 0.0;
   c.velocity = false;
+  return c;
+}
+
+TEST(Spp, CovarianceIsConsistentWithSimulatedNoise) {
+  // With the noise model equal to the simulation (sigma 0.3 m, GLONASS x1.5, no other error
+  // terms) the normalised estimation error squared averages to 3 (chi-square, 3 dof).
+  SppConfig c = simulationNoiseConfig();
   SimOptions o;
   o.position = kNagoyaRover;
   o.noise = 0.3;
@@ -276,14 +283,7 @@ TEST(Spp, VarianceFactorScalesTheCovarianceWhenTheWeightsAreOptimistic) {
   // The noise is 3x the weighting model's sigma (1 m against 0.3 m): the least-squares covariance
   // is 9x too small (NEES ~27); scaled by the a-posteriori variance factor it describes the error
   // again (NEES ~3). The solution itself does not change.
-  SppConfig c = plainConfig();
-  c.weighting.a = 0.3;
-  c.weighting.b = 0.0;
-  c.ephemerisError.fill(0.0);
-  c.faultExclusion.enabled = false;
-  c.robust.enabled = false;
-  c.isbPriorSigma = 0.0;
-  c.velocity = false;
+  SppConfig c = simulationNoiseConfig();
   SppConfig raw = c;
   raw.covarianceScaling.enabled = false;
   SimOptions o;
