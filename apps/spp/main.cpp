@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "gvins/base/atomic_output_file.hpp"
 #include "gvins/base/constants.hpp"
 #include "gvins/base/geodetic.hpp"
 #include "gvins/base/heap_pages.hpp"
@@ -335,15 +336,18 @@ int main(int argc, char** argv) {
   channels.mergeMissing(nav.glonassChannels());
   if (hdr.station.approxPosition) solver.setInitialPosition(*hdr.station.approxPosition);
 
-  std::ofstream file;
+  // The .pos file is written under a temporary name and renamed only when the run succeeds: a
+  // failed run leaves no file that looks valid (and an older file of that name intact).
+  std::optional<AtomicOutputFile> file;
   std::ostream* out = &std::cout;
   if (args.out != "-") {
-    file.open(args.out);
-    if (!file) {
-      std::fprintf(stderr, "gvins-spp: error: cannot create '%s'\n", args.out.c_str());
+    file.emplace(args.out);
+    try {
+      out = &file->stream();
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "gvins-spp: error: cannot create '%s': %s\n", args.out.c_str(), e.what());
       return 1;
     }
-    out = &file;
   }
   PosWriterOptions popt;
   popt.coordinates = args.xyz ? PosCoordinates::Xyz : PosCoordinates::Llh;
@@ -449,11 +453,16 @@ int main(int argc, char** argv) {
     }
   }
   writer.finish();
-  if (file.is_open()) {
-    file.close();
-    if (!file) {
-      std::fprintf(stderr, "gvins-spp: error: writing '%s' failed\n", args.out.c_str());
-      exitCode = 1;
+  if (file) {
+    if (exitCode == 0) {
+      try {
+        file->commit();
+      } catch (const std::exception& e) {
+        std::fprintf(stderr, "gvins-spp: error: writing '%s' failed: %s\n", args.out.c_str(), e.what());
+        exitCode = 1;
+      }
+    } else {
+      std::fprintf(stderr, "gvins-spp: no output written to '%s' (the run failed)\n", args.out.c_str());
     }
   }
   if (!args.quiet && tty) std::fprintf(stderr, "\r%60s\r", "");

@@ -155,6 +155,8 @@ spp_cases() {
   reject spp gzip-nav-no-trailer "trailer.nav.gz|truncated gzip" -- "$S" -q -o "$d/x.pos" "$ROVER" "$d/trailer.nav.gz"
   rinex_epochs "$ROVER" "$d/swap.obs" swap 10 11
   reject spp epochs-swapped-strict "swap.obs:|epoch time|before the previous epoch" -- "$S" -q --strict -o "$d/x.pos" "$d/swap.obs" "$NAV"
+  # A run that fails half way leaves no .pos behind (written under a temporary name).
+  reject spp failed-run-leaves-no-pos "swap.obs:|no output written" --absent "$d/swapped.pos" -- "$S" -q --strict -o "$d/swapped.pos" "$d/swap.obs" "$NAV"
   rinex_epochs "$ROVER" "$d/repeat.obs" repeat 10 0
   reject spp epoch-repeated-strict "repeat.obs:|epoch time|repeat" -- "$S" -q --strict -o "$d/x.pos" "$d/repeat.obs" "$NAV"
   rinex_epochs "$ROVER" "$d/past.obs" past 5 40
@@ -202,6 +204,7 @@ rtk_cases() {
   same rtk crlf-rover "$d/ref.pos" "$d/crlf.pos" -- "$R" -q --base-llh "$BASE_LLH" -o "$d/crlf.pos" "$d/crlf.obs" "$BASE" "$NAV"
   rinex_epochs "$d/rover.obs" "$d/swap.obs" swap 10 11
   reject rtk epochs-swapped-strict "swap.obs:|epoch time" -- "$R" -q --strict --base-llh "$BASE_LLH" -o "$d/x.pos" "$d/swap.obs" "$BASE" "$NAV"
+  reject rtk failed-run-leaves-no-pos "swap.obs:|no output written" --absent "$d/swapped.pos" -- "$R" -q --strict --base-llh "$BASE_LLH" -o "$d/swapped.pos" "$d/swap.obs" "$BASE" "$NAV"
   rinex_epochs "$d/rover.obs" "$d/repeat.obs" repeat 10 0
   reject rtk epoch-repeated-strict "repeat.obs:|epoch time|repeat" -- "$R" -q --strict --base-llh "$BASE_LLH" -o "$d/x.pos" "$d/repeat.obs" "$BASE" "$NAV"
   rinex_epochs "$d/rover.obs" "$d/past.obs" past 5 40
