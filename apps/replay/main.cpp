@@ -285,16 +285,18 @@ int main(int argc, char** argv) {
     }
     ec = estimatorConfigFor(ec, *gnssMode);
     const ReplaySummary s = ec.use_float ? run<float>(dataset, ec, gc, opt) : run<double>(dataset, ec, gc, opt);
-    s.print(std::cout);
-    for (const auto& f : s.files) std::cout << "wrote " << f << "\n";
     if (s.framesProcessed == 0) {
-      // Output files of a run without a single frame would look like a result.
+      // Output files of a run without a single frame would look like a result: removed.
+      for (const auto& f : s.files) std::filesystem::remove(f);
       std::fprintf(stderr,
                    "gvins-replay: %s: no frame was processed (%zu frames in the dataset): empty or unreadable "
-                   "cam0 data (features.csv / data.csv), or a --start/--duration window without frames\n",
+                   "cam0 data (features.csv / data.csv), or a --start/--duration window without frames; "
+                   "no output written\n",
                    dataset.c_str(), s.frames);
       return 1;
     }
+    s.print(std::cout);
+    for (const auto& f : s.files) std::cout << "wrote " << f << "\n";
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "gvins-replay: %s\n", e.what());

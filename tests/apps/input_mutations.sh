@@ -393,7 +393,7 @@ replay_cases() {
   dataset_copy empty_features
   : >"$W/empty_features/mav0/cam0/features.csv"
   : >"$W/empty_features/mav0/cam1/features.csv"
-  reject replay features-empty "no frame was processed" -- "$R" "$W/empty_features" -q --no-eval -o "$d/x"
+  reject replay features-empty "no frame was processed" --absent "$d/x/trajectory.tum" -- "$R" "$W/empty_features" -q --no-eval -o "$d/x"
   dataset_copy imu_1e30
   awk -F, 'NR == 100 { $5 = "1e30" } { print }' OFS=, "$DS/mav0/imu0/data.csv" >"$W/imu_1e30/mav0/imu0/data.csv"
   reject replay imu-1e30 "imu0/data.csv:100|a_x" -- "$R" "$W/imu_1e30" -q --no-eval -o "$d/x"
