@@ -303,17 +303,14 @@ int main(int argc, char** argv) {
 
   // The .pos file is written under a temporary name and renamed only when the run succeeds: a
   // failed run leaves no file that looks valid (and an older file of that name intact).
-  std::optional<AtomicOutputFile> file;
-  std::ostream* out = &std::cout;
-  if (args.out != "-") {
-    file.emplace(args.out);
-    try {
-      out = &file->stream();
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "gvins-rtk: error: cannot create '%s': %s\n", args.out.c_str(), e.what());
-      return 1;
-    }
+  std::optional<OutputTarget> output;
+  try {
+    output.emplace(args.out);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "gvins-rtk: error: %s\n", e.what());
+    return 1;
   }
+  std::ostream* out = &output->stream();
   PosWriterOptions popt;
   popt.coordinates = args.xyz ? PosCoordinates::Xyz : PosCoordinates::Llh;
   popt.velocity = !args.noVelocity;
@@ -477,18 +474,15 @@ int main(int argc, char** argv) {
   }
   if (!writer) writer = std::make_unique<PosWriter>(*out, popt);
   writer->finish();
-  if (file) {
-    if (exitCode == 0) {
-      try {
-        file->commit();
-      } catch (const std::exception& e) {
-        std::fprintf(stderr, "gvins-rtk: error: writing '%s' failed: %s\n", args.out.c_str(), e.what());
-        exitCode = 1;
-      }
-    } else {
-      std::fprintf(stderr, "gvins-rtk: no output written to '%s' (the run failed)\n", args.out.c_str());
-    }
+  const bool toFile = output->isFile();
+  try {
+    output->finish(exitCode == 0);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "gvins-rtk: error: %s\n", e.what());
+    exitCode = 1;
   }
+  if (exitCode != 0 && toFile)
+    std::fprintf(stderr, "gvins-rtk: no output written to '%s' (the run failed)\n", args.out.c_str());
   if (!args.quiet && tty) std::fprintf(stderr, "\r%90s\r", "");
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 

@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <iostream>
 #include <stdexcept>
 
 namespace gvins {
@@ -38,6 +39,23 @@ void AtomicOutputFile::commit() {
   if (std::rename(temp_.c_str(), path_.c_str()) != 0)
     throw std::runtime_error("cannot write '" + path_ + "': " + std::strerror(errno));
   committed_ = true;
+}
+
+OutputTarget::OutputTarget(const std::string& path) {
+  if (path == "-") return;
+  file_.emplace(path);
+  file_->stream();
+}
+
+std::ostream& OutputTarget::stream() { return file_ ? static_cast<std::ostream&>(file_->stream()) : std::cout; }
+
+void OutputTarget::finish(bool success) {
+  if (!file_) {
+    std::cout.flush();
+    return;
+  }
+  if (success) file_->commit();
+  else file_.reset();
 }
 
 }  // namespace gvins

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <fstream>
+#include <optional>
+#include <ostream>
 #include <string>
 
 namespace gvins {
@@ -31,6 +33,21 @@ class AtomicOutputFile {
   std::string path_, temp_;
   std::ofstream out_;
   bool opened_ = false, committed_ = false;
+};
+
+/// A tool's main output: standard output for "-", else an AtomicOutputFile opened at once.
+class OutputTarget {
+ public:
+  /// Throws std::runtime_error naming `path` if the file cannot be created.
+  explicit OutputTarget(const std::string& path);
+  std::ostream& stream();
+  bool isFile() const { return file_.has_value(); }
+  /// The run's end: with `success` the file is renamed into place (throws std::runtime_error
+  /// naming it on a write or rename failure), else it is discarded and no file is left.
+  void finish(bool success);
+
+ private:
+  std::optional<AtomicOutputFile> file_;
 };
 
 }  // namespace gvins
