@@ -761,6 +761,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
     spp_ = std::make_unique<SppSolver>(nav);
     if (config_.usesDifferences()) {
       rtk_ = std::make_unique<RtkSolver>(nav);
+      rtk_->setRoverDopplerCheckedByCaller();  // checked at the input below, once
       baseWarned_ = 0;
       if (config_.basePosition) rtk_->setBasePosition(*config_.basePosition);
     }

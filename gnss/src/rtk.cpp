@@ -429,19 +429,22 @@ bool RtkSolver::phasePairsAsProcessed() const {
   return true;
 }
 
-const ObsEpoch& RtkSolver::checkedRover(const ObsEpoch& rover) {
-  if (&rover == &roverChecked_) return rover;
-  roverChecked_ = rover;
+GlonassChannels RtkSolver::roverGlonassChannels() const {
   GlonassChannels ch = roverChannels_;
   ch.mergeMissing(nav_.glonassChannels());
-  roverDoppler_.apply(roverChecked_, ch);
+  return ch;
+}
+
+const ObsEpoch& RtkSolver::checkedRover(const ObsEpoch& rover) {
+  if (!checkRoverDoppler_ || &rover == &roverChecked_) return rover;
+  roverChecked_ = rover;
+  roverDoppler_.apply(roverChecked_, roverGlonassChannels());
   return roverChecked_;
 }
 
 std::optional<double> RtkSolver::differences(const ObsEpoch& roverIn, const Eigen::Vector3d& x, TransmitStates* states) {
   const ObsEpoch& rover = checkedRover(roverIn);
-  GlonassChannels ch = roverChannels_;
-  ch.mergeMissing(nav_.glonassChannels());
+  const GlonassChannels ch = roverGlonassChannels();
   detectSlips(rover, ch);
   if (base_.snapshot(rover.time, snapshot_) != BaseAvailability::Ok) {
     dd_.clear();
@@ -476,8 +479,7 @@ RtkSolution RtkSolver::processEpoch(const ObsEpoch& rover, TransmitStates* state
     sol.velocity = spp.velocity.velocity;
     sol.velocityCovariance = spp.velocity.covariance;
   }
-  GlonassChannels ch = roverChannels_;
-  ch.mergeMissing(nav_.glonassChannels());
+  const GlonassChannels ch = roverGlonassChannels();
   detectSlips(rover, ch);
   lastProcess_ = rover.time;
   processedPairs_.clear();

@@ -187,6 +187,9 @@ class RtkSolver {
   /// Doppler sanity of the rover stream (every rover epoch passes it before SPP and the slip
   /// detector; the base's is base().doppler()).
   const DopplerConsistency& roverDoppler() const { return roverDoppler_; }
+  /// For a caller that runs the rover's Doppler check itself before handing epochs over (the
+  /// fusion): the solver then takes them as they are, without a second check or a copy.
+  void setRoverDopplerCheckedByCaller() { checkRoverDoppler_ = false; }
 
  private:
   struct Ambiguity {
@@ -248,6 +251,9 @@ class RtkSolver {
   CycleSlipDetector roverSlips_;
   DopplerConsistency roverDoppler_{"rover"};
   ObsEpoch roverChecked_;  // the rover epoch with its Doppler checked (checkedRover)
+  bool checkRoverDoppler_ = true;
+  /// The rover's GLONASS channels, completed from the navigation records.
+  GlonassChannels roverGlonassChannels() const;
   const ObsEpoch& checkedRover(const ObsEpoch& rover);
   DoubleDifferenceBuilder builder_;
   GlonassChannels roverChannels_;
