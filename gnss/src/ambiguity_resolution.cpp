@@ -51,10 +51,10 @@ double fixedFailureRateCriticalRatio(const LtdlFactor& f, const AmbiguityResolut
   const Eigen::VectorXd sd = f.d.cwiseMax(0.0).cwiseSqrt();
   const Eigen::MatrixXd Lt = f.L.transpose();
   std::vector<double> wrong;  // ratios of the draws whose best candidate is not z
-  Eigen::VectorXd w(n);
+  Eigen::VectorXd w(n), zhat(n);
   for (int k = 0; k < samples; ++k) {
     for (int i = 0; i < n; ++i) w[i] = sd[i] * normal(rng);
-    const Eigen::VectorXd zhat = Lt.triangularView<Eigen::Upper>() * w;
+    zhat.noalias() = Lt.triangularView<Eigen::Upper>() * w;
     const IlsSearchResult r = searchIntegerLeastSquares(f, zhat, so);
     if (!r.complete || r.candidates.size() < 2) {
       wrong.push_back(std::numeric_limits<double>::infinity());
