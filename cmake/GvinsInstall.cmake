@@ -13,15 +13,21 @@ get_property(gvins_libraries GLOBAL PROPERTY GVINS_LIBRARIES)
 # running executable (<bindir>/<GVINS_DATA_FROM_BIN>/data, see sim/src/scenario.cpp) or through
 # GVINS_DATA_DIR, never through a path of this build tree. The build tree holds the same layout
 # under build/share/sri_gvins, so the tools, tests and benchmarks (bin/, tests/, bench/, fuzz/,
-# all one level below the build folder) find it the same way.
+# all one level below the build folder) find it the same way; there the data files are symbolic
+# links to tests/data (the same files as the source tree's scenarios name), the installed ones
+# copies.
 file(RELATIVE_PATH GVINS_DATA_FROM_BIN ${CMAKE_INSTALL_FULL_BINDIR}
      ${CMAKE_INSTALL_FULL_DATADIR}/${GVINS_DATA_SUBDIR})
 get_filename_component(gvins_stage "${PROJECT_BINARY_DIR}/bin/${GVINS_DATA_FROM_BIN}" ABSOLUTE)
 set(gvins_nav_dir gnss/nagoya_static_2024)
-foreach(f base.nav.gz LICENSE.MatRTKLIB)
-  configure_file(${PROJECT_SOURCE_DIR}/tests/data/${gvins_nav_dir}/${f}
-                 ${gvins_stage}/data/${gvins_nav_dir}/${f} COPYONLY)
+set(gvins_nav_files ${PROJECT_SOURCE_DIR}/tests/data/${gvins_nav_dir}/base.nav.gz
+                    ${PROJECT_SOURCE_DIR}/tests/data/${gvins_nav_dir}/LICENSE.MatRTKLIB)
+file(MAKE_DIRECTORY ${gvins_stage}/data/${gvins_nav_dir})
+foreach(f IN LISTS gvins_nav_files)
+  get_filename_component(name ${f} NAME)
+  file(CREATE_LINK ${f} ${gvins_stage}/data/${gvins_nav_dir}/${name} SYMBOLIC COPY_ON_ERROR)
 endforeach()
+install(FILES ${gvins_nav_files} DESTINATION ${CMAKE_INSTALL_DATADIR}/${GVINS_DATA_SUBDIR}/data/${gvins_nav_dir})
 # The scenarios name the navigation file relative to themselves (../tests/data/... in the source
 # tree); the installed copies point at ../data/... instead.
 file(GLOB gvins_scenarios CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/config/*.yaml)
@@ -31,7 +37,7 @@ foreach(f IN LISTS gvins_scenarios)
   string(REPLACE "../tests/data/" "../data/" text "${text}")
   file(CONFIGURE OUTPUT ${gvins_stage}/config/${name} CONTENT "${text}" @ONLY)
 endforeach()
-install(DIRECTORY ${gvins_stage}/ DESTINATION ${CMAKE_INSTALL_DATADIR}/${GVINS_DATA_SUBDIR})
+install(DIRECTORY ${gvins_stage}/config DESTINATION ${CMAKE_INSTALL_DATADIR}/${GVINS_DATA_SUBDIR})
 if(TARGET gvins_sim)
   set_property(SOURCE ${PROJECT_SOURCE_DIR}/sim/src/scenario.cpp TARGET_DIRECTORY gvins_sim APPEND
                PROPERTY COMPILE_DEFINITIONS GVINS_SIM_DATA_FROM_BIN="${GVINS_DATA_FROM_BIN}")

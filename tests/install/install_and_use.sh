@@ -48,6 +48,11 @@ while IFS= read -r -d '' f; do
     leaks=$((leaks + 1))
   fi
 done < <(find "$prefix" -type f -print0)
+while IFS= read -r -d '' f; do
+  case "$(readlink "$f")" in
+    "$src"*|"$build"*) echo "  ${f#$prefix/} -> $(readlink "$f")" >&2; leaks=$((leaks + 1)) ;;
+  esac
+done < <(find "$prefix" -type l -print0)
 [ "$leaks" -eq 0 ] || fail "$leaks installed files name the source or build tree"
 grep -q 'EIGEN_MAX_ALIGN_BYTES=64' "$prefix/lib/cmake/SriGvins/SriGvinsTargets.cmake" ||
   fail "EIGEN_MAX_ALIGN_BYTES is not a usage requirement of the exported targets"
