@@ -36,7 +36,10 @@ function(gvins_add_library)
   target_compile_definitions(${A_NAME} PUBLIC ${GVINS_EIGEN_DEFINITIONS})
   target_compile_options(${A_NAME} PRIVATE ${GVINS_WARNINGS})
   string(REGEX REPLACE "^gvins_" "" export_name ${A_NAME})
-  set_target_properties(${A_NAME} PROPERTIES EXPORT_NAME ${export_name})
+  # Static libraries by default; with -DBUILD_SHARED_LIBS=ON the shared objects are versioned
+  # (0.x: the minor version changes the ABI).
+  set_target_properties(${A_NAME} PROPERTIES EXPORT_NAME ${export_name} VERSION ${PROJECT_VERSION}
+    SOVERSION ${PROJECT_VERSION_MAJOR}.${PROJECT_VERSION_MINOR})
   add_library(SriGvins::${export_name} ALIAS ${A_NAME})
   install(TARGETS ${A_NAME} EXPORT SriGvinsTargets
     ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}

@@ -3,8 +3,8 @@
 # would (tests/install/CMakeLists.txt):
 #  1. `cmake --install BUILD --prefix WORK/prefix` (no rebuild);
 #  2. no installed file names the source or the build tree (`strings` on the libraries and tools,
-#     grep on the CMake package and pkg-config files), and the package files are where
-#     find_package and pkg-config look;
+#     grep on the CMake package and pkg-config files), the package files are where find_package
+#     and pkg-config look, and every installed header compiles with the installed flags alone;
 #  3. examples/satellite_spp and examples/rtcm_decode configured and built with
 #     find_package(SriGvins CONFIG) and, separately, with their pkg-config Makefiles, and run on
 #     tests/data: the satellite position and clock against RTKLIB's, the SPP fixes against the
@@ -57,9 +57,15 @@ done < <(find "$prefix" -type l -print0)
 grep -q 'EIGEN_MAX_ALIGN_BYTES=64' "$prefix/lib/cmake/SriGvins/SriGvinsTargets.cmake" ||
   fail "EIGEN_MAX_ALIGN_BYTES is not a usage requirement of the exported targets"
 
+step "every installed header compiles with the pkg-config flags of sri-gvins.pc"
+export PKG_CONFIG_PATH=$prefix/lib/pkgconfig
+(cd "$prefix/include" && find gvins -name '*.hpp' | sort | sed 's/.*/#include <&>/') >"$work/all_headers.cpp"
+"$cxx" -std=c++20 -fsyntax-only $(pkg-config --cflags sri-gvins) "$work/all_headers.cpp" ||
+  fail "the installed headers do not compile on their own"
+echo "  $(wc -l <"$work/all_headers.cpp") headers"
+
 generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)
-export PKG_CONFIG_PATH=$prefix/lib/pkgconfig
 
 build_example() {  # name -> $work/<name>-cmake/<name>, $work/<name>-pc/<name>
   local name=$1
