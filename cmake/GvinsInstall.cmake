@@ -109,8 +109,8 @@ function(gvins_pkgconfig_requirements target requires_var libs_var)
     elseif(item MATCHES "^-")
       list(APPEND libs "${item}")
     else()
-      message(FATAL_ERROR "pkg-config file of ${target}: no pkg-config name known for '${item}' "
-                          "(add it to gvins_pkgconfig_requirements in cmake/GvinsInstall.cmake)")
+      message(WARNING "the pkg-config file of ${target} lacks '${item}': no pkg-config name known for it "
+                      "(add one to gvins_pkgconfig_requirements in cmake/GvinsInstall.cmake)")
     endif()
   endforeach()
   list(REMOVE_DUPLICATES requires)
