@@ -214,7 +214,6 @@ def scan_functions(text):
     """[(name, first_line, last_line)] of the function bodies of a C++ text."""
     code = blank_out(text)
     stack = ["scope"]
-    header_start = 0
     header_parts = []
     functions = []
     open_fn = None  # (name, first line, depth)
@@ -320,10 +319,10 @@ def main(argv=None):
 
     if not a.check:
         print(f"{len(files)} files, {sum(s[0] for s in sizes)} lines, {len(funcs)} functions")
-        print(f"largest files (lines):")
+        print("largest files (lines):")
         for lines, f in sizes[:a.top]:
             print(f"  {lines:6d}  {f}")
-        print(f"longest functions (lines, first line to closing brace):")
+        print("longest functions (lines, first line to closing brace):")
         for lines, f, first, name in funcs[:a.top]:
             print(f"  {lines:6d}  {f}:{first}  {name}")
         return 0
