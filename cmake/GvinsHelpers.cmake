@@ -21,13 +21,32 @@ if(GVINS_FUZZ)
 endif()
 
 # gvins_add_library(NAME <target> SOURCES ... DEPS ...)
-# A library folder: public headers under include/, sources under src/.
+# A library folder: public headers under include/, sources under src/. The library is installed
+# with its headers and exported as SriGvins::<module> (gvins_base -> SriGvins::base; the package
+# config is made at the top level). Eigen's heap alignment (GVINS_EIGEN_DEFINITIONS, set at the top
+# level) is a PUBLIC definition: every translation unit that allocates or frees Eigen objects
+# across the library boundary, ours or a consumer's, must be compiled with the same value.
 function(gvins_add_library)
   cmake_parse_arguments(A "" "NAME" "SOURCES;DEPS;PRIVATE_DEPS" ${ARGN})
   add_library(${A_NAME} ${A_SOURCES})
-  target_include_directories(${A_NAME} PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include)
+  target_include_directories(${A_NAME} PUBLIC
+    $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>
+    $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
   target_link_libraries(${A_NAME} PUBLIC ${A_DEPS} PRIVATE ${A_PRIVATE_DEPS})
+  target_compile_definitions(${A_NAME} PUBLIC ${GVINS_EIGEN_DEFINITIONS})
   target_compile_options(${A_NAME} PRIVATE ${GVINS_WARNINGS})
+  string(REGEX REPLACE "^gvins_" "" export_name ${A_NAME})
+  # Static libraries by default; with -DBUILD_SHARED_LIBS=ON the shared objects are versioned
+  # (0.x: the minor version changes the ABI).
+  set_target_properties(${A_NAME} PROPERTIES EXPORT_NAME ${export_name} VERSION ${PROJECT_VERSION}
+    SOVERSION ${PROJECT_VERSION_MAJOR}.${PROJECT_VERSION_MINOR})
+  add_library(SriGvins::${export_name} ALIAS ${A_NAME})
+  install(TARGETS ${A_NAME} EXPORT SriGvinsTargets
+    ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+    LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+    RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+  install(DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+  set_property(GLOBAL APPEND PROPERTY GVINS_LIBRARIES ${A_NAME})
 endfunction()
 
 # gvins_add_app(NAME gvins-<verb> SOURCES ... DEPS ...)

@@ -1,6 +1,7 @@
 #include "gvins/sim/scenario.hpp"
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
@@ -12,8 +13,10 @@
 #include "gvins/base/parse_error.hpp"
 #include "gvins/base/text_fields.hpp"
 
-#ifndef GVINS_SIM_DATA_DIR
-#define GVINS_SIM_DATA_DIR ""
+// Where the installed data (data/gnss/...) lies relative to the folder of the running executable:
+// <prefix>/bin/../share/sri_gvins; the build tree has the same layout (cmake/GvinsInstall.cmake).
+#ifndef GVINS_SIM_DATA_FROM_BIN
+#define GVINS_SIM_DATA_FROM_BIN "../share/sri_gvins"
 #endif
 
 namespace gvins::sim {
@@ -481,8 +484,16 @@ vio::CameraCalibration downwardCamera(const std::string& name, const Eigen::Vect
   return c;
 }
 
+std::string bundledDataDirectory() {
+  if (const char* env = std::getenv("GVINS_DATA_DIR"); env != nullptr && *env != '\0') return env;
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  const std::filesystem::path base = ec ? std::filesystem::path(".") : exe.parent_path();
+  return (base / GVINS_SIM_DATA_FROM_BIN / "data").lexically_normal().string();
+}
+
 std::string bundledNavigationFile() {
-  return std::string(GVINS_SIM_DATA_DIR) + "/gnss/nagoya_static_2024/base.nav.gz";
+  return bundledDataDirectory() + "/gnss/nagoya_static_2024/base.nav.gz";
 }
 
 Scenario defaultScenario() {

@@ -77,7 +77,14 @@ vio::CameraCalibration downwardCamera(const std::string& name, const Eigen::Vect
 /// followed by small mount angles (deg): R_look Rz(yaw) Ry(pitch) Rx(roll).
 Eigen::Matrix3d cameraMountRotation(bool lookDown, const Eigen::Vector3d& mountRpyDeg);
 
-/// Path of the navigation file bundled with the sources (tests/data/gnss/nagoya_static_2024).
+/// Folder of the data installed with the library (the navigation file of the default scenario):
+/// $GVINS_DATA_DIR when that environment variable is set (a source tree's tests/data will do),
+/// else <folder of the running executable>/../share/sri_gvins/data, which is where an installed
+/// tool (<prefix>/bin) and the build tree's tools and tests find it. Programs elsewhere set
+/// GVINS_DATA_DIR or name the file (scenario `gnss.navigation`).
+std::string bundledDataDirectory();
+/// Path of the bundled navigation file (gnss/nagoya_static_2024/base.nav.gz of
+/// bundledDataDirectory(); a copy of tests/data/gnss/nagoya_static_2024/base.nav.gz).
 std::string bundledNavigationFile();
 
 }  // namespace gvins::sim
