@@ -44,6 +44,7 @@ struct Comparison {
   std::int64_t epochs = 0, values = 0, theirSignals = 0;
   double maxC = 0, maxL = 0, maxD = 0, maxS = 0;
   std::int64_t lliBit1Mismatch = 0;
+  std::int64_t slipAgree = 0, slipDisagree = 0;  // LLI bit 0 after the first epoch
 };
 
 Comparison compareWithConvbin(const std::vector<ObsEpoch>& ours, const std::string& ref) {
@@ -81,6 +82,8 @@ Comparison compareWithConvbin(const std::vector<ObsEpoch>& ours, const std::stri
           c.maxL = std::max(c.maxL, std::abs(o->carrierPhase - tsig.carrierPhase));
           ++c.values;
           if (((o->lli ^ tsig.lli) & 2) != 0) ++c.lliBit1Mismatch;
+          // convbin flags every phase of the first epoch; we flag only zero locktimes there.
+          if (c.epochs > 1) ++(((o->lli ^ tsig.lli) & 1) ? c.slipDisagree : c.slipAgree);
         }
         if (o->hasDoppler() && tsig.hasDoppler()) c.maxD = std::max(c.maxD, std::abs(o->doppler - tsig.doppler)), ++c.values;
         if (o->hasSnr() && tsig.hasSnr()) c.maxS = std::max(c.maxS, std::abs(o->snr - tsig.snr)), ++c.values;
@@ -119,9 +122,10 @@ TEST(UbxRawx, EqualsConvbinOnEveryLogWithRawx) {
     EXPECT_LE(c.maxD, 0.0005 + 1e-6);  // doMes is a float: convbin rounds the same value
     EXPECT_LE(c.maxS, 0.0005 + 1e-9);
     EXPECT_EQ(c.lliBit1Mismatch, 0);
+    EXPECT_LE(c.slipDisagree * 100, c.slipAgree) << "loss-of-lock flags differ from convbin's in more than 1 %";
     std::cerr << cs.log << ": " << c.epochs << " epochs, " << st.signalsDelivered << " signals ours, "
               << c.theirSignals << " convbin, " << st.noisyPhases << " phases with cpStdev > 5, " << c.values << " values compared, max |dC| " << c.maxC
-              << " m, |dL| " << c.maxL << " cyc, |dD| " << c.maxD << " Hz, |dS| " << c.maxS << "\n";
+              << " m, |dL| " << c.maxL << ", LLI bit 0 agree/differ " << c.slipAgree << "/" << c.slipDisagree << ", |dD| " << c.maxD << " Hz, |dS| " << c.maxS << "\n";
   }
 }
 
