@@ -42,7 +42,8 @@ struct NavigationCounts {
   std::uint64_t crcFailures = 0;      ///< Galileo I/NAV CRC-24Q failures
   std::uint64_t incompleteSets = 0;   ///< partial sets dropped (issue of data changed before completion)
   std::uint64_t unknownMessages = 0;  ///< unhandled pages/subframes/strings, bad layout, unknown signals
-  std::uint64_t skipped = 0;          ///< messages of systems not decoded (SBAS, IMES, NavIC)
+  std::uint64_t skipped = 0;          ///< messages not decoded: SBAS, NavIC, GPS/QZSS CNAV,
+                                      ///< Galileo F/NAV and E6, BeiDou B-CNAV1/2, GLONASS CDMA
   std::uint64_t ephemerides = 0;      ///< complete records emitted
   std::uint64_t ionosphere = 0;       ///< ionosphere parameter sets emitted
 };
@@ -59,14 +60,17 @@ class NavigationAssembler {
   /// Never throws on bad navigation data: bad parity/CRC and malformed parts are counted.
   NavDataUpdate add(const SfrbxMessage& msg, const GpsTime& receiveTime);
 
-  const NavigationCounts& counts(System system) const { return counts_[systemIndex(system)]; }
-  /// Sum over all systems.
+  const NavigationCounts& counts(System system) const {
+    return counts_[static_cast<std::size_t>(systemIndex(system))];
+  }
+  /// Sum over all systems (messages of an unknown gnssId count as unknown messages).
   NavigationCounts total() const;
 
  private:
   struct State;
   std::unique_ptr<State> state_;
   std::array<NavigationCounts, kNumSystems> counts_{};
+  std::uint64_t unknownGnss_ = 0;
 };
 
 }  // namespace gvins::ubx
