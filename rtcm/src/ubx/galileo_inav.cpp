@@ -12,7 +12,7 @@
 namespace gvins::ubx::detail {
 
 std::optional<InavWord> inavWord(const std::vector<std::uint32_t>& words) {
-  if (words.size() != 8) return std::nullopt;
+  if (words.size() != 8 && words.size() != 9) return std::nullopt;  // F9 firmware adds a pad word
   NavBits even, odd;
   for (int k = 0; k < 4; ++k) even.push(words[static_cast<std::size_t>(k)], 32);
   for (int k = 4; k < 8; ++k) odd.push(words[static_cast<std::size_t>(k)], 32);
@@ -55,8 +55,8 @@ void GalileoInavDecoder::add(const SfrbxMessage& msg, SatId sat, const GpsTime& 
     out.ionosphere.galileo = q;
     ++counts.ionosphere;
   }
-  auto& slot = p.word[static_cast<std::size_t>(type - 1)];
-  slot = d;
+  p.word[static_cast<std::size_t>(type - 1)] = d;
+  p.fromE5b[static_cast<std::size_t>(type - 1)] = msg.sigId == 5;
   // IODnav of words 1-4 must agree (5.1.9.2).
   if (type <= 4) {
     bool dropped = false;
@@ -118,9 +118,12 @@ void GalileoInavDecoder::add(const SfrbxMessage& msg, SatId sat, const GpsTime& 
   const int e1bDvs = static_cast<int>(w5.u(72, 1));
   const int wn = static_cast<int>(w5.u(73, 12));
   const double tow = static_cast<double>(w5.u(85, 20));
-  // RINEX 3.04 table A8 bit fields, as the RTCM 1046 decoder sets them.
+  // RINEX 3.04 table A8 bit fields, as the RTCM 1046 decoder sets them; data sources: bit 0 when
+  // a word came from E1-B, bit 2 when one came from E5b-I, bit 9 (clock for E5b,E1) always.
   e.health = e1bDvs | (e1bHs << 1) | (e5bDvs << 6) | (e5bHs << 7);
-  e.codesOnL2 = (1 << 0) | (1 << 2) | (1 << 9);
+  bool e1b = false, e5b = false;
+  for (bool f : p.fromE5b) (f ? e5b : e1b) = true;
+  e.codesOnL2 = (e1b ? 1 << 0 : 0) | (e5b ? 1 << 2 : 0) | (1 << 9);
   if (toe >= kSecondsPerWeek || toc >= kSecondsPerWeek || tow >= kSecondsPerWeek) {
     ++counts.unknownMessages;
     return;
@@ -132,7 +135,8 @@ void GalileoInavDecoder::add(const SfrbxMessage& msg, SatId sat, const GpsTime& 
   gpstToGst(receiveTime, gstWeek, gstTow);
   int diff = ((wn - gstWeek) % 4096 + 4096) % 4096;
   if (diff >= 2048) diff -= 4096;
-  const int week = gstWeek + diff;
+  // Without a receive time the GST week count is taken as it is (valid until 2077).
+  const int week = receiveTime.week() < kFirstValidWeek ? wn : gstWeek + diff;
   e.ttr = gstToGpst(week, tow);
   e.toe = rtcm::nearWeek(gstToGpst(week, toe), e.ttr);
   e.toc = rtcm::nearWeek(gstToGpst(week, toc), e.toe);

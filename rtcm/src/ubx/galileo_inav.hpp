@@ -12,7 +12,7 @@
 namespace gvins::ubx::detail {
 
 /// The 128-bit word of an I/NAV even/odd page pair delivered as eight 32-bit words (even part in
-/// words 0-3, odd part in words 4-7, each 120 bits left-aligned). std::nullopt when the layout is
+/// words 0-3, odd part in words 4-7, each 120 bits left-aligned; a ninth word is padding). std::nullopt when the layout is
 /// not an even-odd nominal pair; `crcOk` false when the CRC-24Q over the pair fails.
 struct InavWord {
   NavBits data;  // 128 bits: word type (6) first
@@ -28,6 +28,7 @@ class GalileoInavDecoder {
  private:
   struct Partial {
     std::array<std::optional<NavBits>, 5> word;  // word types 1-5
+    std::array<bool, 5> fromE5b{};               // the word came from E5b-I (else E1-B)
     int lastIod = -1;
     std::uint32_t lastToe = 0xffffffff;
   };

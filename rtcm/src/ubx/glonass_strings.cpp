@@ -83,6 +83,7 @@ void GlonassDecoder::add(const SfrbxMessage& msg, SatId sat, const GpsTime& rece
   const NavBits& s4 = *p.string[3];
   const int tb = static_cast<int>(s2.u(9, 7));
   if (tb == p.lastTb) return;
+  if (receiveTime.week() < kFirstValidWeek) return;  // no time yet for the day: keep the set
   const int tkH = static_cast<int>(s1.u(9, 5));
   const int tkM = static_cast<int>(s1.u(14, 6));
   const int tkS = static_cast<int>(s1.u(20, 1));

@@ -42,17 +42,16 @@ int iodcOf(const NavBits& sf1) { return static_cast<int>((sf1.u(70, 2) << 8) | s
 std::optional<NavBits> lnavDataBits(const std::vector<std::uint32_t>& words) {
   if (words.size() != 10) return std::nullopt;
   NavBits bits;
-  // The word before the TLM word (word 10 of the previous subframe) ends in two zero bits
-  // (IS-GPS-200 20.3.5.2), so the TLM word is never inverted.
-  int d29 = 0, d30 = 0;
   for (std::uint32_t w : words) {
     w &= 0x3fffffffu;                   // the two most significant bits are padding
     const std::uint32_t data = w >> 6;  // already non-inverted
-    std::uint32_t sent = w & 0x3fu;     // parity as delivered: inverted with the data if D30*
-    if (d30) sent ^= 0x3fu;
-    if (lnavParity(data, d29, d30) != sent) return std::nullopt;
-    d29 = static_cast<int>((sent >> 1) & 1u);
-    d30 = static_cast<int>(sent & 1u);
+    // The receiver inverts whole words (data and parity) where the transmitted D30* was set, so a
+    // delivered word satisfies the parity equations with D30* = 0 and D29* = D29* xor D30*. That
+    // term is taken from neither the padding nor the previous word (words of one subframe may
+    // follow a gap): both values are accepted. Every single bit error is still detected, since
+    // no data bit enters exactly the parity bits D25, D27 and D30 that D29* enters.
+    const std::uint32_t p = w & 0x3fu;
+    if (lnavParity(data, 0, 0) != p && lnavParity(data, 1, 0) != p) return std::nullopt;
     bits.push(data, 24);
   }
   return bits;
@@ -111,6 +110,7 @@ void GpsLnavDecoder::add(const SfrbxMessage& msg, SatId sat, const GpsTime& rece
   const int iodc = iodcOf(*s1);
   const std::uint32_t toeRaw = s2->u(216, 16);
   if (iodc == p.lastIodc && toeRaw == p.lastToe) return;  // this set was emitted already
+  if (receiveTime.week() < kFirstValidWeek) return;  // no time yet for the 10-bit week: keep the set
 
   KeplerEphemeris e;
   e.sat = sat;
@@ -153,11 +153,13 @@ void GpsLnavDecoder::add(const SfrbxMessage& msg, SatId sat, const GpsTime& rece
     ++counts.unknownMessages;
     return;
   }
-  // Times: the week of subframe 1 is the week of transmission modulo 1024; the transmission time
-  // is the start of subframe 1 (HOW TOW count = start of the next subframe, 20.3.3.2).
+  // Times: the week of subframe 1 is the week of transmission modulo 1024 (HOW TOW count = start
+  // of the next subframe, 20.3.3.2). The transmission time is the time the set became complete,
+  // as the RTCM decoder uses the reception time.
+  e.ttr = receiveTime;
   const int week = resolveWeek(week10, 10, receiveTime);
-  e.ttr = GpsTime::fromWeekTow(week, static_cast<double>(s1->u(24, 17)) * 6.0 - 6.0);
-  e.toe = rtcm::nearWeek(GpsTime::fromWeekTow(week, toe), e.ttr);
+  const GpsTime sf1Start = GpsTime::fromWeekTow(week, static_cast<double>(s1->u(24, 17)) * 6.0 - 6.0);
+  e.toe = rtcm::nearWeek(GpsTime::fromWeekTow(week, toe), sf1Start);
   e.toc = rtcm::nearWeek(GpsTime::fromWeekTow(week, toc), e.toe);
   e.toeSeconds = toe;
   e.week = e.toe.week();

@@ -12,9 +12,8 @@
 
 namespace gvins::ubx::detail {
 
-/// IS-GPS-200 20.3.5.2 parity of ten 30-bit words as u-blox delivers them: whole words (data and
-/// parity) inverted where the preceding transmitted D30 was set, so the data bits need no further
-/// inversion. Returns the 240 data bits, or std::nullopt when any word fails its parity.
+/// IS-GPS-200 20.3.5.2 parity of ten 30-bit words as u-blox delivers them (data bits already
+/// non-inverted). Returns the 240 data bits, or std::nullopt when any word fails its parity.
 std::optional<NavBits> lnavDataBits(const std::vector<std::uint32_t>& words);
 
 class GpsLnavDecoder {

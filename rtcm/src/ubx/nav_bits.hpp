@@ -34,6 +34,9 @@ class NavBits {
   int n_ = 0;
 };
 
+/// Receive times before this GPS week (1999) stand for "no time known yet" (e.g. GpsTime{}).
+inline constexpr int kFirstValidWeek = 1024;
+
 inline constexpr double kSemicircle = constants::kPi;  // semicircles to radians (ICD value of pi)
 inline double scaled(std::int64_t v, int e) { return std::ldexp(static_cast<double>(v), e); }
 
