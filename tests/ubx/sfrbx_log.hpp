@@ -6,6 +6,7 @@
 
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <vector>
 
 #include "gvins/ubx/navigation_assembler.hpp"
@@ -22,7 +23,9 @@ struct DecodedLog {
   std::size_t sfrbx = 0;
 };
 
-inline DecodedLog decodeLog(const std::filesystem::path& path) {
+/// `mutate` (optional) changes each message before the assembler sees it.
+inline DecodedLog decodeLog(const std::filesystem::path& path,
+                            const std::function<void(SfrbxMessage&)>& mutate = {}) {
   DecodedLog out;
   const std::vector<std::uint8_t> bytes = readBytes(path);
   Framer framer;
@@ -43,7 +46,9 @@ inline DecodedLog decodeLog(const std::filesystem::path& path) {
       receiveTime = GpsTime::fromWeekTow(week, itow * 1e-3);
     } else if (f.type() == 0x0213) {
       ++out.sfrbx;
-      NavDataUpdate u = out.assembler.add(parseSfrbx(f.payload), receiveTime);
+      SfrbxMessage m = parseSfrbx(f.payload);
+      if (mutate) mutate(m);
+      NavDataUpdate u = out.assembler.add(m, receiveTime);
       out.kepler.insert(out.kepler.end(), u.kepler.begin(), u.kepler.end());
       out.glonass.insert(out.glonass.end(), u.glonass.begin(), u.glonass.end());
       if (!u.empty()) out.updates.push_back(std::move(u));
