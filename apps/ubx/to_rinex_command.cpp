@@ -2,18 +2,22 @@
 // Two passes over the stream (stdin is spooled to a temporary file first): the first collects
 // the observation types, GLONASS channels, epoch span and approximate position for the header,
 // the second writes PREFIX.obs (RINEX 3.04) epoch by epoch with every signal of RXM-RAWX.
+// PREFIX.nav (RINEX 3.04) holds every distinct ephemeris assembled from RXM-SFRBX and the
+// ionosphere parameters last broadcast.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <tuple>
 
 #include "commands.hpp"
 #include "gvins/base/atomic_output_file.hpp"
 #include "gvins/base/constants.hpp"
 #include "gvins/base/geodetic.hpp"
 #include "gvins/base/rinex_obs_writer.hpp"
+#include "gvins/ephemeris/rinex_nav.hpp"
 #include "stream_summary.hpp"
 #include "ubx_summary.hpp"
 
@@ -54,6 +58,8 @@ int runToRinex(const std::vector<std::string>& args) {
   std::map<std::int64_t, int> spacing;  // epoch spacing in ms -> count
   std::optional<GpsTime> prev;
   std::optional<ubx::NavPvt> fix;
+  NavData nav;
+  std::map<std::tuple<int, int, std::int64_t, int>, bool> seen;  // sat index, message, toe, iode
   ubx::Decoder scan(opt);
   decodeAll(in, scan, [&](const ubx::Decoded& item) {
     if (const auto* e = std::get_if<ObsEpoch>(&item)) {
@@ -62,6 +68,21 @@ int runToRinex(const std::vector<std::string>& args) {
       prev = e->time;
     } else if (const auto* p = std::get_if<ubx::NavPvt>(&item)) {
       if (!fix && p->fixOk() && p->fixType >= 3) fix = *p;
+    } else if (const auto* u = std::get_if<ubx::NavDataUpdate>(&item)) {
+      for (const KeplerEphemeris& k : u->kepler) {
+        const auto key = std::make_tuple(satIndex(k.sat), static_cast<int>(k.message), k.toe.wholeSeconds(), k.iode);
+        if (!seen[key]) nav.kepler.push_back(k);
+        seen[key] = true;
+      }
+      for (const GlonassEphemeris& g : u->glonass) {
+        const auto key = std::make_tuple(satIndex(g.sat), -1, g.toe.wholeSeconds(), g.iode);
+        if (!seen[key]) nav.glonass.push_back(g);
+        seen[key] = true;
+      }
+      if (u->ionosphere.gps) nav.iono.gps = u->ionosphere.gps;
+      if (u->ionosphere.qzss) nav.iono.qzss = u->ionosphere.qzss;
+      if (u->ionosphere.beidou) nav.iono.beidou = u->ionosphere.beidou;
+      if (u->ionosphere.galileo) nav.iono.galileo = u->ionosphere.galileo;
     }
   });
   const ubx::DecoderStats& st = scan.stats();
@@ -111,14 +132,32 @@ int runToRinex(const std::vector<std::string>& args) {
   });
   writer.finish();
   if (in != stdin) std::fclose(in);
+  // Navigation file (only when the log carried SFRBX).
+  const std::string navPath = prefix + ".nav";
+  std::optional<AtomicOutputFile> navFile;
+  if (st.sfrbx > 0) {
+    std::sort(nav.kepler.begin(), nav.kepler.end(), [](const KeplerEphemeris& a, const KeplerEphemeris& b) {
+      return std::make_tuple(a.sat, a.toe) < std::make_tuple(b.sat, b.toe);
+    });
+    std::sort(nav.glonass.begin(), nav.glonass.end(), [](const GlonassEphemeris& a, const GlonassEphemeris& b) {
+      return std::make_tuple(a.sat, a.toe) < std::make_tuple(b.sat, b.toe);
+    });
+    nav.leapSeconds = header.leapSeconds;
+    navFile.emplace(navPath);
+    writeRinexNav(navFile->stream(), nav, "gvins-ubx");
+  }
   obsFile.commit();
-  // Navigation file: the SFRBX subframes become ephemerides through gvins::ubx::NavigationAssembler
-  // (rtcm/include/gvins/ubx/navigation_assembler.hpp), written with writeRinexNav as gvins-rtcm
-  // does. HOOK: not yet wired - the assembler's implementation is on the `sfrbx` branch.
+  if (navFile) navFile->commit();
   std::cerr << "wrote " << obsPath << " (" << writer.epochsWritten() << " epochs";
   if (writer.droppedValues() > 0) std::cerr << ", " << writer.droppedValues() << " values not representable";
-  std::cerr << "); no navigation file: " << dec.stats().sfrbx
-            << " SFRBX messages not converted (navigation decoding pending)\n";
+  std::cerr << ")";
+  if (navFile) {
+    std::cerr << " and " << navPath << " (" << nav.kepler.size() << " Keplerian + " << nav.glonass.size()
+              << " GLONASS records from " << st.sfrbx << " SFRBX messages)";
+  } else {
+    std::cerr << "; no SFRBX, no navigation file";
+  }
+  std::cerr << "\n";
   printSummary(std::cerr, dec, ex, name);
   return 0;
 }

@@ -69,7 +69,10 @@ void printSummary(std::ostream& out, const ubx::Decoder& dec, const SummaryExtra
   }
   out << "lock           " << st.slips << " phases flagged lost lock, " << st.halfCycleUnresolved
       << " with unresolved half cycle, " << st.clockResets << " receiver clock resets\n";
-  out << "SFRBX          " << st.sfrbx << " navigation messages\n";
+  const ubx::NavigationCounts nc = dec.navigationCounts();
+  out << "SFRBX          " << st.sfrbx << " navigation messages: " << st.ephemerides << " ephemerides, "
+      << nc.parityFailures << " parity and " << nc.crcFailures << " CRC failures, " << nc.skipped
+      << " of systems not decoded, " << st.sfrbxUndated << " before the first RAWX epoch\n";
   if (ex.navPvt > 0) {
     out << "NAV-PVT        " << ex.navPvt << " (" << ex.navPvtFixes << " with gnssFixOK)";
     if (ex.lastPvt) {

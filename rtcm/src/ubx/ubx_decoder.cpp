@@ -8,6 +8,8 @@
 #include "gvins/base/parse_error.hpp"
 #include "gvins/rtcm/message_error.hpp"
 #include "gvins/ubx/rawx.hpp"
+#include "gvins/ubx/sfrbx.hpp"
+#include "gvins/ubx/sfrbx_error.hpp"
 #include "gvins/ubx/ubx_signals.hpp"
 
 namespace gvins::ubx {
@@ -35,6 +37,7 @@ struct Decoder::State {
   DecoderStats stats;
   std::deque<Decoded> out;
   GlonassChannels glonass;
+  NavigationAssembler navigation;
   std::map<std::tuple<int, char, char>, LockState> locks;  // (satIndex, band, attr)
   std::optional<GpsTime> lastEpoch;
   std::int64_t rawxEpochs = 0;
@@ -58,8 +61,18 @@ struct Decoder::State {
       if (cls == kClassRxm && id == kIdRawx) {
         rawx(parseRawx(p));
       } else if (cls == kClassRxm && id == kIdSfrbx) {
-        out.emplace_back(SfrbxPayload{{p.begin(), p.end()}, offset, lastEpoch});
         ++stats.sfrbx;
+        if (!opt.decodeNavigation) return;
+        const SfrbxMessage msg = parseSfrbx(p);
+        if (!lastEpoch) {
+          ++stats.sfrbxUndated;
+          return;
+        }
+        NavDataUpdate u = navigation.add(msg, *lastEpoch);
+        if (!u.empty()) {
+          stats.ephemerides += static_cast<std::int64_t>(u.kepler.size() + u.glonass.size());
+          out.emplace_back(std::move(u));
+        }
       } else if (cls == kClassNav && id == kIdNavPvt) {
         out.emplace_back(parseNavPvt(p));
       } else if (cls == kClassNav && id == kIdNavClock) {
@@ -81,12 +94,16 @@ struct Decoder::State {
       }
       ++stats.decoded;
     } catch (const rtcm::MessageError& e) {
-      ++stats.malformed;
-      if (opt.strict) {
-        throw ParseError(opt.streamName, offset, messageName(type) + " " + e.field(), e.what());
-      }
-      if (stats.issues.size() < opt.maxIssues) stats.issues.push_back({offset, type, e.field(), e.what()});
+      malformed(offset, type, e.field(), e.what());
+    } catch (const SfrbxError& e) {
+      malformed(offset, type, e.field(), e.what());
     }
+  }
+
+  void malformed(std::int64_t offset, int type, const std::string& field, const std::string& what) {
+    ++stats.malformed;
+    if (opt.strict) throw ParseError(opt.streamName, offset, messageName(type) + " " + field, what);
+    if (stats.issues.size() < opt.maxIssues) stats.issues.push_back({offset, type, field, what});
   }
 
   // Loss-of-lock flags of one phase (see the header comment).
@@ -204,6 +221,7 @@ void Decoder::decodeMessage(std::uint8_t msgClass, std::uint8_t msgId, std::span
 
 const DecoderStats& Decoder::stats() const { return s_->stats; }
 const GlonassChannels& Decoder::glonassChannels() const { return s_->glonass; }
+NavigationCounts Decoder::navigationCounts() const { return s_->navigation.total(); }
 std::optional<GpsTime> Decoder::lastEpochTime() const { return s_->lastEpoch; }
 
 }  // namespace gvins::ubx

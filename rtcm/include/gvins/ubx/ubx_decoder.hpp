@@ -17,9 +17,11 @@
 // trkStat.halfCyc says the half cycle is not resolved.
 //
 // Other messages. NAV-PVT, NAV-CLOCK, NAV-TIMEGPS (gvins/ubx/nav_solution.hpp) and ESF-RAW /
-// ESF-MEAS IMU samples (gvins/ubx/esf.hpp) are delivered as decoded. RXM-SFRBX payloads are
-// delivered whole, with the time of the latest RAWX epoch, for the navigation message assembler
-// (gvins/ubx/navigation_assembler.hpp). Every other message is only counted.
+// ESF-MEAS IMU samples (gvins/ubx/esf.hpp) are delivered as decoded. RXM-SFRBX messages go
+// through gvins::ubx::NavigationAssembler (gvins/ubx/navigation_assembler.hpp) with the time of
+// the latest RAWX epoch; the ephemerides and ionosphere parameters they complete are delivered as
+// a NavDataUpdate (SFRBX before the first RAWX epoch cannot be dated and is only counted). Every
+// other message is only counted.
 //
 // Errors. Frames with bad checksums are skipped by the splitter and counted. A frame with a good
 // checksum but impossible content (numMeas larger than the payload, rcvTow not a time of week,
@@ -42,6 +44,7 @@
 #include "gvins/base/observation.hpp"
 #include "gvins/ubx/esf.hpp"
 #include "gvins/ubx/nav_solution.hpp"
+#include "gvins/ubx/navigation_assembler.hpp"
 #include "gvins/ubx/stream_splitter.hpp"
 
 namespace gvins::ubx {
@@ -59,18 +62,13 @@ struct DecoderOptions {
   /// (counted in DecoderStats::noisyPhases). Default: keep every phase trkStat marks valid.
   /// RTKLIB's convbin uses 0.020 (cpStdev > 5 dropped).
   std::optional<double> maxPhaseStdDev;
+  /// Assemble ephemerides from RXM-SFRBX (false: SFRBX is only counted).
+  bool decodeNavigation = true;
   /// Largest UBX payload accepted (longer lengths are treated as corruption).
   std::size_t maxPayload = Framer::kDefaultMaxPayload;
 };
 
-/// A UBX-RXM-SFRBX payload, for gvins::ubx::parseSfrbx and the NavigationAssembler.
-struct SfrbxPayload {
-  std::vector<std::uint8_t> payload;
-  std::int64_t offset = 0;                 ///< byte offset of the frame in the stream
-  std::optional<GpsTime> receiveTime;      ///< time of the latest RAWX epoch before it
-};
-
-using Decoded = std::variant<ObsEpoch, NavPvt, NavClock, NavTimeGps, ImuSample, SfrbxPayload>;
+using Decoded = std::variant<ObsEpoch, NavPvt, NavClock, NavTimeGps, ImuSample, NavDataUpdate>;
 
 /// A malformed message (good checksum, bad content).
 struct DecodeIssue {
@@ -97,7 +95,9 @@ struct DecoderStats {
   std::int64_t clockResets = 0;          ///< RAWX epochs with recStat.clkReset
   std::int64_t slips = 0;                ///< phases flagged LLI bit 0
   std::int64_t halfCycleUnresolved = 0;  ///< phases flagged LLI bit 1
-  std::int64_t sfrbx = 0;                ///< SFRBX messages delivered
+  std::int64_t sfrbx = 0;                ///< SFRBX messages read
+  std::int64_t sfrbxUndated = 0;         ///< SFRBX before the first RAWX epoch (not assembled)
+  std::int64_t ephemerides = 0;          ///< ephemeris records delivered (NavDataUpdate)
   std::int64_t imuSamples = 0;           ///< ESF samples delivered
   std::optional<GpsTime> firstEpoch, lastEpoch;
   std::optional<int> leapSeconds;        ///< GPS - UTC from RAWX (leapSec flag) or NAV-TIMEGPS
@@ -126,6 +126,8 @@ class Decoder {
   const DecoderStats& stats() const;
   /// GLONASS FDMA channels seen in RAWX freqId.
   const GlonassChannels& glonassChannels() const;
+  /// Counters of the navigation message assembler (parity/CRC failures etc.).
+  NavigationCounts navigationCounts() const;
   /// Time of the latest RAWX epoch.
   std::optional<GpsTime> lastEpochTime() const;
 
