@@ -34,7 +34,6 @@ TrackComparison runSpp(bool gpsOnly) {
   decoder.feed(bytes);
   decoder.finish();
   EphemerisStore store;
-  NavigationAssembler assembler;
   SppConfig config;
   config.ionosphere = IonosphereOption::DualFrequency;  // no GPS page 18 in 134 s: no Klobuchar
   config.frequencies = 2;
@@ -44,8 +43,8 @@ TrackComparison runSpp(bool gpsOnly) {
   TrackComparison out;
   std::optional<GpsTime> first, firstFix;
   while (auto item = decoder.poll()) {
-    if (const auto* s = std::get_if<SfrbxPayload>(&*item)) {
-      assembler.add(parseSfrbx(s->payload), s->receiveTime.value_or(GpsTime{})).addTo(store);
+    if (const auto* u = std::get_if<NavDataUpdate>(&*item)) {
+      u->addTo(store);  // the decoder runs the SFRBX messages through its NavigationAssembler
     } else if (const auto* e = std::get_if<ObsEpoch>(&*item)) {
       ++out.epochs;
       if (!first) first = e->time;
