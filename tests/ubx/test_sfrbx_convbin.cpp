@@ -21,7 +21,7 @@ using testing::decodeLog;
 // 5e-12 of the value.
 void expectPrinted(double ours, double ref, const char* field, SatId sat) {
   EXPECT_LE(std::fabs(ours - ref), 5e-12 * std::fabs(ref) + 1e-300)
-      << field << " of " << systemLetter(sat.system) << sat.prn << ": ours " << ours << ", convbin " << ref;
+      << field << " of " << systemLetter(sat.system) << static_cast<int>(sat.prn) << ": ours " << ours << ", convbin " << ref;
 }
 
 const KeplerEphemeris* findKepler(const std::vector<KeplerEphemeris>& list, const KeplerEphemeris& r) {

@@ -82,13 +82,17 @@ void GlonassDecoder::add(const SfrbxMessage& msg, SatId sat, const GpsTime& rece
   const NavBits& s3 = *p.string[2];
   const NavBits& s4 = *p.string[3];
   const int tb = static_cast<int>(s2.u(9, 7));
-  if (tb == p.lastTb) return;
+  if (tb == p.lastTb) {  // this set was emitted already
+    p.string = {};
+    return;
+  }
   if (receiveTime.week() < kFirstValidWeek) return;  // no time yet for the day: keep the set
   const int tkH = static_cast<int>(s1.u(9, 5));
   const int tkM = static_cast<int>(s1.u(14, 6));
   const int tkS = static_cast<int>(s1.u(20, 1));
   if (tb < 1 || tb > 96 || tkH > 23 || tkM > 59) {
     ++counts.unknownMessages;
+    p.string = {};
     return;
   }
   GlonassEphemeris g;
@@ -112,6 +116,7 @@ void GlonassDecoder::add(const SfrbxMessage& msg, SatId sat, const GpsTime& rece
   g.toe = rtcm::glonassTodNear(tb * 900.0, receiveTime);
   g.tof = rtcm::glonassTodNear(tkH * 3600.0 + tkM * 60.0 + tkS * 30.0, g.toe);
   p.lastTb = tb;
+  p.string = {};  // parts of an emitted set never count as incomplete
   ++counts.ephemerides;
   out.glonass.push_back(g);
 }

@@ -40,7 +40,7 @@ struct NavigationCounts {
   std::uint64_t messages = 0;         ///< SFRBX messages of the system
   std::uint64_t parityFailures = 0;   ///< GPS/QZSS parity, BeiDou BCH, GLONASS Hamming failures
   std::uint64_t crcFailures = 0;      ///< Galileo I/NAV CRC-24Q failures
-  std::uint64_t incompleteSets = 0;   ///< partial sets dropped (issue of data changed before completion)
+  std::uint64_t incompleteSets = 0;   ///< partial sets dropped unused (another issue of data or frame came first)
   std::uint64_t unknownMessages = 0;  ///< unhandled pages/subframes/strings, bad layout, unknown signals
   std::uint64_t skipped = 0;          ///< messages not decoded: SBAS, NavIC, GPS/QZSS CNAV,
                                       ///< Galileo F/NAV and E6, BeiDou B-CNAV1/2, GLONASS CDMA
