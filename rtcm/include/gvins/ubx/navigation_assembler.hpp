@@ -57,7 +57,8 @@ class NavigationAssembler {
 
   /// receiveTime: time of the latest RAWX epoch (resolves week/day ambiguities; the message's own
   /// week numbers are used where they exist). A time before GPS week 1024 (e.g. GpsTime{}) means
-  /// "not known yet": GPS/QZSS and GLONASS sets are then kept until a message arrives with a time.
+  /// "not known yet": GPS/QZSS sets are then kept until a message arrives with a time; GLONASS
+  /// sets are dated by NT/N4 once string 5 arrives.
   /// Returns the records completed by this message.
   /// Never throws on bad navigation data: bad parity/CRC and malformed parts are counted.
   NavDataUpdate add(const SfrbxMessage& msg, const GpsTime& receiveTime);
