@@ -13,10 +13,9 @@
 #include "gvins/ephemeris/sun_position.hpp"
 #include "gvins/fusion/gnss_clock_init.hpp"
 #include "gvins/gnss/ionosphere_free.hpp"
-#include "gvins/gnss/klobuchar.hpp"
 #include "gvins/gnss/phase_windup.hpp"
 #include "gvins/gnss/sagnac.hpp"
-#include "gvins/gnss/troposphere.hpp"
+#include "gvins/gnss/satellite_observation_model.hpp"
 #include "gvins/gnss/zero_difference.hpp"
 #include "gvins/sri/chi_square.hpp"
 
@@ -89,9 +88,13 @@ template <typename Scalar>
 std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& rover, const EphemerisStore& nav,
                                                                  const Eigen::Vector3d& x, TransmitStates* states) const {
   std::vector<SatelliteModel> out;
-  const Geodetic g = ecefToGeodetic(x);
-  const IonosphereParameters& iono = nav.ionosphere();
-  const double fL1 = *carrierFrequency(System::Gps, '1');
+  // The shared per-satellite model (satellite_observation_model.hpp): standard-atmosphere
+  // troposphere, the broadcast ionosphere where asked for, the Shapiro delay.
+  ObservationModelOptions options;
+  options.broadcastIonosphere = true;
+  options.shapiro = true;
+  const SatelliteObservationModel model(x, rover.time, options, &nav.ionosphere());
+  const Geodetic& g = model.geodetic();
   // Phase wind-up (vio+dopp+ppp): the Sun for the satellites' yaw steering (once per epoch), the
   // receiver antenna level with x north, y west (its heading is common to all satellites).
   std::optional<Eigen::Vector3d> sun;
@@ -120,12 +123,14 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     m.ssr = tx->state.ssr;
     m.groupDelay = nav.codeDelay(tx->state, so.sat, s->code, tx->transmitTime);
     m.wavelength = kC / *f;
-    m.azel = azimuthElevation(g, x, m.position);
+    m.azel = model.azimuthElevation(m.position);
     if (m.azel.elevation < config_.elevationMaskDeg * constants::kDegToRad) continue;
-    const TroposphereDelay tropo = slantTroposphereDelay(g, m.azel.elevation, rover.time);
-    m.troposphere = tropo.slant;
-    m.mapWet = tropo.mapWet;
-    m.shapiro = shapiroDelay(m.position, x);
+    // The broadcast ionosphere is asked for (frequency) only where it is used: single frequency.
+    const bool singleFrequency = config_.ionosphere != GnssIonosphere::kDualFrequency;
+    const SatelliteModelTerms terms = model.terms(m.position, m.azel, so.sat.system, singleFrequency ? *f : 0.0);
+    m.troposphere = terms.troposphere.slant;
+    m.mapWet = terms.troposphere.mapWet;
+    m.shapiro = terms.shapiro;
     m.pseudorange = s->pseudorange;
     const double sinEl = std::max(std::sin(m.azel.elevation), 0.1);
     // Code variance (below: single frequency after the pair search, the pair inside it): white
@@ -150,11 +155,10 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     // ionospheric model error.
     if (config_.ionosphere == GnssIonosphere::kDualFrequency) {
       const std::string& order = config_.bands[static_cast<std::size_t>(systemIndex(so.sat.system))];
-      for (char b2 : order) {
-        if (b2 == band) continue;
-        const SignalObs* s2 = so.bestOnBand(b2, SignalObs::kCode);
-        const auto f2 = s2 ? carrierFrequency(so.sat.system, b2, channel) : std::nullopt;
-        if (!f2 || !(s2->pseudorange > 1e6 && s2->pseudorange < 1e8)) continue;
+      if (const auto second = secondCode(so, order, order.size(), band, channel)) {
+        const SignalObs* s2 = second->signal;
+        const double* f2 = &second->frequency;
+        const char b2 = s2->code.band;
         const IonosphereFreeCoefficients c = ionosphereFreeCoefficients(*f, *f2);
         m.pseudorange = c.a1 * s->pseudorange + c.a2 * s2->pseudorange;
         m.groupDelay = c.a1 * m.groupDelay + c.a2 * nav.codeDelay(tx->state, so.sat, s2->code, tx->transmitTime);
@@ -181,19 +185,13 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
             }
           }
         }
-        break;
       }
     }
     if (!m.ionosphereFree) {
       // Single frequency (broadcast ionosphere, or no second band tracked): the broadcast model,
       // evaluated only here (an ionosphere-free pair needs none), and 30 % of it in the code
       // variance (Klobuchar corrects about half of the delay; IS-GPS-200N 20.3.3.5.2.5).
-      if (so.sat.system == System::BeiDou && iono.beidou) {
-        m.ionosphere = beidouKlobucharDelayB1I(*iono.beidou, g, m.azel, rover.time) *
-                       ionosphereFrequencyScale(*carrierFrequency(System::BeiDou, '2'), *f);
-      } else if (iono.gps) {
-        m.ionosphere = klobucharDelayL1(*iono.gps, g, m.azel, rover.time) * ionosphereFrequencyScale(fL1, *f);
-      }
+      m.ionosphere = singleFrequency ? terms.ionosphere.slant : model.ionosphere(so.sat.system, m.azel, *f).slant;
       m.codeVariance = std::pow(config_.codeSigma * smoothingFactor, 2) * (0.5 + 0.5 / (sinEl * sinEl)) +
                        std::pow(0.3 * m.ionosphere, 2) + ephemerisVariance;
     }
