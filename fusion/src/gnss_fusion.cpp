@@ -121,7 +121,7 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     m.clockDrift = tx->state.clockDrift;
     m.precise = tx->state.precise;
     m.ssr = tx->state.ssr;
-    m.groupDelay = nav.codeDelay(tx->state, so.sat, s->code, tx->transmitTime);
+    m.groupDelay = transmitGroupDelay(nav, *tx, so.sat, s->code);
     m.wavelength = kC / *f;
     m.azel = model.azimuthElevation(m.position);
     if (m.azel.elevation < config_.elevationMaskDeg * constants::kDegToRad) continue;
@@ -161,7 +161,7 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
         const char b2 = s2->code.band;
         const IonosphereFreeCoefficients c = ionosphereFreeCoefficients(*f, *f2);
         m.pseudorange = c.a1 * s->pseudorange + c.a2 * s2->pseudorange;
-        m.groupDelay = c.a1 * m.groupDelay + c.a2 * nav.codeDelay(tx->state, so.sat, s2->code, tx->transmitTime);
+        m.groupDelay = c.a1 * m.groupDelay + c.a2 * transmitGroupDelay(nav, *tx, so.sat, s2->code);
         m.ionosphere = 0.0;
         m.ionosphereFree = true;
         m.code2 = s2->code;

@@ -15,6 +15,7 @@
 #include "gvins/gnss/klobuchar.hpp"
 #include "gvins/gnss/sagnac.hpp"
 #include "gvins/gnss/satellite_observation_model.hpp"
+#include "gvins/gnss/zero_difference.hpp"
 #include "normal_equations.hpp"
 
 namespace gvins {
@@ -148,62 +149,17 @@ bool SppSolver::gatherMeasurements(const ObsEpoch& epoch, SppSolution& sol, std:
       m.ionosphereFree = true;
       m.noiseFactor = ifc.noiseFactor();
     }
-    // Transmit time: t_rx - P/c - dt_s, with dt_s evaluated at the first approximation.
-    GpsTime ttx = epoch.time - m.pseudorange / kC;
-    // One record selection per satellite for the state and the group delays.
-    const GlonassEphemeris* ge = nullptr;
-    const KeplerEphemeris* ke = nullptr;
-    if (so.sat.system == System::Glonass) ge = ephemerides_.glonass(so.sat, ttx);
-    else ke = ephemerides_.kepler(so.sat, ttx);
-    if (!ge && !ke) {
+    // Transmit time, satellite state (broadcast, precise or SSR) and group delays: the one
+    // satellite-source choice (zero_difference.hpp), with this solver's record cache.
+    const auto tx = satelliteAtTransmit(nav_, so.sat, epoch.time, m.pseudorange, cfg.ephemeris, &ephemerides_);
+    if (!tx) {
       out.use = SatelliteUse::NoEphemeris;
       continue;
     }
-    std::optional<SatelliteState> st = ge ? glonassSatelliteState(*ge, ttx) : keplerSatelliteState(*ke, ttx);
-    // Move the state by -dt_s (|dt_s| < 1 ms): a first-order step is exact to < 1e-6 m, since the
-    // orbital acceleration (< 1 m/s^2) contributes a*dt^2/2.
-    const double dts = st->clockBias;
-    ttx -= dts;
-    st->position -= st->velocity * dts;
-    st->clockBias -= st->clockDrift * dts;
-    if (std::abs(dts) > 0.01) st = ge ? glonassSatelliteState(*ge, ttx) : keplerSatelliteState(*ke, ttx);
-    // Precise products, where set and covering, replace the broadcast orbit and clock (the
-    // broadcast record still gives the group delays). The transmit time from the broadcast clock
-    // is within a few ns (< 0.1 mm of satellite motion) of that from the precise clock.
-    if (st && nav_.precise()) {
-      if (auto p = nav_.preciseState(so.sat, ttx)) {
-        p->healthy = st->healthy;
-        st = p;
-      }
-    }
-    // SSR corrections (real-time streams) where no products cover the satellite: the record the
-    // correction names, corrected; a satellite of a system the stream covers but without its own
-    // correction is left out (its broadcast clock is in another datum).
-    if (st && !st->precise && !nav_.ssr().empty()) {
-      if (auto c = nav_.ssrState(so.sat, ttx, cfg.ephemeris)) {
-        c->healthy = st->healthy;
-        st = c;
-      } else if (nav_.ssr().coversSystem(so.sat.system, ttx)) {
-        out.use = SatelliteUse::NoEphemeris;
-        continue;
-      }
-    }
-    if (!st || (!st->healthy && !cfg.ephemeris.allowUnhealthy) || !st->position.allFinite() ||
-        st->position.norm() < 1e7) {
-      out.use = SatelliteUse::NoEphemeris;
-      continue;
-    }
-    m.state = *st;
-    // Code biases: the OSBs that go with precise clocks or the SSR code biases that go with SSR
-    // clocks (EphemerisStore::codeDelay's rule), else the broadcast group delays of the record
-    // selected above.
-    auto groupDelayOf = [&](ObsCode c) {
-      if (const auto osb = nav_.preciseCodeBias(*st, so.sat, c, ttx)) return *osb;
-      return ge ? broadcastGroupDelay(*ge, c) : broadcastGroupDelay(*ke, c);
-    };
-    double gd = groupDelayOf(s1->code);
-    if (m.ionosphereFree) gd = ifc.a1 * gd + ifc.a2 * groupDelayOf(s2->code);
-    m.satClock = st->clockBias - gd;
+    m.state = tx->state;
+    double gd = transmitGroupDelay(nav_, *tx, so.sat, s1->code);
+    if (m.ionosphereFree) gd = ifc.a1 * gd + ifc.a2 * transmitGroupDelay(nav_, *tx, so.sat, s2->code);
+    m.satClock = m.state.clockBias - gd;
     // Doppler: the primary signal's, else any signal with a known wavelength.
     const SignalObs* d = s1->hasDoppler() ? s1 : nullptr;
     double fd = f1;
