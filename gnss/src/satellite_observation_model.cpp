@@ -3,7 +3,9 @@
 #include <algorithm>
 
 #include "gvins/base/signal.hpp"
+#include "gvins/ephemeris/sun_position.hpp"
 #include "gvins/gnss/klobuchar.hpp"
+#include "gvins/gnss/phase_windup.hpp"
 #include "gvins/gnss/sagnac.hpp"
 
 namespace gvins {
@@ -52,6 +54,12 @@ SatelliteModelTerms SatelliteObservationModel::terms(const Eigen::Vector3d& sate
   m.ionosphere = ionosphere(system, azel, frequency);
   if (options_.shapiro) m.shapiro = shapiroDelay(satellite, receiver_);
   return m;
+}
+
+double SatelliteObservationModel::phaseWindup(const Eigen::Vector3d& satellite) const {
+  if (!sun_) sun_ = sunPositionEcef(time_);
+  return phaseWindupCycles(satellite, receiver_, yawSteeringAxes(satellite, *sun_),
+                           levelAntennaAxes(geodetic_.lat, geodetic_.lon));
 }
 
 IonosphereDelay SatelliteObservationModel::ionosphere(System system, const AzEl& azel, double frequency) const {

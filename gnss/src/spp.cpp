@@ -620,7 +620,7 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
     out.azel = m.azel;
     out.sigma = std::sqrt(m.variance / m.inflation);
     out.weightFactor = 1.0 / m.inflation;
-    const double rho = (m.state.position - x).norm() + sagnacRangeCorrection(m.state.position, x);
+    const double rho = geometricRange(m.state.position, x);
     const double c = col[m.sys] >= 0 ? clk[col[m.sys]] : 0.0;
     out.residual = m.pseudorange - (rho + c - kC * m.satClock + m.iono + m.ionoMap * ion + m.tropo);
     if (!use[i]) continue;

@@ -2,7 +2,7 @@
 // and the fusion share: the receiver-dependent parts computed once per receiver position and
 // epoch (geodetic position, local frame, zenith tropospheric delays and mapping coefficients),
 // and one function, SatelliteObservationModel::terms, that gives a satellite's azimuth/elevation,
-// slant troposphere, broadcast ionosphere and Shapiro delay, each only when the caller asks for
+// slant troposphere, broadcast ionosphere, Shapiro delay and phase wind-up, each only when the caller asks for
 // it. The choice of the code signals of the ionosphere-free pair is here as well, so that every
 // user pairs bands the same way (the coefficients: ionosphere_free.hpp).
 //
@@ -84,6 +84,10 @@ class SatelliteObservationModel {
   /// `frequency` (Hz; only the ionosphere uses it): az/el always, troposphere / broadcast
   /// ionosphere / Shapiro as the options ask. No tropospheric delay at or below the horizon.
   SatelliteModelTerms terms(const Eigen::Vector3d& satellite, System system, double frequency) const;
+  /// Carrier-phase wind-up (cycles, not continued across epochs: phase_windup.hpp continueWindup)
+  /// of a yaw-steered satellite (the Sun once per model) for a level receiver antenna with x
+  /// north and y west (its heading is common to all satellites).
+  double phaseWindup(const Eigen::Vector3d& satellite) const;
   /// The broadcast ionosphere term alone (zero when the options do not ask for it).
   IonosphereDelay ionosphere(System system, const AzEl& azel, double frequency) const;
   /// The same for a known az/el (no recomputation).
@@ -98,6 +102,7 @@ class SatelliteObservationModel {
   Eigen::Matrix3d enu_;
   double doy_ = 0.0;
   StationTroposphere troposphere_;
+  mutable std::optional<Eigen::Vector3d> sun_;  // ECEF, on first use (phaseWindup)
 };
 
 /// A code signal usable for positioning: a pseudorange in 1e6..1e8 m and a known frequency.
