@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "gvins/base/signal.hpp"
+#include "gvins/ephemeris/satellite_antenna.hpp"
 #include "gvins/ephemeris/sun_position.hpp"
 #include "gvins/gnss/klobuchar.hpp"
 #include "gvins/gnss/phase_windup.hpp"

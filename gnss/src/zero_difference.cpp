@@ -21,7 +21,6 @@ std::optional<TransmitState> satelliteAtTransmit(const EphemerisStore& nav, SatI
     return out.glonass ? glonassSatelliteState(*out.glonass, t) : keplerSatelliteState(*out.kepler, t);
   };
   std::optional<SatelliteState> st = evaluate(ttx);
-  if (!st) return std::nullopt;
   // Move the state by -dt_s (|dt_s| < 1 ms): a first-order step is exact to < 1e-6 m, since the
   // orbital acceleration (< 1 m/s^2) contributes a*dt^2/2.
   const double dts = st->clockBias;

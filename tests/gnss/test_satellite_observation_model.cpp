@@ -3,7 +3,9 @@
 // broadcast data.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "gvins/base/constants.hpp"
@@ -75,6 +77,7 @@ TEST(BroadcastIonosphere, OneParameterSetForGpsAndQzssLinesOfSightGpsFirst) {
   const double gpsByHand = zenithKlobucharByHand(kamakuraGps(), rx, tow);
   const double qzssByHand = zenithKlobucharByHand(kamakuraQzss(), rx, tow);
   // The two sets disagree by decimetres here: which one a QZSS satellite gets matters.
+  std::printf("Kamakura zenith L1 Klobuchar at 14:00 local: GPS set %.3f m, QZSS set %.3f m\n", gpsByHand, qzssByHand);
   EXPECT_GT(std::abs(gpsByHand - qzssByHand), 0.1);
 
   IonosphereParameters both;
@@ -171,7 +174,7 @@ TEST(SatelliteObservationModelTerms, GeometryAndTheTermsAskedFor) {
   const Eigen::Vector3d eastSat = kKamakura + 2.0e7 * (std::cos(30.0 * kDegToRad) * east + std::sin(30.0 * kDegToRad) * up);
   const double fL1 = *carrierFrequency(System::Gps, '1');
   const SatelliteModelTerms z = model.terms(zenithSat, System::Gps, fL1);
-  EXPECT_NEAR(z.azel.elevation, 0.5 * kPi, 1e-9);
+  EXPECT_NEAR(z.azel.elevation, 0.5 * kPi, 1e-7);  // asin near 1: ~sqrt(eps) resolution
   const SatelliteModelTerms e = model.terms(eastSat, System::Gps, fL1);
   EXPECT_NEAR(e.azel.elevation, 30.0 * kDegToRad, 1e-9);
   EXPECT_NEAR(e.azel.azimuth, 90.0 * kDegToRad, 1e-9);
@@ -230,11 +233,10 @@ TEST(SatelliteSource, TransmitTimeStateAndGroupDelayFromOneBroadcastRecord) {
     // t_tx = t_rx - P/c - dt_s, with dt_s the clock at t_tx (to first order, < 1e-15 s).
     EXPECT_NEAR((trx - tx->transmitTime) - pr / kSpeedOfLight - tx->state.clockBias, 0.0, 1e-12) << sat.str();
     // The state is that of the selected record at t_tx (first-order move: < 1 mm).
-    const auto direct = tx->glonass ? glonassSatelliteState(*tx->glonass, tx->transmitTime)
-                                    : keplerSatelliteState(*tx->kepler, tx->transmitTime);
-    ASSERT_TRUE(direct);
-    EXPECT_LT((direct->position - tx->state.position).norm(), 1e-3) << sat.str();
-    EXPECT_NEAR(direct->clockBias, tx->state.clockBias, 1e-15) << sat.str();
+    const SatelliteState direct = tx->glonass ? glonassSatelliteState(*tx->glonass, tx->transmitTime)
+                                              : keplerSatelliteState(*tx->kepler, tx->transmitTime);
+    EXPECT_LT((direct.position - tx->state.position).norm(), 1e-3) << sat.str();
+    EXPECT_NEAR(direct.clockBias, tx->state.clockBias, 1e-15) << sat.str();
     // The record is the store's choice; the cache makes the same one, bit for bit.
     const auto cached = satelliteAtTransmit(nav, sat, trx, pr, {}, &cache);
     ASSERT_TRUE(cached);
