@@ -81,17 +81,18 @@ class SatelliteObservationModel {
   AzEl azimuthElevation(const Eigen::Vector3d& satellite) const;
 
   /// The terms of a satellite at `satellite` (ECEF of its transmit time) of `system`, observed on
-  /// `frequency` (Hz; only the ionosphere uses it): az/el always, troposphere / broadcast
-  /// ionosphere / Shapiro as the options ask. No tropospheric delay at or below the horizon.
+  /// `frequency` (Hz; only the ionosphere uses it, 0 for an ionosphere-free combination: no
+  /// ionosphere term): az/el always, troposphere / broadcast ionosphere / Shapiro as the options
+  /// ask. No tropospheric delay at or below the horizon.
   SatelliteModelTerms terms(const Eigen::Vector3d& satellite, System system, double frequency) const;
+  /// The same for a known az/el (no recomputation).
+  SatelliteModelTerms terms(const Eigen::Vector3d& satellite, const AzEl& azel, System system, double frequency) const;
   /// Carrier-phase wind-up (cycles, not continued across epochs: phase_windup.hpp continueWindup)
   /// of a yaw-steered satellite (the Sun once per model) for a level receiver antenna with x
   /// north and y west (its heading is common to all satellites).
   double phaseWindup(const Eigen::Vector3d& satellite) const;
   /// The broadcast ionosphere term alone (zero when the options do not ask for it).
   IonosphereDelay ionosphere(System system, const AzEl& azel, double frequency) const;
-  /// The same for a known az/el (no recomputation).
-  SatelliteModelTerms terms(const Eigen::Vector3d& satellite, const AzEl& azel, System system, double frequency) const;
 
  private:
   ObservationModelOptions options_;
