@@ -9,15 +9,7 @@
 
 #include "gvins/base/constants.hpp"
 #include "gvins/base/local_frame.hpp"
-#include "gvins/ephemeris/satellite_antenna.hpp"
-#include "gvins/ephemeris/sun_position.hpp"
-#include "gvins/fusion/gnss_clock_init.hpp"
-#include "gvins/gnss/ionosphere_free.hpp"
-#include "gvins/gnss/klobuchar.hpp"
 #include "gvins/gnss/phase_windup.hpp"
-#include "gvins/gnss/sagnac.hpp"
-#include "gvins/gnss/troposphere.hpp"
-#include "gvins/gnss/zero_difference.hpp"
 #include "gvins/sri/chi_square.hpp"
 
 namespace gvins::fusion {
@@ -28,8 +20,6 @@ constexpr double kC = constants::kSpeedOfLight;
 std::int64_t toNs(const GpsTime& t) {
   return t.wholeSeconds() * 1000000000LL + std::llround(t.fraction() * 1e9);
 }
-
-System clockSystemOf(System s) { return s == System::Qzss ? System::Gps : s; }
 
 /// Marginalizes a client block that is in the state and forgets its id.
 template <typename Scalar>
@@ -74,138 +64,6 @@ template <typename Scalar>
 void GnssFusion<Scalar>::setBasePosition(const Eigen::Vector3d& ecef) {
   config_.basePosition = ecef;
   if (rtk_) rtk_->setBasePosition(ecef);
-}
-
-template <typename Scalar>
-int GnssFusion<Scalar>::clockIndex(SatId sat) const {
-  const System s = clockSystemOf(sat.system);
-  for (std::size_t i = 0; i < clockSystems_.size(); ++i) {
-    if (clockSystems_[i] == s) return static_cast<int>(i);
-  }
-  return -1;
-}
-
-template <typename Scalar>
-std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& rover, const EphemerisStore& nav,
-                                                                 const Eigen::Vector3d& x, TransmitStates* states) const {
-  std::vector<SatelliteModel> out;
-  const Geodetic g = ecefToGeodetic(x);
-  const IonosphereParameters& iono = nav.ionosphere();
-  const double fL1 = *carrierFrequency(System::Gps, '1');
-  // Phase wind-up (vio+dopp+ppp): the Sun for the satellites' yaw steering (once per epoch), the
-  // receiver antenna level with x north, y west (its heading is common to all satellites).
-  std::optional<Eigen::Vector3d> sun;
-  const Eigen::Matrix3d levelAxes = levelAntennaAxes(g.lat, g.lon);
-  for (const SatObs& so : rover.sats) {
-    if (!so.sat.valid() || !config_.useSystem(so.sat.system)) continue;
-    const char band = primaryBand(so.sat.system);
-    const SignalObs* s = so.bestOnBand(band, SignalObs::kCode);
-    if (!s) continue;
-    std::optional<int> channel;
-    if (so.sat.system == System::Glonass) channel = nav.glonassChannels().get(so.sat.prn);
-    const auto f = carrierFrequency(so.sat.system, band, channel);
-    if (!f) continue;
-    const auto tx = transmitState(states, nav, so.sat, rover.time, s->pseudorange);
-    if (!tx) continue;
-    SatelliteModel m;
-    m.sat = so.sat;
-    m.code = s->code;
-    m.clock = clockIndex(so.sat);
-    m.transmitTime = tx->transmitTime;
-    m.position = tx->state.position;
-    m.velocity = tx->state.velocity;
-    m.clockBias = tx->state.clockBias;
-    m.clockDrift = tx->state.clockDrift;
-    m.precise = tx->state.precise;
-    m.ssr = tx->state.ssr;
-    m.groupDelay = nav.codeDelay(tx->state, so.sat, s->code, tx->transmitTime);
-    m.wavelength = kC / *f;
-    m.azel = azimuthElevation(g, x, m.position);
-    if (m.azel.elevation < config_.elevationMaskDeg * constants::kDegToRad) continue;
-    const TroposphereDelay tropo = slantTroposphereDelay(g, m.azel.elevation, rover.time);
-    m.troposphere = tropo.slant;
-    m.mapWet = tropo.mapWet;
-    m.shapiro = shapiroDelay(m.position, x);
-    m.pseudorange = s->pseudorange;
-    const double sinEl = std::max(std::sin(m.azel.elevation), 0.1);
-    // Code variance (below: single frequency after the pair search, the pair inside it): white
-    // noise and multipath growing with 1/sin(el), and the ephemeris error.
-    // Broadcast orbit/clock error (SISRE) of the system: a bias per satellite, in the variance so
-    // that systems with poorer broadcast products weigh less.
-    // Precise products (SP3/RINEX clock) or SSR corrections where the store has them: centimetres
-    // instead.
-    // SSR-corrected states (real-time streams) count as precise: their orbit/clock error is that
-    // of real-time products, a few centimetres.
-    const auto& ephemerisError =
-        tx->state.precise || tx->state.ssr ? config_.preciseEphemerisError : config_.ephemerisError;
-    const double ephemerisVariance = std::pow(ephemerisError[static_cast<std::size_t>(systemIndex(so.sat.system))], 2);
-    m.ephemerisVariance = ephemerisVariance;
-    // Carrier-smoothed code: noise and multipath averaged over the arc (CarrierSmoother), down
-    // to `smoothed_code_factor` of the raw sigma.
-    const double smoothingFactor =
-        smoother_ ? std::max(config_.smoothedCodeFactor, smoother_->noiseFactor(so.sat)) : 1.0;
-    // Dual frequency: the ionosphere-free pair with the first other band tracked (`bands`: the
-    // SPP band order, GPS/QZSS L5 before L2), group delays combined alike; its noise is the
-    // single-band noise times sqrt(a1² + a2²) (2.98 for L1/L2, 2.59 for L1/L5) and it carries no
-    // ionospheric model error.
-    if (config_.ionosphere == GnssIonosphere::kDualFrequency) {
-      const std::string& order = config_.bands[static_cast<std::size_t>(systemIndex(so.sat.system))];
-      for (char b2 : order) {
-        if (b2 == band) continue;
-        const SignalObs* s2 = so.bestOnBand(b2, SignalObs::kCode);
-        const auto f2 = s2 ? carrierFrequency(so.sat.system, b2, channel) : std::nullopt;
-        if (!f2 || !(s2->pseudorange > 1e6 && s2->pseudorange < 1e8)) continue;
-        const IonosphereFreeCoefficients c = ionosphereFreeCoefficients(*f, *f2);
-        m.pseudorange = c.a1 * s->pseudorange + c.a2 * s2->pseudorange;
-        m.groupDelay = c.a1 * m.groupDelay + c.a2 * nav.codeDelay(tx->state, so.sat, s2->code, tx->transmitTime);
-        m.ionosphere = 0.0;
-        m.ionosphereFree = true;
-        m.code2 = s2->code;
-        m.ifA1 = c.a1;
-        m.ifA2 = c.a2;
-        m.codeVariance = std::pow(config_.codeSigma * c.noiseFactor() * smoothingFactor, 2) *
-                             (0.5 + 0.5 / (sinEl * sinEl)) + ephemerisVariance;
-        // vio+dopp+ppp: the ionosphere-free phase of the same bands (the phase of another
-        // tracking mode on a band only shifts the float ambiguity).
-        if (config_.mode == GnssFusionMode::kDoppPpp) {
-          const SignalObs* p1 = so.bestOnBand(band, SignalObs::kPhase);
-          const SignalObs* p2 = so.bestOnBand(b2, SignalObs::kPhase);
-          if (p1 && p2 && p1->carrierPhase != 0.0 && p2->carrierPhase != 0.0) {
-            m.hasCarrier = true;
-            m.carrierRange = c.a1 * (kC / *f) * p1->carrierPhase + c.a2 * (kC / *f2) * p2->carrierPhase;
-            m.phaseVariance = std::pow(config_.phaseSigma * c.noiseFactor(), 2) * (0.5 + 0.5 / (sinEl * sinEl));
-            m.windupWavelength = c.a1 * (kC / *f) + c.a2 * (kC / *f2);
-            if (config_.phaseWindup) {
-              if (!sun) sun = sunPositionEcef(rover.time);
-              m.windup = phaseWindupCycles(m.position, x, yawSteeringAxes(m.position, *sun), levelAxes);
-            }
-          }
-        }
-        break;
-      }
-    }
-    if (!m.ionosphereFree) {
-      // Single frequency (broadcast ionosphere, or no second band tracked): the broadcast model,
-      // evaluated only here (an ionosphere-free pair needs none), and 30 % of it in the code
-      // variance (Klobuchar corrects about half of the delay; IS-GPS-200N 20.3.3.5.2.5).
-      if (so.sat.system == System::BeiDou && iono.beidou) {
-        m.ionosphere = beidouKlobucharDelayB1I(*iono.beidou, g, m.azel, rover.time) *
-                       ionosphereFrequencyScale(*carrierFrequency(System::BeiDou, '2'), *f);
-      } else if (iono.gps) {
-        m.ionosphere = klobucharDelayL1(*iono.gps, g, m.azel, rover.time) * ionosphereFrequencyScale(fL1, *f);
-      }
-      m.codeVariance = std::pow(config_.codeSigma * smoothingFactor, 2) * (0.5 + 0.5 / (sinEl * sinEl)) +
-                       std::pow(0.3 * m.ionosphere, 2) + ephemerisVariance;
-    }
-    m.dopplerVariance = std::pow(config_.dopplerSigma, 2) * (0.5 + 0.5 / (sinEl * sinEl));
-    const SignalObs* d = s->hasDoppler() ? s : nullptr;
-    if (d && std::abs(d->doppler) < 1e5) {
-      m.hasDoppler = true;
-      m.rangeRate = -m.wavelength * d->doppler;
-    }
-    out.push_back(m);
-  }
-  return out;
 }
 
 template <typename Scalar>
@@ -380,69 +238,6 @@ bool GnssFusion<Scalar>::frameKnownInEnu(const vio::EstimatorBackend<Scalar>& es
   const double sth = config_.frameYawSigmaDeg * constants::kDegToRad;
   const double sp = config_.frameReanchorPositionSigma;
   return P(6, 6) < sth * sth && Pn.diagonal().maxCoeff() < sp * sp;
-}
-
-template <typename Scalar>
-bool GnssFusion<Scalar>::initClocks(vio::EstimatorBackend<Scalar>& est, const std::vector<SatelliteModel>& models,
-                                    const AntennaKinematics& k, const GpsTime& t) {
-  clockSystems_.clear();
-  for (const SatelliteModel& m : models) {
-    const System s = clockSystemOf(m.sat.system);
-    if (std::find(clockSystems_.begin(), clockSystems_.end(), s) == clockSystems_.end()) clockSystems_.push_back(s);
-  }
-  std::sort(clockSystems_.begin(), clockSystems_.end());
-  if (clockSystems_.empty()) return false;
-  const int n = static_cast<int>(clockSystems_.size());
-  std::vector<ClockRow> rows;
-  for (const SatelliteModel& m : models) {
-    const int c = clockIndex(m.sat);
-    const double rho = geometricRange(m.position, k.x_E);
-    rows.push_back(
-        {c, m.pseudorange - (rho - kC * (m.clockBias - m.groupDelay) + m.troposphere + m.ionosphere + m.shapiro),
-         config_.clockRansacThreshold});
-    if (m.hasDoppler) {
-      const Eigen::Vector3d e = (m.position - k.x_E).normalized();
-      const double h = e.dot(m.velocity - k.u_E) + sagnacRangeRateCorrection(m.position, m.velocity, k.x_E, k.u_E) -
-                       kC * m.clockDrift;
-      rows.push_back({n, m.rangeRate - h, std::max(0.5, 10.0 * config_.dopplerSigma)});
-    }
-  }
-  const ClockInitResult r = initializeClocksRansac(rows, n + 1, 64, 1, 7);
-  if (r.inliers[static_cast<std::size_t>(n)] == 0) return false;  // no drift
-  std::vector<double> x(static_cast<std::size_t>(n + 1)), sigma(x.size());
-  for (int i = 0; i <= n; ++i) {
-    const auto u = static_cast<std::size_t>(i);
-    x[u] = r.x[u];
-    // The antenna position error (SPP level after the frame initialisation) enters the bias.
-    sigma[u] = i < n ? std::max(r.sigma[u], 5.0) : std::max(r.sigma[u], 0.3);
-    if (r.inliers[u] == 0) sigma[u] = 1e3;
-  }
-  // The prior: b_s ~ N(x_s, σ_s²) independently per system and the drift N(x_n, σ_n²), written
-  // on the receiver clock c = b_0 and the inter-system biases i_s = b_s − b_0: a prior on
-  // [c, ḋ] and, for each other system, the row (c + i_s − x_s)/σ_s on both blocks.
-  using Vec = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
-  Vec xc(2), sc(2);
-  xc << static_cast<Scalar>(x[0]), static_cast<Scalar>(x[static_cast<std::size_t>(n)]);
-  sc << static_cast<Scalar>(sigma[0]), static_cast<Scalar>(sigma[static_cast<std::size_t>(n)]);
-  clockBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_clock", 2), sri::BlockEstimate<Scalar>::fromVector(xc),
-                             sri::Prior<Scalar>::stdDevs(sc));
-  if (n > 1) {
-    Vec xi(n - 1);
-    for (int s = 1; s < n; ++s) xi[s - 1] = static_cast<Scalar>(x[static_cast<std::size_t>(s)] - x[0]);
-    isbBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_isb", n - 1), sri::BlockEstimate<Scalar>::fromVector(xi),
-                             sri::Prior<Scalar>::uninformative());
-    sri::Measurement<Scalar> m(n - 1);
-    Vec w(n - 1);
-    for (int s = 1; s < n; ++s) w[s - 1] = static_cast<Scalar>(1.0 / sigma[static_cast<std::size_t>(s)]);
-    m.jacobian(clockBlock_, 2).col(0) = w;  // (each jacobian() call may move the storage)
-    m.jacobian(isbBlock_, n - 1) = w.asDiagonal();
-    m.residual().setZero();  // at the estimates above, c + i_s = x_s
-    m.setWhitened();
-    est.update(m, 1.0);
-    isbTime_ = t;
-  }
-  clockTime_ = t;
-  return true;
 }
 
 template <typename Scalar>

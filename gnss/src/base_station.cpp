@@ -7,7 +7,7 @@
 #include "gvins/base/constants.hpp"
 #include "gvins/base/geodetic.hpp"
 #include "gvins/base/local_frame.hpp"
-#include "gvins/gnss/troposphere.hpp"
+#include "gvins/gnss/satellite_observation_model.hpp"
 #include "gvins/gnss/zero_difference.hpp"
 
 namespace gvins {
@@ -120,7 +120,9 @@ void BaseStation::addEpoch(const ObsEpoch& epoch) {
 void BaseStation::model(Epoch& e) {
   if (e.modelled || !position_) return;
   const Eigen::Vector3d& rb = *position_;
-  const Geodetic g = ecefToGeodetic(rb);
+  ObservationModelOptions modelOptions;  // az/el and the troposphere (satellite_observation_model.hpp)
+  modelOptions.troposphere = config_.troposphere ? TroposphereMeteo::StandardAtmosphere : TroposphereMeteo::Off;
+  const SatelliteObservationModel model(rb, e.time, modelOptions);
   GlonassChannels ch = channels_;
   ch.mergeMissing(nav_.glonassChannels());
   std::vector<BaseSignal> out;
@@ -148,9 +150,9 @@ void BaseStation::model(Epoch& e) {
       continue;
     }
     const double range = geometricRange(tx->state.position, rb);
-    const AzEl azel = azimuthElevation(g, rb, tx->state.position);
-    double tropo = 0.0;
-    if (config_.troposphere && azel.elevation > 0.0) tropo = slantTroposphereDelay(g, azel.elevation, e.time).slant;
+    const SatelliteModelTerms terms = model.terms(tx->state.position, sat.system, 0.0);
+    const AzEl& azel = terms.azel;
+    const double tropo = terms.troposphere.slant;
     const double computed = range - constants::kSpeedOfLight * tx->state.clockBias + tropo;
     std::optional<int> channel;
     if (sat.system == System::Glonass) channel = ch.get(sat.prn);

@@ -8,7 +8,7 @@
 
 #include "gvins/base/geodetic.hpp"
 #include "gvins/base/local_frame.hpp"
-#include "gvins/gnss/troposphere.hpp"
+#include "gvins/gnss/satellite_observation_model.hpp"
 #include "gvins/gnss/zero_difference.hpp"
 
 namespace gvins {
@@ -171,7 +171,11 @@ void DoubleDifferenceBuilder::form(const ObsEpoch& rover, const CycleSlipDetecto
   out.basePosition = basePosition;
   const double r = x.norm();
   const Eigen::Vector3d xr = (r > 5.3e6 && r < 7.4e6) ? x : basePosition;
-  const Geodetic g = ecefToGeodetic(xr);
+  // The shared per-satellite model (satellite_observation_model.hpp): az/el and, where asked
+  // for, the standard-atmosphere troposphere.
+  ObservationModelOptions modelOptions;
+  modelOptions.troposphere = config_.troposphere ? TroposphereMeteo::StandardAtmosphere : TroposphereMeteo::Off;
+  const SatelliteObservationModel model(xr, rover.time, modelOptions);
   const bool prevOk = haveLast_;
   const GpsTime prevEpoch = lastEpoch_;
   GlonassChannels ch = channels_;
@@ -222,7 +226,7 @@ void DoubleDifferenceBuilder::form(const ObsEpoch& rover, const CycleSlipDetecto
       ++stats_.noEphemeris;
       continue;
     }
-    const AzEl azel = azimuthElevation(g, xr, tx->state.position);
+    const AzEl azel = model.azimuthElevation(tx->state.position);
     if (azel.elevation < config_.elevationMask) {
       ++stats_.belowMask;
       continue;
@@ -232,8 +236,7 @@ void DoubleDifferenceBuilder::form(const ObsEpoch& rover, const CycleSlipDetecto
       ++stats_.lowSnr;
       continue;
     }
-    double tropo = 0.0;
-    if (config_.troposphere) tropo = slantTroposphereDelay(g, azel.elevation, rover.time).slant;
+    const double tropo = model.terms(tx->state.position, azel, sys, 0.0).troposphere.slant;
     const double sinEl = std::max(std::sin(azel.elevation), 0.05);
     const double varPhase = 2.0 * (a2 + b2 / (sinEl * sinEl));
     const double f = config_.codePhaseRatio * config_.codeSystemFactor[static_cast<std::size_t>(systemIndex(sys))];

@@ -13,10 +13,9 @@
 #include "gvins/base/geodetic.hpp"
 #include "gvins/gnss/ionosphere_free.hpp"
 #include "gvins/gnss/klobuchar.hpp"
-#include "gvins/gnss/meteo_climatology.hpp"
-#include "gvins/gnss/niell_mapping.hpp"
-#include "gvins/gnss/saastamoinen.hpp"
 #include "gvins/gnss/sagnac.hpp"
+#include "gvins/gnss/satellite_observation_model.hpp"
+#include "gvins/gnss/zero_difference.hpp"
 #include "normal_equations.hpp"
 
 namespace gvins {
@@ -115,26 +114,17 @@ bool SppSolver::gatherMeasurements(const ObsEpoch& epoch, SppSolution& sol, std:
       channel = channels_.get(so.sat.prn);
       if (!channel) channel = nav_.glonassChannels().get(so.sat.prn);
     }
-    // Bands considered, in order of preference.
+    // Bands considered, in order of preference: the first usable code, paired with the next
+    // usable band of the list (the pairing every user shares: satellite_observation_model.hpp).
     const std::string& bands = cfg.bands[sys];
     const std::size_t nb = std::min<std::size_t>(bands.size(), static_cast<std::size_t>(std::clamp(cfg.frequencies, 1, 3)));
-    const SignalObs* s1 = nullptr;
-    const SignalObs* s2 = nullptr;
-    double f1 = 0.0, f2 = 0.0;
-    for (std::size_t i = 0; i < nb; ++i) {
-      const SignalObs* s = so.bestOnBand(bands[i], SignalObs::kCode);
-      if (!s || !(s->pseudorange > 1e6 && s->pseudorange < 1e8)) continue;
-      const auto f = carrierFrequency(so.sat.system, bands[i], channel);
-      if (!f) continue;
-      if (!s1) {
-        s1 = s;
-        f1 = *f;
-      } else if (!s2) {
-        s2 = s;
-        f2 = *f;
-        break;
-      }
-    }
+    std::optional<CodeSignal> c1, c2;
+    for (std::size_t i = 0; i < nb && !c1; ++i) c1 = usableCode(so, bands[i], channel);
+    if (c1) c2 = secondCode(so, bands, nb, c1->signal->code.band, channel);
+    const SignalObs* s1 = c1 ? c1->signal : nullptr;
+    const SignalObs* s2 = c2 ? c2->signal : nullptr;
+    const double f1 = c1 ? c1->frequency : 0.0;
+    const double f2 = c2 ? c2->frequency : 0.0;
     if (!s1) {
       out.use = SatelliteUse::NoSignal;
       continue;
@@ -159,62 +149,17 @@ bool SppSolver::gatherMeasurements(const ObsEpoch& epoch, SppSolution& sol, std:
       m.ionosphereFree = true;
       m.noiseFactor = ifc.noiseFactor();
     }
-    // Transmit time: t_rx - P/c - dt_s, with dt_s evaluated at the first approximation.
-    GpsTime ttx = epoch.time - m.pseudorange / kC;
-    // One record selection per satellite for the state and the group delays.
-    const GlonassEphemeris* ge = nullptr;
-    const KeplerEphemeris* ke = nullptr;
-    if (so.sat.system == System::Glonass) ge = ephemerides_.glonass(so.sat, ttx);
-    else ke = ephemerides_.kepler(so.sat, ttx);
-    if (!ge && !ke) {
+    // Transmit time, satellite state (broadcast, precise or SSR) and group delays: the one
+    // satellite-source choice (zero_difference.hpp), with this solver's record cache.
+    const auto tx = satelliteAtTransmit(nav_, so.sat, epoch.time, m.pseudorange, cfg.ephemeris, &ephemerides_);
+    if (!tx) {
       out.use = SatelliteUse::NoEphemeris;
       continue;
     }
-    std::optional<SatelliteState> st = ge ? glonassSatelliteState(*ge, ttx) : keplerSatelliteState(*ke, ttx);
-    // Move the state by -dt_s (|dt_s| < 1 ms): a first-order step is exact to < 1e-6 m, since the
-    // orbital acceleration (< 1 m/s^2) contributes a*dt^2/2.
-    const double dts = st->clockBias;
-    ttx -= dts;
-    st->position -= st->velocity * dts;
-    st->clockBias -= st->clockDrift * dts;
-    if (std::abs(dts) > 0.01) st = ge ? glonassSatelliteState(*ge, ttx) : keplerSatelliteState(*ke, ttx);
-    // Precise products, where set and covering, replace the broadcast orbit and clock (the
-    // broadcast record still gives the group delays). The transmit time from the broadcast clock
-    // is within a few ns (< 0.1 mm of satellite motion) of that from the precise clock.
-    if (st && nav_.precise()) {
-      if (auto p = nav_.preciseState(so.sat, ttx)) {
-        p->healthy = st->healthy;
-        st = p;
-      }
-    }
-    // SSR corrections (real-time streams) where no products cover the satellite: the record the
-    // correction names, corrected; a satellite of a system the stream covers but without its own
-    // correction is left out (its broadcast clock is in another datum).
-    if (st && !st->precise && !nav_.ssr().empty()) {
-      if (auto c = nav_.ssrState(so.sat, ttx, cfg.ephemeris)) {
-        c->healthy = st->healthy;
-        st = c;
-      } else if (nav_.ssr().coversSystem(so.sat.system, ttx)) {
-        out.use = SatelliteUse::NoEphemeris;
-        continue;
-      }
-    }
-    if (!st || (!st->healthy && !cfg.ephemeris.allowUnhealthy) || !st->position.allFinite() ||
-        st->position.norm() < 1e7) {
-      out.use = SatelliteUse::NoEphemeris;
-      continue;
-    }
-    m.state = *st;
-    // Code biases: the OSBs that go with precise clocks or the SSR code biases that go with SSR
-    // clocks (EphemerisStore::codeDelay's rule), else the broadcast group delays of the record
-    // selected above.
-    auto groupDelayOf = [&](ObsCode c) {
-      if (const auto osb = nav_.preciseCodeBias(*st, so.sat, c, ttx)) return *osb;
-      return ge ? broadcastGroupDelay(*ge, c) : broadcastGroupDelay(*ke, c);
-    };
-    double gd = groupDelayOf(s1->code);
-    if (m.ionosphereFree) gd = ifc.a1 * gd + ifc.a2 * groupDelayOf(s2->code);
-    m.satClock = st->clockBias - gd;
+    m.state = tx->state;
+    double gd = transmitGroupDelay(nav_, *tx, so.sat, s1->code);
+    if (m.ionosphereFree) gd = ifc.a1 * gd + ifc.a2 * transmitGroupDelay(nav_, *tx, so.sat, s2->code);
+    m.satClock = m.state.clockBias - gd;
     // Doppler: the primary signal's, else any signal with a known wavelength.
     const SignalObs* d = s1->hasDoppler() ? s1 : nullptr;
     double fd = f1;
@@ -240,11 +185,6 @@ bool SppSolver::gatherMeasurements(const ObsEpoch& epoch, SppSolution& sol, std:
 }
 
 namespace {
-
-/// Per-epoch constant parts of the models (time-dependent only).
-struct EpochModel {
-  double dayOfYear = 0.0;
-};
 
 /// A weighted least-squares fit of the measurements flagged in `use`.
 struct LsqResult {
@@ -277,15 +217,10 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
   if (last_ && std::abs(epoch.time - lastTime_) < 600.0) x0 = *last_;
   else if (initial_) x0 = *initial_;
 
-  const CalendarTime cal = epoch.time.toCalendar();
-  const double doy = dayOfYear(cal.year, cal.month, cal.day) + (cal.hour + cal.minute / 60.0 + cal.second / 3600.0) / 24.0;
   const IonosphereParameters& ionoPar = nav_.ionosphere();
   // Zenith ionosphere correction to the broadcast model as an extra unknown (with a prior).
   const bool estIono = cfg.ionosphereEstimation.enabled && cfg.ionosphere != IonosphereOption::Off && ionoPar.gps.has_value();
   double ionoPriorVar = 1.0;
-
-  const double fL1 = *carrierFrequency(System::Gps, '1');
-  const double fB1 = *carrierFrequency(System::BeiDou, '2');
 
   // Updates az/el, atmospheric delays, variances and the mask flag of every measurement at x.
   // Model values change by < 1 mm when the position moves by less than a metre (elevations by
@@ -295,25 +230,19 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
     if (modelPoint && (x - *modelPoint).norm() < 0.5) return;
     modelPoint = x;
     const bool surface = nearSurface(x);
-    Geodetic g;
-    SurfaceMeteo meteo;
-    double zhd = 0.0, zwd = 0.0;
     // Station-dependent parts of the models, computed once for all satellites.
-    Eigen::Matrix3d enu = Eigen::Matrix3d::Identity();
-    NiellCoefficients niell;
+    std::optional<SatelliteObservationModel> model;
     if (surface) {
-      g = ecefToGeodetic(x);
-      enu = ecefToEnuRotation(g.lat, g.lon);
-      if (cfg.troposphere == TroposphereOption::Saastamoinen && g.height > -500.0 && g.height < 20000.0) {
-        meteo = cfg.climatologicalMeteo ? climatologicalMeteo(g.lat, g.height, doy)
-                                        : standardAtmosphere(g.height, cfg.relativeHumidity);
-        zhd = saastamoinenZenithHydrostatic(meteo.pressure, g.lat, g.height);
-        zwd = saastamoinenZenithWet(meteo.temperature, meteo.waterVapour);
-        niell = niellCoefficients(g, doy);
-      }
+      ObservationModelOptions mo;
+      mo.troposphere = cfg.troposphere != TroposphereOption::Saastamoinen ? TroposphereMeteo::Off
+                       : cfg.climatologicalMeteo                         ? TroposphereMeteo::Climatology
+                                                                         : TroposphereMeteo::StandardAtmosphere;
+      mo.relativeHumidity = cfg.relativeHumidity;
+      mo.broadcastIonosphere = cfg.ionosphere != IonosphereOption::Off;
+      model.emplace(x, epoch.time, mo, &ionoPar);
     }
     if (surface && estIono && ionoPar.gps) {
-      const double iz = klobucharDelayL1(*ionoPar.gps, g, AzEl{0.0, 0.5 * constants::kPi}, epoch.time);
+      const double iz = klobucharDelayL1(*ionoPar.gps, model->geodetic(), AzEl{0.0, 0.5 * constants::kPi}, epoch.time);
       ionoPriorVar = std::pow(std::max(cfg.ionosphereEstimation.priorFraction * iz, cfg.ionosphereEstimation.minPriorSigma), 2);
     }
     for (Measurement& m : meas) {
@@ -322,37 +251,21 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
       double ionoVar = 0.0, tropoVar = 0.0;
       m.ionoMap = 0.0;
       if (surface) {
-        m.azel = azimuthElevation(enu, x, m.state.position);
+        // An ionosphere-free pseudorange (frequency 0) gets no ionosphere term.
+        const SatelliteModelTerms t = model->terms(m.state.position, m.sat.system, m.ionosphereFree ? 0.0 : m.frequency);
+        m.azel = t.azel;
         m.active = m.azel.elevation >= cfg.elevationMask;
-        if (zhd > 0.0) {
-          const MappingFactors mf = niellMapping(niell, m.azel.elevation);
-          m.tropo = zhd * mf.hydrostatic + zwd * mf.wet;
-          const double e = cfg.troposphereZenithError * mf.hydrostatic;
+        if (model->troposphere().valid()) {
+          m.tropo = t.troposphere.slant;
+          const double e = cfg.troposphereZenithError * t.troposphere.mapHydrostatic;
           tropoVar = e * e;
         }
         if (!m.ionosphereFree && cfg.ionosphere != IonosphereOption::Off) {
-          const System s = m.sat.system;
-          // Obliquity of the broadcast model (IS-GPS-200N 20.3.3.5.2.5), shared by the delay and
-          // its partial below.
-          const double obliquity = klobucharObliquity(m.azel.elevation);
-          if (s == System::BeiDou && ionoPar.beidou) {
-            m.iono = beidouKlobucharDelayB1I(*ionoPar.beidou, g, m.azel, epoch.time) *
-                     ionosphereFrequencyScale(fB1, m.frequency);
-          } else if (s == System::Qzss && ionoPar.qzss) {
-            m.iono = klobucharDelayL1(*ionoPar.qzss, g, m.azel, epoch.time, obliquity) *
-                     ionosphereFrequencyScale(fL1, m.frequency);
-          } else if (ionoPar.gps) {
-            m.iono = klobucharDelayL1(*ionoPar.gps, g, m.azel, epoch.time, obliquity) *
-                     ionosphereFrequencyScale(fL1, m.frequency);
-          } else if (ionoPar.qzss) {
-            m.iono = klobucharDelayL1(*ionoPar.qzss, g, m.azel, epoch.time, obliquity) *
-                     ionosphereFrequencyScale(fL1, m.frequency);
-          }
+          m.iono = t.ionosphere.slant;
           const double e = cfg.ionosphereModelError * m.iono;
           ionoVar = e * e;
           if (m.iono == 0.0) ionoVar = 25.0;  // no model available: ~5 m slant delay unaccounted
-          // The obliquity scaled to the frequency.
-          m.ionoMap = obliquity * ionosphereFrequencyScale(fL1, m.frequency);
+          m.ionoMap = t.ionosphere.mapL1;  // the obliquity scaled to the frequency
         }
       } else {
         m.azel = AzEl{0.0, 0.5 * constants::kPi};
@@ -707,7 +620,7 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
     out.azel = m.azel;
     out.sigma = std::sqrt(m.variance / m.inflation);
     out.weightFactor = 1.0 / m.inflation;
-    const double rho = (m.state.position - x).norm() + sagnacRangeCorrection(m.state.position, x);
+    const double rho = geometricRange(m.state.position, x);
     const double c = col[m.sys] >= 0 ? clk[col[m.sys]] : 0.0;
     out.residual = m.pseudorange - (rho + c - kC * m.satClock + m.iono + m.ionoMap * ion + m.tropo);
     if (!use[i]) continue;

@@ -1,0 +1,212 @@
+// The fusion's per-satellite models of a rover epoch (the shared gnss observation model plus
+// the fusion's weights and band choice) and the receiver clocks started from their residuals.
+#include <algorithm>
+#include <cmath>
+
+#include "gvins/base/constants.hpp"
+#include "gvins/fusion/gnss_clock_init.hpp"
+#include "gvins/fusion/gnss_fusion.hpp"
+#include "gvins/gnss/ionosphere_free.hpp"
+#include "gvins/gnss/satellite_observation_model.hpp"
+#include "gvins/gnss/zero_difference.hpp"
+
+namespace gvins::fusion {
+namespace {
+
+constexpr double kC = constants::kSpeedOfLight;
+
+System clockSystemOf(System s) { return s == System::Qzss ? System::Gps : s; }
+
+}  // namespace
+
+template <typename Scalar>
+int GnssFusion<Scalar>::clockIndex(SatId sat) const {
+  const System s = clockSystemOf(sat.system);
+  for (std::size_t i = 0; i < clockSystems_.size(); ++i) {
+    if (clockSystems_[i] == s) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+template <typename Scalar>
+std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& rover, const EphemerisStore& nav,
+                                                                 const Eigen::Vector3d& x, TransmitStates* states) const {
+  std::vector<SatelliteModel> out;
+  // The shared per-satellite model (satellite_observation_model.hpp): standard-atmosphere
+  // troposphere, the broadcast ionosphere where asked for, the Shapiro delay, the phase wind-up
+  // (vio+dopp+ppp).
+  ObservationModelOptions options;
+  options.broadcastIonosphere = true;
+  options.shapiro = true;
+  const SatelliteObservationModel model(x, rover.time, options, &nav.ionosphere());
+  for (const SatObs& so : rover.sats) {
+    if (!so.sat.valid() || !config_.useSystem(so.sat.system)) continue;
+    const char band = primaryBand(so.sat.system);
+    const SignalObs* s = so.bestOnBand(band, SignalObs::kCode);
+    if (!s) continue;
+    std::optional<int> channel;
+    if (so.sat.system == System::Glonass) channel = nav.glonassChannels().get(so.sat.prn);
+    const auto f = carrierFrequency(so.sat.system, band, channel);
+    if (!f) continue;
+    const auto tx = transmitState(states, nav, so.sat, rover.time, s->pseudorange);
+    if (!tx) continue;
+    SatelliteModel m;
+    m.sat = so.sat;
+    m.code = s->code;
+    m.clock = clockIndex(so.sat);
+    m.transmitTime = tx->transmitTime;
+    m.position = tx->state.position;
+    m.velocity = tx->state.velocity;
+    m.clockBias = tx->state.clockBias;
+    m.clockDrift = tx->state.clockDrift;
+    m.precise = tx->state.precise;
+    m.ssr = tx->state.ssr;
+    m.groupDelay = transmitGroupDelay(nav, *tx, so.sat, s->code);
+    m.wavelength = kC / *f;
+    m.azel = model.azimuthElevation(m.position);
+    if (m.azel.elevation < config_.elevationMaskDeg * constants::kDegToRad) continue;
+    // The broadcast ionosphere is asked for (frequency) only where it is used: single frequency.
+    const bool singleFrequency = config_.ionosphere != GnssIonosphere::kDualFrequency;
+    const SatelliteModelTerms terms = model.terms(m.position, m.azel, so.sat.system, singleFrequency ? *f : 0.0);
+    m.troposphere = terms.troposphere.slant;
+    m.mapWet = terms.troposphere.mapWet;
+    m.shapiro = terms.shapiro;
+    m.pseudorange = s->pseudorange;
+    const double sinEl = std::max(std::sin(m.azel.elevation), 0.1);
+    // Code variance (below: single frequency after the pair search, the pair inside it): white
+    // noise and multipath growing with 1/sin(el), and the ephemeris error.
+    // Broadcast orbit/clock error (SISRE) of the system: a bias per satellite, in the variance so
+    // that systems with poorer broadcast products weigh less.
+    // Precise products (SP3/RINEX clock) or SSR corrections where the store has them: centimetres
+    // instead.
+    // SSR-corrected states (real-time streams) count as precise: their orbit/clock error is that
+    // of real-time products, a few centimetres.
+    const auto& ephemerisError =
+        tx->state.precise || tx->state.ssr ? config_.preciseEphemerisError : config_.ephemerisError;
+    const double ephemerisVariance = std::pow(ephemerisError[static_cast<std::size_t>(systemIndex(so.sat.system))], 2);
+    m.ephemerisVariance = ephemerisVariance;
+    // Carrier-smoothed code: noise and multipath averaged over the arc (CarrierSmoother), down
+    // to `smoothed_code_factor` of the raw sigma.
+    const double smoothingFactor =
+        smoother_ ? std::max(config_.smoothedCodeFactor, smoother_->noiseFactor(so.sat)) : 1.0;
+    // Dual frequency: the ionosphere-free pair with the first other band tracked (`bands`: the
+    // SPP band order, GPS/QZSS L5 before L2), group delays combined alike; its noise is the
+    // single-band noise times sqrt(a1² + a2²) (2.98 for L1/L2, 2.59 for L1/L5) and it carries no
+    // ionospheric model error.
+    if (config_.ionosphere == GnssIonosphere::kDualFrequency) {
+      const std::string& order = config_.bands[static_cast<std::size_t>(systemIndex(so.sat.system))];
+      if (const auto second = secondCode(so, order, order.size(), band, channel)) {
+        const SignalObs* s2 = second->signal;
+        const double* f2 = &second->frequency;
+        const char b2 = s2->code.band;
+        const IonosphereFreeCoefficients c = ionosphereFreeCoefficients(*f, *f2);
+        m.pseudorange = c.a1 * s->pseudorange + c.a2 * s2->pseudorange;
+        m.groupDelay = c.a1 * m.groupDelay + c.a2 * transmitGroupDelay(nav, *tx, so.sat, s2->code);
+        m.ionosphere = 0.0;
+        m.ionosphereFree = true;
+        m.code2 = s2->code;
+        m.ifA1 = c.a1;
+        m.ifA2 = c.a2;
+        m.codeVariance = std::pow(config_.codeSigma * c.noiseFactor() * smoothingFactor, 2) *
+                             (0.5 + 0.5 / (sinEl * sinEl)) + ephemerisVariance;
+        // vio+dopp+ppp: the ionosphere-free phase of the same bands (the phase of another
+        // tracking mode on a band only shifts the float ambiguity).
+        if (config_.mode == GnssFusionMode::kDoppPpp) {
+          const SignalObs* p1 = so.bestOnBand(band, SignalObs::kPhase);
+          const SignalObs* p2 = so.bestOnBand(b2, SignalObs::kPhase);
+          if (p1 && p2 && p1->carrierPhase != 0.0 && p2->carrierPhase != 0.0) {
+            m.hasCarrier = true;
+            m.carrierRange = c.a1 * (kC / *f) * p1->carrierPhase + c.a2 * (kC / *f2) * p2->carrierPhase;
+            m.phaseVariance = std::pow(config_.phaseSigma * c.noiseFactor(), 2) * (0.5 + 0.5 / (sinEl * sinEl));
+            m.windupWavelength = c.a1 * (kC / *f) + c.a2 * (kC / *f2);
+            if (config_.phaseWindup) m.windup = model.phaseWindup(m.position);
+          }
+        }
+      }
+    }
+    if (!m.ionosphereFree) {
+      // Single frequency (broadcast ionosphere, or no second band tracked): the broadcast model,
+      // evaluated only here (an ionosphere-free pair needs none), and 30 % of it in the code
+      // variance (Klobuchar corrects about half of the delay; IS-GPS-200N 20.3.3.5.2.5).
+      m.ionosphere = singleFrequency ? terms.ionosphere.slant : model.ionosphere(so.sat.system, m.azel, *f).slant;
+      m.codeVariance = std::pow(config_.codeSigma * smoothingFactor, 2) * (0.5 + 0.5 / (sinEl * sinEl)) +
+                       std::pow(0.3 * m.ionosphere, 2) + ephemerisVariance;
+    }
+    m.dopplerVariance = std::pow(config_.dopplerSigma, 2) * (0.5 + 0.5 / (sinEl * sinEl));
+    const SignalObs* d = s->hasDoppler() ? s : nullptr;
+    if (d && std::abs(d->doppler) < 1e5) {
+      m.hasDoppler = true;
+      m.rangeRate = -m.wavelength * d->doppler;
+    }
+    out.push_back(m);
+  }
+  return out;
+}
+
+template <typename Scalar>
+bool GnssFusion<Scalar>::initClocks(vio::EstimatorBackend<Scalar>& est, const std::vector<SatelliteModel>& models,
+                                    const AntennaKinematics& k, const GpsTime& t) {
+  clockSystems_.clear();
+  for (const SatelliteModel& m : models) {
+    const System s = clockSystemOf(m.sat.system);
+    if (std::find(clockSystems_.begin(), clockSystems_.end(), s) == clockSystems_.end()) clockSystems_.push_back(s);
+  }
+  std::sort(clockSystems_.begin(), clockSystems_.end());
+  if (clockSystems_.empty()) return false;
+  const int n = static_cast<int>(clockSystems_.size());
+  std::vector<ClockRow> rows;
+  for (const SatelliteModel& m : models) {
+    // Residuals of the measurement models at zero receiver clock and drift.
+    rows.push_back({clockIndex(m.sat), pseudorangeRow(m, k, 0.0).residual, config_.clockRansacThreshold});
+    if (m.hasDoppler) rows.push_back({n, dopplerRow(m, k, 0.0).residual, std::max(0.5, 10.0 * config_.dopplerSigma)});
+  }
+  const ClockInitResult r = initializeClocksRansac(rows, n + 1, 64, 1, 7);
+  if (r.inliers[static_cast<std::size_t>(n)] == 0) return false;  // no drift
+  std::vector<double> x(static_cast<std::size_t>(n + 1)), sigma(x.size());
+  for (int i = 0; i <= n; ++i) {
+    const auto u = static_cast<std::size_t>(i);
+    x[u] = r.x[u];
+    // The antenna position error (SPP level after the frame initialisation) enters the bias.
+    sigma[u] = i < n ? std::max(r.sigma[u], 5.0) : std::max(r.sigma[u], 0.3);
+    if (r.inliers[u] == 0) sigma[u] = 1e3;
+  }
+  // The prior: b_s ~ N(x_s, σ_s²) independently per system and the drift N(x_n, σ_n²), written
+  // on the receiver clock c = b_0 and the inter-system biases i_s = b_s − b_0: a prior on
+  // [c, ḋ] and, for each other system, the row (c + i_s − x_s)/σ_s on both blocks.
+  using Vec = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
+  Vec xc(2), sc(2);
+  xc << static_cast<Scalar>(x[0]), static_cast<Scalar>(x[static_cast<std::size_t>(n)]);
+  sc << static_cast<Scalar>(sigma[0]), static_cast<Scalar>(sigma[static_cast<std::size_t>(n)]);
+  clockBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_clock", 2), sri::BlockEstimate<Scalar>::fromVector(xc),
+                             sri::Prior<Scalar>::stdDevs(sc));
+  if (n > 1) {
+    Vec xi(n - 1);
+    for (int s = 1; s < n; ++s) xi[s - 1] = static_cast<Scalar>(x[static_cast<std::size_t>(s)] - x[0]);
+    isbBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_isb", n - 1), sri::BlockEstimate<Scalar>::fromVector(xi),
+                             sri::Prior<Scalar>::uninformative());
+    sri::Measurement<Scalar> m(n - 1);
+    Vec w(n - 1);
+    for (int s = 1; s < n; ++s) w[s - 1] = static_cast<Scalar>(1.0 / sigma[static_cast<std::size_t>(s)]);
+    m.jacobian(clockBlock_, 2).col(0) = w;  // (each jacobian() call may move the storage)
+    m.jacobian(isbBlock_, n - 1) = w.asDiagonal();
+    m.residual().setZero();  // at the estimates above, c + i_s = x_s
+    m.setWhitened();
+    est.update(m, 1.0);
+    isbTime_ = t;
+  }
+  clockTime_ = t;
+  return true;
+}
+
+#define GVINS_INSTANTIATE(S)                                                                                  \
+  template int GnssFusion<S>::clockIndex(SatId) const;                                                        \
+  template std::vector<SatelliteModel> GnssFusion<S>::satelliteModels(const ObsEpoch&, const EphemerisStore&,  \
+                                                                      const Eigen::Vector3d&, TransmitStates*) \
+      const;                                                                                                   \
+  template bool GnssFusion<S>::initClocks(vio::EstimatorBackend<S>&, const std::vector<SatelliteModel>&,       \
+                                          const AntennaKinematics&, const GpsTime&);
+GVINS_INSTANTIATE(float)
+GVINS_INSTANTIATE(double)
+#undef GVINS_INSTANTIATE
+
+}  // namespace gvins::fusion
