@@ -351,8 +351,38 @@ void parseCameras(const Reader& r, const YAML::Node& n, Scenario& sc) {
   }
 }
 
+void parseStructure(const Reader& r, const YAML::Node& n, Scenario& sc) {
+  r.map(n, "scene.structure", {"street_half_width_m", "building_length_m", "building_depth_m", "building_height_m",
+                               "gap_m", "facade_density_per_m2", "ground_density_per_m2", "relief_m", "pole_spacing_m",
+                               "tile_m"});
+  UrbanConfig c;
+  const std::string p = "scene.structure.";
+  auto interval = [&](const char* name, double lo, double hi, double& a, double& b) {
+    if (!n[name]) return;
+    const auto v = r.numbers(n[name], p + name, 2, lo, hi);
+    if (v[1] < v[0]) r.fail(n[name], p + name, "expected [min, max] with min <= max");
+    a = v[0];
+    b = v[1];
+  };
+  if (n["street_half_width_m"]) c.streetHalfWidth = r.number(n["street_half_width_m"], p + "street_half_width_m", 3.0, 200.0);
+  interval("building_length_m", 2.0, 1000.0, c.buildingLengthMin, c.buildingLengthMax);
+  interval("building_depth_m", 2.0, 1000.0, c.buildingDepthMin, c.buildingDepthMax);
+  interval("building_height_m", 1.0, 1000.0, c.buildingHeightMin, c.buildingHeightMax);
+  interval("gap_m", 0.0, 1000.0, c.gapMin, c.gapMax);
+  if (n["facade_density_per_m2"]) c.facadeDensity = r.number(n["facade_density_per_m2"], p + "facade_density_per_m2", 0.0, 10.0);
+  if (n["ground_density_per_m2"]) c.groundDensity = r.number(n["ground_density_per_m2"], p + "ground_density_per_m2", 0.0, 10.0);
+  if (n["relief_m"]) c.relief = r.number(n["relief_m"], p + "relief_m", 0.0, 100.0);
+  if (n["pole_spacing_m"]) {
+    c.poleSpacing = r.number(n["pole_spacing_m"], p + "pole_spacing_m", 0.0, 10000.0);
+    if (c.poleSpacing > 0.0 && c.poleSpacing < 2.0) r.fail(n["pole_spacing_m"], p + "pole_spacing_m", "expected 0 (none) or >= 2 m");
+  }
+  if (n["tile_m"]) c.tileSize = r.number(n["tile_m"], p + "tile_m", 5.0, 1000.0);
+  sc.structure = c;
+}
+
 void parseScene(const Reader& r, const YAML::Node& n, Scenario& sc) {
-  r.map(n, "scene", {"texture", "checkerboard"});
+  r.map(n, "scene", {"texture", "checkerboard", "structure"});
+  if (const YAML::Node u = n["structure"]) parseStructure(r, u, sc);
   if (const YAML::Node t = n["texture"]) {
     r.map(t, "scene.texture", {"texel_m", "levels", "finest_feature_m", "octaves", "mean_dn", "amplitude_dn", "cache_mb"});
     GroundTextureConfig& c = sc.texture;
@@ -447,6 +477,8 @@ void parseRoot(const Reader& r, const YAML::Node& root, Scenario& sc) {
     }
   }
   // Consistency between sections.
+  if (sc.structure && sc.output == CameraOutput::Images && !sc.cameras.empty())
+    r.fail(root["scene"], "scene.structure", "3-D structure gives feature tracks only: set cameras.output: features");
   if (sc.trajectory == TrajectoryKind::Flight && sc.flight.pattern == FlightPattern::Drive &&
       sc.flight.restHeight <= 0.0)
     r.fail(root["trajectory"], "trajectory.rest_height_m", "a ground vehicle needs its IMU above the ground");
