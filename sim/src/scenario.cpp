@@ -135,7 +135,7 @@ void parseFlight(const Reader& r, const YAML::Node& n, Scenario& sc) {
     if (name == "type") continue;
     if (name == "pattern") {
       if (!flightPatternFromString(r.string(v, key), f.pattern))
-        r.fail(v, key, "expected lawnmower, circle, figure_eight, waypoints or drive");
+        r.fail(v, key, "expected lawnmower, circle, figure_eight, waypoints, drive or walk");
     } else if (name == "height_m") f.height = r.number(v, key, 0.5, 10000.0);
     else if (name == "length_m") f.length = r.number(v, key, 1.0, 1e6);
     else if (name == "speed_mps") f.speed = r.number(v, key, 0.1, 100.0);
@@ -154,6 +154,11 @@ void parseFlight(const Reader& r, const YAML::Node& n, Scenario& sc) {
       for (std::size_t i = 0; i < v.size(); ++i) f.waypoints.push_back(r.vec3(v[i], key, -1e6, 1e6));
     } else if (name == "corner_radius_m") f.cornerRadius = r.number(v, key, 0.5, 1000.0);
     else if (name == "stop_s") f.stopSeconds = r.number(v, key, 0.0, 3600.0);
+    else if (name == "corner_stop_s") f.cornerStopSeconds = r.number(v, key, 0.0, 3600.0);
+    else if (name == "gait_step_m") f.gait.stepLength = r.number(v, key, 0.2, 2.0);
+    else if (name == "gait_bob_m") f.gait.bob = r.number(v, key, 0.0, 0.2);
+    else if (name == "gait_sway_m") f.gait.sway = r.number(v, key, 0.0, 0.2);
+    else if (name == "gait_tilt_deg") f.gait.tiltDeg = r.number(v, key, 0.0, 20.0);
     else if (name == "rest_height_m") f.restHeight = r.number(v, key, 0.0, 100.0);
     else if (name == "takeoff_landing") f.takeoffLanding = r.boolean(v, key);
     else if (name == "hover_start_s") f.hoverStart = r.number(v, key, 2.0, 3600.0);
@@ -479,9 +484,10 @@ void parseRoot(const Reader& r, const YAML::Node& root, Scenario& sc) {
   // Consistency between sections.
   if (sc.structure && sc.output == CameraOutput::Images && !sc.cameras.empty())
     r.fail(root["scene"], "scene.structure", "3-D structure gives feature tracks only: set cameras.output: features");
-  if (sc.trajectory == TrajectoryKind::Flight && sc.flight.pattern == FlightPattern::Drive &&
+  if (sc.trajectory == TrajectoryKind::Flight &&
+      (sc.flight.pattern == FlightPattern::Drive || sc.flight.pattern == FlightPattern::Walk) &&
       sc.flight.restHeight <= 0.0)
-    r.fail(root["trajectory"], "trajectory.rest_height_m", "a ground vehicle needs its IMU above the ground");
+    r.fail(root["trajectory"], "trajectory.rest_height_m", "a ground vehicle or walker needs its IMU above the ground");
 }
 
 }  // namespace
