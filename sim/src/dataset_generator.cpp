@@ -316,7 +316,16 @@ GenerationSummary generateDataset(const Scenario& sc, const fs::path& dir, const
       obs << "#timestamp [ns],landmark_id,u [px],v [px]\n";
       tru << "#timestamp [ns],landmark_id,u_true [px],v_true [px],outlier\n";
       for (std::size_t k = 0; k < stamps.size(); ++k) {
-        const auto o = fsim.observe(*traj, times[k], hash4(seed, 0xFEA7, static_cast<std::int64_t>(c), static_cast<std::int64_t>(k)));
+        std::vector<FeatureObservation> o;
+        try {
+          o = fsim.observe(*traj, times[k], hash4(seed, 0xFEA7, static_cast<std::int64_t>(c), static_cast<std::int64_t>(k)));
+        } catch (const std::invalid_argument& e) {
+          if (urban) throw;
+          // A camera seeing far over the ground plane (looking forward from a vehicle).
+          throw std::invalid_argument(std::string(e.what()) + " for " + cam + " at t = " + std::to_string(times[k]) +
+                                      " s: the ground-plane landmarks suit downward cameras; give a forward-looking "
+                                      "camera 3-D structure (scene.structure, docs/dataset_format.md)");
+        }
         for (const FeatureObservation& f : o) {
           obs.integer(stamps[k]).put(',').unsignedInteger(f.landmark).put(',').fixed(f.pixel.x(), 4).put(',').fixed(f.pixel.y(), 4).put('\n');
           tru.integer(stamps[k]).put(',').unsignedInteger(f.landmark).put(',').fixed(f.truePixel.x(), 6).put(',').fixed(f.truePixel.y(), 6).put(',').integer(f.outlier ? 1 : 0).put('\n');
