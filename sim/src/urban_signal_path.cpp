@@ -7,6 +7,10 @@
 namespace gvins::sim {
 namespace {
 
+// Farther reflectors are ignored: their reflections arrive too weak to be tracked (a modelling
+// choice; it bounds the NLOS extra path by 2 x 60 m).
+constexpr double kMaxReflectorDistance = 60.0;
+
 /// Whether the ray from p along u (upwards) enters one of the candidates below its roof; `skip`
 /// is not tested (the reflecting building itself).
 bool rayBlocked(const UrbanStructure& world, const Eigen::Vector3d& p, const Eigen::Vector3d& u,
@@ -52,7 +56,7 @@ UrbanSignalPath urbanSignalPath(const UrbanStructure& world, const Eigen::Vector
       const Eigen::Vector2d a = bl.corner(f), e = bl.corner(f + 1);
       const double d = (p.head<2>() - a).dot(n2);  // antenna in front of the face
       const double un = u.dot(n);
-      if (!(d > 0.0) || !(un > 1e-3)) continue;
+      if (!(d > 0.0) || d > kMaxReflectorDistance || !(un > 1e-3)) continue;
       // Reflection point: on the line from the image antenna p - 2 d n towards the satellite.
       const Eigen::Vector3d q = p - 2.0 * d * n + (d / un) * u;
       const double s = (q.head<2>() - a).dot(e - a) / (e - a).squaredNorm();

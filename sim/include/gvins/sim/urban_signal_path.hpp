@@ -1,9 +1,9 @@
 // The path of a GNSS signal through an UrbanStructure (urban_structure.hpp): for a satellite in
 // direction u seen from an antenna at p (both in W), the direct ray either clears every
 // building (line of sight) or enters one below its roof (blocked). A blocked satellite is still
-// received, delayed, when a facade facing it reflects the signal to the antenna (non-line-of-
-// sight: the reflection point on the face, below its roof, with a clear ray from there to the
-// satellite); the extra path of a reflection off a vertical plane at distance d from the
+// received, delayed, when a facade facing it within 60 m reflects the signal to the antenna
+// (non-line-of-sight: the reflection point on the face, below its roof, with a clear ray from
+// there to the satellite); the extra path of a reflection off a vertical plane at distance d from the
 // antenna, whose outward normal n faces the satellite (u.n > 0), is 2 d (u.n) (image-antenna
 // geometry; e.g. Groves, "Principles of GNSS, Inertial, and Multisensor Integrated Navigation
 // Systems", 2nd ed., 10.4). Otherwise the signal is lost. Multipath grows near facades:
