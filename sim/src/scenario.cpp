@@ -382,6 +382,11 @@ void parseStructure(const Reader& r, const YAML::Node& n, Scenario& sc) {
     if (c.poleSpacing > 0.0 && c.poleSpacing < 2.0) r.fail(n["pole_spacing_m"], p + "pole_spacing_m", "expected 0 (none) or >= 2 m");
   }
   if (n["tile_m"]) c.tileSize = r.number(n["tile_m"], p + "tile_m", 5.0, 1000.0);
+  try {
+    c.validate();
+  } catch (const std::invalid_argument& e) {
+    r.fail(n, "scene.structure", e.what());
+  }
   sc.structure = c;
 }
 

@@ -64,6 +64,11 @@ void UrbanConfig::validate() const {
   range(poleSpacing, poleSpacing, 0.0, 10000.0, "pole_spacing_m");
   if (poleSpacing > 0.0 && poleSpacing < 2.0) throw std::invalid_argument("structure: pole_spacing_m must be 0 or >= 2 m");
   range(tileSize, tileSize, 5.0, 1000.0, "tile_m");
+  // Bounded work per tile: at most 1e5 points on a face or on a tile's ground.
+  if (facadeDensity * buildingLengthMax * buildingHeightMax > 1e5 || facadeDensity * buildingDepthMax * buildingHeightMax > 1e5)
+    throw std::invalid_argument("structure: facade_density_per_m2 x building size gives more than 1e5 points per facade");
+  if (groundDensity * tileSize * tileSize > 1e5)
+    throw std::invalid_argument("structure: ground_density_per_m2 x tile_m^2 gives more than 1e5 points per tile");
   if (maxCachedTiles < 16 || maxCachedTiles > 1000000) throw std::invalid_argument("structure: cache of 16 to 1e6 tiles");
 }
 
@@ -159,6 +164,7 @@ void UrbanStructure::placeBuildings(const std::vector<Eigen::Vector2d>& q) {
   for (std::size_t i = 1; i < q.size(); ++i) S[i] = S[i - 1] + (q[i] - q[i - 1]).norm();
   const double total = S.back();
   const double w = cfg_.streetHalfWidth;
+  std::vector<int> candidates;
   for (const double side : {1.0, -1.0}) {
     Rng rng(seed_, nameHash(side > 0 ? "buildings left" : "buildings right"));
     double s = rng.uniform(0.0, cfg_.gapMax);
@@ -184,21 +190,23 @@ void UrbanStructure::placeBuildings(const std::vector<Eigen::Vector2d>& q) {
       b.height = H;
       b.c = 0.5 * (p0 + p1) + (w + 0.5 * D) * b.v;
       if (!clearOfRoute(b)) continue;
+      // Not overlapping one already placed (candidates from the grid: footprints that overlap
+      // have overlapping bounds).
       bool free = true;
-      for (const UrbanBuilding& o : buildings_)
-        if (overlaps(o, b)) {
+      candidates.clear();
+      buildingsIn(b.bounds(), candidates);
+      for (const int k : candidates)
+        if (overlaps(buildings_[static_cast<std::size_t>(k)], b)) {
           free = false;
           break;
         }
       if (!free) continue;
+      const Eigen::AlignedBox2d box = b.bounds();
+      for (std::int64_t j = cellOf(box.min().y(), gridCell_); j <= cellOf(box.max().y(), gridCell_); ++j)
+        for (std::int64_t i = cellOf(box.min().x(), gridCell_); i <= cellOf(box.max().x(), gridCell_); ++i)
+          buildingGrid_[key(i, j)].push_back(static_cast<int>(buildings_.size()));
       buildings_.push_back(b);
     }
-  }
-  for (std::size_t k = 0; k < buildings_.size(); ++k) {
-    const Eigen::AlignedBox2d box = buildings_[k].bounds();
-    for (std::int64_t j = cellOf(box.min().y(), gridCell_); j <= cellOf(box.max().y(), gridCell_); ++j)
-      for (std::int64_t i = cellOf(box.min().x(), gridCell_); i <= cellOf(box.max().x(), gridCell_); ++i)
-        buildingGrid_[key(i, j)].push_back(static_cast<int>(k));
   }
   if (!(cfg_.poleSpacing > 0.0)) return;
   // Poles and trees on the pavement, 1.5 m in front of the facades.

@@ -239,6 +239,7 @@ TEST(Scenario, MalformedInputNamesFileLineAndKey) {
       {"scene:\n  structure: {building_length_m: 20}\n", 2, "scene.structure.building_length_m"},
       {"scene:\n  structure: {pole_spacing_m: 1}\n", 2, "scene.structure.pole_spacing_m"},
       {"scene:\n  structure: {roofs: 3}\n", 2, "scene.structure.roofs"},
+      {"scene:\n  structure: {facade_density_per_m2: 10, building_height_m: [10, 1000]}\n", 2, "scene.structure"},
       {"cameras:\n  output: images\nscene:\n  structure: {}\n", 4, "scene.structure"},
       {"trajectory:\n  gait_bob_m: 1\n", 2, "trajectory.gait_bob_m"},
       {"trajectory:\n  corner_stop_s: -1\n", 2, "trajectory.corner_stop_s"},
