@@ -7,6 +7,7 @@
 #include <iomanip>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <ostream>
 #include <sstream>
 #include <stdexcept>
@@ -17,6 +18,8 @@
 #include "gvins/sim/dataset_writer.hpp"
 #include "gvins/sim/gnss_simulator.hpp"
 #include "gvins/sim/random.hpp"
+#include "gvins/sim/urban_signal_path.hpp"
+#include "gvins/sim/urban_structure.hpp"
 
 namespace gvins::sim {
 namespace fs = std::filesystem;
@@ -112,6 +115,7 @@ void GenerationSummary::print(std::ostream& os) const {
       os << "  features            " << featureObservations << " observations of " << landmarks << " landmarks, "
          << meanFeaturesPerImage << " per image\n";
   }
+  if (buildings > 0) os << "  structure           " << buildings << " buildings along the route\n";
   os << std::setprecision(1);
   os << "  time                trajectory+IMU " << secondsTrajectoryImu << " s, cameras " << secondsCameras
      << " s, GNSS " << secondsGnss << " s, total " << secondsTotal << " s\n";
@@ -237,9 +241,20 @@ GenerationSummary generateDataset(const Scenario& sc, const fs::path& dir, const
   if (log) *log << "[gvins-sim] trajectory " << std::fixed << std::setprecision(1) << duration << " s, "
                 << imu.size() << " IMU samples\n" << std::defaultfloat;
 
+  // ---- 3-D structure along the route (features and GNSS)
+  const bool features = opt.featuresOnly || sc.output == CameraOutput::Features;
+  std::unique_ptr<UrbanStructure> urban;
+  if (sc.structure) {
+    if (!features && !sc.cameras.empty())
+      throw std::invalid_argument("scenario '" + sc.name + "': 3-D structure gives feature tracks only (cameras.output: features)");
+    urban = std::make_unique<UrbanStructure>(*sc.structure, horizontalRoute(*traj), hashCombine(seed, nameHash("structure")));
+    sum.buildings = urban->buildings().size();
+    if (log) *log << "[gvins-sim] structure: " << urban->buildings().size() << " buildings, " << urban->poles().size()
+                  << " poles and trees along the route\n";
+  }
+
   // ---- cameras
   const auto tCam = Clock::now();
-  const bool features = opt.featuresOnly || sc.output == CameraOutput::Features;
   sum.images = !features;
   sum.cameras = static_cast<int>(sc.cameras.size());
   std::vector<std::int64_t> stamps;
@@ -282,22 +297,35 @@ GenerationSummary generateDataset(const Scenario& sc, const fs::path& dir, const
   }
 
   if (nCams > 0 && features) {
-    double density = sc.features.densityPerM2;
-    if (!(density > 0.0))
-      density = autoLandmarkDensity(sc.cameras[0].intrinsics, medianCameraHeight(*traj, sc.cameras[0]),
-                                    sc.features.landmarksPerImage);
-    const LandmarkField field(density, sc.features.heightSigma, hashCombine(seed, nameHash("landmarks")));
+    std::optional<LandmarkField> field;
+    if (!urban) {
+      double density = sc.features.densityPerM2;
+      if (!(density > 0.0))
+        density = autoLandmarkDensity(sc.cameras[0].intrinsics, medianCameraHeight(*traj, sc.cameras[0]),
+                                      sc.features.landmarksPerImage);
+      field.emplace(density, sc.features.heightSigma, hashCombine(seed, nameHash("landmarks")));
+    }
     std::map<std::uint64_t, Eigen::Vector3d> seen;
     Progress prog(log, "feature frames", stamps.size() * nCams);
     for (std::size_t c = 0; c < nCams; ++c) {
-      const FeatureSimulator fsim(sc.cameras[c], sc.features, field, sc.imaging.lineTime);
+      const FeatureSimulator fsim = urban ? FeatureSimulator(sc.cameras[c], sc.features, *urban, sc.imaging.lineTime)
+                                          : FeatureSimulator(sc.cameras[c], sc.features, *field, sc.imaging.lineTime);
       const std::string cam = "cam" + std::to_string(c);
       TextFile obs(mav0 / cam / "features.csv");
       TextFile tru(truthDir / (cam + "_features.csv"));
       obs << "#timestamp [ns],landmark_id,u [px],v [px]\n";
       tru << "#timestamp [ns],landmark_id,u_true [px],v_true [px],outlier\n";
       for (std::size_t k = 0; k < stamps.size(); ++k) {
-        const auto o = fsim.observe(*traj, times[k], hash4(seed, 0xFEA7, static_cast<std::int64_t>(c), static_cast<std::int64_t>(k)));
+        std::vector<FeatureObservation> o;
+        try {
+          o = fsim.observe(*traj, times[k], hash4(seed, 0xFEA7, static_cast<std::int64_t>(c), static_cast<std::int64_t>(k)));
+        } catch (const std::invalid_argument& e) {
+          if (urban) throw;
+          // A camera seeing far over the ground plane (looking forward from a vehicle).
+          throw std::invalid_argument(std::string(e.what()) + " for " + cam + " at t = " + std::to_string(times[k]) +
+                                      " s: the ground-plane landmarks suit downward cameras; give a forward-looking "
+                                      "camera 3-D structure (scene.structure, docs/dataset_format.md)");
+        }
         for (const FeatureObservation& f : o) {
           obs.integer(stamps[k]).put(',').unsignedInteger(f.landmark).put(',').fixed(f.pixel.x(), 4).put(',').fixed(f.pixel.y(), 4).put('\n');
           tru.integer(stamps[k]).put(',').unsignedInteger(f.landmark).put(',').fixed(f.truePixel.x(), 6).put(',').fixed(f.truePixel.y(), 6).put(',').integer(f.outlier ? 1 : 0).put('\n');
@@ -388,6 +416,26 @@ GenerationSummary generateDataset(const Scenario& sc, const fs::path& dir, const
   if (sc.gnss && opt.gnss) {
     GnssSimulator gsim(*sc.gnss);
     gsim.setProgressStream(log);
+    if (urban) {
+      // The rover's signals through the same buildings (W coordinates of the ECEF antenna and
+      // direction); the buildings near the antenna are gathered again after 20 m of travel.
+      struct Near {
+        Eigen::Vector3d at = Eigen::Vector3d::Constant(1e300);
+        std::vector<int> buildings;
+      };
+      auto near = std::make_shared<Near>();
+      const UrbanStructure* world = urban.get();
+      const LocalFrame frame = sc.frame;
+      const Eigen::Matrix3d R_WE = frame.rotationEcefFromW().transpose();
+      gsim.setRoverPathModel([world, frame, R_WE, near](const Eigen::Vector3d& antenna, const Eigen::Vector3d& toSat) {
+        const Eigen::Vector3d p = frame.fromEcef(antenna);
+        if ((p - near->at).norm() > 20.0) {
+          near->at = p;
+          near->buildings = buildingsNear(*world, p, 320.0);
+        }
+        return urbanSignalPath(*world, p, R_WE * toSat, near->buildings);
+      });
+    }
     const GnssSimSummary g = gsim.run(*traj, sc.frame, sc.leverArm, seed, dir);
     std::ostringstream os;
     g.print(os);

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "gvins/sim/random.hpp"
+#include "gvins/sim/urban_structure.hpp"
 
 namespace gvins::sim {
 namespace {
@@ -68,10 +69,36 @@ void FeatureSimConfig::validate() const {
 
 FeatureSimulator::FeatureSimulator(const vio::CameraCalibration& camera, const FeatureSimConfig& config,
                                    const LandmarkField& field, double lineTime)
-    : calib_(camera), model_(camera.intrinsics), cfg_(config), field_(field), lineTime_(lineTime) {
+    : calib_(camera), model_(camera.intrinsics), cfg_(config), field_(&field), lineTime_(lineTime) {
   cfg_.validate();
   R_BC_ = camera.T_BS.topLeftCorner<3, 3>();
   p_BC_ = camera.T_BS.topRightCorner<3, 1>();
+}
+
+FeatureSimulator::FeatureSimulator(const vio::CameraCalibration& camera, const FeatureSimConfig& config,
+                                   const UrbanStructure& world, double lineTime)
+    : calib_(camera), model_(camera.intrinsics), cfg_(config), world_(&world), lineTime_(lineTime) {
+  cfg_.validate();
+  R_BC_ = camera.T_BS.topLeftCorner<3, 3>();
+  p_BC_ = camera.T_BS.topRightCorner<3, 1>();
+}
+
+void FeatureSimulator::structureCandidates(const Eigen::Matrix3d& R_WC, const Eigen::Vector3d& p_WC,
+                                           std::vector<Landmark>& lms, std::vector<int>& buildings) const {
+  // Horizontal footprint of the frustum: the camera and the rays through the image border at
+  // the maximum range.
+  const int W = calib_.intrinsics.width, H = calib_.intrinsics.height;
+  Eigen::AlignedBox2d box(Eigen::Vector2d(p_WC.head<2>()));
+  for (int k = 0; k <= 16; ++k) {
+    const double f = k / 16.0;
+    const Eigen::Vector2d border[4] = {{f * (W - 1), 0.0}, {f * (W - 1), H - 1.0}, {0.0, f * (H - 1)}, {W - 1.0, f * (H - 1)}};
+    for (const auto& px : border) {
+      const Eigen::Vector3d d = R_WC * model_.bearing(px).normalized();
+      box.extend(Eigen::Vector2d((p_WC + cfg_.maxRange * d).head<2>()));
+    }
+  }
+  world_->landmarks(box, lms);
+  world_->buildingsIn(box, buildings);
 }
 
 bool FeatureSimulator::project(const Trajectory& trajectory, double t, const Eigen::Vector3d& p_W,
@@ -95,31 +122,36 @@ std::vector<FeatureObservation> FeatureSimulator::observe(const Trajectory& traj
   const TrajectoryState s = trajectory.evaluate(t);
   const Eigen::Matrix3d R_WC = s.R_WB * R_BC_;
   const Eigen::Vector3d p_WC = s.p_WB + s.R_WB * p_BC_;
-  // Ground region in view: rays through the image border, clipped at the maximum range.
   const int W = calib_.intrinsics.width, H = calib_.intrinsics.height;
-  double x0 = p_WC.x(), x1 = p_WC.x(), y0 = p_WC.y(), y1 = p_WC.y();
-  const double hMax = 3.0 * cfg_.heightSigma;  // landmarks are at most this high (3 sigma)
-  for (int k = 0; k <= 32; ++k) {
-    const double f = k / 32.0;
-    const Eigen::Vector2d border[4] = {{f * (W - 1), 0.0}, {f * (W - 1), H - 1.0}, {0.0, f * (H - 1)}, {W - 1.0, f * (H - 1)}};
-    for (const auto& px : border) {
-      const Eigen::Vector3d d = R_WC * model_.bearing(px);
-      double lam = cfg_.maxRange;
-      if (d.z() < -1e-9) lam = std::min(lam, (p_WC.z() - 0.0) / -d.z());
-      // Also the intersection with the top of the landmark layer (raised landmarks seen nearer).
-      for (const double z : {0.0, hMax}) {
-        const double l = d.z() < -1e-9 ? std::min(cfg_.maxRange, (p_WC.z() - z) / -d.z()) : lam;
-        const Eigen::Vector3d g = p_WC + std::max(l, 0.0) * d;
-        x0 = std::min(x0, g.x());
-        x1 = std::max(x1, g.x());
-        y0 = std::min(y0, g.y());
-        y1 = std::max(y1, g.y());
+  std::vector<Landmark> lms;
+  std::vector<int> buildings;
+  if (world_) {
+    structureCandidates(R_WC, p_WC, lms, buildings);
+  } else {
+    // Ground region in view: rays through the image border, clipped at the maximum range.
+    double x0 = p_WC.x(), x1 = p_WC.x(), y0 = p_WC.y(), y1 = p_WC.y();
+    const double hMax = 3.0 * cfg_.heightSigma;  // landmarks are at most this high (3 sigma)
+    for (int k = 0; k <= 32; ++k) {
+      const double f = k / 32.0;
+      const Eigen::Vector2d border[4] = {{f * (W - 1), 0.0}, {f * (W - 1), H - 1.0}, {0.0, f * (H - 1)}, {W - 1.0, f * (H - 1)}};
+      for (const auto& px : border) {
+        const Eigen::Vector3d d = R_WC * model_.bearing(px);
+        double lam = cfg_.maxRange;
+        if (d.z() < -1e-9) lam = std::min(lam, (p_WC.z() - 0.0) / -d.z());
+        // Also the intersection with the top of the landmark layer (raised landmarks seen nearer).
+        for (const double z : {0.0, hMax}) {
+          const double l = d.z() < -1e-9 ? std::min(cfg_.maxRange, (p_WC.z() - z) / -d.z()) : lam;
+          const Eigen::Vector3d g = p_WC + std::max(l, 0.0) * d;
+          x0 = std::min(x0, g.x());
+          x1 = std::max(x1, g.x());
+          y0 = std::min(y0, g.y());
+          y1 = std::max(y1, g.y());
+        }
       }
     }
+    const double margin = 2.0 + 0.05 * std::max(x1 - x0, y1 - y0);
+    field_->query(x0 - margin, y0 - margin, x1 + margin, y1 + margin, lms);
   }
-  const double margin = 2.0 + 0.05 * std::max(x1 - x0, y1 - y0);
-  std::vector<Landmark> lms;
-  field_.query(x0 - margin, y0 - margin, x1 + margin, y1 + margin, lms);
 
   struct Seen {
     const Landmark* l;
@@ -145,6 +177,13 @@ std::vector<FeatureObservation> FeatureSimulator::observe(const Trajectory& traj
   std::sort(seen.begin(), seen.end(), [](const Seen& a, const Seen& b) {
     return a.l->priority != b.l->priority ? a.l->priority > b.l->priority : a.l->id < b.l->id;
   });
+  if (world_) {
+    // Occlusion by the buildings, tested in priority order until the image is full.
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < seen.size() && kept < static_cast<std::size_t>(cfg_.maxPerImage); ++i)
+      if (!world_->segmentBlocked(p_WC, seen[i].l->p_W, buildings)) seen[kept++] = seen[i];
+    seen.resize(kept);
+  }
   if (seen.size() > static_cast<std::size_t>(cfg_.maxPerImage)) seen.resize(static_cast<std::size_t>(cfg_.maxPerImage));
   std::sort(seen.begin(), seen.end(), [](const Seen& a, const Seen& b) { return a.l->id < b.l->id; });
 

@@ -35,13 +35,14 @@ const char* toString(FlightPattern p) {
     case FlightPattern::FigureEight: return "figure_eight";
     case FlightPattern::Waypoints: return "waypoints";
     case FlightPattern::Drive: return "drive";
+    case FlightPattern::Walk: return "walk";
   }
   return "?";
 }
 
 bool flightPatternFromString(const std::string& s, FlightPattern& out) {
   for (FlightPattern p : {FlightPattern::Lawnmower, FlightPattern::Circle, FlightPattern::FigureEight,
-                          FlightPattern::Waypoints, FlightPattern::Drive})
+                          FlightPattern::Waypoints, FlightPattern::Drive, FlightPattern::Walk})
     if (s == toString(p)) {
       out = p;
       return true;
@@ -60,6 +61,13 @@ void FlightSpec::validate() const {
   require(laps >= 1 && laps <= 1000, "laps must be in [1, 1000]");
   require(std::isfinite(cornerRadius) && cornerRadius > 0.0, "corner_radius must be positive");
   require(std::isfinite(stopSeconds) && stopSeconds >= 0.0 && stopSeconds <= 3600.0, "stop_seconds out of range");
+  require(std::isfinite(cornerStopSeconds) && cornerStopSeconds >= 0.0 && cornerStopSeconds <= 3600.0,
+          "corner_stop_seconds out of range");
+  if (pattern == FlightPattern::Walk) {
+    gait.validate();
+    // The gait (about speed / stepLength Hz) needs several spline knots per period.
+    require(knotInterval <= gait.stepLength / speed / 8.0, "walk: knot_interval must be <= step length / speed / 8");
+  }
   require(std::isfinite(restHeight) && restHeight >= 0.0 && restHeight < height, "rest_height must be in [0, height)");
   require(std::isfinite(hoverStart) && hoverStart >= 2.0 && hoverStart <= 3600.0, "hover_start must be in [2, 3600] s");
   require(std::isfinite(hoverEnd) && hoverEnd >= 2.0 && hoverEnd <= 3600.0, "hover_end must be in [2, 3600] s");
@@ -91,7 +99,7 @@ Route buildRoute(const FlightSpec& s) {
   const double turnSign = s.turnRight ? -1.0 : 1.0;  // CCW-positive angle of a turn towards `side`
   auto at = [](const Eigen::Vector2d& xy, double z) { return Eigen::Vector3d(xy.x(), xy.y(), z); };
 
-  if (s.pattern == FlightPattern::Drive) {
+  if (s.pattern == FlightPattern::Drive || s.pattern == FlightPattern::Walk) {
     const double r = s.cornerRadius;
     // Perimeter of a rounded 2H x H rectangle: 6H - (8 - 2 pi) r.
     const double perLap = s.length / s.laps;
@@ -102,14 +110,21 @@ Route buildRoute(const FlightSpec& s) {
     const double z = s.restHeight;
     auto P = [&](double f, double sd) { return Eigen::Vector2d(f * fwd + sd * side); };
     Route route(at(P(0, 0), z));
+    auto corner = [&] {
+      if (s.cornerStopSeconds > 0.0) route.stop(s.cornerStopSeconds);
+    };
     for (int lap = 0; lap < s.laps; ++lap) {
       route.lineTo(at(P(W / 2 - r, 0), z), s.speed);
+      corner();
       route.arcAround(P(W / 2 - r, r), turnSign * kPi / 2, s.speed);
       route.lineTo(at(P(W / 2, H - r), z), s.speed);
+      corner();
       route.arcAround(P(W / 2 - r, H - r), turnSign * kPi / 2, s.speed);
       route.lineTo(at(P(-W / 2 + r, H), z), s.speed);
+      corner();
       route.arcAround(P(-W / 2 + r, H - r), turnSign * kPi / 2, s.speed);
       route.lineTo(at(P(-W / 2, r), z), s.speed);
+      corner();
       route.arcAround(P(-W / 2 + r, r), turnSign * kPi / 2, s.speed);
       route.lineTo(at(P(0, 0), z), s.speed);
       if (lap + 1 < s.laps && s.stopSeconds > 0.0) route.stop(s.stopSeconds);
@@ -176,7 +191,8 @@ Route buildRoute(const FlightSpec& s) {
         route.lineTo(at(Eigen::Vector2d::Zero(), h), s.climbRate);
       break;
     }
-    case FlightPattern::Drive: break;  // handled above
+    case FlightPattern::Drive:
+    case FlightPattern::Walk: break;  // handled above
   }
   if (s.takeoffLanding) route.lineTo(at(Eigen::Vector2d::Zero(), s.restHeight), s.climbRate);
   return route;
@@ -213,11 +229,36 @@ std::unique_ptr<SplineTrajectory> buildFlight(const FlightSpec& spec, std::uint6
   if (spec.pattern == FlightPattern::Drive) {
     att = spec.vehicleAttitude;
     att.model = AttitudeModel::GroundVehicle;
+  } else if (spec.pattern == FlightPattern::Walk) {
+    att.model = AttitudeModel::GroundVehicle;  // level, heading along the path
+    att.rollPerLateralAccel = 0.0;
+    att.pitchPerLongitudinalAccel = 0.0;
   } else {
     att.model = AttitudeModel::Multirotor;
   }
   att.gravity = spec.gravity;
   const double duration = samples.duration();
+  if (spec.pattern == FlightPattern::Walk) {
+    // Gait: bob and sway in the positions, hand angles (plus the random wobble, interpolated
+    // from its coarser knots) as the attitude perturbation on the samples' grid.
+    const GaitPhase phase = gaitPhase(spec.gait, samples);
+    std::vector<Eigen::Vector3d> c = gaitAngles(spec.gait, phase);
+    if (spec.wobbleDeg > 0.0) {
+      Rng rng(seed, nameHash("attitude wobble"));
+      const double sigma = spec.wobbleDeg * kPi / 180.0;
+      std::vector<Eigen::Vector3d> w;
+      const auto n = static_cast<std::size_t>(std::ceil(duration / spec.wobbleInterval)) + 2;
+      for (std::size_t j = 0; j < n; ++j) w.emplace_back(rng.normal(sigma), rng.normal(sigma), rng.normal(sigma));
+      for (std::size_t k = 0; k < c.size(); ++k) {
+        const double x = static_cast<double>(k) * samples.dt / spec.wobbleInterval;
+        const auto j = static_cast<std::size_t>(std::floor(x));
+        c[k] += phase.weight[k] * ((static_cast<double>(j + 1) - x) * w[j] + (x - static_cast<double>(j)) * w[j + 1]);
+      }
+    }
+    att.wobble = UniformBSpline<3>(0.0, samples.dt, std::move(c));
+    addGaitMotion(spec.gait, phase, samples);
+    return trajectoryFromSamples(samples, spec.yawKnotInterval, std::move(att));
+  }
   if (spec.wobbleDeg > 0.0) {
     Rng rng(seed, nameHash("attitude wobble"));
     const double sigma = spec.wobbleDeg * kPi / 180.0;

@@ -236,6 +236,8 @@ void GnssReceiverSim::produce(const GpsTime& tag, const GpsTime& t, GnssSimEpoch
     const AzEl azel = azimuthElevation(rxGeo, rx.position, g.satRx);
     if (azel.elevation < mask) {
       lose(st, nullptr);
+      st.pathState = 0;  // an open path event ended at the last epoch above the mask
+      st.pathEvent = -1;
       continue;
     }
 
@@ -259,6 +261,29 @@ void GnssReceiverSim::produce(const GpsTime& tag, const GpsTime& t, GnssSimEpoch
     if (outSys[systemIndex(sat.system)]) {
       lose(st, "outage");
       continue;
+    }
+    // Structure between the antenna and the satellite (path model).
+    double pathBias = 0.0, mpScale = 1.0;
+    bool pathNlos = false;
+    if (pathModel_) {
+      const UrbanSignalPath sp = pathModel_(rx.position, (g.satRx - rx.position) / g.range);
+      const int state = sp.kind == UrbanSignalPath::Kind::Blocked ? 2 : sp.kind == UrbanSignalPath::Kind::Reflected ? 1 : 0;
+      if (state != st.pathState) {
+        if (st.pathEvent >= 0) events_[static_cast<std::size_t>(st.pathEvent)].end = t;
+        st.pathEvent = -1;
+        if (state != 0) {
+          st.pathEvent = static_cast<int>(events_.size());
+          events_.push_back({role_, state == 2 ? "blockage" : "nlos", sat, "", t, t, state == 1 ? sp.extraPath : 0.0});
+        }
+        lose(st, state == 2 ? "blockage" : "nlos");
+        st.pathState = state;
+      } else if (st.pathEvent >= 0) {
+        events_[static_cast<std::size_t>(st.pathEvent)].end = t;
+      }
+      if (state == 2) continue;
+      pathNlos = state == 1;
+      pathBias = sp.extraPath;
+      mpScale = sp.multipathScale;
     }
     bool nlosChange = false;
     if (st.nlos && !(t < st.nlosEnd)) {
@@ -307,6 +332,7 @@ void GnssReceiverSim::produce(const GpsTime& tag, const GpsTime& t, GnssSimEpoch
     satTruth.ionosphereModelL1 = atmo.ionosphereModelL1;
     satTruth.ionosphereL1Rate = ionoRate;
     satTruth.nlosBias = st.nlos ? st.nlosBias : 0.0;
+    if (pathNlos) satTruth.nlosBias += pathBias;
     double windupRate = 0.0;  // cycles per second of true time
     if (cfg_.phaseWindup) {
       const Eigen::Matrix3d satAxes = yawSteeringAxes(g.satRx, sun);
@@ -336,6 +362,7 @@ void GnssReceiverSim::produce(const GpsTime& tag, const GpsTime& t, GnssSimEpoch
       double cn0 = rc_.cn0.zenith - (rc_.cn0.zenith - rc_.cn0.horizon) * oneMinus * oneMinus +
                    cfg_.cn0Offset(sat.system, sg.code) + st.cn0Offset + sg.rng.normal(rc_.cn0.noise);
       if (st.nlos) cn0 -= rc_.nlos.cn0Drop;
+      if (pathNlos) cn0 -= rc_.nlos.cn0Drop;
       // Multipath (advanced even while the signal is not tracked: it belongs to the geometry).
       const double a = sg.mpStarted ? std::exp(-std::max(t - sg.mpTime, 0.0) / rc_.multipath.timeConstant) : 0.0;
       const double wc = sg.rng.normal(), wp = sg.rng.normal();
@@ -364,6 +391,10 @@ void GnssReceiverSim::produce(const GpsTime& tag, const GpsTime& t, GnssSimEpoch
       sgt.interFrequencyBias = channel ? rc_.clock.glonassIfbPerChannel * *channel : 0.0;
       sgt.multipathCode = rc_.multipath.code * elFactor * sg.mpCode;
       sgt.multipathPhase = std::clamp(rc_.multipath.phase * elFactor * sg.mpPhase, -0.25 * lambda, 0.25 * lambda);
+      if (pathModel_) {  // larger near facades
+        sgt.multipathCode *= mpScale;
+        sgt.multipathPhase = std::clamp(rc_.multipath.phase * mpScale * elFactor * sg.mpPhase, -0.25 * lambda, 0.25 * lambda);
+      }
       const double thermal = std::pow(10.0, (45.0 - cn0) / 20.0);
       sgt.codeSigma = rc_.noise.code * cfg_.codeNoiseFactor(sat.system, sg.code) * thermal;
       sgt.phaseSigma = rc_.noise.phase * lambda * thermal;

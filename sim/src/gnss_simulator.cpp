@@ -87,6 +87,7 @@ GnssSimSummary GnssSimulator::run(const NavData& nav, const Trajectory& trajecto
   const std::filesystem::path dir = datasetDir / "gnss";
   std::filesystem::create_directories(dir);
   GnssEpochGenerator gen(config_, nav, trajectory, frame, leverArmBody, seed);
+  if (pathModel_) gen.setRoverPathModel(pathModel_);
   const GnssSimWorld& world = gen.world();
   // A start outside the navigation data would give observation files without a single epoch.
   bool covered = false;

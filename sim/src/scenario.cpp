@@ -138,7 +138,7 @@ void parseFlight(const Reader& r, const YAML::Node& n, Scenario& sc) {
     if (name == "type") continue;
     if (name == "pattern") {
       if (!flightPatternFromString(r.string(v, key), f.pattern))
-        r.fail(v, key, "expected lawnmower, circle, figure_eight, waypoints or drive");
+        r.fail(v, key, "expected lawnmower, circle, figure_eight, waypoints, drive or walk");
     } else if (name == "height_m") f.height = r.number(v, key, 0.5, 10000.0);
     else if (name == "length_m") f.length = r.number(v, key, 1.0, 1e6);
     else if (name == "speed_mps") f.speed = r.number(v, key, 0.1, 100.0);
@@ -157,6 +157,11 @@ void parseFlight(const Reader& r, const YAML::Node& n, Scenario& sc) {
       for (std::size_t i = 0; i < v.size(); ++i) f.waypoints.push_back(r.vec3(v[i], key, -1e6, 1e6));
     } else if (name == "corner_radius_m") f.cornerRadius = r.number(v, key, 0.5, 1000.0);
     else if (name == "stop_s") f.stopSeconds = r.number(v, key, 0.0, 3600.0);
+    else if (name == "corner_stop_s") f.cornerStopSeconds = r.number(v, key, 0.0, 3600.0);
+    else if (name == "gait_step_m") f.gait.stepLength = r.number(v, key, 0.2, 2.0);
+    else if (name == "gait_bob_m") f.gait.bob = r.number(v, key, 0.0, 0.2);
+    else if (name == "gait_sway_m") f.gait.sway = r.number(v, key, 0.0, 0.2);
+    else if (name == "gait_tilt_deg") f.gait.tiltDeg = r.number(v, key, 0.0, 20.0);
     else if (name == "rest_height_m") f.restHeight = r.number(v, key, 0.0, 100.0);
     else if (name == "takeoff_landing") f.takeoffLanding = r.boolean(v, key);
     else if (name == "hover_start_s") f.hoverStart = r.number(v, key, 2.0, 3600.0);
@@ -354,8 +359,43 @@ void parseCameras(const Reader& r, const YAML::Node& n, Scenario& sc) {
   }
 }
 
+void parseStructure(const Reader& r, const YAML::Node& n, Scenario& sc) {
+  r.map(n, "scene.structure", {"street_half_width_m", "building_length_m", "building_depth_m", "building_height_m",
+                               "gap_m", "facade_density_per_m2", "ground_density_per_m2", "relief_m", "pole_spacing_m",
+                               "tile_m"});
+  UrbanConfig c;
+  const std::string p = "scene.structure.";
+  auto interval = [&](const char* name, double lo, double hi, double& a, double& b) {
+    if (!n[name]) return;
+    const auto v = r.numbers(n[name], p + name, 2, lo, hi);
+    if (v[1] < v[0]) r.fail(n[name], p + name, "expected [min, max] with min <= max");
+    a = v[0];
+    b = v[1];
+  };
+  if (n["street_half_width_m"]) c.streetHalfWidth = r.number(n["street_half_width_m"], p + "street_half_width_m", 3.0, 200.0);
+  interval("building_length_m", 2.0, 1000.0, c.buildingLengthMin, c.buildingLengthMax);
+  interval("building_depth_m", 2.0, 1000.0, c.buildingDepthMin, c.buildingDepthMax);
+  interval("building_height_m", 1.0, 1000.0, c.buildingHeightMin, c.buildingHeightMax);
+  interval("gap_m", 0.0, 1000.0, c.gapMin, c.gapMax);
+  if (n["facade_density_per_m2"]) c.facadeDensity = r.number(n["facade_density_per_m2"], p + "facade_density_per_m2", 0.0, 10.0);
+  if (n["ground_density_per_m2"]) c.groundDensity = r.number(n["ground_density_per_m2"], p + "ground_density_per_m2", 0.0, 10.0);
+  if (n["relief_m"]) c.relief = r.number(n["relief_m"], p + "relief_m", 0.0, 100.0);
+  if (n["pole_spacing_m"]) {
+    c.poleSpacing = r.number(n["pole_spacing_m"], p + "pole_spacing_m", 0.0, 10000.0);
+    if (c.poleSpacing > 0.0 && c.poleSpacing < 2.0) r.fail(n["pole_spacing_m"], p + "pole_spacing_m", "expected 0 (none) or >= 2 m");
+  }
+  if (n["tile_m"]) c.tileSize = r.number(n["tile_m"], p + "tile_m", 5.0, 1000.0);
+  try {
+    c.validate();
+  } catch (const std::invalid_argument& e) {
+    r.fail(n, "scene.structure", e.what());
+  }
+  sc.structure = c;
+}
+
 void parseScene(const Reader& r, const YAML::Node& n, Scenario& sc) {
-  r.map(n, "scene", {"texture", "checkerboard"});
+  r.map(n, "scene", {"texture", "checkerboard", "structure"});
+  if (const YAML::Node u = n["structure"]) parseStructure(r, u, sc);
   if (const YAML::Node t = n["texture"]) {
     r.map(t, "scene.texture", {"texel_m", "levels", "finest_feature_m", "octaves", "mean_dn", "amplitude_dn", "cache_mb"});
     GroundTextureConfig& c = sc.texture;
@@ -450,9 +490,12 @@ void parseRoot(const Reader& r, const YAML::Node& root, Scenario& sc) {
     }
   }
   // Consistency between sections.
-  if (sc.trajectory == TrajectoryKind::Flight && sc.flight.pattern == FlightPattern::Drive &&
+  if (sc.structure && sc.output == CameraOutput::Images && !sc.cameras.empty())
+    r.fail(root["scene"], "scene.structure", "3-D structure gives feature tracks only: set cameras.output: features");
+  if (sc.trajectory == TrajectoryKind::Flight &&
+      (sc.flight.pattern == FlightPattern::Drive || sc.flight.pattern == FlightPattern::Walk) &&
       sc.flight.restHeight <= 0.0)
-    r.fail(root["trajectory"], "trajectory.rest_height_m", "a ground vehicle needs its IMU above the ground");
+    r.fail(root["trajectory"], "trajectory.rest_height_m", "a ground vehicle or walker needs its IMU above the ground");
 }
 
 }  // namespace

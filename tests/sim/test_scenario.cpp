@@ -164,6 +164,33 @@ struct BadCase {
   const char* key;
 };
 
+TEST(Scenario, GroundScenariosReadTheirStructureAndGait) {
+  const Scenario car = loadScenario((configDir() / "car_city_drive.yaml").string());
+  EXPECT_EQ(car.flight.pattern, FlightPattern::Drive);
+  EXPECT_EQ(car.flight.cornerStopSeconds, 8.0);
+  EXPECT_EQ(car.output, CameraOutput::Features);
+  ASSERT_TRUE(car.structure.has_value());
+  EXPECT_EQ(car.structure->streetHalfWidth, 10.0);
+  EXPECT_EQ(car.structure->buildingHeightMin, 8.0);
+  EXPECT_EQ(car.structure->buildingHeightMax, 45.0);
+  ASSERT_EQ(car.cameras.size(), 2u);
+  // Forward-looking: the optical axis (camera z) along body x.
+  EXPECT_GT((car.cameras[0].T_BS.topLeftCorner<3, 3>() * Eigen::Vector3d::UnitZ()).x(), 0.99);
+  const auto drive = buildTrajectory(car, car.seed);
+  EXPECT_NEAR(drive->evaluate(drive->duration() / 2).p_WB.z(), 1.4, 1e-6);
+  const Scenario walk = loadScenario((configDir() / "handheld_walk.yaml").string());
+  EXPECT_EQ(walk.flight.pattern, FlightPattern::Walk);
+  EXPECT_EQ(walk.flight.gait.stepLength, 0.7);
+  EXPECT_EQ(walk.flight.gait.bob, 0.025);
+  EXPECT_EQ(walk.flight.gait.sway, 0.02);
+  EXPECT_EQ(walk.flight.gait.tiltDeg, 1.5);
+  ASSERT_TRUE(walk.structure.has_value());
+  EXPECT_EQ(walk.structure->streetHalfWidth, 6.0);
+  const Scenario fuzz = loadScenario((fs::path(GVINS_TEST_DATA) / "fuzz" / "scenario" / "structure_walk.yaml").string());
+  ASSERT_TRUE(fuzz.structure.has_value());
+  EXPECT_EQ(fuzz.structure->tileSize, 40.0);
+}
+
 TEST(Scenario, MalformedInputNamesFileLineAndKey) {
   const BadCase cases[] = {
       {"bogus: 1\n", 1, "bogus"},
@@ -207,6 +234,16 @@ TEST(Scenario, MalformedInputNamesFileLineAndKey) {
       {"cameras:\n  png_compression: 10\n", 2, "cameras.png_compression"},
       {"scene:\n  texture: {levels: 30}\n", 2, "scene.texture.levels"},
       {"scene:\n  checkerboard: {inner_corners: [1, 6]}\n", 2, "scene.checkerboard.inner_corners"},
+      {"scene:\n  structure: {street_half_width_m: 1}\n", 2, "scene.structure.street_half_width_m"},
+      {"scene:\n  structure: {building_height_m: [30, 10]}\n", 2, "scene.structure.building_height_m"},
+      {"scene:\n  structure: {building_length_m: 20}\n", 2, "scene.structure.building_length_m"},
+      {"scene:\n  structure: {pole_spacing_m: 1}\n", 2, "scene.structure.pole_spacing_m"},
+      {"scene:\n  structure: {roofs: 3}\n", 2, "scene.structure.roofs"},
+      {"scene:\n  structure: {facade_density_per_m2: 10, building_height_m: [10, 1000]}\n", 2, "scene.structure"},
+      {"cameras:\n  output: images\nscene:\n  structure: {}\n", 4, "scene.structure"},
+      {"trajectory:\n  gait_bob_m: 1\n", 2, "trajectory.gait_bob_m"},
+      {"trajectory:\n  corner_stop_s: -1\n", 2, "trajectory.corner_stop_s"},
+      {"trajectory:\n  pattern: walk\n  speed_mps: 1.4\n  rest_height_m: 1.3\n", 2, "trajectory"},
       {"lever_arm_m: [1, 2]\n", 1, "lever_arm_m"},
       {"lever_arm_m: [1, 2, x]\n", 1, "lever_arm_m"},
       {"gnss:\n  rover: {rate_hz: 0}\n", 2, "gnss.rover.rate_hz"},

@@ -40,6 +40,7 @@ struct GenerationSummary {
   bool images = true;
   std::size_t featureObservations = 0;
   std::size_t landmarks = 0;
+  std::size_t buildings = 0;  ///< of the 3-D structure (scene.structure), 0 without
   double meanFeaturesPerImage = 0.0;
   double meanBlurSamples = 0.0;
   std::size_t textureTiles = 0;

@@ -19,6 +19,8 @@
 
 namespace gvins::sim {
 
+class UrbanStructure;
+
 struct Landmark {
   std::uint64_t id = 0;
   Eigen::Vector3d p_W = Eigen::Vector3d::Zero();
@@ -68,6 +70,9 @@ class FeatureSimulator {
  public:
   FeatureSimulator(const vio::CameraCalibration& camera, const FeatureSimConfig& config, const LandmarkField& field,
                    double lineTime = 0.0);
+  /// Landmarks of a 3-D structure (must outlive the simulator) instead of the ground plane.
+  FeatureSimulator(const vio::CameraCalibration& camera, const FeatureSimConfig& config, const UrbanStructure& world,
+                   double lineTime = 0.0);
 
   /// Observations in the image stamped at flight time t; noise from `noiseSeed`.
   std::vector<FeatureObservation> observe(const Trajectory& trajectory, double t, std::uint64_t noiseSeed) const;
@@ -78,10 +83,15 @@ class FeatureSimulator {
   const vio::CameraModel& model() const { return model_; }
 
  private:
+  /// Landmarks of the structure in the frustum's horizontal footprint, and the buildings there.
+  void structureCandidates(const Eigen::Matrix3d& R_WC, const Eigen::Vector3d& p_WC, std::vector<Landmark>& lms,
+                           std::vector<int>& buildings) const;
+
   vio::CameraCalibration calib_;
   vio::CameraModel model_;
   FeatureSimConfig cfg_;
-  const LandmarkField& field_;
+  const LandmarkField* field_ = nullptr;
+  const UrbanStructure* world_ = nullptr;
   double lineTime_;
   Eigen::Matrix3d R_BC_;
   Eigen::Vector3d p_BC_;

@@ -13,7 +13,10 @@
 //                 (forward/right of the heading), crossing at home; A from the length.
 //   waypoints:    straight legs through `waypoints` (x east, y north, z up, m), then home.
 //   drive:        a ground vehicle at `restHeight` on laps around a rounded rectangle (2:1,
-//                 corner radius `cornerRadius`) with a stop of `stopSeconds` after each lap.
+//                 corner radius `cornerRadius`) with a stop of `stopSeconds` after each lap
+//                 and, when `cornerStopSeconds` > 0, before every corner (traffic lights).
+//   walk:         the same route walked with a hand-held rig at `restHeight` (hand height),
+//                 with the gait oscillation of `gait` (gait.hpp) added to the motion.
 // `length` is the horizontal path length (climb and descent excluded).
 #pragma once
 
@@ -24,15 +27,16 @@
 
 #include <Eigen/Core>
 
+#include "gvins/sim/gait.hpp"
 #include "gvins/sim/route.hpp"
 #include "gvins/sim/spline_trajectory.hpp"
 
 namespace gvins::sim {
 
-enum class FlightPattern { Lawnmower, Circle, FigureEight, Waypoints, Drive };
+enum class FlightPattern { Lawnmower, Circle, FigureEight, Waypoints, Drive, Walk };
 enum class YawMode { FollowPath, Fixed };
 
-/// "lawnmower", "circle", "figure_eight", "waypoints", "drive".
+/// "lawnmower", "circle", "figure_eight", "waypoints", "drive", "walk".
 const char* toString(FlightPattern p);
 bool flightPatternFromString(const std::string& s, FlightPattern& out);
 
@@ -50,6 +54,8 @@ struct FlightSpec {
   std::vector<Eigen::Vector3d> waypoints;  ///< waypoints pattern
   double cornerRadius = 12.0;  ///< drive, m
   double stopSeconds = 3.0;    ///< drive: stop after each lap
+  double cornerStopSeconds = 0.0;  ///< drive, walk: stop before every corner (0: none)
+  GaitConfig gait;             ///< walk
   double restHeight = 0.3;     ///< m, IMU height above the ground at rest (drive: while driving)
   bool takeoffLanding = true;  ///< false: start and end hovering at `height` above home
   double hoverStart = 5.0;     ///< s at rest before moving (>= 2)

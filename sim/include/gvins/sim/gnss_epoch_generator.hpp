@@ -42,6 +42,8 @@ class GnssEpochGenerator {
   std::optional<GnssSimEpoch> next();
   /// Closes ambiguity arcs and event intervals of both receivers.
   void finish();
+  /// Blockage and NLOS of the rover's signals through 3-D structure (GnssReceiverSim::setPathModel).
+  void setRoverPathModel(GnssPathModel model) { rover_->setPathModel(std::move(model)); }
 
   const GnssSimWorld& world() const { return *world_; }
   const GnssReceiverSim& rover() const { return *rover_; }

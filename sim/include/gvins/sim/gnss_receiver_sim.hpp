@@ -20,6 +20,7 @@
 #include "gvins/sim/gnss_receiver_clock.hpp"
 #include "gvins/sim/gnss_sim_epoch.hpp"
 #include "gvins/sim/gnss_sim_world.hpp"
+#include "gvins/sim/urban_signal_path.hpp"
 
 namespace gvins::sim {
 
@@ -32,12 +33,22 @@ struct GnssAntennaState {
   Eigen::Matrix3d axes = Eigen::Matrix3d::Zero();
 };
 using GnssAntennaMotion = std::function<GnssAntennaState(const GpsTime& gpst)>;
+/// The path of a satellite's signal to the antenna (both ECEF: antenna position, unit vector
+/// towards the satellite) through 3-D structure (urban_signal_path.hpp).
+using GnssPathModel = std::function<UrbanSignalPath(const Eigen::Vector3d& antenna, const Eigen::Vector3d& toSatellite)>;
 
 class GnssReceiverSim {
  public:
   /// `world` must outlive the receiver. Epoch tags lie on the grid of multiples of 1/rate (in
   /// receiver time); epochs whose true time falls outside the world's span are not produced.
   GnssReceiverSim(const GnssSimWorld& world, GnssReceiverRole role, GnssAntennaMotion motion);
+
+  /// Decide blockage and non-line-of-sight reception per satellite ray with `model` (in
+  /// addition to the random events of the configuration): a blocked satellite is lost, a
+  /// reflected one delayed by the extra path with C/N0 lowered by nlos.cn0_drop_db, and the
+  /// multipath scaled; each change of path restarts the carrier (new ambiguity). Events are
+  /// recorded like the random ones ("blockage", "nlos" with the extra path at its start).
+  void setPathModel(GnssPathModel model) { pathModel_ = std::move(model); }
 
   /// The next epoch (observations may be empty during a total outage); std::nullopt at the end.
   std::optional<GnssSimEpoch> next();
@@ -79,6 +90,8 @@ class GnssReceiverSim {
     GpsTime nlosEnd;
     double nlosBias = 0.0;
     int nlosEvent = -1;
+    int pathState = 0;   // path model: 0 line of sight, 1 reflected, 2 blocked
+    int pathEvent = -1;  // its open event interval
     std::optional<double> windup;  // cycles, continued while the satellite is in view
     GnssRandom rng;
     std::vector<SignalTrack> signals;
@@ -92,6 +105,7 @@ class GnssReceiverSim {
   GnssReceiverRole role_;
   GnssReceiverConfig rc_;
   GnssAntennaMotion motion_;
+  GnssPathModel pathModel_;
   GnssReceiverClock clock_;
   GpsTime gridStart_;
   std::int64_t k_ = 0;

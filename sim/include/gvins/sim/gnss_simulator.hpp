@@ -23,6 +23,7 @@
 #include <Eigen/Core>
 
 #include "gvins/ephemeris/rinex_nav.hpp"
+#include "gvins/sim/gnss_receiver_sim.hpp"
 #include "gvins/sim/gnss_sim_config.hpp"
 #include "gvins/sim/local_frame.hpp"
 #include "gvins/sim/trajectory.hpp"
@@ -72,11 +73,14 @@ class GnssSimulator {
 
   /// Progress lines (percent of the flight) go here when set (e.g. &std::cerr).
   void setProgressStream(std::ostream* os) { progress_ = os; }
+  /// Rover signals through 3-D structure (GnssReceiverSim::setPathModel); none by default.
+  void setRoverPathModel(GnssPathModel model) { pathModel_ = std::move(model); }
   const GnssSimConfig& config() const { return config_; }
 
  private:
   GnssSimConfig config_;
   std::ostream* progress_ = nullptr;
+  GnssPathModel pathModel_;
 };
 
 }  // namespace gvins::sim

@@ -23,6 +23,7 @@
 #include "gvins/sim/imu_simulator.hpp"
 #include "gvins/sim/local_frame.hpp"
 #include "gvins/sim/recorded_trajectory.hpp"
+#include "gvins/sim/urban_structure.hpp"
 #include "gvins/vio/sensor_yaml.hpp"
 
 namespace gvins::sim {
@@ -53,6 +54,10 @@ struct Scenario {
   ImagingConfig imaging;
   FeatureSimConfig features;
   GroundTextureConfig texture;  ///< texture.seed is replaced by one derived from the run's seed
+  /// 3-D structure along the route (`scene.structure`): the feature tracks come from its
+  /// facades, poles and ground instead of the ground plane, and it blocks and reflects the
+  /// rover's GNSS signals. Feature output only (not rendered).
+  std::optional<UrbanConfig> structure;
 
   Eigen::Vector3d leverArm = Eigen::Vector3d(0.08, 0.0, 0.18);  ///< GNSS antenna in the IMU frame, m
   std::optional<GnssSimConfig> gnss;  ///< no GNSS when absent
