@@ -17,6 +17,8 @@
 #                      outage_ddcp, outage_psr), default all; tables show n/a for the others
 #     --force          rerun replays whose outputs exist
 #     --keep-data      keep rendered datasets (--images deletes each after its runs)
+#     --markdown FILE  also write the tables as a results page (e.g. docs/results/uav_flights.md)
+#                      headed by the command, the commit and the date of the run
 # Timing: the replays' own times are only usable with --jobs 1 on an idle machine; the GNSS share
 # of the estimator time is measured apart on the first flight by bench/fusion/gnss_time_share.sh
 # (VIO and GNSS runs paired on the two cores, 4 rounds; gnss_time_share.txt).
@@ -41,6 +43,8 @@ JOBS=$(nproc)
 IMAGES=0
 FORCE=0
 KEEP=0
+MARKDOWN=""
+COMMAND_LINE="bench/fusion/paper_tables.sh $*"
 FLIGHTS=""
 ONLY_RUNS=""
 while [ $# -gt 0 ]; do
@@ -53,7 +57,8 @@ while [ $# -gt 0 ]; do
     --runs) ONLY_RUNS=$2; shift ;;
     --force) FORCE=1 ;;
     --keep-data) KEEP=1 ;;
-    -h|--help) sed -n '2,34p' "$0"; exit 0 ;;
+    --markdown) MARKDOWN=$2; shift ;;
+    -h|--help) sed -n '2,36p' "$0"; exit 0 ;;
     *) echo "paper_tables.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
   shift
@@ -322,3 +327,16 @@ END {
   printf "\n%d target(s) not met\n", fails
 }' "$ALL" | tee "$OUT/tables.md"
 echo "tables: $OUT/tables.md, every figure: $ALL, runs: $OUT/runs/" >&2
+if [ -n "$MARKDOWN" ]; then
+  mkdir -p "$(dirname "$MARKDOWN")"
+  {
+    echo "# The ten simulated UAV flights: the paper's tables"
+    echo
+    echo "Written by \`$COMMAND_LINE\` at commit $(git -C "$ROOT" rev-parse --short HEAD 2>/dev/null || echo unknown)"
+    echo "on $(date -u '+%Y-%m-%d %H:%M UTC') ($KIND; $(nproc) cores). Do not edit by hand: run the script again."
+    echo "Definitions: the header of bench/fusion/paper_tables.sh; the model: docs/gnss_fusion.md."
+    echo
+    cat "$OUT/tables.md"
+  } >"$MARKDOWN"
+  echo "results page: $MARKDOWN" >&2
+fi

@@ -16,6 +16,8 @@
 #     --force          rerun replays whose outputs exist
 #     --keep-data      keep the rendered datasets (and the saved tracks) in DIR/data/
 #     --float-images   float replays from the images too (default: from the double run's tracks)
+#     --markdown FILE  also write the table as a results page (e.g. docs/results/rendered_flights.md)
+#                      headed by the command, the commit and the date of the run
 #
 # Columns (metrics.csv of gvins-replay, docs/replay.md): RMSE after the 4-DoF alignment over the
 # whole flight; drift = local_drift_percent (100 m segments); NEES p / θ under the first-pose
@@ -28,6 +30,8 @@ FLIGHTS=""
 CONFIG=""
 FORCE=0
 KEEP=0
+MARKDOWN=""
+COMMAND_LINE="bench/vio/rendered_flights.sh $*"
 FLOAT_IMAGES=0
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -37,8 +41,9 @@ while [ $# -gt 0 ]; do
     --config) CONFIG=$2; shift ;;
     --force) FORCE=1 ;;
     --keep-data) KEEP=1 ;;
+    --markdown) MARKDOWN=$2; shift ;;
     --float-images) FLOAT_IMAGES=1 ;;
-    -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,24p' "$0"; exit 0 ;;
     *) echo "rendered_flights.sh: unknown option $1 (see --help)" >&2; exit 2 ;;
   esac
   shift
@@ -139,3 +144,16 @@ END {
     sd / nf, sdr / nf, snp / nf, snt / nf, sf / nf, 100 * (sr / nf - 1), sfr / nf, sfp / nf, sft / nf, se / nf, sef / nf, sfe / nf
 }' "$ALL" | tee "$OUT/tables.md"
 echo "rendered_flights.sh: $OUT/tables.md, $OUT/metrics.csv ($(( $(date +%s) - start )) s)" >&2
+if [ -n "$MARKDOWN" ]; then
+  mkdir -p "$(dirname "$MARKDOWN")"
+  {
+    echo "# VIO on the ten rendered UAV flights"
+    echo
+    echo "Written by \`$COMMAND_LINE\` at commit $(git -C "$ROOT" rev-parse --short HEAD 2>/dev/null || echo unknown)"
+    echo "on $(date -u '+%Y-%m-%d %H:%M UTC') ($(nproc) cores, $(( $(date +%s) - start )) s). Do not edit by hand: run the script again."
+    echo "Columns: the header of bench/vio/rendered_flights.sh; the estimator: docs/vio_estimator.md."
+    echo
+    cat "$OUT/tables.md"
+  } >"$MARKDOWN"
+  echo "results page: $MARKDOWN" >&2
+fi

@@ -77,7 +77,7 @@ struct FeatureTrackerConfig {
   /// ~0.01-0.03 px per image (docs/vio_frontend.md), while on a still camera it does not: old,
   /// far-travelled tracks stop following one scene point, and the estimator, which takes every
   /// observation of a feature as the same point with white noise, turns that into a biased,
-  /// overconfident state. Measured on the rendered demo flight in docs/vio_frontend.md.
+  /// overconfident state (tests RenderedDrift.*).
   double maxTrackTravel = 50.0;  ///< px (0: no limit)
   /// Every tracked position is refined by aligning the track's template (its patch in the
   /// detection image) with the image under an affine warp with gain and bias (affine_patch.hpp):
