@@ -11,6 +11,7 @@
 #include <Eigen/Dense>
 
 #include "gvins/base/constants.hpp"
+#include "gvins/gnss/cycle_slip_detector.hpp"
 #include "gvins/gnss/rtk.hpp"
 #include "gvins/gnss/rtk_combination.hpp"
 #include "gvins/gnss/rtk_pass.hpp"
@@ -203,4 +204,37 @@ TEST(RtkCombined, WeakCasesNoWrongFixAndAtLeastTheForwardFixRate) {
   EXPECT_EQ(wrongCount(cut.combined), 0);
   EXPECT_GT(fixedCount(cut.combined), fixedCount(cut.forward));
   EXPECT_GE(fixedCount(cut.combined), fixedCount(cut.backward));
+}
+
+// Backward slip detection on real rover phases: a loss-of-lock flag at epoch 10 marks a slip
+// between epochs 9 and 10. Forward, epoch 10 starts the new arc; backward (20 down to 0), epoch 9
+// does, and the arcs on either side are whole (no other flag, no gap) in both directions.
+TEST(RtkCombined, BackwardSlipDetectionFlagsTheEpochBeforeTheLossOfLock) {
+  const test::RecordedPair& d = test::nagoyaPair();
+  std::vector<ObsEpoch> rover(d.rover.begin(), d.rover.begin() + 21);
+  const SatId sat = rover[10].sats.front().sat;
+  SignalObs* sig = nullptr;
+  for (SignalObs& s : rover[10].sats.front().signals) {
+    if (s.hasPhase() && !sig) sig = &s;
+  }
+  ASSERT_NE(sig, nullptr);
+  sig->lli |= 1;
+  const ObsCode code = sig->code;
+  for (const TimeDirection dir : {TimeDirection::Forward, TimeDirection::Backward}) {
+    CycleSlipDetector det;
+    det.setDirection(dir);
+    std::vector<int> flagged;
+    for (int k = 0; k < 21; ++k) {
+      const int i = dir == TimeDirection::Forward ? k : 20 - k;
+      det.process(rover[static_cast<std::size_t>(i)], d.roverHeader.glonassChannels);
+      const std::uint8_t f = det.flags(sat, code);
+      if (f & kSlipLli) flagged.push_back(i);
+      if (k > 0) {
+        EXPECT_EQ(f & (kSlipGap | kSlipDoppler | kSlipGeometryFree), 0) << toString(dir) << " " << i;
+      }
+    }
+    ASSERT_EQ(flagged.size(), 1u) << toString(dir);
+    EXPECT_EQ(flagged[0], dir == TimeDirection::Forward ? 10 : 9);
+    EXPECT_EQ(*det.arcStart(sat, code), rover[dir == TimeDirection::Forward ? 10u : 9u].time);
+  }
 }
