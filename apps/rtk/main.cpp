@@ -30,7 +30,9 @@
 #include "gvins/gnss/base_reader.hpp"
 #include "gvins/gnss/pos_writer.hpp"
 #include "gvins/gnss/rtk.hpp"
+#include "gvins/gnss/rtk_combination.hpp"
 #include "gvins/gnss/rtk_config.hpp"
+#include "gvins/gnss/rtk_pass.hpp"
 #include "gvins/gnss/spp_config.hpp"
 
 namespace {
@@ -54,6 +56,8 @@ const char* kUsage =
     "  --mode M              static | kinematic (default kinematic)\n"
     "  --dynamics D          random-walk | constant-velocity (kinematic; default random-walk)\n"
     "  --armode M            off | continuous | instantaneous | fix-and-hold (default continuous)\n"
+    "  -c, --combined        post-processing: forward and backward passes combined per epoch\n"
+    "                        (any --armode; reads all epochs into memory; docs/rtk.md)\n"
     "  --ratio R             ratio-test threshold (default 3)\n"
     "  --validation V        fixed-failure-rate | ratio | success-rate | ratio+success-rate\n"
     "                        (default fixed-failure-rate: the ratio's critical value bounds the\n"
@@ -83,6 +87,7 @@ struct Args {
   std::optional<std::string> mode, dynamics, armode, systems, arSystems, validation;
   std::optional<double> ratio, elmask, maxAge, maxFailureRate;
   std::optional<int> freq;
+  bool combined = false;
   bool noPartial = false, noInterpolation = false, xyz = false, noVelocity = false, strict = false, quiet = false;
   int timeDecimals = 3;
 };
@@ -140,6 +145,8 @@ Args parseArgs(int argc, char** argv) {
       if (*a.ratio < 1.0) usageError("--ratio must be at least 1");
     } else if (o == "--validation") {
       a.validation = value(i, o);
+    } else if (o == "--combined" || o == "-c") {
+      a.combined = true;
     } else if (o == "--no-partial") {
       a.noPartial = true;
     } else if (o == "--systems") {
@@ -340,6 +347,7 @@ int main(int argc, char** argv) {
                 systemsText(cfg.arSystems).c_str(), cfg.ar.ratioThreshold, toString(cfg.ar.validation),
                 cfg.ar.maxFailureRate, cfg.ar.partial ? ", partial" : "");
   popt.headerFields.emplace_back("amb res", buf);
+  if (args.combined) popt.headerFields.emplace_back("solution", "combined (forward + backward)");
   // The base position line is added once known (before the first row is written).
   std::unique_ptr<PosWriter> writer;
 
@@ -379,7 +387,113 @@ int main(int argc, char** argv) {
   long baseEpochs = 0;
   std::optional<Eigen::Vector3d> basePosUsed = args.baseXyz;
 
-  while (haveRover) {
+  // Counts and writes one solution (streamed, or the combined solution of an epoch).
+  auto consume = [&](const RtkSolution& sol) {
+    if (sol.issue != RtkIssue::None) ++issues[sol.issue];
+    if (sol.quality == SolutionQuality::Fix || sol.quality == SolutionQuality::Float) {
+      ++arStatus[sol.ar];
+      if (sol.ar != ArStatus::Off && sol.ar != ArStatus::TooFewAmbiguities && sol.ratio > 0.0) {
+        ratios.add(sol.ratio);
+        ratioMin = std::min(ratioMin, sol.ratio);
+        ratioMax = std::max(ratioMax, sol.ratio);
+        ratioSum += sol.ratio;
+        ++ratioCount;
+      }
+    }
+    switch (sol.quality) {
+      case SolutionQuality::Fix: ++fixed; break;
+      case SolutionQuality::Float: ++floats; break;
+      case SolutionQuality::Single: ++singles; break;
+      default: ++none; break;
+    }
+    if (sol.ar == ArStatus::PartialFixed && sol.quality == SolutionQuality::Fix) ++partial;
+    if (sol.held) ++held;
+    if (sol.valid()) {
+      if (!writer) {
+        if (basePosUsed) {
+          std::snprintf(buf, sizeof buf, "%.4f %.4f %.4f (%s)", (*basePosUsed)[0], (*basePosUsed)[1], (*basePosUsed)[2],
+                        baseSource.c_str());
+          popt.headerFields.emplace_back("ref pos", buf);
+        }
+        writer = std::make_unique<PosWriter>(*out, popt);
+      }
+      writer->write(sol.toPositionSolution());
+      satSum += sol.numSatellites;
+      if (sol.quality != SolutionQuality::Single) ageMax = std::max(ageMax, sol.age);
+      if (fixStats && sol.quality == SolutionQuality::Fix) {
+        fixStats->addPosition(sol.position);
+        if ((sol.position - *args.truth).norm() > kWrongFix) ++wrongFixes;
+      }
+      if (rtkStats && sol.quality != SolutionQuality::Single) rtkStats->addPosition(sol.position);
+    }
+  };
+
+  // Combined mode (post-processing): every rover and base epoch in memory, a forward and a
+  // backward pass, and per epoch the combination of the two (rtk_combination.hpp).
+  std::optional<RtkSolver> backward;
+  CombinationCounts combination;
+  double passSeconds[2] = {0.0, 0.0};
+  if (args.combined) {
+    std::vector<ObsEpoch> rovers, bases;
+    try {
+      while (haveRover) {
+        rovers.push_back(roverEpoch);
+        haveRover = rover->next(roverEpoch);
+      }
+      while (base->next(baseEpoch)) bases.push_back(baseEpoch);
+    } catch (const ParseError& e) {
+      printError(e);
+      exitCode = 1;
+    }
+    baseEpochs = static_cast<long>(bases.size());
+    if (!args.baseXyz) {
+      if (auto p = base->antennaPosition()) {
+        basePosUsed = p;
+        baseSource = base->format() == BaseFormat::Rtcm ? "RTCM 1005/1006" : "RINEX header";
+      }
+    }
+    backward.emplace(nav, cfg, sppCfg);
+    for (RtkSolver* s : {&solver, &*backward}) {
+      s->setRoverGlonassChannels(hdr.glonassChannels);
+      if (hdr.station.approxPosition && hdr.station.approxPosition->norm() > 1e6) {
+        s->setRoverInitialPosition(*hdr.station.approxPosition);
+      }
+      if (basePosUsed) s->setBasePosition(*basePosUsed);
+      s->setBaseGlonassChannels(base->glonassChannels());
+      s->setPhaseAlignment(roverAlignment, base->phaseAlignment());
+    }
+    std::vector<RtkSolution> passes[2];
+    for (int p = 0; p < 2; ++p) {
+      const TimeDirection dir = p == 0 ? TimeDirection::Forward : TimeDirection::Backward;
+      long passFixed = 0;
+      const auto t0 = std::chrono::steady_clock::now();
+      passes[p] = runRtkPass(p == 0 ? solver : *backward, rovers, bases, dir,
+                             [&](std::size_t done, std::size_t total, const RtkSolution& sol) {
+                               if (sol.quality == SolutionQuality::Fix) ++passFixed;
+                               if (args.quiet) return;
+                               const auto now = std::chrono::steady_clock::now();
+                               if (done < total && now - lastProgress < std::chrono::milliseconds(tty ? 200 : 5000)) return;
+                               lastProgress = now;
+                               std::fprintf(stderr, "%s%s pass: %s epoch %zu/%zu fix %ld%s", tty ? "\r" : "", toString(dir),
+                                            sol.time.toString(1).c_str(), done, total, passFixed, tty ? "   " : "\n");
+                               std::fflush(stderr);
+                             });
+      passSeconds[p] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      if (!args.quiet && tty) std::fputc('\n', stderr);
+    }
+    showDopplerWarnings(solver.roverDoppler(), roverWarned);
+    showDopplerWarnings(solver.base().doppler(), baseWarned);
+    for (std::size_t i = 0; i < rovers.size(); ++i) {
+      Combination how;
+      const RtkSolution sol = combineSolutions(passes[0][i], passes[1][i], CombinationOptions{}, &how);
+      combination.add(passes[0][i], passes[1][i], how);
+      ++epochs;
+      if (!first) first = rovers[i].time;
+      consume(sol);
+    }
+  }
+
+  while (!args.combined && haveRover) {
     ++epochs;
     if (!first) first = roverEpoch.time;
     // Feed base epochs up to the rover time and the first one after it (for interpolation),
@@ -424,43 +538,7 @@ int main(int argc, char** argv) {
     const RtkSolution sol = solver.process(roverEpoch);
     showDopplerWarnings(solver.roverDoppler(), roverWarned);
     showDopplerWarnings(solver.base().doppler(), baseWarned);
-    if (sol.issue != RtkIssue::None) ++issues[sol.issue];
-    if (sol.quality == SolutionQuality::Fix || sol.quality == SolutionQuality::Float) {
-      ++arStatus[sol.ar];
-      if (sol.ar != ArStatus::Off && sol.ar != ArStatus::TooFewAmbiguities && sol.ratio > 0.0) {
-        ratios.add(sol.ratio);
-        ratioMin = std::min(ratioMin, sol.ratio);
-        ratioMax = std::max(ratioMax, sol.ratio);
-        ratioSum += sol.ratio;
-        ++ratioCount;
-      }
-    }
-    switch (sol.quality) {
-      case SolutionQuality::Fix: ++fixed; break;
-      case SolutionQuality::Float: ++floats; break;
-      case SolutionQuality::Single: ++singles; break;
-      default: ++none; break;
-    }
-    if (sol.ar == ArStatus::PartialFixed && sol.quality == SolutionQuality::Fix) ++partial;
-    if (sol.held) ++held;
-    if (sol.valid()) {
-      if (!writer) {
-        if (basePosUsed) {
-          std::snprintf(buf, sizeof buf, "%.4f %.4f %.4f (%s)", (*basePosUsed)[0], (*basePosUsed)[1], (*basePosUsed)[2],
-                        baseSource.c_str());
-          popt.headerFields.emplace_back("ref pos", buf);
-        }
-        writer = std::make_unique<PosWriter>(*out, popt);
-      }
-      writer->write(sol.toPositionSolution());
-      satSum += sol.numSatellites;
-      if (sol.quality != SolutionQuality::Single) ageMax = std::max(ageMax, sol.age);
-      if (fixStats && sol.quality == SolutionQuality::Fix) {
-        fixStats->addPosition(sol.position);
-        if ((sol.position - *args.truth).norm() > kWrongFix) ++wrongFixes;
-      }
-      if (rtkStats && sol.quality != SolutionQuality::Single) rtkStats->addPosition(sol.position);
-    }
+    consume(sol);
     if (!args.quiet) {
       const auto now = std::chrono::steady_clock::now();
       if (now - lastProgress > std::chrono::milliseconds(tty ? 200 : 5000)) {
@@ -525,6 +603,17 @@ int main(int argc, char** argv) {
   }
   std::fprintf(stderr, "  mean satellites        %8.1f   max age %.1f s\n", solved ? satSum / solved : 0.0, ageMax);
   if (held) std::fprintf(stderr, "  fix-and-hold updates   %8ld\n", held);
+  if (args.combined) {
+    const CombinationCounts& k = combination;
+    std::fprintf(stderr, "  combined               forward %lld fixed (%.1f s), backward %lld fixed (%.1f s)\n",
+                 static_cast<long long>(k.forwardFixed), passSeconds[0], static_cast<long long>(k.backwardFixed),
+                 passSeconds[1]);
+    std::fprintf(stderr, "  combined fixes         %8lld  (%lld both, %lld forward only, %lld backward only)\n",
+                 static_cast<long long>(k.combinedFixed), static_cast<long long>(k.bothFixed),
+                 static_cast<long long>(k.forwardOnlyFixed), static_cast<long long>(k.backwardOnlyFixed));
+    std::fprintf(stderr, "  combined to float      %8lld disagreements (both fixed), %lld fixes inconsistent with the other float\n",
+                 static_cast<long long>(k.disagreements), static_cast<long long>(k.fixRejected));
+  }
   for (const auto& [i, n] : issues) std::fprintf(stderr, "  no RTK: %-30s %6ld\n", toString(i), n);
   for (const auto& [s, n] : arStatus) {
     if (s != ArStatus::Fixed && s != ArStatus::PartialFixed) std::fprintf(stderr, "  AR: %-34s %6ld\n", toString(s), n);

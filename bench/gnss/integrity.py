@@ -19,7 +19,9 @@ Doppler sign flipped in a copy, the base's codes rewritten to other tracking mod
 Simulated flights (gvins-sim, bench/gnss/harsh_flight.yaml): NLOS, blockages and slips on the
 rover, base 5 and 10 km away, seeds 1..N (4); truth: the simulated antenna track.
 AR modes: continuous, instantaneous, fix-and-hold, each with and without partial AR (RTKLIB
-2.4.3 has no partial AR: its figures stand in both rows).
+2.4.3 has no partial AR: its figures stand in both rows), and each again as the combined
+forward + backward post-processing solution (mode "... +c": gvins-rtk --combined beside
+rnx2rtkp -c).
 
 A wrong fix is a fixed epoch (Q=1) more than 0.10 m (3-D) from the truth. The fix rate is the
 share of rover epochs written with Q=1. Prints progress on stderr and a summary table on stdout
@@ -31,7 +33,12 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 WRONG_M = 0.10
 SYS_BITS = {'G': 1, 'R': 4, 'E': 8, 'J': 16, 'C': 32}
 EXTRA = []  # --ours-args: further gvins-rtk options (experiments)
-MODES = ['continuous', 'instantaneous', 'fix-and-hold']
+MODES = ['continuous', 'instantaneous', 'fix-and-hold', 'continuous+c', 'instantaneous+c', 'fix-and-hold+c']
+
+
+def split_mode(mode):
+    """AR mode and whether the combined (forward + backward) solution is asked for ('+c')."""
+    return (mode[:-2], True) if mode.endswith('+c') else (mode, False)
 
 
 def opt(args, name, default):
@@ -181,11 +188,14 @@ def count_epochs(path):
 # --- The two tools.
 
 def run_ours(build, rover, base, base_xyz, navs, out, mode, partial, freq, mask, systems):
+    mode, combined = split_mode(mode)
     cmd = [os.path.join(build, 'bin', 'gvins-rtk'), '-q', '--xyz', '--armode', mode, '--freq', str(freq),
            '--elmask', str(mask), '--systems', systems, '--base-xyz', ','.join('%.4f' % v for v in base_xyz), '--ar-systems', systems.replace('R', '') or 'G',
            '-o', out, rover, base] + navs
     if not partial:
         cmd.insert(1, '--no-partial')
+    if combined:
+        cmd.insert(1, '--combined')
     cmd[1:1] = EXTRA
     r = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     if r.returncode not in (0, 3):
@@ -194,11 +204,13 @@ def run_ours(build, rover, base, base_xyz, navs, out, mode, partial, freq, mask,
 
 
 def run_rtklib(conf_template, rover, base, base_xyz, navs, out, mode, freq, mask, systems, tmp):
+    mode, combined = split_mode(mode)
     lines = open(conf_template).read().splitlines()
     bits = sum(SYS_BITS[s] for s in systems)
     set_ = {'pos1-posmode': 'kinematic', 'pos2-armode': mode, 'pos1-elmask': str(mask),
             'pos2-arelmask': str(mask), 'pos1-navsys': str(bits), 'out-solformat': 'xyz',
-            'pos1-frequency': {1: 'l1', 2: 'l1+2', 3: 'l1+2+5'}[freq]}
+            'pos1-frequency': {1: 'l1', 2: 'l1+2', 3: 'l1+2+5'}[freq],
+            'pos1-soltype': 'combined' if combined else 'forward'}
     out_lines, seen = [], set()
     for l in lines:
         k = l.split('=')[0].strip()
@@ -212,7 +224,7 @@ def run_rtklib(conf_template, rover, base, base_xyz, navs, out, mode, freq, mask
     conf = os.path.join(tmp, 'rtklib.conf')
     with open(conf, 'w') as f:
         f.write('\n'.join(out_lines) + '\n')
-    r = subprocess.run(['rnx2rtkp', '-k', conf, '-r'] + ['%.4f' % v for v in base_xyz] + ['-o', out, rover, base] + navs, stdout=subprocess.DEVNULL,
+    r = subprocess.run(['rnx2rtkp', '-k', conf] + (['-c'] if combined else []) + ['-r'] + ['%.4f' % v for v in base_xyz] + ['-o', out, rover, base] + navs, stdout=subprocess.DEVNULL,
                        stderr=subprocess.DEVNULL)
     return r.returncode
 
@@ -391,7 +403,7 @@ def main(args):
                     fixed = wrong = 0
                     worst = 0.0
                     for i, r in enumerate(rovers):
-                        out = os.path.join(tmp, 'ours_%s_%d_%d.pos' % (mode, partial, i))
+                        out = os.path.join(tmp, 'ours_%s_%d_%d.pos' % (mode.replace('+', '_'), partial, i))
                         run_ours(build, r, base, ds['base_xyz'], ds['navs'], out, mode, partial, freq, mask, systems)
                         f, w, m = score(out, ds['truth'])
                         fixed, wrong, worst = fixed + f, wrong + w, max(worst, m)
@@ -401,7 +413,7 @@ def main(args):
                     fixed = wrong = 0
                     worst = 0.0
                     for i, r in enumerate(rovers):
-                        out = os.path.join(tmp, 'rtklib_%s_%d.pos' % (mode, i))
+                        out = os.path.join(tmp, 'rtklib_%s_%d.pos' % (mode.replace('+', '_'), i))
                         run_rtklib(conf, r, base, ds['base_xyz'], ds['navs'], out, mode, freq, mask, systems, tmp)
                         f, w, m = score(out, ds['truth'])
                         fixed, wrong, worst = fixed + f, wrong + w, max(worst, m)
@@ -445,7 +457,9 @@ def main(args):
                     'truth, stressed variants, simulated flights). A wrong fix is a fixed epoch more than %.2f m '
                     '(3-D) from the truth; fix %% is of all rover epochs. "no-PAR": `--no-partial`. RTKLIB '
                     '(rnx2rtkp, same elevation mask, frequencies, systems and AR mode, ratio 3) has no partial '
-                    'fixing. Model of the fix: docs/rtk.md, "Integrity of the fix".\n\n' % WRONG_M)
+                    'fixing. AR mode "... +c": the combined forward + backward solution (`gvins-rtk --combined`, '
+                    '`rnx2rtkp -c`; docs/rtk.md, "Combined forward + backward solution"). Model of the fix: '
+                    'docs/rtk.md, "Integrity of the fix".\n\n' % WRONG_M)
             f.write('| ' + ' | '.join(head) + ' |\n|' + '---|' * len(head) + '\n')
             for r in table:
                 f.write('| ' + ' | '.join(r) + ' |\n')

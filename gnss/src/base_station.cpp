@@ -70,13 +70,21 @@ std::optional<GpsTime> BaseStation::latestTime() const {
   return epochs_.back().time;
 }
 
+void BaseStation::setDirection(TimeDirection d) {
+  if (d == direction_) return;
+  direction_ = d;
+  clear();
+  slips_.setDirection(d);
+  doppler_.setDirection(d);
+}
+
 void BaseStation::clear() {
   epochs_.clear();
   slips_.reset();
 }
 
 void BaseStation::addEpoch(const ObsEpoch& epoch) {
-  if (!epochs_.empty() && !(epoch.time - epochs_.back().time > 1e-6)) {
+  if (!epochs_.empty() && !(elapsed(direction_, epoch.time, epochs_.back().time) > 1e-6)) {
     ++stats_.outOfOrder;
     return;
   }
@@ -93,7 +101,7 @@ void BaseStation::addEpoch(const ObsEpoch& epoch) {
   // held up to maxAge older, and the rate window of extrapolation up to maxInterpolationGap before
   // that; at least two epochs, at most kMaxEpochs.
   const double keep = config_.maxAge + config_.maxInterpolationGap + 1.0;
-  while (epochs_.size() > 2 && epochs_.back().time - epochs_[1].time > keep) epochs_.pop_front();
+  while (epochs_.size() > 2 && elapsed(direction_, epochs_.back().time, epochs_[1].time) > keep) epochs_.pop_front();
   while (epochs_.size() > kMaxEpochs) epochs_.pop_front();
   // Record slip flags and arcs now: the detector only knows the latest epoch.
   Epoch& last = epochs_.back();
@@ -181,10 +189,11 @@ BaseAvailability BaseStation::snapshot(const GpsTime& t, BaseSnapshot& out) {
   out.extrapolated = false;
   if (!position_) return BaseAvailability::NoPosition;
   if (epochs_.empty()) return BaseAvailability::NoData;
-  // eB: newest epoch not after t (within the sync tolerance); eA: the one after it.
+  // eB: newest epoch not after t (within the sync tolerance); eA: the one after it (in
+  // processing order).
   int b = -1;
   for (int k = static_cast<int>(epochs_.size()) - 1; k >= 0; --k) {
-    if (epochs_[static_cast<std::size_t>(k)].time - t <= kSyncTolerance) {
+    if (elapsed(direction_, epochs_[static_cast<std::size_t>(k)].time, t) <= kSyncTolerance) {
       b = k;
       break;
     }
@@ -193,7 +202,7 @@ BaseAvailability BaseStation::snapshot(const GpsTime& t, BaseSnapshot& out) {
   if (b < 0) return BaseAvailability::NoData;
   Epoch& eb = epochs_[static_cast<std::size_t>(b)];
   model(eb);
-  const double ageB = t - eb.time;
+  const double ageB = elapsed(direction_, t, eb.time);
   if (std::abs(ageB) <= kSyncTolerance) {
     out.time = eb.time;
     out.age = ageB;
@@ -202,12 +211,12 @@ BaseAvailability BaseStation::snapshot(const GpsTime& t, BaseSnapshot& out) {
   }
   if (config_.interpolateBase && a >= 0) {
     Epoch& ea = epochs_[static_cast<std::size_t>(a)];
-    const double gap = ea.time - eb.time;
+    const double gap = elapsed(direction_, ea.time, eb.time);
     if (gap <= config_.maxInterpolationGap && gap > 0.0) {
       model(ea);
-      const double w = (t - eb.time) / gap;
+      const double w = ageB / gap;
       out.time = t;
-      out.age = std::min(ageB, ea.time - t);
+      out.age = std::min(ageB, elapsed(direction_, ea.time, t));
       out.interpolated = true;
       std::size_t j = 0;
       for (const BaseSignal& s0 : eb.signals) {
@@ -245,8 +254,9 @@ void BaseStation::extrapolate(int b, const GpsTime& t, BaseSnapshot& out) {
   // they span at least kMinRateSpan seconds (shorter spans make the rate noise, multiplied by the
   // age, larger than the effect).
   int first = b;
-  while (first > 0 && eb.time - epochs_[static_cast<std::size_t>(first - 1)].time <= config_.maxInterpolationGap) --first;
-  if (eb.time - epochs_[static_cast<std::size_t>(first)].time < kMinRateSpan) return;
+  while (first > 0 && elapsed(direction_, eb.time, epochs_[static_cast<std::size_t>(first - 1)].time) <= config_.maxInterpolationGap)
+    --first;
+  if (elapsed(direction_, eb.time, epochs_[static_cast<std::size_t>(first)].time) < kMinRateSpan) return;
   const GpsTime firstTime = epochs_[static_cast<std::size_t>(first)].time;
   if (!eb.ratesValid || !(eb.ratesFirst == firstTime) || eb.ratesCount != b - first) {
     for (int k = first; k < b; ++k) model(epochs_[static_cast<std::size_t>(k)]);
@@ -262,7 +272,7 @@ void BaseStation::extrapolate(int b, const GpsTime& t, BaseSnapshot& out) {
     std::vector<Sums> sums(eb.signals.size());
     for (int k = first; k < b; ++k) {
       const Epoch& e = epochs_[static_cast<std::size_t>(k)];
-      const double x = e.time - eb.time;
+      const double x = elapsed(direction_, e.time, eb.time);  // rates per second of processing order
       std::size_t j = 0;
       for (std::size_t i = 0; i < eb.signals.size(); ++i) {
         const BaseSignal& s1 = eb.signals[i];
@@ -301,7 +311,7 @@ void BaseStation::extrapolate(int b, const GpsTime& t, BaseSnapshot& out) {
     eb.ratesCount = b - first;
   }
   if (!eb.ratesUsable || eb.rates.size() != out.signals.size()) return;
-  const double age = t - eb.time;
+  const double age = elapsed(direction_, t, eb.time);
   for (std::size_t i = 0; i < out.signals.size(); ++i) {
     if (std::isfinite(eb.rates[i])) out.signals[i].phaseOmc += eb.rates[i] * age;
   }

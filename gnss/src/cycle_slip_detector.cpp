@@ -43,6 +43,11 @@ void CycleSlipDetector::reset() {
   for (auto& v : tracks_) v.clear();
 }
 
+void CycleSlipDetector::setDirection(TimeDirection d) {
+  direction_ = d;
+  reset();
+}
+
 void CycleSlipDetector::restart(SatId sat, ObsCode code) {
   if (!sat.valid()) return;
   if (Track* t = find(sat, code)) {
@@ -80,15 +85,24 @@ void CycleSlipDetector::process(const ObsEpoch& epoch, const GlonassChannels& ch
       if (!tr->valid) {
         f |= kSlipNewArc;
       } else {
-        const double dt = t - tr->last;
-        if (!(dt > 0.0) || dt > options_.maxGap) {
+        const double dt = t - tr->last;  // signed: negative backward
+        const double gap = elapsed(direction_, t, tr->last);
+        if (!(gap > 0.0) || gap > options_.maxGap) {
           f |= kSlipGap;
         } else if (options_.doppler && lam && s.hasDoppler() && tr->hasDoppler) {
           const double predicted = -0.5 * (tr->doppler + s.doppler) * dt;  // cycles
           dres = *lam * ((s.carrierPhase - tr->phase) - predicted);
         }
       }
-      if (options_.useLli && s.lossOfLock()) f |= kSlipLli;
+      if (options_.useLli) {
+        // Backward, the flagged epoch's slip lies between it and the epoch processed next.
+        if (direction_ == TimeDirection::Forward) {
+          if (s.lossOfLock()) f |= kSlipLli;
+        } else {
+          if (tr->valid && tr->lliPending) f |= kSlipLli;
+          tr->lliPending = s.lossOfLock();
+        }
+      }
       if (s.halfCycle()) f |= kSlipHalfCycle;
       tr->flags = f;
       tr->flagsTime = t;
@@ -115,7 +129,7 @@ void CycleSlipDetector::process(const ObsEpoch& epoch, const GlonassChannels& ch
         const bool comparable = options_.geometryFree && !refNew && tr->hasGf && tr->gfRef == rt->code &&
                                 (tr->flags & (kSlipNewArc | kSlipGap)) == 0;
         if (comparable) {
-          const double dt = t - tr->last;
+          const double dt = elapsed(direction_, t, tr->last);
           if (std::abs(gf - tr->gf) > options_.geometryFreeThreshold + options_.geometryFreeRate * dt) {
             tr->flags |= kSlipGeometryFree;
             rt->flags |= kSlipGeometryFree;
@@ -138,7 +152,7 @@ void CycleSlipDetector::process(const ObsEpoch& epoch, const GlonassChannels& ch
     const double median = work_[mid];
     for (Pending& p : pending_) {
       if (!std::isfinite(p.dopplerResidual)) continue;
-      const double dt = t - p.track->last;
+      const double dt = elapsed(direction_, t, p.track->last);
       const double thr = options_.dopplerThreshold + options_.dopplerJerk * dt * dt * dt / 12.0;
       if (std::abs(p.dopplerResidual - median) > thr) p.track->flags |= kSlipDoppler;
     }

@@ -54,7 +54,7 @@ DopplerVerdict DopplerConsistency::verdict(System sys, ObsCode code) const {
 
 void DopplerConsistency::apply(ObsEpoch& epoch, const GlonassChannels& channels) {
   if (!options_.enabled) return;
-  const bool fresh = !lastEpoch_ || epoch.time - *lastEpoch_ > 1e-6;
+  const bool fresh = !lastEpoch_ || elapsed(direction_, epoch.time, *lastEpoch_) > 1e-6;
   if (fresh) {
     ++counts_.epochs;
     sample(epoch, channels);
@@ -100,19 +100,23 @@ void DopplerConsistency::sample(const ObsEpoch& epoch, const GlonassChannels& ch
       SignalState& st = state(so.sat.system, s.code);
       const auto lam = carrierWavelength(so.sat.system, s.code.band, channel);
       if (tr && lam && st.report.verdict == DopplerVerdict::Pending) {
+        // dt signed (rates are the same both ways), span in processing order.
         const double dt = t - tr->time;
-        if (dt > 0.0 && dt <= options_.maxGap) {
+        const double span = elapsed(direction_, t, tr->time);
+        // The interval's loss of lock is flagged at its later epoch.
+        const bool lockLost = direction_ == TimeDirection::Forward ? s.lossOfLock() : tr->lossOfLock;
+        if (span > 0.0 && span <= options_.maxGap) {
           const double vd = -*lam * 0.5 * (tr->doppler + s.doppler);  // m/s, Doppler range rate
           double vl = 0.0, tol = 0.0;
           bool ok = false;
-          if (hasPhase && tr->hasPhase && !s.lossOfLock()) {
+          if (hasPhase && tr->hasPhase && !lockLost) {
             vl = *lam * (s.carrierPhase - tr->phase) / dt;
             tol = options_.phaseTolerance + options_.dopplerJerk * dt * dt / 12.0;
             ok = true;
           } else if (!hasPhase && hasCode && tr->hasCode) {
             // Signals without phase only: a phase-less interval of a phase signal is a slip.
             vl = (s.pseudorange - tr->pseudorange) / dt;
-            tol = 2.0 * std::sqrt(2.0) * options_.codeSigma / dt + options_.phaseTolerance +
+            tol = 2.0 * std::sqrt(2.0) * options_.codeSigma / span + options_.phaseTolerance +
                   options_.dopplerJerk * dt * dt / 12.0;
             ok = true;
           }
@@ -140,6 +144,7 @@ void DopplerConsistency::sample(const ObsEpoch& epoch, const GlonassChannels& ch
       tr->phase = s.carrierPhase;
       tr->pseudorange = s.pseudorange;
       tr->doppler = s.doppler;
+      tr->lossOfLock = s.lossOfLock();
     }
   }
   for (SignalState* s : touched) decide(*s);

@@ -91,6 +91,15 @@ void RtkSolver::setPhaseAlignment(const PhaseAlignments& rover, const PhaseAlign
 
 void RtkSolver::setRoverInitialPosition(const Eigen::Vector3d& ecef) { spp_.setInitialPosition(ecef); }
 
+void RtkSolver::setTimeDirection(TimeDirection d) {
+  direction_ = d;
+  base_.setDirection(d);
+  roverSlips_.setDirection(d);
+  roverDoppler_.setDirection(d);
+  slipEpoch_.reset();
+  reset();
+}
+
 void RtkSolver::addBaseEpoch(const ObsEpoch& epoch) { base_.addEpoch(epoch); }
 
 void RtkSolver::reset() {
@@ -132,7 +141,9 @@ void RtkSolver::initialize(const Eigen::Vector3d& x, double sigma, const SppSolu
 }
 
 void RtkSolver::timeUpdate(double dt, const SppSolution& spp) {
+  // dt: signed (negative backward); the process noise grows with the elapsed |dt| either way.
   if (cfg_.mode == RtkMode::Static) return;
+  const double adt = std::abs(dt);
   const Eigen::Vector3d x = positionEstimate();
   const std::optional<Eigen::Vector3d> v =
       spp.velocity.valid ? std::optional<Eigen::Vector3d>(spp.velocity.velocity) : std::nullopt;
@@ -142,10 +153,10 @@ void RtkSolver::timeUpdate(double dt, const SppSolution& spp) {
     if (cfg_.dopplerAided && v) {
       // Trapezoid of the Doppler velocities at both ends of the interval.
       delta = lastVelocity_ ? Eigen::Vector3d(0.5 * (*lastVelocity_ + *v) * dt) : Eigen::Vector3d(*v * dt);
-      Q = cfg_.dopplerAidedSigma * cfg_.dopplerAidedSigma * dt * Eigen::Matrix3d::Identity() +
+      Q = cfg_.dopplerAidedSigma * cfg_.dopplerAidedSigma * adt * Eigen::Matrix3d::Identity() +
           dt * dt * spp.velocity.covariance;
     } else {
-      Q = cfg_.randomWalkSigma * cfg_.randomWalkSigma * dt * Eigen::Matrix3d::Identity();
+      Q = cfg_.randomWalkSigma * cfg_.randomWalkSigma * adt * Eigen::Matrix3d::Identity();
     }
     Q += 1e-10 * Eigen::Matrix3d::Identity();
     sri::Propagation<double> p;
@@ -162,7 +173,9 @@ void RtkSolver::timeUpdate(double dt, const SppSolution& spp) {
     q = q.cwiseProduct(q);
     const Eigen::Matrix3d Qa = Ren.transpose() * q.asDiagonal() * Ren + 1e-8 * Eigen::Matrix3d::Identity();
     Eigen::MatrixXd Q(6, 6);
-    Q << dt * dt * dt / 3.0 * Qa, dt * dt / 2.0 * Qa, dt * dt / 2.0 * Qa, dt * Qa;
+    // Integrated white acceleration over the interval; backward the position and velocity noises
+    // are anti-correlated (cross term dt·|dt|/2).
+    Q << adt * adt * adt / 3.0 * Qa, dt * adt / 2.0 * Qa, dt * adt / 2.0 * Qa, adt * Qa;
     Eigen::MatrixXd phiP = Eigen::MatrixXd::Zero(6, 3), phiV = Eigen::MatrixXd::Zero(6, 3);
     phiP.topRows(3).setIdentity();
     phiV.topRows(3) = dt * Eigen::Matrix3d::Identity();
@@ -247,7 +260,7 @@ void RtkSolver::manageAmbiguities(const Eigen::Vector3d& x0, RtkSolution& sol) {
   // Ambiguities of satellites gone for too long.
   std::vector<std::uint32_t> stale;
   for (const auto& [k, a] : amb_) {
-    if (dd_.time - a.lastSeen > cfg_.ambiguityOutage) stale.push_back(k);
+    if (elapsed(direction_, dd_.time, a.lastSeen) > cfg_.ambiguityOutage) stale.push_back(k);
   }
   for (std::uint32_t k : stale) {
     dropAmbiguity(k);
@@ -515,8 +528,7 @@ RtkSolution RtkSolver::processEpoch(const ObsEpoch& rover, TransmitStates* state
     else initialize(basePos, std::max(cfg_.initialPositionSigma, 1e4), spp);
     lastTime_ = rover.time;
   } else {
-    const double dt = rover.time - lastTime_;
-    if (dt > 0.0) timeUpdate(dt, spp);
+    if (elapsed(direction_, rover.time, lastTime_) > 0.0) timeUpdate(rover.time - lastTime_, spp);
     lastTime_ = rover.time;
   }
   if (spp.velocity.valid) lastVelocity_ = spp.velocity.velocity;

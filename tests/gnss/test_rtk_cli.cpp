@@ -95,6 +95,35 @@ TEST(RtkCli, GeonetStaticMatchesRtklib) {
   std::filesystem::remove(out);
 }
 
+// Combined mode on GEONET, GPS L1 only, kinematic: the backward pass fixes the first epochs the
+// forward pass spends converging. Rows in increasing time, one per epoch as forward; no fixed
+// epoch more than 0.10 m from RTKLIB's static solution; more fixes than the forward run.
+TEST(RtkCli, CombinedGeonetL1FixesMoreThanForwardAndNoneWrong) {
+  const std::string fwd = tmp("gf.pos"), comb = tmp("gc.pos");
+  const std::string inputs = " --systems G --freq 1 --xyz " + kGeonet + "07590920.05o.gz " + kGeonet + "30400920.05o.gz " +
+                             kGeonet + "30400920.05n.gz";
+  const CliRun f = run("-q -o " + fwd + inputs);
+  const CliRun c = run("--combined -o " + comb + inputs);
+  ASSERT_EQ(f.code, 0) << f.err;
+  ASSERT_EQ(c.code, 0) << c.err;
+  EXPECT_NE(c.err.find("backward pass:"), std::string::npos) << c.err;
+  EXPECT_NE(c.err.find("combined fixes"), std::string::npos) << c.err;
+  EXPECT_NE(c.err.find("0 disagreements (both fixed)"), std::string::npos) << c.err;
+  const PosFile a = readPosFile(fwd), b = readPosFile(comb);
+  ASSERT_EQ(a.solutions.size(), 120u);
+  ASSERT_EQ(b.solutions.size(), 120u);
+  const Eigen::Vector3d truth = readPosFile(kData + "/reference/rtklib-2.4.3/geonet_0759_rtk_static.pos").solutions.back().position;
+  for (std::size_t i = 0; i < b.solutions.size(); ++i) {
+    EXPECT_NEAR(b.solutions[i].time - a.solutions[i].time, 0.0, 1e-6) << i;
+    if (b.solutions[i].quality == SolutionQuality::Fix) {
+      EXPECT_LT((b.solutions[i].position - truth).norm(), 0.10) << i;
+    }
+  }
+  EXPECT_GT(countQ(b, SolutionQuality::Fix), countQ(a, SolutionQuality::Fix));
+  std::filesystem::remove(fwd);
+  std::filesystem::remove(comb);
+}
+
 // Base epochs 30..59 missing (15 minutes at 30 s): beyond max age the tool writes single-point rows
 // and says why; the rover's last epochs after the gap are fixed again.
 TEST(RtkCli, DoctoredBaseDegradesWithCountedReasons) {

@@ -23,6 +23,10 @@
 //     out keeps extrapolated and merely held signals consistent. Codes are held (their noise
 //     dwarfs the effect).
 //
+// Backward processing (setDirection, the backward pass of post-processing): "earlier", "newest",
+// ages and gaps are taken in processing order (time_direction.hpp), so a held epoch is the
+// nearest later one in time and extrapolation uses the rates of the epochs after it.
+//
 // Cycle slips of the base are detected here (its own CycleSlipDetector); every signal carries the
 // start of its continuous arc so that the rover side can tell when its single-difference
 // ambiguity must be reset.
@@ -41,6 +45,7 @@
 #include "gvins/gnss/cycle_slip_detector.hpp"
 #include "gvins/gnss/doppler_consistency.hpp"
 #include "gvins/gnss/rtk_config.hpp"
+#include "gvins/gnss/time_direction.hpp"
 
 namespace gvins {
 
@@ -81,7 +86,7 @@ const char* toString(BaseAvailability a);
 
 struct BaseStationStats {
   std::int64_t epochs = 0;          ///< base epochs added
-  std::int64_t outOfOrder = 0;      ///< dropped: not later than the previous one
+  std::int64_t outOfOrder = 0;      ///< dropped: not after the previous one in processing order
   std::int64_t noEphemeris = 0;     ///< satellite-epochs without a usable ephemeris
   std::int64_t positionChanges = 0; ///< base position changed (buffer cleared)
 };
@@ -105,11 +110,15 @@ class BaseStation {
   /// GLONASS FDMA channels of the base (RINEX header, RTCM 1020/MSM); the navigation data fill gaps.
   void setGlonassChannels(const GlonassChannels& channels);
 
-  /// Adds a base epoch; epochs must come in increasing time (others are dropped and counted).
+  /// Order of the epochs (default forward); changing it clears the buffer and the slip history.
+  void setDirection(TimeDirection d);
+  TimeDirection direction() const { return direction_; }
+  /// Adds a base epoch; epochs must come in increasing time, or decreasing when the direction is
+  /// backward (others are dropped and counted).
   void addEpoch(const ObsEpoch& epoch);
   /// Aligns the buffered base data to a rover time (see the file comment).
   BaseAvailability snapshot(const GpsTime& roverTime, BaseSnapshot& out);
-  /// Time of the newest base epoch, if any.
+  /// Time of the newest base epoch (the last added), if any.
   std::optional<GpsTime> latestTime() const;
   /// Drops all buffered epochs and slip history.
   void clear();
@@ -141,6 +150,7 @@ class BaseStation {
   const EphemerisStore& nav_;
   RtkConfig config_;
   std::optional<Eigen::Vector3d> position_;
+  TimeDirection direction_ = TimeDirection::Forward;
   GlonassChannels channels_;
   CycleSlipDetector slips_;
   DopplerConsistency doppler_{"base"};

@@ -14,6 +14,10 @@
 //     receiver clock jump/drift change in common to all signals, which is removed with the median
 //     of the epoch; a remainder above `dopplerThreshold` + `dopplerJerk`·Δt³/12 (the trapezoid
 //     error of a range with that third derivative) is a slip.
+// Epochs may come backward in time (setDirection): gaps and allowances then use the elapsed time
+// in processing order, the Doppler prediction the signed time difference, and a loss-of-lock
+// indicator, which marks a slip between the flagged epoch and the one before it in time, flags the
+// next epoch processed (the one before it in time) instead of its own.
 // A half-cycle flag (LLI bit 1) is reported separately: such a phase may still be used, but its
 // ambiguity must not be fixed to an integer.
 #pragma once
@@ -24,6 +28,7 @@
 #include <vector>
 
 #include "gvins/base/observation.hpp"
+#include "gvins/gnss/time_direction.hpp"
 
 namespace gvins {
 
@@ -66,7 +71,12 @@ class CycleSlipDetector {
  public:
   explicit CycleSlipDetector(CycleSlipOptions options = {});
 
-  /// Tests every phase signal of the epoch (epochs in increasing time). GLONASS wavelengths need
+  /// Order of the epochs given to process() (default forward); set before the first epoch (it
+  /// forgets the history).
+  void setDirection(TimeDirection d);
+  TimeDirection direction() const { return direction_; }
+  /// Tests every phase signal of the epoch (epochs in increasing time, or decreasing when the
+  /// direction is backward). GLONASS wavelengths need
   /// the FDMA channels; GLONASS signals without a channel are only checked by LLI and gaps.
   void process(const ObsEpoch& epoch, const GlonassChannels& channels = {});
   /// Flags of a signal in the last processed epoch (kSlipNone if it was not in that epoch).
@@ -94,6 +104,7 @@ class CycleSlipDetector {
     ObsCode gfRef;
     bool hasGf = false;
     std::uint8_t flags = 0;
+    bool lliPending = false;  // backward: the last epoch's loss of lock, for the next one processed
     GpsTime flagsTime;
     GpsTime arcStart;
   };
@@ -101,6 +112,7 @@ class CycleSlipDetector {
   const Track* find(SatId sat, ObsCode code) const;
 
   CycleSlipOptions options_;
+  TimeDirection direction_ = TimeDirection::Forward;
   std::vector<std::vector<Track>> tracks_;  // by satIndex
   CycleSlipCounts counts_;
   GpsTime lastEpoch_;

@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "gvins/base/observation.hpp"
+#include "gvins/gnss/time_direction.hpp"
 
 namespace gvins {
 
@@ -90,7 +91,11 @@ class DopplerConsistency {
   /// `label` names the receiver in warnings ("rover", "base", a station name).
   explicit DopplerConsistency(std::string label = "rover", DopplerConsistencyOptions options = {});
 
-  /// Takes one epoch of the stream (increasing time; an epoch with the time of the previous one
+  /// Order of the epochs given to apply() (default forward). Backward, intervals are measured in
+  /// processing order, rates with the signed time difference, and the loss of lock of the epoch
+  /// processed before (later in time) breaks the interval. Set before the first epoch.
+  void setDirection(TimeDirection d) { direction_ = d; }
+  /// Takes one epoch of the stream (increasing time, or decreasing backward; an epoch with the time of the previous one
   /// is only corrected again, not sampled twice) and corrects it in place: Dopplers of
   /// consistent signals pass, flipped ones are negated, others are removed (present bit cleared,
   /// value zero). GLONASS FDMA wavelengths use the channels when known (channel 0 otherwise:
@@ -133,6 +138,7 @@ class DopplerConsistency {
     GpsTime time;
     bool hasPhase = false, hasCode = false;
     double phase = 0.0, pseudorange = 0.0, doppler = 0.0;
+    bool lossOfLock = false;
   };
   SignalState& state(System sys, ObsCode code);
   void sample(const ObsEpoch& epoch, const GlonassChannels& channels);
@@ -145,6 +151,7 @@ class DopplerConsistency {
   std::vector<std::vector<Track>> tracks_;    // by satIndex
   std::vector<std::string> warnings_;
   std::optional<GpsTime> lastEpoch_;
+  TimeDirection direction_ = TimeDirection::Forward;
   DopplerConsistencyCounts counts_;
 };
 

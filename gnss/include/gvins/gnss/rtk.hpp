@@ -23,6 +23,11 @@
 //      waits for the next epoch's fix of the same integers. In fix-and-hold mode only such
 //      validated, confirmed fixes are fed back as constraints.
 //
+// Epochs may be processed backward in time (setTimeDirection: the backward pass of the combined
+// forward + backward post-processing solution, rtk_combination.hpp): base buffer, slip detectors,
+// Doppler checks, ambiguity outages and the process noise of the time update then measure time in
+// processing order (time_direction.hpp); the dynamics models are the same in reverse time.
+//
 // The float state is [SD ambiguities (cycles)..., position (, velocity)] in ECEF; ambiguities sit in
 // front so the position block stays at the back, where the filter updates and reads it cheaply.
 #pragma once
@@ -45,6 +50,7 @@
 #include "gvins/gnss/rtk_config.hpp"
 #include "gvins/gnss/spp.hpp"
 #include "gvins/gnss/spp_config.hpp"
+#include "gvins/gnss/time_direction.hpp"
 #include "gvins/sri/sri_filter.hpp"
 
 namespace gvins {
@@ -142,7 +148,11 @@ class RtkSolver {
   /// A-priori rover position for the first SPP iteration (e.g. RINEX header).
   void setRoverInitialPosition(const Eigen::Vector3d& ecef);
 
-  /// Base epochs, in time order, up to (and, for interpolation, one past) each rover epoch.
+  /// Order in which base and rover epochs are given (default forward). Set before the first
+  /// epoch: it clears the base buffer, the slip histories and the float solution.
+  void setTimeDirection(TimeDirection d);
+  TimeDirection timeDirection() const { return direction_; }
+  /// Base epochs, in time order (reverse time order backward), up to (and, for interpolation, one past) each rover epoch.
   void addBaseEpoch(const ObsEpoch& epoch);
   /// Processes one rover epoch. `states` (optional): satellite states of this epoch that the
   /// caller has computed (or wants filled) for its own use, shared with the differences.
@@ -246,6 +256,7 @@ class RtkSolver {
 
   const EphemerisStore& nav_;
   RtkConfig cfg_;
+  TimeDirection direction_ = TimeDirection::Forward;
   SppSolver spp_;
   BaseStation base_;
   CycleSlipDetector roverSlips_;
