@@ -531,8 +531,11 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
       model1 = std::make_unique<vio::CameraModel>(ds.cameraCalibration(1).intrinsics);
       c1 = readFeatureTracksCsv((mav0 / "cam1" / "features.csv").string());
     }
-    trackFrames = std::make_unique<FeatureTrackFrames>(readFeatureTracksCsv((mav0 / "cam0" / "features.csv").string()),
-                                                       *model0, std::move(c1), model1.get());
+    std::vector<std::int64_t> imageStamps;
+    for (const vio::EurocFrame& fr : frames) imageStamps.push_back(fr.t_ns);
+    trackFrames = std::make_unique<FeatureTrackFrames>(
+        withImageStamps(readFeatureTracksCsv((mav0 / "cam0" / "features.csv").string()), imageStamps), *model0,
+        std::move(c1), model1.get());
     for (std::size_t i = 0; i < trackFrames->size(); ++i)
       if (trackFrames->stamp(i) >= tFirst && trackFrames->stamp(i) <= tLast) trackIndex.push_back(i);
   } else {

@@ -2,6 +2,8 @@
 // (visual_inertial_initializer.hpp, docs/vio_estimator.md "Initialisation", "In motion (mono)").
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <unordered_map>
 #include <utility>
@@ -36,14 +38,19 @@ namespace gvins::vio {
 // those two a weakly accelerating flight passed the fit's check at a scale 35-40 % off
 // (docs/vio_estimator.md, "Initialisation").
 std::optional<MotionAlignment> alignMonoInMotion(const SriSwfConfig& cfg, const std::deque<FeatureFrame>& init_frames,
-                                                std::span<const ImuSample> imu, const CameraExtrinsic& e0) {
+                                                std::span<const ImuSample> imu, const CameraExtrinsic& e0,
+                                                 InitStatus* why) {
+  auto fail = [why](InitStatus r) {
+    if (why) *why = r;
+    return std::nullopt;
+  };
   const int N = cfg.init_mono_motion_frames;
-  if (static_cast<int>(init_frames.size()) < N) return std::nullopt;
+  if (static_cast<int>(init_frames.size()) < N) return fail(InitStatus::kCollecting);
   const std::size_t first = init_frames.size() - static_cast<std::size_t>(N);
   const FeatureFrame& F0 = init_frames[first];
   const std::int64_t t0 = F0.t_ns;
   const std::int64_t tN = init_frames.back().t_ns;
-  if (!imuCovers(imu, t0, tN)) return std::nullopt;
+  if (!imuCovers(imu, t0, tN)) return fail(InitStatus::kCollecting);
   const int M = N - 1;  // later frames
   std::vector<Eigen::Matrix3d> R0(static_cast<std::size_t>(M));
   std::vector<Eigen::Vector3d> alpha(static_cast<std::size_t>(M));
@@ -158,7 +165,8 @@ std::optional<MotionAlignment> alignMonoInMotion(const SriSwfConfig& cfg, const 
       kbest = j;
     }
   }
-  if (kbest < 0 || best < 2.0 * M_PI / 180.0) return std::nullopt;
+  if (kbest < 0) return fail(InitStatus::kTooFewTracks);
+  if (best < 2.0 * M_PI / 180.0) return fail(InitStatus::kTooLittleParallax);
   const auto& fk = fj[static_cast<std::size_t>(kbest)];
   // 1. Baseline direction and unit-baseline structure (relative to C_0).
   Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
@@ -193,7 +201,7 @@ std::optional<MotionAlignment> alignMonoInMotion(const SriSwfConfig& cfg, const 
   } else {
     triangulated = triangulateAll(d);
   }
-  if (triangulated < 20) return std::nullopt;
+  if (triangulated < 20) return fail(InitStatus::kTooFewTracks);
   // 2. Camera centres c̄_j of all later frames from the bearings of the points.
   std::vector<Eigen::Vector3d> cbar(static_cast<std::size_t>(M));
   for (int j = 0; j < M; ++j) {
@@ -208,7 +216,7 @@ std::optional<MotionAlignment> alignMonoInMotion(const SriSwfConfig& cfg, const 
       g += K.transpose() * (K * it->second);
       ++n;
     }
-    if (n < 10) return std::nullopt;
+    if (n < 10) return fail(InitStatus::kTooFewTracks);
     cbar[static_cast<std::size_t>(j)] = H.ldlt().solve(g);
   }
   // 3. s c̄_j − v₀ Δt_j − ½ g Δt_j² = α_j + (R_0j − I) p_IC; x = [s; v₀; g] or, with g = G·dir
@@ -263,7 +271,9 @@ std::optional<MotionAlignment> alignMonoInMotion(const SriSwfConfig& cfg, const 
   };
   Eigen::Matrix<double, 7, 1> x;
   double sSigma = 0.0;
-  if (!align(x, sSigma, Eigen::Vector3d::Zero()) || sSigma > cfg.init_mono_max_scale_sigma * x(0)) return std::nullopt;
+  if (!align(x, sSigma, Eigen::Vector3d::Zero())) return fail(InitStatus::kInconsistent);
+  if (std::getenv("GVINS_INIT_DEBUG")) std::fprintf(stderr, "mono t=%.2f s=%.3f ssig=%.3f par=%.2fdeg\n", tN*1e-9, x(0), sSigma/x(0), best*180/M_PI);
+  if (sSigma > cfg.init_mono_max_scale_sigma * x(0)) return fail(InitStatus::kTooLittleAcceleration);
   // Excitation: the scale a constant accelerometer error of init_mono_accel_error (bias, and the
   // tilt that a wrong gravity direction leaves) along each body axis would give. The fit's own
   // residuals cannot show such a systematic error; with weak acceleration it moves the scale
@@ -278,7 +288,8 @@ std::optional<MotionAlignment> alignMonoInMotion(const SriSwfConfig& cfg, const 
                         : std::numeric_limits<double>::infinity();
     }
   }
-  if (sensitivity > cfg.init_mono_max_scale_sigma) return std::nullopt;
+  if (std::getenv("GVINS_INIT_DEBUG")) std::fprintf(stderr, "   sens=%.3f v=%.2f\n", sensitivity, x.segment(1,3).norm());
+  if (sensitivity > cfg.init_mono_max_scale_sigma) return fail(InitStatus::kTooLittleAcceleration);
   const Eigen::Vector3d gb = x.tail(3);
   return MotionAlignment{t0, tN, gb, Eigen::Vector3d(x.segment(1, 3)), bg};
 }

@@ -132,6 +132,7 @@ SriSwfConfig parseRoot(const YAML::Node& root, const Ctx& c, const SriSwfConfig*
       {"static_max_accel_std", d(cfg.static_max_accel_std, "init.static_max_accel_std")},
       {"static_max_gyro_std", d(cfg.static_max_gyro_std, "init.static_max_gyro_std")},
       {"static_max_parallax", d(cfg.static_max_parallax, "init.static_max_parallax")},
+      {"static_without_tracks", b(cfg.init_static_without_tracks, "init.static_without_tracks")},
       {"in_motion", b(cfg.init_in_motion, "init.in_motion")},
       {"motion_frames", i(cfg.init_motion_frames, "init.motion_frames")},
       {"mono_in_motion", b(cfg.init_mono_in_motion, "init.mono_in_motion")},

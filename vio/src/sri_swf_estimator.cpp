@@ -951,7 +951,10 @@ struct SriSwfEstimator<Scalar>::Impl {
     if (cfg.zero_velocity_update) {
       Eigen::Vector3d ma, mg;
       int n = 0;
-      if (standstill(cfg, imuSpan(), frame, recent, ma, mg, n)) {
+      // Without tracks (init_static_without_tracks) the IMU alone decides; the χ² gate rejects the
+      // update when the state is known to move (a constant-velocity climb has a quiet IMU too).
+      const Standstill st = standstill(cfg, imuSpan(), frame, recent, ma, mg, n);
+      if (st == Standstill::kYes || (st == Standstill::kImuOnly && cfg.init_static_without_tracks)) {
         const ImuState s = newestState();
         const PoseEstimate prev = poseOf(f.nominal(previous_pose));
         Meas z(6);

@@ -21,11 +21,12 @@ double initMedian(std::vector<double> v) {
   std::nth_element(v.begin(), mid, v.end());
   return *mid;
 }
-bool standstill(const SriSwfConfig& cfg, std::span<const ImuSample> imu, const FeatureFrame& frame,
-                const std::deque<FeatureFrame>& frames, Eigen::Vector3d& ma, Eigen::Vector3d& mg, int& n) {
+
+Standstill standstill(const SriSwfConfig& cfg, std::span<const ImuSample> imu, const FeatureFrame& frame,
+                      const std::deque<FeatureFrame>& frames, Eigen::Vector3d& ma, Eigen::Vector3d& mg, int& n) {
   const std::int64_t t1 = frame.t_ns;
   const std::int64_t t0 = t1 - static_cast<std::int64_t>(cfg.init_window * 1e9);
-  if (!imuCovers(imu, t0, t1)) return false;
+  if (!imuCovers(imu, t0, t1)) return Standstill::kNo;
   const FeatureFrame* ref = nullptr;
   for (const FeatureFrame& fr : frames) {
     if (fr.t_ns >= t0) {
@@ -33,7 +34,7 @@ bool standstill(const SriSwfConfig& cfg, std::span<const ImuSample> imu, const F
       break;
     }
   }
-  if (!ref || static_cast<double>(t1 - ref->t_ns) < 0.5e9 * cfg.init_window) return false;
+  if (!ref || static_cast<double>(t1 - ref->t_ns) < 0.5e9 * cfg.init_window) return Standstill::kNo;
   ma.setZero();
   mg.setZero();
   Eigen::Vector3d sa = Eigen::Vector3d::Zero(), sg = Eigen::Vector3d::Zero();
@@ -46,13 +47,13 @@ bool standstill(const SriSwfConfig& cfg, std::span<const ImuSample> imu, const F
     sg += s.gyro.cwiseAbs2();
     ++n;
   }
-  if (n < 10) return false;
+  if (n < 10) return Standstill::kNo;
   ma /= n;
   mg /= n;
   const Eigen::Vector3d va = (sa / n - ma.cwiseAbs2()).cwiseMax(0.0);
   const Eigen::Vector3d vg = (sg / n - mg.cwiseAbs2()).cwiseMax(0.0);
   if (std::sqrt(va.maxCoeff()) > cfg.static_max_accel_std || std::sqrt(vg.maxCoeff()) > cfg.static_max_gyro_std) {
-    return false;
+    return Standstill::kNo;
   }
   std::unordered_map<std::uint64_t, Eigen::Vector2d> refpx;
   for (const FeatureObservation& o : ref->features) refpx.emplace(o.id, o.pixel0);
@@ -61,9 +62,9 @@ bool standstill(const SriSwfConfig& cfg, std::span<const ImuSample> imu, const F
     auto it = refpx.find(o.id);
     if (it != refpx.end()) par.push_back((o.pixel0 - it->second).norm());
   }
-  return par.size() >= 5 && initMedian(par) <= cfg.static_max_parallax;
+  if (par.size() < 5) return Standstill::kImuOnly;
+  return initMedian(par) <= cfg.static_max_parallax ? Standstill::kYes : Standstill::kFeaturesMove;
 }
-
 
 std::optional<double> stereoDepth(const SriSwfConfig& cfg, const CameraExtrinsic& e0, const CameraExtrinsic& e1,
                                   const FeatureObservation& o) {
@@ -163,7 +164,8 @@ std::optional<InitialState> VisualInertialInitializer::fromStandstill(const Feat
   const SriSwfConfig& cfg = cfg_;
   Eigen::Vector3d ma, mg;
   int n = 0;
-  if (!standstill(cfg, imu, frame, frames_, ma, mg, n)) return std::nullopt;
+  const Standstill st = standstill(cfg, imu, frame, frames_, ma, mg, n);
+  if (!(st == Standstill::kYes || (st == Standstill::kImuOnly && cfg.init_static_without_tracks))) return std::nullopt;
   const std::int64_t t1 = frame.t_ns;
   ImuState s;
   s.t_ns = t1;

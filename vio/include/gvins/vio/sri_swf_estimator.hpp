@@ -97,6 +97,10 @@ struct SriSwfConfig {
   double static_max_accel_std = 0.15;  ///< m/s², per-axis std of the accelerometer at rest
   double static_max_gyro_std = 0.02;   ///< rad/s
   double static_max_parallax = 1.0;    ///< px, median feature displacement over the window
+  /// Standstill from the IMU alone when fewer than 5 features are tracked over the window (a
+  /// downward camera on the ground before take-off is too close to track): initialisation and
+  /// zero-velocity updates then trust the IMU's rest test. false: tracks must confirm it.
+  bool init_static_without_tracks = true;
   bool init_in_motion = true;          ///< linear visual-inertial alignment (stereo; mono see below)
   /// Mono rigs: also try the mono in-motion alignment (gyro bias from the window's epipolar
   /// constraints, scale/velocity/gravity, an excitation test against accelerometer errors;
@@ -215,7 +219,7 @@ struct SriSwfConfig {
 ///   gravity, pixel_noise, surface_noise, window, max_slam_features, min_track_msckf, min_depth, max_depth,
 ///   min_baseline_ratio, chi2_probability, max_msckf_per_frame, reanchor_sigma, lockout_reset_s,
 ///   position_random_walk, attitude_random_walk,
-///   init: {window, static_max_accel_std, static_max_gyro_std, static_max_parallax, in_motion,
+///   init: {window, static_max_accel_std, static_max_gyro_std, static_max_parallax, static_without_tracks, in_motion,
 ///          motion_frames, mono_in_motion, mono_motion_frames, mono_max_scale_sigma, mono_gyro_bias, mono_max_gyro_bias, mono_accel_error, position_sigma, yaw_sigma, tilt_sigma, velocity_sigma,
 ///          gyro_bias_sigma, accel_bias_sigma}, zero_velocity_update, zero_velocity_sigma,
 ///   first_estimate_jacobians, first_estimate_delay, calibrate_extrinsics, extrinsic_rotation_sigma, extrinsic_translation_sigma,

@@ -16,6 +16,7 @@
 #include "gvins/vio/imu_propagation.hpp"
 #include "gvins/vio/imu_sample.hpp"
 #include "gvins/vio/imu_state.hpp"
+#include "gvins/vio/init_status.hpp"
 #include "gvins/vio/sri_swf_estimator.hpp"
 #include "gvins/vio/visual_jacobians.hpp"
 
@@ -48,10 +49,18 @@ inline bool imuCovers(std::span<const ImuSample> imu, std::int64_t t0, std::int6
   return !imu.empty() && imu.front().t_ns <= t0 && imu.back().t_ns >= t1;
 }
 
+/// Outcome of the standstill test.
+enum class Standstill {
+  kNo,            ///< the IMU moves (or the window is not covered yet)
+  kImuOnly,       ///< the IMU is at rest, fewer than 5 features tracked over the window to confirm it
+  kFeaturesMove,  ///< the IMU is at rest but the features move: constant velocity
+  kYes,           ///< IMU at rest and median feature displacement within static_max_parallax
+};
+
 /// Standstill test over the last init_window: accelerometer/gyro spread and the median feature
 /// displacement against the oldest frame of `frames` in the window (at least half a window old).
-/// On success ma, mg are the mean specific force and angular rate over the window of n samples.
-bool standstill(const SriSwfConfig& cfg, std::span<const ImuSample> imu, const FeatureFrame& frame,
+/// Unless kNo, ma, mg are the mean specific force and angular rate over the window of n samples.
+Standstill standstill(const SriSwfConfig& cfg, std::span<const ImuSample> imu, const FeatureFrame& frame,
                 const std::deque<FeatureFrame>& frames, Eigen::Vector3d& ma, Eigen::Vector3d& mg, int& n);
 
 /// Stereo depth of a cam0 observation: d with p_C0 = d (n0, 1), within [min_depth, max_depth].
@@ -64,8 +73,10 @@ std::optional<MotionAlignment> alignStereoInMotion(const SriSwfConfig& cfg, cons
                                                    const CameraExtrinsic& e1);
 
 /// Mono in-motion alignment over the last init_mono_motion_frames frames (mono_inertial_alignment.cpp).
+/// `why` (if given) receives the reason of a failure.
 std::optional<MotionAlignment> alignMonoInMotion(const SriSwfConfig& cfg, const std::deque<FeatureFrame>& init_frames,
-                                                 std::span<const ImuSample> imu, const CameraExtrinsic& e0);
+                                                 std::span<const ImuSample> imu, const CameraExtrinsic& e0,
+                                                 InitStatus* why = nullptr);
 
 /// Buffers the frames before initialisation and tries, per frame, the standstill and (when
 /// configured) the in-motion alignment of the rig (stereo when the configuration has two cameras).
