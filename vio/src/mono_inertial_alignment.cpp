@@ -2,8 +2,6 @@
 // (visual_inertial_initializer.hpp, docs/vio_estimator.md "Initialisation", "In motion (mono)").
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <unordered_map>
 #include <utility>
@@ -272,7 +270,6 @@ std::optional<MotionAlignment> alignMonoInMotion(const SriSwfConfig& cfg, const 
   Eigen::Matrix<double, 7, 1> x;
   double sSigma = 0.0;
   if (!align(x, sSigma, Eigen::Vector3d::Zero())) return fail(InitStatus::kInconsistent);
-  if (std::getenv("GVINS_INIT_DEBUG")) std::fprintf(stderr, "mono t=%.2f s=%.3f ssig=%.3f par=%.2fdeg\n", tN*1e-9, x(0), sSigma/x(0), best*180/M_PI);
   if (sSigma > cfg.init_mono_max_scale_sigma * x(0)) return fail(InitStatus::kTooLittleAcceleration);
   // Excitation: the scale a constant accelerometer error of init_mono_accel_error (bias, and the
   // tilt that a wrong gravity direction leaves) along each body axis would give. The fit's own
@@ -288,7 +285,6 @@ std::optional<MotionAlignment> alignMonoInMotion(const SriSwfConfig& cfg, const 
                         : std::numeric_limits<double>::infinity();
     }
   }
-  if (std::getenv("GVINS_INIT_DEBUG")) std::fprintf(stderr, "   sens=%.3f v=%.2f\n", sensitivity, x.segment(1,3).norm());
   if (sensitivity > cfg.init_mono_max_scale_sigma) return fail(InitStatus::kTooLittleAcceleration);
   const Eigen::Vector3d gb = x.tail(3);
   return MotionAlignment{t0, tN, gb, Eigen::Vector3d(x.segment(1, 3)), bg};

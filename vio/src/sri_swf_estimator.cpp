@@ -930,10 +930,12 @@ struct SriSwfEstimator<Scalar>::Impl {
     clearCaches();
     if (!initialized) {
       res.initialized = tryInitialize(frame);
+      res.init_status = initializer.status();
       trimImu();
       return res;
     }
     res.initialized = true;
+    res.init_status = InitStatus::kInitialized;
     if (frame.t_ns <= t_newest || !imuCovers(t_newest, frame.t_ns)) {
       res.slam_features = static_cast<int>(slam.size());
       return res;

@@ -85,13 +85,17 @@ std::optional<double> stereoDepth(const SriSwfConfig& cfg, const CameraExtrinsic
 // Linear visual-inertial alignment over the buffered stereo frames (in motion).
 std::optional<MotionAlignment> alignStereoInMotion(const SriSwfConfig& cfg, const std::deque<FeatureFrame>& init_frames,
                                                   std::span<const ImuSample> imu, const CameraExtrinsic& e0,
-                                                  const CameraExtrinsic& e1) {
+                                                  const CameraExtrinsic& e1, InitStatus* why) {
+  auto fail = [why](InitStatus r) {
+    if (why) *why = r;
+    return std::nullopt;
+  };
   const int N = cfg.init_motion_frames;
-  if (static_cast<int>(init_frames.size()) < N) return std::nullopt;
+  if (static_cast<int>(init_frames.size()) < N) return fail(InitStatus::kCollecting);
   const FeatureFrame& F0 = init_frames[init_frames.size() - static_cast<std::size_t>(N)];
   const std::int64_t t0 = F0.t_ns;
   const std::int64_t tN = init_frames.back().t_ns;
-  if (!imuCovers(imu, t0, tN)) return std::nullopt;
+  if (!imuCovers(imu, t0, tN)) return fail(InitStatus::kCollecting);
   std::unordered_map<std::uint64_t, Eigen::Vector3d> pts;  // in I0
   for (const FeatureObservation& o : F0.features) {
     if (!o.stereo) continue;
@@ -99,7 +103,7 @@ std::optional<MotionAlignment> alignStereoInMotion(const SriSwfConfig& cfg, cons
       pts.emplace(o.id, e0.R_IC * (*d * Eigen::Vector3d(o.normalized0.x(), o.normalized0.y(), 1.0)) + e0.p_IC);
     }
   }
-  if (pts.size() < 15) return std::nullopt;
+  if (pts.size() < 15) return fail(InitStatus::kTooFewTracks);
   Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix<double, 6, 1> b = Eigen::Matrix<double, 6, 1>::Zero();
   std::vector<double> dts;
@@ -118,7 +122,7 @@ std::optional<MotionAlignment> alignStereoInMotion(const SriSwfConfig& cfg, cons
       const Eigen::Matrix3d K = so3::skew(bj) * e0.R_IC.transpose();
       rows.emplace_back(-K * R0j.transpose(), -K * (R0j.transpose() * it->second - e0.p_IC));
     }
-    if (rows.size() < 10) return std::nullopt;
+    if (rows.size() < 10) return fail(InitStatus::kTooFewTracks);
     Eigen::Vector3d t = Eigen::Vector3d::Zero();
     std::vector<char> use(rows.size(), 1);
     for (int pass = 0; pass < 2; ++pass) {
@@ -146,7 +150,7 @@ std::optional<MotionAlignment> alignStereoInMotion(const SriSwfConfig& cfg, cons
   }
   const Eigen::Matrix<double, 6, 1> x = A.ldlt().solve(b);
   Eigen::Vector3d gb = x.tail<3>();
-  if (std::abs(gb.norm() - cfg.gravity) > 1.0) return std::nullopt;
+  if (std::abs(gb.norm() - cfg.gravity) > 1.0) return fail(InitStatus::kInconsistent);
   gb *= cfg.gravity / gb.norm();
   double sdd = 0.0;
   Eigen::Vector3d sv = Eigen::Vector3d::Zero();
@@ -160,12 +164,17 @@ std::optional<MotionAlignment> alignStereoInMotion(const SriSwfConfig& cfg, cons
 
 
 std::optional<InitialState> VisualInertialInitializer::fromStandstill(const FeatureFrame& frame,
-                                                                    std::span<const ImuSample> imu) const {
+                                                                    std::span<const ImuSample> imu) {
   const SriSwfConfig& cfg = cfg_;
   Eigen::Vector3d ma, mg;
   int n = 0;
   const Standstill st = standstill(cfg, imu, frame, frames_, ma, mg, n);
-  if (!(st == Standstill::kYes || (st == Standstill::kImuOnly && cfg.init_static_without_tracks))) return std::nullopt;
+  if (!(st == Standstill::kYes || (st == Standstill::kImuOnly && cfg.init_static_without_tracks))) {
+    status_ = st == Standstill::kImuOnly        ? InitStatus::kStaticNoTracks
+              : st == Standstill::kFeaturesMove ? InitStatus::kMovingNoAcceleration
+                                                : InitStatus::kCollecting;
+    return std::nullopt;
+  }
   const std::int64_t t1 = frame.t_ns;
   ImuState s;
   s.t_ns = t1;
@@ -199,6 +208,70 @@ InitialState VisualInertialInitializer::fromMotion(const MotionAlignment& a, std
 }
 
 
+// Bounded cost (issue 43): the mono alignment costs 5-25 ms; it runs only when the cheap
+// excitation test passes and at most every init_mono_attempt_interval after a failure.
+std::optional<MotionAlignment> VisualInertialInitializer::tryMono(const FeatureFrame& frame,
+                                                                 std::span<const ImuSample> imu,
+                                                                 const CameraExtrinsic& e0) {
+  const SriSwfConfig& cfg = cfg_;
+  const int N = cfg.init_mono_motion_frames;
+  if (static_cast<int>(frames_.size()) < N) {
+    status_ = InitStatus::kCollecting;
+    return std::nullopt;
+  }
+  const std::int64_t t0 = frames_[frames_.size() - static_cast<std::size_t>(N)].t_ns;
+  if (cfg.init_mono_min_accel_change > 0.0) {
+    const std::optional<double> ex = accelerationChange(imu, t0, frame.t_ns);
+    if (!ex) {
+      status_ = InitStatus::kCollecting;
+      return std::nullopt;
+    }
+    if (*ex < cfg.init_mono_min_accel_change) {
+      status_ = InitStatus::kTooLittleAcceleration;
+      return std::nullopt;
+    }
+  }
+  if (last_attempt_ns_ && static_cast<double>(frame.t_ns - *last_attempt_ns_) * 1e-9 < cfg.init_mono_attempt_interval) {
+    return std::nullopt;  // status_: the last attempt's reason
+  }
+  last_attempt_ns_ = frame.t_ns;
+  return alignMonoInMotion(cfg, frames_, imu, e0, &status_);
+}
+
+std::optional<double> accelerationChange(std::span<const ImuSample> imu, std::int64_t t0, std::int64_t t1) {
+  if (!imuCovers(imu, t0, t1) || t1 - t0 < 200'000'000) return std::nullopt;
+  // Specific force rotated into the frame at t0 by the integrated gyro (first order per sample),
+  // averaged over 0.1 s bins; the result is the largest distance of a bin mean from their mean.
+  auto it = std::lower_bound(imu.begin(), imu.end(), t0, [](const ImuSample& a, std::int64_t t) { return a.t_ns < t; });
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  std::vector<Eigen::Vector3d> bins;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int count = 0;
+  std::int64_t bin_end = t0 + 100'000'000;
+  std::int64_t prev = it->t_ns;
+  for (; it != imu.end() && it->t_ns <= t1; ++it) {
+    const double dt = static_cast<double>(it->t_ns - prev) * 1e-9;
+    prev = it->t_ns;
+    R = R * so3::exp(it->gyro * dt);
+    if (it->t_ns > bin_end) {
+      if (count > 0) bins.push_back(sum / count);
+      sum.setZero();
+      count = 0;
+      bin_end += 100'000'000;
+    }
+    sum += R * it->accel;
+    ++count;
+  }
+  if (count > 0) bins.push_back(sum / count);
+  if (bins.size() < 2) return std::nullopt;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& b : bins) mean += b;
+  mean /= static_cast<double>(bins.size());
+  double worst = 0.0;
+  for (const Eigen::Vector3d& b : bins) worst = std::max(worst, (b - mean).norm());
+  return worst;
+}
+
 std::optional<InitialState> VisualInertialInitializer::tryInitialize(const FeatureFrame& frame,
                                                                    std::span<const ImuSample> imu,
                                                                    const std::vector<CameraExtrinsic>& ext) {
@@ -214,13 +287,16 @@ std::optional<InitialState> VisualInertialInitializer::tryInitialize(const Featu
   if (!s && cfg.init_in_motion) {
     std::optional<MotionAlignment> a;
     if (stereo) {
-      a = alignStereoInMotion(cfg, frames_, imu, ext[0], ext[1]);
+      a = alignStereoInMotion(cfg, frames_, imu, ext[0], ext[1], &status_);
     } else if (cfg.init_mono_in_motion) {
-      a = alignMonoInMotion(cfg, frames_, imu, ext[0]);
+      a = tryMono(frame, imu, ext[0]);
     }
     if (a) s = fromMotion(*a, imu);
   }
-  if (s) frames_.clear();
+  if (s) {
+    frames_.clear();
+    status_ = InitStatus::kInitialized;
+  }
   return s;
 }
 

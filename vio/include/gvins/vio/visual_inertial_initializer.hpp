@@ -70,13 +70,20 @@ std::optional<double> stereoDepth(const SriSwfConfig& cfg, const CameraExtrinsic
 /// Linear visual-inertial alignment over the last init_motion_frames stereo frames.
 std::optional<MotionAlignment> alignStereoInMotion(const SriSwfConfig& cfg, const std::deque<FeatureFrame>& init_frames,
                                                    std::span<const ImuSample> imu, const CameraExtrinsic& e0,
-                                                   const CameraExtrinsic& e1);
+                                                   const CameraExtrinsic& e1, InitStatus* why = nullptr);
 
 /// Mono in-motion alignment over the last init_mono_motion_frames frames (mono_inertial_alignment.cpp).
 /// `why` (if given) receives the reason of a failure.
 std::optional<MotionAlignment> alignMonoInMotion(const SriSwfConfig& cfg, const std::deque<FeatureFrame>& init_frames,
                                                  std::span<const ImuSample> imu, const CameraExtrinsic& e0,
                                                  InitStatus* why = nullptr);
+
+/// The excitation of the accelerometer over [t0, t1]: the largest distance (m/s²) of a 0.1 s mean
+/// of the specific force, rotated into the IMU frame at t0 by the gyro, from the mean of those
+/// means. A constant acceleration (cruise, a steady climb) gives about 0; the mono alignment
+/// needs it to change, since a constant one trades against gravity and velocity. nullopt: the
+/// IMU does not cover the interval or it is shorter than 0.2 s.
+std::optional<double> accelerationChange(std::span<const ImuSample> imu, std::int64_t t0, std::int64_t t1);
 
 /// Buffers the frames before initialisation and tries, per frame, the standstill and (when
 /// configured) the in-motion alignment of the rig (stereo when the configuration has two cameras).
@@ -92,15 +99,25 @@ class VisualInertialInitializer {
     if (frames_.empty()) return std::nullopt;
     return frames_.front().t_ns;
   }
-  void clear() { frames_.clear(); }
+  void clear() {
+    frames_.clear();
+    last_attempt_ns_.reset();
+    status_ = InitStatus::kCollecting;
+  }
+  /// Why the last tryInitialize did not initialise (kInitialized after it did).
+  InitStatus status() const { return status_; }
 
  private:
-  std::optional<InitialState> fromStandstill(const FeatureFrame& frame, std::span<const ImuSample> imu) const;
+  std::optional<InitialState> fromStandstill(const FeatureFrame& frame, std::span<const ImuSample> imu);
   InitialState fromMotion(const MotionAlignment& a, std::span<const ImuSample> imu) const;
+  std::optional<MotionAlignment> tryMono(const FeatureFrame& frame, std::span<const ImuSample> imu,
+                                         const CameraExtrinsic& e0);
 
   const SriSwfConfig& cfg_;
   ImuPropagator prop_;
   std::deque<FeatureFrame> frames_;
+  std::optional<std::int64_t> last_attempt_ns_;  // the last mono alignment attempt
+  InitStatus status_ = InitStatus::kCollecting;
 };
 
 }  // namespace gvins::vio
