@@ -147,6 +147,7 @@ std::optional<MotionAlignment> alignMonoInMotion(const SriSwfConfig& cfg, const 
   std::vector<std::unordered_map<std::uint64_t, Eigen::Vector3d>> fj(static_cast<std::size_t>(M));
   int kbest = -1;
   double best = 0.0;
+  bool tracked = false;  // some frame shares >= 20 features with F_0
   for (int j = 0; j < M; ++j) {
     std::vector<double> par;
     for (const FeatureObservation& o : init_frames[first + 1 + static_cast<std::size_t>(j)].features) {
@@ -157,14 +158,15 @@ std::optional<MotionAlignment> alignMonoInMotion(const SriSwfConfig& cfg, const 
       par.push_back(std::acos(std::clamp(r.dot(it->second), -1.0, 1.0)));
     }
     if (par.size() < 20) continue;
+    tracked = true;
     const double med = initMedian(par);
     if (med > best) {
       best = med;
       kbest = j;
     }
   }
-  if (kbest < 0) return fail(InitStatus::kTooFewTracks);
-  if (best < 2.0 * M_PI / 180.0) return fail(InitStatus::kTooLittleParallax);
+  if (!tracked) return fail(InitStatus::kTooFewTracks);
+  if (kbest < 0 || best < 2.0 * M_PI / 180.0) return fail(InitStatus::kTooLittleParallax);
   const auto& fk = fj[static_cast<std::size_t>(kbest)];
   // 1. Baseline direction and unit-baseline structure (relative to C_0).
   Eigen::Matrix3d S = Eigen::Matrix3d::Zero();

@@ -62,7 +62,13 @@ Standstill standstill(const SriSwfConfig& cfg, std::span<const ImuSample> imu, c
     auto it = refpx.find(o.id);
     if (it != refpx.end()) par.push_back((o.pixel0 - it->second).norm());
   }
-  if (par.size() < 5) return Standstill::kImuOnly;
+  if (par.size() < 5) {
+    // Without tracks the spread alone would pass a steady coordinated turn (constant specific force
+    // and rate in the body): the IMU alone must also show gravity and a bias-sized rate.
+    if (std::abs(ma.norm() - cfg.gravity) > 3.0 * cfg.static_max_accel_std || mg.norm() > cfg.init_mono_max_gyro_bias)
+      return Standstill::kNo;
+    return Standstill::kImuOnly;
+  }
   return initMedian(par) <= cfg.static_max_parallax ? Standstill::kYes : Standstill::kFeaturesMove;
 }
 
@@ -227,7 +233,9 @@ std::optional<MotionAlignment> VisualInertialInitializer::tryMono(const FeatureF
       return std::nullopt;
     }
     if (*ex < cfg.init_mono_min_accel_change) {
-      status_ = InitStatus::kTooLittleAcceleration;
+      // The standstill test's finding (at rest without tracks, constant velocity) says more.
+      if (status_ != InitStatus::kStaticNoTracks && status_ != InitStatus::kMovingNoAcceleration)
+        status_ = InitStatus::kTooLittleAcceleration;
       return std::nullopt;
     }
   }
