@@ -85,6 +85,7 @@ std::vector<TrackStamp> parseFeatureTracksCsv(std::string_view text, const std::
 }
 
 std::vector<TrackStamp> withImageStamps(std::vector<TrackStamp> tracks, const std::vector<std::int64_t>& images) {
+  if (tracks.empty()) return tracks;  // a file without any track is no camera input at all
   std::vector<TrackStamp> out;
   out.reserve(std::max(tracks.size(), images.size()));
   std::size_t k = 0;

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <string>
 
+#include "gvins/fusion/replay_feature_tracks.hpp"
 #include "gvins/fusion/replay_pipeline.hpp"
 #include "gvins/fusion/replay_sri_swf.hpp"
 #include "gvins/fusion/sim_dataset_info.hpp"
@@ -79,6 +80,21 @@ TEST(InitReplay, MonoTakeOffInitialisesOnTheGround) {
   const ReplaySummary without = replay("tracks", false);
   EXPECT_TRUE(std::isnan(without.initSeconds) || without.initSeconds > 10.0) << without.initSeconds;
   EXPECT_LT(static_cast<double>(without.framesInitialized), 0.5 * static_cast<double>(without.framesProcessed));
+}
+
+TEST(InitReplay, ImageStampsWithoutTracksBecomeEmptyFrames) {
+  std::vector<TrackStamp> tracks = parseFeatureTracksCsv("20,7,1.5,2.5\n40,7,3.5,4.5\n40,8,5,6\n", "t.csv");
+  const std::vector<TrackStamp> all = withImageStamps(tracks, {10, 20, 30, 40, 50});
+  ASSERT_EQ(all.size(), 5u);
+  const std::size_t sizes[] = {0, 1, 0, 2, 0};
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    EXPECT_EQ(all[i].t_ns, static_cast<std::int64_t>(10 * (i + 1)));
+    EXPECT_EQ(all[i].obs.size(), sizes[i]) << i;
+  }
+  EXPECT_DOUBLE_EQ(all[3].obs[1].pixel.y(), 6.0);
+  // A stamp of the tracks that no image has stays; no tracks at all stay none.
+  EXPECT_EQ(withImageStamps(tracks, {20, 30}).size(), 3u);
+  EXPECT_TRUE(withImageStamps({}, {10, 20}).empty());
 }
 
 }  // namespace
