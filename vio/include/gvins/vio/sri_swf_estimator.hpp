@@ -126,7 +126,7 @@ struct SriSwfConfig {
   /// (accelerationChange, visual_inertial_initializer.hpp) reaches this (m/s²; 0: always), ...
   double init_mono_min_accel_change = 0.3;
   /// ... and at most once per this many seconds (0: every frame).
-  double init_mono_attempt_interval = 0.25;
+  double init_mono_attempt_interval = 0.1;
   double init_position_sigma = 1e-3;   ///< m (gauge: the VIO frame is defined by the start)
   double init_yaw_sigma = 1e-3;        ///< rad (gauge)
   double init_tilt_sigma = 0.02;       ///< rad, roll/pitch
