@@ -240,10 +240,13 @@ std::optional<MotionAlignment> VisualInertialInitializer::tryMono(const FeatureF
     }
   }
   if (last_attempt_ns_ && static_cast<double>(frame.t_ns - *last_attempt_ns_) * 1e-9 < cfg.init_mono_attempt_interval) {
-    return std::nullopt;  // status_: the last attempt's reason
+    status_ = last_attempt_status_;  // the reason found by the last attempt still stands
+    return std::nullopt;
   }
   last_attempt_ns_ = frame.t_ns;
-  return alignMonoInMotion(cfg, frames_, imu, e0, &status_);
+  std::optional<MotionAlignment> a = alignMonoInMotion(cfg, frames_, imu, e0, &status_);
+  last_attempt_status_ = status_;
+  return a;
 }
 
 std::optional<double> accelerationChange(std::span<const ImuSample> imu, std::int64_t t0, std::int64_t t1) {

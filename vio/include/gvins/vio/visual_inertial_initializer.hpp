@@ -118,7 +118,8 @@ class VisualInertialInitializer {
   const SriSwfConfig& cfg_;
   ImuPropagator prop_;
   std::deque<FeatureFrame> frames_;
-  std::optional<std::int64_t> last_attempt_ns_;  // the last mono alignment attempt
+  std::optional<std::int64_t> last_attempt_ns_;  // the last mono alignment attempt ...
+  InitStatus last_attempt_status_ = InitStatus::kCollecting;  // ... and what it found
   InitStatus status_ = InitStatus::kCollecting;
 };
 
