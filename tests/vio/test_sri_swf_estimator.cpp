@@ -945,6 +945,9 @@ TEST(SriSwfConfig, YamlValuesAndErrorsNameLineAndField) {
   expectError("cameras: [cam0/sensor.yaml]\ninit:\n  mono_accel_error: -0.1\n", 1, "init.mono_accel_error");
   expectError("cameras: [cam0/sensor.yaml]\ninit:\n  mono_max_gyro_bias: 0\n", 1, "init.mono_max_gyro_bias");
   expectError("cameras: [cam0/sensor.yaml]\ninit:\n  mono_gyro_bias: 7\n", 3, "init.mono_gyro_bias");
+  expectError("cameras: [cam0/sensor.yaml]\ninit:\n  mono_min_accel_change: -0.3\n", 1, "init.mono_min_accel_change");
+  expectError("cameras: [cam0/sensor.yaml]\ninit:\n  mono_attempt_interval: 11\n", 1, "init.mono_attempt_interval");
+  expectError("cameras: [cam0/sensor.yaml]\ninit:\n  static_without_tracks: 2\n", 3, "init.static_without_tracks");
   expectError("cameras: [cam0/sensor.yaml]\ntime_offset: 5ms\n", 2, "time_offset");
   expectError("cameras: [cam0/sensor.yaml]\nlockout_reset_s: -1\n", 1, "lockout_reset_s");
   // With defaults (a dataset's calibration): the file changes a copy; cameras may be left out.
