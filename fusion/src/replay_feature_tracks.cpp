@@ -84,6 +84,23 @@ std::vector<TrackStamp> parseFeatureTracksCsv(std::string_view text, const std::
   return parse(r);
 }
 
+std::vector<TrackStamp> withImageStamps(std::vector<TrackStamp> tracks, const std::vector<std::int64_t>& images) {
+  std::vector<TrackStamp> out;
+  out.reserve(std::max(tracks.size(), images.size()));
+  std::size_t k = 0;
+  for (TrackStamp& t : tracks) {
+    for (; k < images.size() && images[k] < t.t_ns; ++k) {
+      if (out.empty() || images[k] > out.back().t_ns) out.push_back({images[k], {}});
+    }
+    if (k < images.size() && images[k] == t.t_ns) ++k;
+    out.push_back(std::move(t));
+  }
+  for (; k < images.size(); ++k) {
+    if (out.empty() || images[k] > out.back().t_ns) out.push_back({images[k], {}});
+  }
+  return out;
+}
+
 FeatureTrackFrames::FeatureTrackFrames(std::vector<TrackStamp> cam0, const vio::CameraModel& model0,
                                        std::vector<TrackStamp> cam1, const vio::CameraModel* model1)
     : cam0_(std::move(cam0)), cam1_(std::move(cam1)), model0_(&model0), model1_(model1) {}

@@ -226,6 +226,9 @@ void ReplaySummary::writeMetrics(std::ostream& os) const {
   kv("real_time_factor", realTimeFactor());
   kv("frontend_ms_mean", frontendMsMean);
   kv("estimator_ms_mean", estimatorMsMean);
+  kv("init_s", initSeconds);
+  kv("estimator_ms_mean_before_init", estimatorMsBeforeInit);
+  kv("estimator_ms_mean_after_init", estimatorMsAfterInit);
   kv("estimator_ms_median", estimatorMsMedian);
   kv("gnss_ms_per_epoch", gnssMsMean);
   kv("gnss_ms_per_frame", gnssMsPerFrame);
@@ -293,6 +296,15 @@ void ReplaySummary::print(std::ostream& os) const {
   row("front end [ms/frame]", f("mean %.2f", frontendMsMean) + f(", max %.2f", frontendMsMax));
   row("estimator [ms/frame]", f("mean %.2f", estimatorMsMean) + f(", median %.2f", estimatorMsMedian) +
                                    f(", max %.2f", estimatorMsMax));
+  if (!framesWaitingBy.empty()) {
+    std::string w = f("%.2f s to initialise", initSeconds) + f(" (%.2f ms/frame before, ", estimatorMsBeforeInit) +
+                    f("%.2f after); waiting: ", estimatorMsAfterInit);
+    for (const auto& [why, count] : framesWaitingBy)
+      w += std::string(vio::initStatusText(why)) + " " + std::to_string(count) + ", ";
+    char k[32];
+    std::snprintf(k, sizeof k, "%-30s ", "initialisation");
+    os << k << w.substr(0, w.size() - 2) << '\n';
+  }
   if (gnssEpochs + gnssEpochsSkipped > 0) {
     row("GNSS epochs", std::to_string(gnssEpochs) + " processed (" + std::to_string(gnssEpochsUpdated) + " updated, " +
                            std::to_string(gnssEpochsFixed) + " RTK fixed), " + std::to_string(gnssEpochsSkipped) +
@@ -494,7 +506,7 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
   std::vector<vio::TumPose> poses;
   std::vector<vio::TrajectorySample> localTrack;  // poses with the estimated velocity
   std::vector<vio::PoseCovariance> covs;
-  std::vector<double> estimatorMs;
+  std::vector<double> estimatorMs, estBefore, estAfter;  // per frame; before and after the initialisation
   // Local outputs (trajectory.tum, covariances, the local evaluation) stay in the VIO world frame
   // of the start: once the GNSS fusion has moved the estimator into ENU (ReplayGnss::worldChange),
   // `localMap` takes ENU back to it, fixed at the move.
@@ -537,8 +549,11 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
       model1 = std::make_unique<vio::CameraModel>(ds.cameraCalibration(1).intrinsics);
       c1 = readFeatureTracksCsv((mav0 / "cam1" / "features.csv").string());
     }
-    trackFrames = std::make_unique<FeatureTrackFrames>(readFeatureTracksCsv((mav0 / "cam0" / "features.csv").string()),
-                                                       *model0, std::move(c1), model1.get());
+    std::vector<std::int64_t> imageStamps;
+    for (const vio::EurocFrame& fr : frames) imageStamps.push_back(fr.t_ns);
+    trackFrames = std::make_unique<FeatureTrackFrames>(
+        withImageStamps(readFeatureTracksCsv((mav0 / "cam0" / "features.csv").string()), imageStamps), *model0,
+        std::move(c1), model1.get());
     for (std::size_t i = 0; i < trackFrames->size(); ++i)
       if (trackFrames->stamp(i) >= tFirst && trackFrames->stamp(i) <= tLast) trackIndex.push_back(i);
   } else {
@@ -626,6 +641,9 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
     estimatorMs.push_back(r.estimator_ms);
     sum.estimatorMsMax = std::max(sum.estimatorMsMax, r.estimator_ms);
     if (r.updated) ++sum.framesUpdated;
+    (r.initialized ? estAfter : estBefore).push_back(r.estimator_ms);
+    if (!r.initialized) ++sum.framesWaitingBy[r.init_status];
+    if (r.initialized && std::isnan(sum.initSeconds)) sum.initSeconds = static_cast<double>(frame->t_ns - firstT) * 1e-9;
     if (r.reset) {
       ++sum.estimatorResets;
       // The next poses are in the new state's VIO frame: the local evaluation covers the last
@@ -748,7 +766,8 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
       const double wall = msSince(wall0) * 1e-3;
       const double data = static_cast<double>(lastT - firstT) * 1e-9;
       std::fprintf(stderr, "\r[gvins-replay] frame %zu/%zu  t %.1f s  %s  %.1fx real time   ", sum.framesProcessed, total,
-                   data, init ? "initialised" : "initialising", wall > 0 ? data / wall : 0.0);
+                   data, init ? "initialised" : ("initialising: " + std::string(vio::initStatusText(r.init_status))).c_str(),
+                   wall > 0 ? data / wall : 0.0);
       std::fflush(stderr);
     }
   }
@@ -787,6 +806,13 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
   const double n = static_cast<double>(std::max<std::size_t>(sum.framesProcessed, 1));
   sum.frontendMsMean = feSum / n;
   sum.estimatorMsMean = estSum / n;
+  auto mean = [](const std::vector<double>& v) {
+    double t = 0.0;
+    for (double x : v) t += x;
+    return v.empty() ? std::numeric_limits<double>::quiet_NaN() : t / static_cast<double>(v.size());
+  };
+  sum.estimatorMsBeforeInit = mean(estBefore);
+  sum.estimatorMsAfterInit = mean(estAfter);
   sum.gnssMsMean = sum.gnssEpochs ? gnssSum / static_cast<double>(sum.gnssEpochs) : 0.0;
   sum.datasetSeconds = firstT >= 0 ? static_cast<double>(lastT - firstT) * 1e-9 : 0.0;
   sum.wallSeconds = msSince(wall0) * 1e-3;

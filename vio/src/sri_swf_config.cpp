@@ -53,6 +53,8 @@ void SriSwfConfig::validate() const {
   req(init_mono_max_scale_sigma > 0 && std::isfinite(init_mono_max_scale_sigma), "init.mono_max_scale_sigma must be > 0");
   req(init_mono_max_gyro_bias > 0 && std::isfinite(init_mono_max_gyro_bias), "init.mono_max_gyro_bias must be > 0");
   req(init_mono_accel_error >= 0 && std::isfinite(init_mono_accel_error), "init.mono_accel_error must be >= 0");
+  req(init_mono_min_accel_change >= 0 && init_mono_min_accel_change <= 50, "init.mono_min_accel_change must be in [0, 50] m/s^2");
+  req(init_mono_attempt_interval >= 0 && init_mono_attempt_interval <= 10, "init.mono_attempt_interval must be in [0, 10] s");
   req(init_position_sigma > 0 && init_yaw_sigma > 0 && init_tilt_sigma > 0 && init_velocity_sigma > 0 &&
           init_gyro_bias_sigma > 0 && init_accel_bias_sigma > 0,
       "init sigmas must be positive");
@@ -132,6 +134,7 @@ SriSwfConfig parseRoot(const YAML::Node& root, const Ctx& c, const SriSwfConfig*
       {"static_max_accel_std", d(cfg.static_max_accel_std, "init.static_max_accel_std")},
       {"static_max_gyro_std", d(cfg.static_max_gyro_std, "init.static_max_gyro_std")},
       {"static_max_parallax", d(cfg.static_max_parallax, "init.static_max_parallax")},
+      {"static_without_tracks", b(cfg.init_static_without_tracks, "init.static_without_tracks")},
       {"in_motion", b(cfg.init_in_motion, "init.in_motion")},
       {"motion_frames", i(cfg.init_motion_frames, "init.motion_frames")},
       {"mono_in_motion", b(cfg.init_mono_in_motion, "init.mono_in_motion")},
@@ -140,6 +143,8 @@ SriSwfConfig parseRoot(const YAML::Node& root, const Ctx& c, const SriSwfConfig*
       {"mono_gyro_bias", b(cfg.init_mono_gyro_bias, "init.mono_gyro_bias")},
       {"mono_max_gyro_bias", d(cfg.init_mono_max_gyro_bias, "init.mono_max_gyro_bias")},
       {"mono_accel_error", d(cfg.init_mono_accel_error, "init.mono_accel_error")},
+      {"mono_min_accel_change", d(cfg.init_mono_min_accel_change, "init.mono_min_accel_change")},
+      {"mono_attempt_interval", d(cfg.init_mono_attempt_interval, "init.mono_attempt_interval")},
       {"position_sigma", d(cfg.init_position_sigma, "init.position_sigma")},
       {"yaw_sigma", d(cfg.init_yaw_sigma, "init.yaw_sigma")},
       {"tilt_sigma", d(cfg.init_tilt_sigma, "init.tilt_sigma")},

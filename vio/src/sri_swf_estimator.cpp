@@ -16,6 +16,7 @@
 #include "gvins/sri/qr_update.hpp"
 #include "gvins/vio/imu_propagation.hpp"
 #include "gvins/vio/so3.hpp"
+#include "gvins/vio/visual_inertial_initializer.hpp"
 #include "gvins/vio/visual_jacobians.hpp"
 
 namespace gvins::vio {
@@ -37,13 +38,6 @@ PoseEstimate poseOf(const BlockEstimate<S>& e) {
 template <typename S>
 BlockEstimate<S> poseEstimate(const Eigen::Matrix3d& R, const Eigen::Vector3d& p) {
   return BlockEstimate<S>::fromPose(Eigen::Quaterniond(R).normalized().cast<S>(), p.cast<S>());
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
 }
 
 }  // namespace
@@ -118,7 +112,7 @@ struct SriSwfEstimator<Scalar>::Impl {
   std::vector<double> sigma_n;   // per camera: pixel noise in normalised units
   std::unordered_map<std::uint64_t, Track> tracks;
   std::unordered_map<std::uint64_t, Slam> slam;
-  std::deque<FeatureFrame> init_frames;
+  VisualInertialInitializer initializer;
   std::deque<FeatureFrame> recent;  // frames of the last init_window (zero-velocity detection)
   std::unordered_map<std::uint64_t, PoseEstimate> pose_cache;
   std::unordered_map<std::uint64_t, PoseEstimate> obs_pose_cache;  // poses at the image times
@@ -160,7 +154,7 @@ struct SriSwfEstimator<Scalar>::Impl {
 
   /// `first_block_id`: where the filter's block ids start (after a reset: the old filter's next id).
   Impl(const SriSwfConfig& c, std::uint64_t first_block_id)
-      : cfg(c), f(filterOptions(c, first_block_id)), prop(c.imu, c.gravity), td_start(c.time_offset) {
+      : cfg(c), f(filterOptions(c, first_block_id)), prop(c.imu, c.gravity), td_start(c.time_offset), initializer(c) {
     for (const CameraCalibration& cam : c.cameras) {
       CameraExtrinsic e;
       e.R_IC = Eigen::Quaterniond(Eigen::Matrix3d(cam.T_BS.topLeftCorner<3, 3>())).normalized().toRotationMatrix();
@@ -308,7 +302,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     std::int64_t keep = imu.back().t_ns - static_cast<std::int64_t>(3.0e9);
     if (!initialized) {
       keep = imu.back().t_ns - static_cast<std::int64_t>((cfg.init_window + 2.0) * 1e9);
-      if (!init_frames.empty()) keep = std::min(keep, init_frames.front().t_ns - 100'000'000);
+      if (auto t0 = initializer.oldestFrameTime()) keep = std::min(keep, *t0 - 100'000'000);
     } else if (!clones.empty()) {
       keep = std::min(keep, clones.front().t_ns - 100'000'000);
     }
@@ -317,9 +311,7 @@ struct SriSwfEstimator<Scalar>::Impl {
     if (it - imu.begin() > 2000) imu.erase(imu.begin(), it - 1);  // amortised
   }
   std::span<const ImuSample> imuSpan() const { return {imu.data(), imu.size()}; }
-  bool imuCovers(std::int64_t t0, std::int64_t t1) const {
-    return !imu.empty() && imu.front().t_ns <= t0 && imu.back().t_ns >= t1;
-  }
+  bool imuCovers(std::int64_t t0, std::int64_t t1) const { return vio::imuCovers(imuSpan(), t0, t1); }
 
   // ------------------------------------------------------------------ initialisation
   void createState(const ImuState& s, const Eigen::Matrix3d& Ptheta_world, double sigma_v, double sigma_bg) {
@@ -373,471 +365,13 @@ struct SriSwfEstimator<Scalar>::Impl {
     ++generation;
   }
 
-  /// Standstill test over the last init_window: accelerometer/gyro spread and the median feature
-  /// displacement against the oldest frame of `frames` in the window (at least half a window old).
-  bool staticCheck(const FeatureFrame& frame, const std::deque<FeatureFrame>& frames, Eigen::Vector3d& ma,
-                   Eigen::Vector3d& mg, int& n) const {
-    const std::int64_t t1 = frame.t_ns;
-    const std::int64_t t0 = t1 - static_cast<std::int64_t>(cfg.init_window * 1e9);
-    if (!imuCovers(t0, t1)) return false;
-    const FeatureFrame* ref = nullptr;
-    for (const FeatureFrame& fr : frames) {
-      if (fr.t_ns >= t0) {
-        ref = &fr;
-        break;
-      }
-    }
-    if (!ref || static_cast<double>(t1 - ref->t_ns) < 0.5e9 * cfg.init_window) return false;
-    ma.setZero();
-    mg.setZero();
-    Eigen::Vector3d sa = Eigen::Vector3d::Zero(), sg = Eigen::Vector3d::Zero();
-    n = 0;
-    for (const ImuSample& s : imu) {
-      if (s.t_ns < t0 || s.t_ns > t1) continue;
-      ma += s.accel;
-      mg += s.gyro;
-      sa += s.accel.cwiseAbs2();
-      sg += s.gyro.cwiseAbs2();
-      ++n;
-    }
-    if (n < 10) return false;
-    ma /= n;
-    mg /= n;
-    const Eigen::Vector3d va = (sa / n - ma.cwiseAbs2()).cwiseMax(0.0);
-    const Eigen::Vector3d vg = (sg / n - mg.cwiseAbs2()).cwiseMax(0.0);
-    if (std::sqrt(va.maxCoeff()) > cfg.static_max_accel_std || std::sqrt(vg.maxCoeff()) > cfg.static_max_gyro_std) {
-      return false;
-    }
-    std::unordered_map<std::uint64_t, Eigen::Vector2d> refpx;
-    for (const FeatureObservation& o : ref->features) refpx.emplace(o.id, o.pixel0);
-    std::vector<double> par;
-    for (const FeatureObservation& o : frame.features) {
-      auto it = refpx.find(o.id);
-      if (it != refpx.end()) par.push_back((o.pixel0 - it->second).norm());
-    }
-    return par.size() >= 5 && median(par) <= cfg.static_max_parallax;
-  }
-
-  bool tryStatic(const FeatureFrame& frame) {
-    Eigen::Vector3d ma, mg;
-    int n = 0;
-    if (!staticCheck(frame, init_frames, ma, mg, n)) return false;
-    const std::int64_t t1 = frame.t_ns;
-    ImuState s;
-    s.t_ns = t1;
-    s.R_WI = Eigen::Quaterniond::FromTwoVectors(ma.normalized(), Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    s.bg = mg;
-    const double sigma_mean = cfg.imu.gyroscope_noise_density * std::sqrt(cfg.imu.rate_hz) / std::sqrt(double(n));
-    const double sbg = std::max(5.0 * sigma_mean, 1e-3);
-    const Eigen::Matrix3d Pw =
-        Eigen::Vector3d(cfg.init_tilt_sigma * cfg.init_tilt_sigma, cfg.init_tilt_sigma * cfg.init_tilt_sigma,
-                        cfg.init_yaw_sigma * cfg.init_yaw_sigma)
-            .asDiagonal();
-    createState(s, Pw, cfg.init_velocity_sigma, sbg);
-    return true;
-  }
-
-  // Stereo depth of a cam0 observation: d with p_C0 = d (n0, 1).
-  std::optional<double> stereoDepth(const FeatureObservation& o) const {
-    const CameraExtrinsic& e0 = ext_fixed[0];
-    const CameraExtrinsic& e1 = ext_fixed[1];
-    const Eigen::Matrix3d R10 = e1.R_IC.transpose() * e0.R_IC;
-    const Eigen::Vector3d t10 = e1.R_IC.transpose() * (e0.p_IC - e1.p_IC);
-    const Eigen::Vector3d b0(o.normalized0.x(), o.normalized0.y(), 1.0);
-    const Eigen::Vector3d b1(o.normalized1.x(), o.normalized1.y(), 1.0);
-    const Eigen::Vector3d a = b1.cross(R10 * b0);
-    const Eigen::Vector3d c = b1.cross(t10);
-    const double den = a.squaredNorm();
-    if (den <= 0.0) return std::nullopt;
-    const double d = -a.dot(c) / den;
-    if (!(d >= cfg.min_depth && d <= cfg.max_depth)) return std::nullopt;
-    return d;
-  }
-
-  // State from an in-motion alignment: gravity gb and velocity vb in the IMU frame at t0
-  // (attitude from gravity, yaw 0), propagated to tN; tilt prior 1.5× init_tilt_sigma, velocity
-  // prior 3× init_velocity_sigma.
-  void createMovingState(std::int64_t t0, std::int64_t tN, const Eigen::Vector3d& gb, const Eigen::Vector3d& vb,
-                         const Eigen::Vector3d& bg = Eigen::Vector3d::Zero()) {
-    ImuState s;
-    s.t_ns = t0;
-    s.bg = bg;
-    s.R_WI = Eigen::Quaterniond::FromTwoVectors(-gb.normalized(), Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    s.v_WI = s.R_WI * vb;
-    prop.propagate(s, imuSpan(), tN);
-    const double tilt = 1.5 * cfg.init_tilt_sigma;
-    const Eigen::Matrix3d Pw =
-        Eigen::Vector3d(tilt * tilt, tilt * tilt, cfg.init_yaw_sigma * cfg.init_yaw_sigma).asDiagonal();
-    createState(s, Pw, 3.0 * cfg.init_velocity_sigma, cfg.init_gyro_bias_sigma);
-  }
-
-  // Linear visual-inertial alignment over the buffered stereo frames (in motion).
-  bool tryMotion() {
-    const int N = cfg.init_motion_frames;
-    if (static_cast<int>(init_frames.size()) < N) return false;
-    const FeatureFrame& F0 = init_frames[init_frames.size() - static_cast<std::size_t>(N)];
-    const std::int64_t t0 = F0.t_ns;
-    const std::int64_t tN = init_frames.back().t_ns;
-    if (!imuCovers(t0, tN)) return false;
-    const CameraExtrinsic& e0 = ext_fixed[0];
-    std::unordered_map<std::uint64_t, Eigen::Vector3d> pts;  // in I0
-    for (const FeatureObservation& o : F0.features) {
-      if (!o.stereo) continue;
-      if (auto d = stereoDepth(o)) {
-        pts.emplace(o.id, e0.R_IC * (*d * Eigen::Vector3d(o.normalized0.x(), o.normalized0.y(), 1.0)) + e0.p_IC);
-      }
-    }
-    if (pts.size() < 15) return false;
-    Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Zero();
-    Eigen::Matrix<double, 6, 1> b = Eigen::Matrix<double, 6, 1>::Zero();
-    std::vector<double> dts;
-    std::vector<Eigen::Vector3d> ys;
-    for (std::size_t j = init_frames.size() - static_cast<std::size_t>(N) + 1; j < init_frames.size(); ++j) {
-      const FeatureFrame& Fj = init_frames[j];
-      ImuIntegration integ(cfg.imu, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
-      integ.integrate(imuSpan(), t0, Fj.t_ns);
-      const Eigen::Matrix3d R0j = integ.gamma();
-      // Translation t of I_j in I_0 from bearings of the stereo points: [b]× p_Cj = 0.
-      std::vector<std::pair<Eigen::Matrix3d, Eigen::Vector3d>> rows;
-      for (const FeatureObservation& o : Fj.features) {
-        auto it = pts.find(o.id);
-        if (it == pts.end()) continue;
-        const Eigen::Vector3d bj = Eigen::Vector3d(o.normalized0.x(), o.normalized0.y(), 1.0).normalized();
-        const Eigen::Matrix3d K = so3::skew(bj) * e0.R_IC.transpose();
-        rows.emplace_back(-K * R0j.transpose(), -K * (R0j.transpose() * it->second - e0.p_IC));
-      }
-      if (rows.size() < 10) return false;
-      Eigen::Vector3d t = Eigen::Vector3d::Zero();
-      std::vector<char> use(rows.size(), 1);
-      for (int pass = 0; pass < 2; ++pass) {
-        Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
-        Eigen::Vector3d g = Eigen::Vector3d::Zero();
-        for (std::size_t k = 0; k < rows.size(); ++k) {
-          if (!use[k]) continue;
-          H += rows[k].first.transpose() * rows[k].first;
-          g += rows[k].first.transpose() * rows[k].second;
-        }
-        t = H.ldlt().solve(g);
-        std::vector<double> res(rows.size());
-        for (std::size_t k = 0; k < rows.size(); ++k) res[k] = (rows[k].first * t - rows[k].second).norm();
-        const double med = median(res);
-        for (std::size_t k = 0; k < rows.size(); ++k) use[k] = res[k] <= 3.0 * med + 1e-12;
-      }
-      const double dt = static_cast<double>(Fj.t_ns - t0) * 1e-9;
-      const Eigen::Vector3d y = t - integ.alpha();
-      Eigen::Matrix<double, 3, 6> J;
-      J << dt * Eigen::Matrix3d::Identity(), 0.5 * dt * dt * Eigen::Matrix3d::Identity();
-      A += J.transpose() * J;
-      b += J.transpose() * y;
-      dts.push_back(dt);
-      ys.push_back(y);
-    }
-    const Eigen::Matrix<double, 6, 1> x = A.ldlt().solve(b);
-    Eigen::Vector3d gb = x.tail<3>();
-    if (std::abs(gb.norm() - cfg.gravity) > 1.0) return false;
-    gb *= cfg.gravity / gb.norm();
-    double sdd = 0.0;
-    Eigen::Vector3d sv = Eigen::Vector3d::Zero();
-    for (std::size_t k = 0; k < dts.size(); ++k) {
-      sv += dts[k] * (ys[k] - 0.5 * dts[k] * dts[k] * gb);
-      sdd += dts[k] * dts[k];
-    }
-    const Eigen::Vector3d vb = sv / sdd;
-    createMovingState(t0, tN, gb, vb);
-    return true;
-  }
-
-  // Mono in-motion alignment (no stereo depth), over the last init_mono_motion_frames frames
-  // F_0..F_N−1, in the IMU frame I_0 of F_0, with the gyro-integrated rotations R_0j and the
-  // preintegrated positions α_j (ImuIntegration, biases zero):
-  //  1. structure up to scale: the frame k with the largest rotation-compensated parallax to F_0
-  //     gives the baseline direction of the camera centres (C_k − C_0 ⊥ f_0 × f_k for every
-  //     feature, f the rays in I_0: smallest singular vector; sign from the depths), and the
-  //     features of F_0 and F_k are triangulated with a unit baseline;
-  //  2. every frame's camera centre c̄_j (same unknown scale) from the bearings of those points,
-  //     linear least squares as in the stereo alignment;
-  //  3. s c̄_j = C_j − C_0 = v₀ Δt_j + ½ g Δt_j² + α_j + (R_0j − I) p_IC: linear in (s, v₀, g);
-  //     then |g| is fixed to the configured value and its direction refined on the sphere (two
-  //     tangent unknowns, four iterations, as in VINS-Mono's gravity refinement).
-  // The metric scale comes from the accelerometer, so the motion needs acceleration; the
-  // alignment is rejected if the scale is not positive, the free |g| is more than 1 m/s² off, the
-  // parallax is below 2°, fewer than 20 features are tracked through the window, or the scale's
-  // relative 1-σ (fit residuals, gravity direction free) exceeds init_mono_max_scale_sigma, or
-  // if a constant accelerometer error of init_mono_accel_error would move the scale by more than
-  // that (excitation test). Step 0 estimates the gyro bias first (init_mono_gyro_bias). Without
-  // those two a weakly accelerating flight passed the fit's check at a scale 35-40 % off
-  // (docs/vio_estimator.md, "Initialisation").
-  bool tryMotionMono() {
-    const int N = cfg.init_mono_motion_frames;
-    if (static_cast<int>(init_frames.size()) < N) return false;
-    const std::size_t first = init_frames.size() - static_cast<std::size_t>(N);
-    const FeatureFrame& F0 = init_frames[first];
-    const std::int64_t t0 = F0.t_ns;
-    const std::int64_t tN = init_frames.back().t_ns;
-    if (!imuCovers(t0, tN)) return false;
-    const CameraExtrinsic& e0 = ext_fixed[0];
-    const int M = N - 1;  // later frames
-    std::vector<Eigen::Matrix3d> R0(static_cast<std::size_t>(M));
-    std::vector<Eigen::Vector3d> alpha(static_cast<std::size_t>(M));
-    std::vector<double> dts(static_cast<std::size_t>(M));
-    std::vector<ImuIntegration> integs(static_cast<std::size_t>(M));
-    auto integrateAll = [&](const Eigen::Vector3d& bg) {
-      for (int j = 0; j < M; ++j) {
-        const FeatureFrame& Fj = init_frames[first + 1 + static_cast<std::size_t>(j)];
-        ImuIntegration& integ = integs[static_cast<std::size_t>(j)];
-        integ = ImuIntegration(cfg.imu, bg, Eigen::Vector3d::Zero());
-        integ.integrate(imuSpan(), t0, Fj.t_ns);
-        R0[static_cast<std::size_t>(j)] = integ.gamma();
-        alpha[static_cast<std::size_t>(j)] = integ.alpha();
-        dts[static_cast<std::size_t>(j)] = static_cast<double>(Fj.t_ns - t0) * 1e-9;
-      }
-    };
-    integrateAll(Eigen::Vector3d::Zero());
-    // Rays in I_0 of every feature of F_0 in every later frame that sees it.
-    auto ray = [](const Eigen::Vector2d& n) { return Eigen::Vector3d(n.x(), n.y(), 1.0).normalized(); };
-    std::unordered_map<std::uint64_t, Eigen::Vector3d> f0;
-    for (const FeatureObservation& o : F0.features) f0.emplace(o.id, e0.R_IC * ray(o.normalized0));
-    // 0. Gyro bias from the epipolar constraints (cfg.init_mono_gyro_bias): the rays of F_0 and of
-    // a later frame j, rotated into I_0 by the gyro-integrated R_0j(b_g), are coplanar with the
-    // baseline d_j: d_j · (f_0 × R_0j r_j) = 0. Gauss-Newton on b_g over every frame with enough
-    // features, d_j re-estimated (smallest eigenvector) each iteration. A turn-on gyro bias of
-    // 0.015 rad/s rotates the rays of a 1 s window by 0.9°, as much as half the parallax needed.
-    Eigen::Vector3d bg = Eigen::Vector3d::Zero();
-    if (cfg.init_mono_gyro_bias) {
-      std::vector<std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>> pairs(static_cast<std::size_t>(M));
-      for (int j = 0; j < M; ++j) {
-        for (const FeatureObservation& o : init_frames[first + 1 + static_cast<std::size_t>(j)].features) {
-          auto it = f0.find(o.id);
-          if (it != f0.end()) pairs[static_cast<std::size_t>(j)].emplace_back(it->second, e0.R_IC * ray(o.normalized0));
-        }
-      }
-      std::vector<Eigen::Matrix3d> Rb(static_cast<std::size_t>(M));
-      // First-order bias correction of the zero-bias integrations (Forster et al. 2017, eq. 44):
-      // |b| dt ≤ 0.1 rad in a 1 s window; the final bias is integrated exactly below.
-      auto rotations = [&](const Eigen::Vector3d& b, std::vector<Eigen::Matrix3d>& out) {
-        for (int j = 0; j < M; ++j) out[static_cast<std::size_t>(j)] = integs[static_cast<std::size_t>(j)].gammaFor(b);
-      };
-      // Normal of the plane of the pair's two rays (zero when they are parallel).
-      auto planeNormal = [](const Eigen::Matrix3d& R0j, const std::pair<Eigen::Vector3d, Eigen::Vector3d>& p) {
-        const Eigen::Vector3d n = p.first.cross(R0j * p.second);
-        return n.norm() > 1e-9 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::Zero();
-      };
-      // Residuals d_j · n̂ of frames j ≥ M/2 (the longer baselines) with ≥ 20 shared features.
-      auto residuals = [&](const std::vector<Eigen::Matrix3d>& R, const std::vector<Eigen::Vector3d>& d,
-                           std::vector<double>& e) {
-        e.clear();
-        for (int j = M / 2; j < M; ++j) {
-          const auto& pj = pairs[static_cast<std::size_t>(j)];
-          if (pj.size() < 20) continue;
-          for (const auto& p : pj) e.push_back(d[static_cast<std::size_t>(j)].dot(planeNormal(R[static_cast<std::size_t>(j)], p)));
-        }
-      };
-      std::vector<Eigen::Vector3d> d(static_cast<std::size_t>(M), Eigen::Vector3d::Zero());
-      bool ok = true;
-      for (int it = 0; it < 6; ++it) {
-        rotations(bg, Rb);
-        for (int j = M / 2; j < M; ++j) {
-          Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
-          for (const auto& p : pairs[static_cast<std::size_t>(j)]) {
-            const Eigen::Vector3d n = planeNormal(Rb[static_cast<std::size_t>(j)], p);
-            S += n * n.transpose();
-          }
-          d[static_cast<std::size_t>(j)] = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(S).eigenvectors().col(0);
-        }
-        std::vector<double> e0v, ek;
-        residuals(Rb, d, e0v);
-        if (e0v.size() < 40) {
-          ok = false;
-          break;
-        }
-        Eigen::MatrixXd J(static_cast<Eigen::Index>(e0v.size()), 3);
-        constexpr double h = 1e-5;  // rad/s
-        std::vector<Eigen::Matrix3d> Rh(static_cast<std::size_t>(M));
-        for (int k = 0; k < 3; ++k) {
-          rotations(bg + h * Eigen::Vector3d::Unit(k), Rh);
-          residuals(Rh, d, ek);
-          for (std::size_t i = 0; i < e0v.size(); ++i) J(static_cast<Eigen::Index>(i), k) = (ek[i] - e0v[i]) / h;
-        }
-        const Eigen::VectorXd e = Eigen::Map<const Eigen::VectorXd>(e0v.data(), static_cast<Eigen::Index>(e0v.size()));
-        const Eigen::Vector3d step = -(J.transpose() * J).ldlt().solve(J.transpose() * e);
-        if (!step.allFinite()) {
-          ok = false;
-          break;
-        }
-        bg += step;
-        if (step.norm() < 1e-6) break;
-      }
-      // A bias beyond any plausible turn-on value means the constraint was degenerate: keep none.
-      if (!ok || !bg.allFinite() || bg.norm() > cfg.init_mono_max_gyro_bias) bg.setZero();
-      if (!bg.isZero()) integrateAll(bg);
-    }
-    std::vector<std::unordered_map<std::uint64_t, Eigen::Vector3d>> fj(static_cast<std::size_t>(M));
-    int kbest = -1;
-    double best = 0.0;
-    for (int j = 0; j < M; ++j) {
-      std::vector<double> par;
-      for (const FeatureObservation& o : init_frames[first + 1 + static_cast<std::size_t>(j)].features) {
-        auto it = f0.find(o.id);
-        if (it == f0.end()) continue;
-        const Eigen::Vector3d r = R0[static_cast<std::size_t>(j)] * e0.R_IC * ray(o.normalized0);
-        fj[static_cast<std::size_t>(j)].emplace(o.id, r);
-        par.push_back(std::acos(std::clamp(r.dot(it->second), -1.0, 1.0)));
-      }
-      if (par.size() < 20) continue;
-      const double med = median(par);
-      if (med > best) {
-        best = med;
-        kbest = j;
-      }
-    }
-    if (kbest < 0 || best < 2.0 * M_PI / 180.0) return false;
-    const auto& fk = fj[static_cast<std::size_t>(kbest)];
-    // 1. Baseline direction and unit-baseline structure (relative to C_0).
-    Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
-    for (const auto& [id, rk] : fk) {
-      const Eigen::Vector3d n = f0.at(id).cross(rk);
-      if (n.norm() > 1e-9) S += n.normalized() * n.normalized().transpose();
-    }
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(S);
-    Eigen::Vector3d d = es.eigenvectors().col(0);
-    std::unordered_map<std::uint64_t, Eigen::Vector3d> pts;
-    auto triangulateAll = [&](const Eigen::Vector3d& base) {
-      pts.clear();
-      int positive = 0;
-      for (const auto& [id, rk] : fk) {
-        const Eigen::Vector3d& r0 = f0.at(id);
-        // P = λ r0 = base + μ rk (least squares in λ, μ).
-        Eigen::Matrix<double, 3, 2> A;
-        A << r0, -rk;
-        const Eigen::Vector2d lm = (A.transpose() * A).ldlt().solve(A.transpose() * base);
-        if (lm(0) > 0 && lm(1) > 0) {
-          ++positive;
-          pts.emplace(id, lm(0) * r0);
-        }
-      }
-      return positive;
-    };
-    // Sign of the baseline: the one with more positive depths (pts then holds its points).
-    const int forward = triangulateAll(d);
-    int triangulated = triangulateAll(-d);
-    if (triangulated > forward) {
-      d = -d;
-    } else {
-      triangulated = triangulateAll(d);
-    }
-    if (triangulated < 20) return false;
-    // 2. Camera centres c̄_j of all later frames from the bearings of the points.
-    std::vector<Eigen::Vector3d> cbar(static_cast<std::size_t>(M));
-    for (int j = 0; j < M; ++j) {
-      Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
-      Eigen::Vector3d g = Eigen::Vector3d::Zero();
-      int n = 0;
-      for (const auto& [id, r] : fj[static_cast<std::size_t>(j)]) {
-        auto it = pts.find(id);
-        if (it == pts.end()) continue;
-        const Eigen::Matrix3d K = so3::skew(r);  // r × (P − c) = 0
-        H += K.transpose() * K;
-        g += K.transpose() * (K * it->second);
-        ++n;
-      }
-      if (n < 10) return false;
-      cbar[static_cast<std::size_t>(j)] = H.ldlt().solve(g);
-    }
-    // 3. s c̄_j − v₀ Δt_j − ½ g Δt_j² = α_j + (R_0j − I) p_IC; x = [s; v₀; g] or, with g = G·dir
-    // + T δ, [s; v₀; δ]. Returns the 1-σ of s from the fit residuals.
-    // da: a constant acceleration error added to every α_j (the excitation test below).
-    auto solve = [&](const Eigen::Vector3d& g0, const Eigen::MatrixXd& T, Eigen::Matrix<double, 7, 1>& x,
-                     const Eigen::Vector3d& da) {
-      const int nx = 4 + static_cast<int>(T.cols());
-      Eigen::MatrixXd A = Eigen::MatrixXd::Zero(nx, nx);
-      Eigen::VectorXd b = Eigen::VectorXd::Zero(nx);
-      for (int j = 0; j < M; ++j) {
-        const double dt = dts[static_cast<std::size_t>(j)];
-        Eigen::MatrixXd J(3, nx);
-        J.col(0) = cbar[static_cast<std::size_t>(j)];
-        J.block(0, 1, 3, 3) = -dt * Eigen::Matrix3d::Identity();
-        J.rightCols(nx - 4) = -0.5 * dt * dt * T;
-        const Eigen::Vector3d y = alpha[static_cast<std::size_t>(j)] + 0.5 * dt * dt * da +
-                                  (R0[static_cast<std::size_t>(j)] - Eigen::Matrix3d::Identity()) * e0.p_IC +
-                                  0.5 * dt * dt * g0;
-        A += J.transpose() * J;
-        b += J.transpose() * y;
-      }
-      const Eigen::VectorXd sol = A.ldlt().solve(b);
-      x.head(4) = sol.head(4);
-      x.tail(3) = g0 + T * sol.tail(nx - 4);
-      double rss = 0.0;
-      for (int j = 0; j < M; ++j) {
-        const double dt = dts[static_cast<std::size_t>(j)];
-        const Eigen::Vector3d e = x(0) * cbar[static_cast<std::size_t>(j)] - dt * x.segment(1, 3) -
-                                  0.5 * dt * dt * x.tail(3) - (alpha[static_cast<std::size_t>(j)] + 0.5 * dt * dt * da) -
-                                  (R0[static_cast<std::size_t>(j)] - Eigen::Matrix3d::Identity()) * e0.p_IC;
-        rss += e.squaredNorm();
-      }
-      const double var = rss / std::max(1, 3 * M - nx);
-      return std::sqrt(std::max(0.0, var * A.inverse()(0, 0)));
-    };
-    // Linear solve with |g| free, then |g| fixed and its direction refined; false if implausible.
-    auto align = [&](Eigen::Matrix<double, 7, 1>& x, double& sSigma, const Eigen::Vector3d& da) {
-      solve(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity(), x, da);
-      if (!(x(0) > 0.0) || std::abs(x.tail(3).norm() - cfg.gravity) > 1.0) return false;
-      Eigen::Vector3d gdir = x.tail(3).normalized();
-      sSigma = 0.0;  // of the last refinement, i.e. with the gravity direction free
-      for (int it = 0; it < 4; ++it) {
-        Eigen::Matrix<double, 3, 2> T;
-        const Eigen::Vector3d e1 = gdir.unitOrthogonal();
-        T << e1, gdir.cross(e1);
-        sSigma = solve(cfg.gravity * gdir, T, x, da);
-        gdir = x.tail(3).normalized();
-      }
-      solve(cfg.gravity * gdir, Eigen::MatrixXd(3, 0), x, da);
-      return x(0) > 0.0;
-    };
-    Eigen::Matrix<double, 7, 1> x;
-    double sSigma = 0.0;
-    if (!align(x, sSigma, Eigen::Vector3d::Zero()) || sSigma > cfg.init_mono_max_scale_sigma * x(0)) return false;
-    // Excitation: the scale a constant accelerometer error of init_mono_accel_error (bias, and the
-    // tilt that a wrong gravity direction leaves) along each body axis would give. The fit's own
-    // residuals cannot show such a systematic error; with weak acceleration it moves the scale
-    // by tens of percent while the residuals stay small.
-    double sensitivity = 0.0;
-    if (cfg.init_mono_accel_error > 0.0) {
-      for (int k = 0; k < 3 && sensitivity <= cfg.init_mono_max_scale_sigma; ++k) {
-        Eigen::Matrix<double, 7, 1> xk;
-        double sk = 0.0;
-        sensitivity = align(xk, sk, cfg.init_mono_accel_error * Eigen::Vector3d::Unit(k))
-                          ? std::max(sensitivity, std::abs(xk(0) - x(0)) / x(0))
-                          : std::numeric_limits<double>::infinity();
-      }
-    }
-    if (sensitivity > cfg.init_mono_max_scale_sigma) return false;
-    const Eigen::Vector3d gb = x.tail(3);
-    createMovingState(t0, tN, gb, Eigen::Vector3d(x.segment(1, 3)), bg);
-    return true;
-  }
-
   bool tryInitialize(const FeatureFrame& frame) {
-    init_frames.push_back(frame);
-    const std::int64_t horizon = static_cast<std::int64_t>(cfg.init_window * 1e9);
-    const int keep = stereo() ? cfg.init_motion_frames : cfg.init_mono_motion_frames;
-    while (init_frames.size() > static_cast<std::size_t>(keep) &&
-           frame.t_ns - init_frames.front().t_ns > horizon) {
-      init_frames.pop_front();
-    }
-    bool ok = tryStatic(frame);
-    if (!ok && cfg.init_in_motion) {
-      if (stereo()) {
-        ok = tryMotion();
-      } else if (cfg.init_mono_in_motion) {
-        ok = tryMotionMono();
-      }
-    }
-    if (ok) {
-      init_frames.clear();
-      clearCaches();
-      addObservations(frame);
-    }
-    return ok;
+    const std::optional<InitialState> s = initializer.tryInitialize(frame, imuSpan(), ext_fixed);
+    if (!s) return false;
+    createState(s->state, s->P_theta_world, s->sigma_v, s->sigma_bg);
+    clearCaches();
+    addObservations(frame);
+    return true;
   }
 
   // ------------------------------------------------------------------ propagation
@@ -1396,10 +930,12 @@ struct SriSwfEstimator<Scalar>::Impl {
     clearCaches();
     if (!initialized) {
       res.initialized = tryInitialize(frame);
+      res.init_status = initializer.status();
       trimImu();
       return res;
     }
     res.initialized = true;
+    res.init_status = InitStatus::kInitialized;
     if (frame.t_ns <= t_newest || !imuCovers(t_newest, frame.t_ns)) {
       res.slam_features = static_cast<int>(slam.size());
       return res;
@@ -1417,7 +953,10 @@ struct SriSwfEstimator<Scalar>::Impl {
     if (cfg.zero_velocity_update) {
       Eigen::Vector3d ma, mg;
       int n = 0;
-      if (staticCheck(frame, recent, ma, mg, n)) {
+      // Without tracks (init_static_without_tracks) the IMU alone decides; the χ² gate rejects the
+      // update when the state is known to move (a constant-velocity climb has a quiet IMU too).
+      const Standstill st = standstill(cfg, imuSpan(), frame, recent, ma, mg, n);
+      if (st == Standstill::kYes || (st == Standstill::kImuOnly && cfg.init_static_without_tracks)) {
         const ImuState s = newestState();
         const PoseEstimate prev = poseOf(f.nominal(previous_pose));
         Meas z(6);

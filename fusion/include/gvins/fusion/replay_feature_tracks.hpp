@@ -39,6 +39,10 @@ struct TrackStamp {
 
 std::vector<TrackStamp> readFeatureTracksCsv(const std::string& path);
 std::vector<TrackStamp> parseFeatureTracksCsv(std::string_view text, const std::string& name);
+/// `tracks` with an empty stamp added for every image stamp in `images` (sorted) that has no
+/// track row: a camera too close to the ground, or over a featureless surface, still delivers
+/// frames, and the estimator sees them (standstill initialisation from the IMU, docs/replay.md).
+std::vector<TrackStamp> withImageStamps(std::vector<TrackStamp> tracks, const std::vector<std::int64_t>& images);
 
 /// Builds FeatureFrames from cam0 (and optionally cam1) tracks: normalised coordinates through
 /// the camera models, track lengths counted over consecutive cam0 stamps, stereo where cam1 has

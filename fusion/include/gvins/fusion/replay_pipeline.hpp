@@ -26,6 +26,7 @@
 #include <functional>
 #include <iosfwd>
 #include <limits>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -39,6 +40,7 @@
 #include "gvins/vio/frontend.hpp"
 #include "gvins/vio/imu_sample.hpp"
 #include "gvins/vio/imu_state.hpp"
+#include "gvins/vio/init_status.hpp"
 #include "gvins/vio/pose_covariance_csv.hpp"
 #include "gvins/vio/world_frame_change.hpp"
 
@@ -59,6 +61,7 @@ class ReplayEstimator {
     int slam_features = 0;
     bool reset = false;  ///< the estimator dropped its state after this frame and initialises again
     int state_dim = 0;   ///< error-state dimension after the frame (columns of the square-root factor)
+    vio::InitStatus init_status = vio::InitStatus::kCollecting;  ///< not initialised: why
   };
   virtual ~ReplayEstimator() = default;
   virtual void addImu(const vio::ImuSample& s) = 0;
@@ -186,6 +189,12 @@ struct ReplaySummary {
   std::size_t recordChanges = 0;  ///< broadcast record changes carried over to ambiguities
   double realTimeFactor() const { return wallSeconds > 0.0 ? datasetSeconds / wallSeconds : 0.0; }
   double estimatorMsMedian = 0.0;
+  /// First processed frame to the first initialised one (s; NaN: never), the estimator's mean time
+  /// per frame before and after that, and the frames not initialised by their InitStatus.
+  double initSeconds = std::numeric_limits<double>::quiet_NaN();
+  double estimatorMsBeforeInit = std::numeric_limits<double>::quiet_NaN();
+  double estimatorMsAfterInit = std::numeric_limits<double>::quiet_NaN();
+  std::map<vio::InitStatus, std::size_t> framesWaitingBy;
   double gnssMsPerFrame = 0.0;   ///< GNSS time summed over the run / processed frames
   double cpuSeconds = 0.0;       ///< process CPU time (user + system), all threads
   std::vector<std::string> files;

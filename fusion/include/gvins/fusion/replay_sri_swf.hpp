@@ -17,7 +17,8 @@ class SriSwfReplayEstimator final : public ReplayEstimator {
   void addImu(const vio::ImuSample& s) override { est_.addImu(s); }
   FrameOutcome processFrame(const vio::FeatureFrame& f) override {
     const vio::FrameResult r = est_.processFrame(f);
-    return {r.initialized, r.updated, r.estimator_ms, r.msckf_features, r.slam_features, r.reset, est_.filter().dim()};
+    return {r.initialized, r.updated,    r.estimator_ms,         r.msckf_features,
+            r.slam_features, r.reset, est_.filter().dim(), r.init_status};
   }
   bool initialized() const override { return est_.initialized(); }
   vio::ImuState newestImuState() const override { return est_.newestImuState(); }

@@ -36,6 +36,7 @@
 #include "gvins/vio/feature_frame.hpp"
 #include "gvins/vio/imu_noise.hpp"
 #include "gvins/vio/imu_sample.hpp"
+#include "gvins/vio/init_status.hpp"
 #include "gvins/vio/sensor_yaml.hpp"
 
 namespace gvins::vio {
@@ -97,6 +98,10 @@ struct SriSwfConfig {
   double static_max_accel_std = 0.15;  ///< m/s², per-axis std of the accelerometer at rest
   double static_max_gyro_std = 0.02;   ///< rad/s
   double static_max_parallax = 1.0;    ///< px, median feature displacement over the window
+  /// Standstill from the IMU alone when fewer than 5 features are tracked over the window (a
+  /// downward camera on the ground before take-off is too close to track): initialisation and
+  /// zero-velocity updates then trust the IMU's rest test. false: tracks must confirm it.
+  bool init_static_without_tracks = true;
   bool init_in_motion = true;          ///< linear visual-inertial alignment (stereo; mono see below)
   /// Mono rigs: also try the mono in-motion alignment (gyro bias from the window's epipolar
   /// constraints, scale/velocity/gravity, an excitation test against accelerometer errors;
@@ -117,6 +122,11 @@ struct SriSwfConfig {
   /// bias plus the tilt left by a wrong gravity direction) along any body axis must not move the
   /// scale by more than init_mono_max_scale_sigma; 0: no test.
   double init_mono_accel_error = 0.1;
+  /// The mono alignment is tried only when the accelerometer's excitation over its window
+  /// (accelerationChange, visual_inertial_initializer.hpp) reaches this (m/s²; 0: always), ...
+  double init_mono_min_accel_change = 0.3;
+  /// ... and at most once per this many seconds (0: every frame).
+  double init_mono_attempt_interval = 0.25;
   double init_position_sigma = 1e-3;   ///< m (gauge: the VIO frame is defined by the start)
   double init_yaw_sigma = 1e-3;        ///< rad (gauge)
   double init_tilt_sigma = 0.02;       ///< rad, roll/pitch
@@ -215,8 +225,8 @@ struct SriSwfConfig {
 ///   gravity, pixel_noise, surface_noise, window, max_slam_features, min_track_msckf, min_depth, max_depth,
 ///   min_baseline_ratio, chi2_probability, max_msckf_per_frame, reanchor_sigma, lockout_reset_s,
 ///   position_random_walk, attitude_random_walk,
-///   init: {window, static_max_accel_std, static_max_gyro_std, static_max_parallax, in_motion,
-///          motion_frames, mono_in_motion, mono_motion_frames, mono_max_scale_sigma, mono_gyro_bias, mono_max_gyro_bias, mono_accel_error, position_sigma, yaw_sigma, tilt_sigma, velocity_sigma,
+///   init: {window, static_max_accel_std, static_max_gyro_std, static_max_parallax, static_without_tracks, in_motion,
+///          motion_frames, mono_in_motion, mono_motion_frames, mono_max_scale_sigma, mono_gyro_bias, mono_max_gyro_bias, mono_accel_error, mono_min_accel_change, mono_attempt_interval, position_sigma, yaw_sigma, tilt_sigma, velocity_sigma,
 ///          gyro_bias_sigma, accel_bias_sigma}, zero_velocity_update, zero_velocity_sigma,
 ///   first_estimate_jacobians, first_estimate_delay, calibrate_extrinsics, extrinsic_rotation_sigma, extrinsic_translation_sigma,
 ///   time_offset, calibrate_time_offset, time_offset_sigma, imu_extra_first, imu_bias_renewal, precision: double | float,
@@ -253,6 +263,8 @@ struct FrameResult {
   /// The frame ended a visual lock-out (SriSwfConfig::lockout_reset_s): the state was dropped
   /// and the estimator is initialising again (initialized is false).
   bool reset = false;
+  /// Before initialisation: why the estimator has not initialised yet (kInitialized once it has).
+  InitStatus init_status = InitStatus::kCollecting;
 };
 
 template <typename Scalar>
