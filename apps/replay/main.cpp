@@ -86,6 +86,11 @@ const char* kUsage =
     "                         dataset (links to the rest of DATASET); replaying DIR runs the\n"
     "                         estimator on the same tracks without the front end\n"
     "  --no-eval              no accuracy table/plots\n"
+    "  --truth-pos F.pos      antenna reference for the GNSS accuracy table: a .pos file (RTKLIB layout,\n"
+    "                         e.g. an RTK solution of the same receiver), its epochs of quality <= Q\n"
+    "  --truth-quality Q      1 (fixed only, default), 2 (and float), 5 (and single)\n"
+    "  --camera-less-rate HZ  a dataset without cam0 runs camera-less (IMU and GNSS): frames without\n"
+    "                         features at this rate (default 10 Hz)\n"
     "  -q, --quiet            no progress line\n"
     "  -h, --help             this text\n"
     "\n"
@@ -142,6 +147,9 @@ int main(int argc, char** argv) {
   std::vector<std::string> ssrFiles;
   std::optional<Eigen::Vector3d> basePos, leverArm;
   std::int64_t sensorToGpst = 0;
+  std::string truthPos;
+  int truthQuality = 1;
+  std::optional<double> cameraLessRate;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&]() -> std::string {
@@ -202,6 +210,9 @@ int main(int argc, char** argv) {
     else if (a == "--images") images = true;
     else if (a == "--save-tracks") saveTracks = value();
     else if (a == "--no-eval") noEval = true;
+    else if (a == "--truth-pos") truthPos = value();
+    else if (a == "--truth-quality") truthQuality = static_cast<int>(optionValue([&] { return optionNumber(a, value(), 1, 6); }));
+    else if (a == "--camera-less-rate") cameraLessRate = optionValue([&] { return optionNumber(a, value(), 0.5, 100.0, "Hz"); });
     else if (a == "-q" || a == "--quiet") quiet = true;
     else if (!a.empty() && a[0] == '-') usageError("unknown option " + a);
     else if (dataset.empty()) dataset = a;
@@ -236,6 +247,9 @@ int main(int argc, char** argv) {
     if (images) opt.useFeatureTracks = false;
     if (!saveTracks.empty()) opt.saveTracksDir = saveTracks;
     if (noEval) opt.evaluate = false;
+    opt.truthPos = truthPos;
+    opt.truthPosMaxQuality = truthQuality;
+    if (cameraLessRate) opt.cameraLessRate_hz = *cameraLessRate;
     if (rover) opt.roverObs = *rover;
     if (base) opt.baseObs = *base;
     if (nav) opt.navFile = *nav;
@@ -255,11 +269,14 @@ int main(int argc, char** argv) {
     // cameras, e.g. config/estimator_euroc.yaml, tunes the filter for any dataset).
     fs::path mav0 = fs::path(dataset) / "mav0";
     if (!fs::is_directory(mav0)) mav0 = dataset;
-    const bool datasetCalibration = fs::exists(mav0 / "imu0" / "sensor.yaml") && fs::exists(mav0 / "cam0" / "sensor.yaml");
+    // A rig without a camera (no cam0 folder) runs camera-less: IMU and GNSS only.
+    const bool cameraLess = fs::exists(mav0 / "imu0") && !fs::exists(mav0 / "cam0");
+    const bool datasetCalibration =
+        fs::exists(mav0 / "imu0" / "sensor.yaml") && (cameraLess || fs::exists(mav0 / "cam0" / "sensor.yaml"));
     vio::SriSwfConfig ec;
     if (datasetCalibration || rc.estimatorConfig.empty()) {
       ec.imu = vio::readImuSensorYaml((mav0 / "imu0" / "sensor.yaml").string()).noise;
-      ec.cameras.push_back(vio::readCameraSensorYaml((mav0 / "cam0" / "sensor.yaml").string()));
+      if (!cameraLess) ec.cameras.push_back(vio::readCameraSensorYaml((mav0 / "cam0" / "sensor.yaml").string()));
       if (opt.frontend.useStereo && fs::exists(mav0 / "cam1" / "sensor.yaml"))
         ec.cameras.push_back(vio::readCameraSensorYaml((mav0 / "cam1" / "sensor.yaml").string()));
       if (info && info->gravity) ec.gravity = *info->gravity;

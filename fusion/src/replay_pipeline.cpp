@@ -172,6 +172,22 @@ std::vector<EcefTruthSample> parseEcefTruth(LineReader& r) {
 }
 }  // namespace
 
+std::vector<EcefTruthSample> ecefTruthFromPos(const PosFile& pos, int maxQuality, std::int64_t sensorToGpst_ns) {
+  std::vector<EcefTruthSample> out;
+  for (const PositionSolution& s : pos.solutions) {
+    const int q = static_cast<int>(s.quality);
+    if (q < 1 || q > maxQuality) continue;
+    EcefTruthSample x;
+    x.t_ns = s.time.wholeSeconds() * 1'000'000'000 + static_cast<std::int64_t>(std::llround(s.time.fraction() * 1e9)) -
+             sensorToGpst_ns;
+    x.antenna = s.position;
+    x.antennaVelocity = s.velocity;
+    if (!out.empty() && x.t_ns <= out.back().t_ns) continue;
+    out.push_back(x);
+  }
+  return out;
+}
+
 std::vector<EcefTruthSample> readEcefTruthCsv(const std::string& path) {
   LineReader r(path, 16384);
   return parseEcefTruth(r);
@@ -285,7 +301,7 @@ void ReplaySummary::print(std::ostream& os) const {
     std::snprintf(b, sizeof b, fmt, v);
     return std::string(b);
   };
-  row("camera input", featureTracks ? "simulated feature tracks" : "images (front end thread)");
+  row("camera input", cameraLess ? "none (camera-less: IMU and GNSS)" : featureTracks ? "simulated feature tracks" : "images (front end thread)");
   row("frames", std::to_string(framesProcessed) + " processed of " + std::to_string(frames) + ", " +
                     std::to_string(framesInitialized) + " initialised, " + std::to_string(framesUpdated) + " with visual update" +
                     (estimatorResets ? ", " + std::to_string(estimatorResets) + " VIO resets (lock-out)" : std::string()));
@@ -362,15 +378,24 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
   vio::EurocOptions eo;
   eo.checkImageFiles = !tracks;
   eo.skipMissingImages = opt.skipMissingImages;
+  eo.requireCamera = false;
   const vio::EurocDataset ds(dataset, eo);
   sum.featureTracks = tracks;
   sum.skippedMissingImages = ds.report().missingImages[0] + ds.report().missingImages[1];
-  if (ds.cameraCount() < 1) throw ParseError(mav0.string(), 0, "cam0", "dataset has no camera");
   const auto& imu = ds.imu();
   if (imu.size() < 2) throw ParseError((mav0 / "imu0" / "data.csv").string(), 0, "imu0", "fewer than 2 IMU samples");
 
-  // Frame range.
-  const auto& frames = ds.frames();
+  // Frame range. A camera-less rig (no cam0 folder) gets frames without features at
+  // cameraLessRate_hz over the IMU log: the estimator's clones, IMU propagation and GNSS rows
+  // run as with a camera that sees nothing.
+  sum.cameraLess = ds.cameraCount() == 0;
+  std::vector<vio::EurocFrame> cameraLessFrames;
+  if (sum.cameraLess) {
+    if (!(opt.cameraLessRate_hz > 0.0)) throw std::invalid_argument("runReplay: camera-less frame rate must be positive");
+    const auto period = static_cast<std::int64_t>(std::llround(1e9 / opt.cameraLessRate_hz));
+    for (std::int64_t t = imu.front().t_ns + period; t <= imu.back().t_ns; t += period) cameraLessFrames.push_back({t, 0, {}});
+  }
+  const auto& frames = sum.cameraLess ? cameraLessFrames : ds.frames();
   sum.frames = frames.size();
   if (frames.empty()) throw ParseError((mav0 / "cam0" / "data.csv").string(), 0, "cam0", "no camera frames");
   const std::int64_t tFirst = frames.front().t_ns + static_cast<std::int64_t>(opt.start_s * 1e9);
@@ -556,7 +581,7 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
         std::move(c1), model1.get());
     for (std::size_t i = 0; i < trackFrames->size(); ++i)
       if (trackFrames->stamp(i) >= tFirst && trackFrames->stamp(i) <= tLast) trackIndex.push_back(i);
-  } else {
+  } else if (!sum.cameraLess) {
     const bool stereo = ds.cameraCount() > 1 && opt.frontend.useStereo;
     if (!opt.saveTracksDir.empty())
       trackWriter = std::make_unique<FeatureTrackDatasetWriter>(dataset, opt.saveTracksDir, stereo ? 2 : 1);
@@ -604,6 +629,10 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
     if (tracks) {
       if (cursor >= trackIndex.size()) break;
       frame = trackFrames->frame(trackIndex[cursor++]);
+    } else if (sum.cameraLess) {
+      if (cursor >= sel.size()) break;
+      frame = vio::FeatureFrame{frames[sel[cursor]].t_ns, cursor, {}, {}};
+      ++cursor;
     } else {
       frame = fe->pop();
       if (!frame) break;
@@ -888,8 +917,10 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
   const fs::path ecefTruth = fs::path(dataset) / "truth" / "groundtruth_ecef.csv";
   // The solutions from the first tightly coupled update on (all if the frame never converged).
   const std::vector<EcefTruthSample>& evalTrack = antennaTight.size() >= 2 ? antennaTight : antennaTrack;
-  if (opt.evaluate && gnss && evalTrack.size() >= 2 && fs::exists(ecefTruth)) {
-    const auto truth = readEcefTruthCsv(ecefTruth.string());
+  if (opt.evaluate && gnss && evalTrack.size() >= 2 && (!opt.truthPos.empty() || fs::exists(ecefTruth))) {
+    const auto truth = opt.truthPos.empty()
+                           ? readEcefTruthCsv(ecefTruth.string())
+                           : ecefTruthFromPos(readPosFile(opt.truthPos), opt.truthPosMaxQuality, opt.sensorToGpst_ns);
     if (!truth.empty()) {
       const Eigen::Vector3d origin = truth.front().antenna;
       const Geodetic og = ecefToGeodetic(origin);

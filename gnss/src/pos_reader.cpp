@@ -38,6 +38,16 @@ bool isNanToken(std::string_view t) {
 enum class Layout { Unknown, Ecef, Llh };
 enum class TimeScale { Gpst, Utc };
 
+// An integer column (Q, ns, test). Solution files written by scripts print every column with
+// decimals ("1.0000000"; the rtklibexplorer GNSS_IMU reference tracks): an integral value in that
+// form is accepted, anything else is an error naming the column.
+long integerColumn(std::string_view text, const TextLocation& w, const char* name) {
+  if (text.find('.') == std::string_view::npos) return parseInt(text, w, name);
+  const double v = parseDouble(text, w, name);
+  if (!(std::abs(v - std::round(v)) < 1e-9) || std::abs(v) > 1e9) throwParseError(w, name, "not an integer: '" + std::string(text) + "'");
+  return std::lround(v);
+}
+
 PosFile parse(LineReader& in) {
   PosFile out;
   Layout layout = Layout::Unknown;
@@ -67,7 +77,7 @@ PosFile parse(LineReader& in) {
     auto tok = splitBlanks(l);
     std::optional<ResidualTest> residualTest;
     if (testColumn && tok.size() >= 8) {
-      const long t = parseInt(tok.back(), w, "test");
+      const long t = integerColumn(tok.back(), w, "test");
       if (t < 0 || t > 2) throwParseError(w, "test", "residual test flag outside 0-2");
       residualTest = static_cast<ResidualTest>(t);
       tok.pop_back();
@@ -103,10 +113,10 @@ PosFile parse(LineReader& in) {
     Layout lay = layout;
     for (int i = 0; i < 3; ++i) p[i] = parseDouble(tok[2 + i], w, kPosNames[lay == Layout::Llh ? 1 : 0][i]);
     if (lay == Layout::Unknown) lay = std::abs(p[0]) > 1000.0 || std::abs(p[1]) > 1000.0 ? Layout::Ecef : Layout::Llh;
-    const long q = parseInt(tok[5], w, "Q");
+    const long q = integerColumn(tok[5], w, "Q");
     if (q < 0 || q > 6) throwParseError(w, "Q", "quality flag outside 0-6");
     s.quality = static_cast<SolutionQuality>(q);
-    const long ns = parseInt(tok[6], w, "ns");
+    const long ns = integerColumn(tok[6], w, "ns");
     if (ns < 0 || ns > 999) throwParseError(w, "ns", "number of satellites out of range");
     s.numSatellites = static_cast<int>(ns);
     auto val = [&](std::size_t i, const char* name) { return parseDouble(tok[i], w, name); };

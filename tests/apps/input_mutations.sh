@@ -474,23 +474,23 @@ bag_cases() {
 }
 
 imu_cases() {
-  local I=$BIN/gvins-imu d=$W/imu C=$DATA/gnss_imu/walk_0827_cut
+  local I=$BIN/gvins-imu d=$W/imu C=$DATA/gnss_imu/walk_0827
   mkdir -p "$d"
   local RAW=(--columns ax,ay,az,gx,gy,gz,t --time counter-ms --accel-unit g --gyro-unit deg/s)
-  ok imu baseline "$I" convert "$C/imu_1730_first3000.csv" --tag "$C/imu_1730_first3000.csv.tag" "${RAW[@]}" -o "$d/ref.csv"
-  sed 's/$/\r/' "$C/imu_1730_first3000.csv" >"$d/crlf.csv"
+  ok imu baseline "$I" convert "$C/imu_1730.csv" --tag "$C/imu_1730.csv.tag" "${RAW[@]}" -o "$d/ref.csv"
+  sed 's/$/\r/' "$C/imu_1730.csv" >"$d/crlf.csv"
   # CR LF lines are the file the logger wrote: the tags then match without the CR LF correction
-  same imu crlf-lines "$d/ref.csv" "$d/crlf_out.csv" -- "$I" convert "$d/crlf.csv" --tag "$C/imu_1730_first3000.csv.tag" "${RAW[@]}" -o "$d/crlf_out.csv"
-  reject imu counter-without-tag "--tag" --absent "$d/a.csv" -- "$I" convert "$C/imu_1730_first3000.csv" "${RAW[@]}" -o "$d/a.csv"
-  head -c 70 "$C/imu_1730_first3000.csv.tag" >"$d/short.tag"
-  reject imu cut-tag-file "short.tag|header" --absent "$d/b.csv" -- "$I" convert "$C/imu_1730_first3000.csv" --tag "$d/short.tag" "${RAW[@]}" -o "$d/b.csv"
-  awk 'NR == 500 { print "0.1,0.2,x,0,0,0,3329000"; next } { print }' "$C/imu_1730_first3000.csv" >"$d/bad.csv"
-  reject imu bad-field "bad.csv:500|az" --absent "$d/c.csv" -- "$I" convert "$d/bad.csv" --tag "$C/imu_1730_first3000.csv.tag" "${RAW[@]}" -o "$d/c.csv"
-  awk 'NR == 900 { next } NR == 901 { print; print prev; next } { prev = $0; print }' "$C/imu_1730_first3000.csv" >"$d/swap.csv"
-  reject imu counter-goes-back "swap.csv|counter" --absent "$d/e.csv" -- "$I" convert "$d/swap.csv" --tag "$C/imu_1730_first3000.csv.tag" "${RAW[@]}" -o "$d/e.csv"
-  reject imu bad-column-spec "--columns|gq" -- "$I" info "$C/imu_1730_first3000.csv" --columns ax,ay,az,gx,gy,gq,t
-  reject imu bad-unit "--gyro-unit|rpm" -- "$I" info "$C/imu_1730_first3000.csv" --gyro-unit rpm
-  reject imu bad-rotation "--rotate" -- "$I" info "$C/imu_1730_first3000.csv" --rotate 1,2
+  same imu crlf-lines "$d/ref.csv" "$d/crlf_out.csv" -- "$I" convert "$d/crlf.csv" --tag "$C/imu_1730.csv.tag" "${RAW[@]}" -o "$d/crlf_out.csv"
+  reject imu counter-without-tag "--tag" --absent "$d/a.csv" -- "$I" convert "$C/imu_1730.csv" "${RAW[@]}" -o "$d/a.csv"
+  head -c 70 "$C/imu_1730.csv.tag" >"$d/short.tag"
+  reject imu cut-tag-file "short.tag|header" --absent "$d/b.csv" -- "$I" convert "$C/imu_1730.csv" --tag "$d/short.tag" "${RAW[@]}" -o "$d/b.csv"
+  awk 'NR == 500 { print "0.1,0.2,x,0,0,0,3329000"; next } { print }' "$C/imu_1730.csv" >"$d/bad.csv"
+  reject imu bad-field "bad.csv:500|az" --absent "$d/c.csv" -- "$I" convert "$d/bad.csv" --tag "$C/imu_1730.csv.tag" "${RAW[@]}" -o "$d/c.csv"
+  awk 'NR == 900 { next } NR == 901 { print; print prev; next } { prev = $0; print }' "$C/imu_1730.csv" >"$d/swap.csv"
+  reject imu counter-goes-back "swap.csv|counter" --absent "$d/e.csv" -- "$I" convert "$d/swap.csv" --tag "$C/imu_1730.csv.tag" "${RAW[@]}" -o "$d/e.csv"
+  reject imu bad-column-spec "--columns|gq" -- "$I" info "$C/imu_1730.csv" --columns ax,ay,az,gx,gy,gq,t
+  reject imu bad-unit "--gyro-unit|rpm" -- "$I" info "$C/imu_1730.csv" --gyro-unit rpm
+  reject imu bad-rotation "--rotate" -- "$I" info "$C/imu_1730.csv" --rotate 1,2
 }
 
 for t in spp rtk sim rtcm orbit replay eval bag imu; do

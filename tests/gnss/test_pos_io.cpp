@@ -284,7 +284,17 @@ TEST(PosIo, MalformedRowsNameLineAndColumn) {
   expectError("2024/06/24 08:20:00.000  -3817679.8533   3562838.2326   3650159.8842   9  42\n", 2, "Q");
   expectError("2024-06-24 08:20:00.000  -3817679.8533   3562838.2326   3650159.8842   5  42\n", 2, "week");
   expectError("2024/06/24 08:20:00.000  -3817679.8533   3562838.2326   3650159.8842   5  42 nan 1 1 1 1 1\n", 2, "sd1");
+  expectError("2024/06/24 08:20:00.000  -3817679.8533   3562838.2326   3650159.8842   1.5  42\n", 2, "Q");
   EXPECT_THROW(parsePosText("%  JST    x-ecef(m)\n", "t.pos"), ParseError);
+  // Integer columns printed with decimals (the rtklibexplorer GNSS_IMU reference tracks).
+  const PosFile dec = parsePosText(head + "2024/06/24 08:20:00.000  -3817679.8533   3562838.2326   3650159.8842   1.0000000  25.0000000\n", "d.pos");
+  EXPECT_EQ(dec.solutions.at(0).quality, SolutionQuality::Fix);
+  EXPECT_EQ(dec.solutions.at(0).numSatellites, 25);
+  const PosFile walk = readPosFile(std::string(GVINS_TEST_DATA) + "/gnss_imu/walk_0827/gnss_1730_sf.pos");
+  ASSERT_EQ(walk.solutions.size(), 536u);
+  EXPECT_EQ(std::count_if(walk.solutions.begin(), walk.solutions.end(),
+                          [](const PositionSolution& x) { return x.quality == SolutionQuality::Fix; }),
+            349);
   // Week/tow times and UTC files.
   const PosFile wk = parsePosText(head + "2320 116400.000  -3817679.8533   3562838.2326   3650159.8842   5  42\n", "w.pos");
   EXPECT_EQ(wk.solutions.at(0).time, GpsTime::fromWeekTow(2320, 116400.0));

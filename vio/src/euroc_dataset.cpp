@@ -59,6 +59,7 @@ EurocDataset::EurocDataset(const std::string& root, const EurocOptions& opt) {
   for (int i = 0; i < 2; ++i) {
     const fs::path dir = mav0 / ("cam" + std::to_string(i));
     if (!isDir(dir)) {
+      if (i == 0 && !opt.requireCamera) break;
       if (i == 0) missing(dir, "camera folder");
       if (opt.requireStereo) missing(dir, "second camera folder (stereo required)");
       break;
@@ -92,7 +93,8 @@ EurocDataset::EurocDataset(const std::string& root, const EurocOptions& opt) {
   }
 
   // Stereo pairing by time stamp (both lists are strictly increasing).
-  const auto& c0 = cams_[0].entries;
+  static const std::vector<CameraCsvEntry> kNoImages;
+  const auto& c0 = cams_.empty() ? kNoImages : cams_[0].entries;
   report_.cam0Images = c0.size();
   std::size_t j = 0;
   for (std::size_t i = 0; i < c0.size(); ++i) {

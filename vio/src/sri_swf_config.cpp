@@ -21,7 +21,8 @@ void SriSwfConfig::validate() const {
   auto req = [](bool ok, const std::string& what) {
     if (!ok) throw std::invalid_argument("SriSwfConfig: " + what);
   };
-  req(cameras.size() == 1 || cameras.size() == 2, "cameras: need 1 (mono) or 2 (stereo) cameras");
+  // No camera: an IMU-only state (GNSS/INS through the backend's clients), frames without features.
+  req(cameras.size() <= 2, "cameras: at most 2 (stereo)");
   for (const CameraCalibration& c : cameras) {
     req(c.intrinsics.fx > 0 && c.intrinsics.fy > 0, "cameras: focal lengths must be positive");
   }
@@ -226,7 +227,9 @@ SriSwfConfig parseRoot(const YAML::Node& root, const Ctx& c, const SriSwfConfig*
   walk(root, c, "", top);
   // A Kalibr camchain's timeshift_cam_imu is the time offset unless `time_offset` is given.
   if (have_cams && !root["time_offset"]) cfg.time_offset = cfg.cameras.front().time_offset;
-  if (!have_cams && cfg.cameras.empty()) fail(c, lineOf(root), "cameras", "missing (cameras: [...] or camchain: ...)");
+  // Defaults without cameras are a camera-less rig (IMU-only dataset); a file read alone must name them.
+  if (!have_cams && cfg.cameras.empty() && defaults == nullptr)
+    fail(c, lineOf(root), "cameras", "missing (cameras: [...] or camchain: ...)");
   try {
     cfg.validate();
   } catch (const std::invalid_argument& e) {

@@ -36,6 +36,7 @@
 
 #include "gvins/base/gnss_time.hpp"
 #include "gvins/base/observation.hpp"
+#include "gvins/gnss/pos_reader.hpp"
 #include "gvins/vio/feature_frame.hpp"
 #include "gvins/vio/frontend.hpp"
 #include "gvins/vio/imu_sample.hpp"
@@ -126,6 +127,14 @@ struct ReplayOptions {
   double start_s = 0.0, duration_s = 0.0;
   /// Use camN/features.csv when present instead of images (auto), or force images.
   bool useFeatureTracks = true;
+  /// A dataset without a cam0 folder runs camera-less (IMU and GNSS): the estimator gets frames
+  /// without features at this rate (Hz), each a pose clone for the GNSS rows.
+  double cameraLessRate_hz = 10.0;
+  /// Reference track of the antenna for the global evaluation from a .pos file (RTKLIB layout,
+  /// e.g. an RTK solution of the same receiver), its epochs of quality <= truthPosMaxQuality only
+  /// (1: fixed); empty: the dataset's truth/groundtruth_ecef.csv.
+  std::string truthPos;
+  int truthPosMaxQuality = 1;
   /// Images mode: also write the front end's tracks as a feature-only dataset in this folder
   /// (FeatureTrackDatasetWriter; empty: no). Replaying that folder runs the estimator on the
   /// same tracks without the front end.
@@ -174,6 +183,7 @@ struct ReplaySummary {
   std::size_t imuGaps = 0;
   double largestImuGap_s = 0.0;
   bool featureTracks = false;
+  bool cameraLess = false;  ///< no camera: frames without features (ReplayOptions::cameraLessRate_hz)
   double datasetSeconds = 0.0, wallSeconds = 0.0;
   double frontendMsMean = 0.0, frontendMsMax = 0.0, estimatorMsMean = 0.0, estimatorMsMax = 0.0;
   double gnssMsMean = 0.0;  ///< per epoch
@@ -243,6 +253,9 @@ struct EcefTruthSample {
   std::optional<Eigen::Vector3d> antennaVelocity;  ///< columns 15-17 when present
 };
 std::vector<EcefTruthSample> readEcefTruthCsv(const std::string& path);
+/// The solutions of a .pos file with quality 1..maxQuality (1 fixed, 2 float, 5 single) as
+/// antenna truth on the sensor clock (GPST ns minus sensorToGpst_ns).
+std::vector<EcefTruthSample> ecefTruthFromPos(const PosFile& pos, int maxQuality, std::int64_t sensorToGpst_ns = 0);
 std::vector<EcefTruthSample> parseEcefTruthCsv(std::string_view text, const std::string& name);
 
 /// Runs the whole replay. Throws gvins::ParseError for dataset problems (file, line, field),

@@ -37,6 +37,9 @@ struct EurocOptions {
   bool skipMissingImages = false;
   /// Refuse a dataset without a cam1 folder.
   bool requireStereo = false;
+  /// Refuse a dataset without a cam0 folder; false accepts an IMU-only (camera-less) rig:
+  /// cameraCount() 0, no frames.
+  bool requireCamera = true;
 };
 
 /// One camera time step: the cam0 image and, if paired, the cam1 image (indices into

@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# The real u-blox + MEMS IMU walk (tests/data/gnss_imu/walk_0827, tests/data/ubx/gnss_1730.ubx)
+# through gvins-replay camera-less (IMU and GNSS, no cam0 folder), against the publisher's RTK
+# track on its fixed epochs. Bounds are the measured figures with a margin (bench/fusion/real_walk.py
+# prints them beside our SPP and RTKLIB's):
+#   vio+dopp+psr with the broadcast ionosphere: H 8.16 m, V 15.0 m RMS, velocity 0.26 m/s;
+#   initialised 0.9 s into the log (static start), 1333 of 1342 frames.
+#   tests/fusion/real_walk_camera_less.sh BIN_DIR TEST_DATA_DIR
+set -u
+BIN=$1
+DATA=$2
+W=$(mktemp -d "${TMPDIR:-/tmp}/gvins_walk.XXXXXX")
+trap 'rm -rf "$W"' EXIT
+fail=0
+check() {  # name value op bound
+  if awk -v v="$2" -v b="$4" -v op="$3" 'BEGIN { exit !((op == "<=" && v <= b) || (op == ">=" && v >= b)) }'; then
+    echo "ok   $1 = $2 ($3 $4)"
+  else
+    echo "FAIL $1 = $2 (expected $3 $4)"
+    fail=1
+  fi
+}
+metric() { sed -n "s/^$1,//p" "$2"; }
+mkdir -p "$W/ds/mav0/imu0"
+"$BIN/gvins-imu" convert "$DATA/gnss_imu/walk_0827/imu_1730.csv" --tag "$DATA/gnss_imu/walk_0827/imu_1730.csv.tag" \
+  --columns ax,ay,az,gx,gy,gz,t --time counter-ms --accel-unit g --gyro-unit deg/s -o "$W/ds/mav0/imu0/data.csv" 2>"$W/imu.err" ||
+  { cat "$W/imu.err"; exit 1; }
+cp "$DATA/gnss_imu/walk_0827/imu0_sensor.yaml" "$W/ds/mav0/imu0/sensor.yaml"
+printf 'gnss_fusion:\n  ionosphere: broadcast\n' >"$W/sf.yaml"
+"$BIN/gvins-replay" "$W/ds" --mode vio+dopp+psr --config "$W/sf.yaml" --rover "$DATA/ubx/gnss_1730.ubx" \
+  --truth-pos "$DATA/gnss_imu/walk_0827/gnss_1730_sf.pos" --imu-gaps warn -q -o "$W/psr" >"$W/psr.out" 2>&1 ||
+  { cat "$W/psr.out"; exit 1; }
+M=$W/psr/metrics.csv
+grep -q "camera-less" "$W/psr.out" || { echo "FAIL the summary does not say camera-less"; fail=1; }
+check frames_initialized "$(metric frames_initialized "$M")" ">=" 1300
+check init_s "$(metric init_s "$M")" "<=" 2
+check gnss_epochs_updated "$(metric gnss_epochs_updated "$M")" ">=" 400
+check global_horizontal_rmse_m "$(metric global_horizontal_rmse_m "$M")" "<=" 10
+check global_vertical_rmse_m "$(metric global_vertical_rmse_m "$M")" "<=" 18
+check global_velocity_rmse_mps "$(metric global_velocity_rmse_mps "$M")" "<=" 0.35
+exit $fail
