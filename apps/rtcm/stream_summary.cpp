@@ -1,5 +1,6 @@
 #include "stream_summary.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -8,6 +9,7 @@
 #include <iostream>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 
 #include "gvins/base/constants.hpp"
 #include "gvins/base/geodetic.hpp"
@@ -39,10 +41,30 @@ GpsTime parseDate(const std::string& text) {
 std::FILE* openInput(const std::string& path) {
   if (path == "-") return stdin;
   std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw std::runtime_error("'" + path + "' is a directory, not an RTCM 3 file");
+  if (std::filesystem::is_directory(path, ec)) throw std::runtime_error("'" + path + "' is a directory, not a file");
   std::FILE* f = std::fopen(path.c_str(), "rb");
   if (!f) throw std::runtime_error("cannot open '" + path + "': " + std::strerror(errno));
   return f;
+}
+
+std::FILE* reopenable(const std::string& path) {
+  if (path != "-") return openInput(path);
+  std::FILE* tmp = std::tmpfile();
+  if (!tmp) throw std::runtime_error(std::string("cannot create a temporary file: ") + std::strerror(errno));
+  std::vector<char> buf(1 << 16);
+  std::size_t n;
+  while ((n = std::fread(buf.data(), 1, buf.size(), stdin)) > 0) std::fwrite(buf.data(), 1, n, tmp);
+  std::rewind(tmp);
+  return tmp;
+}
+
+void sortTypes(RinexObsHeader& h) {
+  auto rank = [](ObsType t) { return t == ObsType::Code ? 0 : t == ObsType::Phase ? 1 : t == ObsType::Doppler ? 2 : 3; };
+  for (auto& list : h.obsTypes) {
+    std::stable_sort(list.begin(), list.end(), [&](const ObsDescriptor& a, const ObsDescriptor& b) {
+      return std::make_tuple(a.code.band, a.code.attr, rank(a.type)) < std::make_tuple(b.code.band, b.code.attr, rank(b.type));
+    });
+  }
 }
 
 std::optional<GpsTime> referenceFor(const std::string& path, const std::optional<GpsTime>& date) {

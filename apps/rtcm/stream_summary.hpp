@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "gvins/base/gnss_time.hpp"
+#include "gvins/base/rinex_obs_header.hpp"
 #include "gvins/rtcm/decoder.hpp"
 
 namespace gvins::rtcm_app {
@@ -27,6 +28,14 @@ GpsTime parseDate(const std::string& text);
 
 /// Opens FILE or "-" (stdin); throws std::runtime_error naming the file.
 std::FILE* openInput(const std::string& path);
+
+/// Opens the input for a second reading: a file again, or stdin spooled to a temporary file.
+/// (Shared with gvins-ubx.)
+std::FILE* reopenable(const std::string& path);
+
+/// Sorts each system's observation types for a RINEX header: by band, attribute, then C L D S.
+/// (Shared with gvins-ubx.)
+void sortTypes(RinexObsHeader& h);
 
 /// Reference time for a file: the --date option, else the first absolute time found in the file
 /// (1020 with N4, 1042, 1045/1046), else nullopt (the decoder then uses the host clock).

@@ -4,7 +4,6 @@
 // the second writes PREFIX.obs (RINEX 3.04) epoch by epoch; PREFIX.nav (RINEX 3.04) holds every
 // distinct ephemeris record.
 #include <algorithm>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -19,28 +18,6 @@
 
 namespace gvins::rtcm_app {
 namespace {
-
-/// Opens the input for a second reading: a file again, or stdin spooled to a temporary file.
-std::FILE* reopenable(const std::string& path) {
-  if (path != "-") return openInput(path);
-  std::FILE* tmp = std::tmpfile();
-  if (!tmp) throw std::runtime_error(std::string("cannot create a temporary file: ") + std::strerror(errno));
-  std::vector<char> buf(1 << 16);
-  std::size_t n;
-  while ((n = std::fread(buf.data(), 1, buf.size(), stdin)) > 0) std::fwrite(buf.data(), 1, n, tmp);
-  std::rewind(tmp);
-  return tmp;
-}
-
-/// Header column order: by band, attribute, then C L D S.
-void sortTypes(RinexObsHeader& h) {
-  auto rank = [](ObsType t) { return t == ObsType::Code ? 0 : t == ObsType::Phase ? 1 : t == ObsType::Doppler ? 2 : 3; };
-  for (auto& list : h.obsTypes) {
-    std::stable_sort(list.begin(), list.end(), [&](const ObsDescriptor& a, const ObsDescriptor& b) {
-      return std::make_tuple(a.code.band, a.code.attr, rank(a.type)) < std::make_tuple(b.code.band, b.code.attr, rank(b.type));
-    });
-  }
-}
 
 /// Adds b's satellites/signals into a (same epoch time delivered twice).
 void mergeEpoch(ObsEpoch& a, const ObsEpoch& b) {

@@ -36,12 +36,13 @@
 namespace {
 
 const char* kUsage =
-    "usage: gvins-rtk [options] -o OUT.pos ROVER_OBS BASE_OBS|BASE_RTCM NAV [NAV...]\n"
+    "usage: gvins-rtk [options] -o OUT.pos ROVER_OBS|ROVER_UBX BASE_OBS|BASE_RTCM|BASE_UBX [NAV...]\n"
     "\n"
     "Relative positioning (RTK) with integer ambiguity resolution. ROVER_OBS is RINEX observation\n"
-    "data (2.10/2.11, 3.0x, 4.0x; plain or .gz); the base is RINEX as well or a binary RTCM 3 log\n"
-    "(MSM or legacy observations, 1005/1006 position, ephemerides), told apart by content. NAV are\n"
-    "RINEX navigation files (merged). Writes one RTKLIB-style .pos row per epoch with a solution\n"
+    "data (2.10/2.11, 3.0x, 4.0x; plain or .gz) or a u-blox UBX log (RXM-RAWX); the base is RINEX,\n"
+    "a binary RTCM 3 log (MSM or legacy observations, 1005/1006 position, ephemerides) or UBX, all\n"
+    "told apart by content. NAV are RINEX navigation files (merged); required unless the rover or\n"
+    "the base is a UBX log (whose RXM-SFRBX ephemerides are used as they arrive). Writes one RTKLIB-style .pos row per epoch with a solution\n"
     "(Q=1 fixed, 2 float, 5 single-point fallback), prints progress and a summary to stderr.\n"
     "\n"
     "  -o FILE               output .pos file ('-' for stdout); required\n"
@@ -180,7 +181,11 @@ Args parseArgs(int argc, char** argv) {
     }
   }
   if (a.out.empty()) usageError("no output file (-o OUT.pos)");
-  if (a.inputs.size() < 3) usageError("need a rover observation file, base data and at least one navigation file");
+  const bool ubxInput = a.inputs.size() == 2 && (gvins::BaseReader::detect(a.inputs[0]) == gvins::BaseFormat::Ubx ||
+                                                 gvins::BaseReader::detect(a.inputs[1]) == gvins::BaseFormat::Ubx);
+  if (a.inputs.size() < 3 && !ubxInput) {
+    usageError("need a rover observation file, base data and at least one navigation file (not needed with UBX)");
+  }
   return a;
 }
 
@@ -270,31 +275,37 @@ int main(int argc, char** argv) {
     return 1;
   }
 
-  // Rover and base.
-  std::optional<RinexObsReader> rover;
-  RinexObsReaderOptions ropt;
-  ropt.skipBadEpochs = !args.strict;
+  // Rover and base: RINEX, UBX (rover and base) or RTCM 3 (base), told apart by content
+  // (BaseReader). UBX and RTCM add the ephemerides they carry to `nav` as they are read.
+  std::unique_ptr<BaseReader> rover;
   std::unique_ptr<BaseReader> base;
   ObsEpoch roverEpoch;
   bool haveRover = false;
   try {
-    rover.emplace(args.inputs[0], ropt);
+    if (BaseReader::detect(args.inputs[0]) == BaseFormat::Rtcm) {
+      std::fprintf(stderr, "gvins-rtk: error: rover %s is an RTCM 3 log; convert it with gvins-rtcm to-rinex --date first\n",
+                   args.inputs[0].c_str());
+      return 1;
+    }
+    rover = BaseReader::open(args.inputs[0], GpsTime{}, &nav, !args.strict);
     haveRover = rover->next(roverEpoch);
-    const GpsTime ref = haveRover ? roverEpoch.time : rover->header().firstObs.value_or(GpsTime());
+    const GpsTime ref = haveRover ? roverEpoch.time
+                                  : (rover->rinexHeader() ? rover->rinexHeader()->firstObs.value_or(GpsTime()) : GpsTime());
     base = BaseReader::open(args.inputs[1], ref, &nav, !args.strict);
   } catch (const ParseError& e) {
     printError(e);
     return 1;
   }
-  if (nav.size() == 0 && base->format() != BaseFormat::Rtcm) {
+  if (nav.size() == 0 && base->format() == BaseFormat::Rinex && rover->format() == BaseFormat::Rinex) {
     std::fprintf(stderr, "gvins-rtk: error: no usable ephemeris in the navigation files\n");
     return 1;
   }
-  const RinexObsHeader& hdr = rover->header();
+  static const RinexObsHeader kNoHeader;
+  const RinexObsHeader& hdr = rover->rinexHeader() ? *rover->rinexHeader() : kNoHeader;
 
   RtkSolver solver(nav, cfg, sppCfg);
-  solver.setRoverGlonassChannels(hdr.glonassChannels);
-  const PhaseAlignments roverAlignment = phaseAlignmentOf(hdr);
+  solver.setRoverGlonassChannels(rover->glonassChannels());
+  const PhaseAlignments roverAlignment = rover->phaseAlignment();
   if (hdr.station.approxPosition && hdr.station.approxPosition->norm() > 1e6) {
     solver.setRoverInitialPosition(*hdr.station.approxPosition);
   }
@@ -387,7 +398,7 @@ int main(int argc, char** argv) {
           if (auto p = base->antennaPosition()) {
             solver.setBasePosition(*p);
             basePosUsed = p;
-            baseSource = base->format() == BaseFormat::Rtcm ? "RTCM 1005/1006" : "RINEX header";
+            baseSource = base->format() == BaseFormat::Rtcm ? "RTCM 1005/1006" : "RINEX header";  // UBX gives none
           }
         }
         solver.setBaseGlonassChannels(base->glonassChannels());
@@ -405,10 +416,11 @@ int main(int argc, char** argv) {
       if (auto p = base->antennaPosition()) {
         solver.setBasePosition(*p);
         basePosUsed = p;
-        baseSource = base->format() == BaseFormat::Rtcm ? "RTCM 1005/1006" : "RINEX header";
+        baseSource = base->format() == BaseFormat::Rtcm ? "RTCM 1005/1006" : "RINEX header";  // UBX gives none
       }
     }
 
+    if (rover->format() != BaseFormat::Rinex) solver.setRoverGlonassChannels(rover->glonassChannels());
     const RtkSolution sol = solver.process(roverEpoch);
     showDopplerWarnings(solver.roverDoppler(), roverWarned);
     showDopplerWarnings(solver.base().doppler(), baseWarned);
@@ -558,10 +570,11 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "  base input             %lld epochs out of order, %lld position changes\n",
                  static_cast<long long>(bs.outOfOrder), static_cast<long long>(bs.positionChanges));
   }
-  const auto& rs = rover->stats();
-  if (rs.skippedEpochs || base->skipped()) {
-    std::fprintf(stderr, "  input                  %lld malformed rover epochs skipped, %lld base epochs/frames skipped\n",
-                 static_cast<long long>(rs.skippedEpochs), static_cast<long long>(base->skipped()));
+  static const RinexObsReaderStats kNoStats;
+  const RinexObsReaderStats& rs = rover->rinexStats() ? *rover->rinexStats() : kNoStats;
+  if (rover->skipped() || base->skipped()) {
+    std::fprintf(stderr, "  input                  %lld malformed rover epochs/frames skipped, %lld base epochs/frames skipped\n",
+                 static_cast<long long>(rover->skipped()), static_cast<long long>(base->skipped()));
     for (const auto& m : rs.messages) std::fprintf(stderr, "    %s\n", m.c_str());
   }
   std::fprintf(stderr, "  time                   %8.3f s (%.0f epochs/s)\n", wall, wall > 0 ? epochs / wall : 0.0);

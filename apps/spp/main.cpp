@@ -23,6 +23,7 @@
 #include "gvins/ephemeris/precise_product_files.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "gvins/gnss/accuracy_statistics.hpp"
+#include "gvins/gnss/base_reader.hpp"
 #include "gvins/gnss/carrier_smoothing.hpp"
 #include "gvins/gnss/doppler_consistency.hpp"
 #include "gvins/gnss/pos_reader.hpp"
@@ -34,12 +35,13 @@
 namespace {
 
 const char* kUsage =
-    "usage: gvins-spp [options] -o OUT.pos OBS NAV [NAV...] [ORBIT.sp3...] [CLOCK.clk...] [ANT.atx]\n"
+    "usage: gvins-spp [options] -o OUT.pos OBS [NAV...] [ORBIT.sp3...] [CLOCK.clk...] [ANT.atx]\n"
     "                 [BIAS.bia...]\n"
     "       gvins-spp --score FILE.pos --truth X,Y,Z | --truth-llh LAT,LON,H\n"
     "\n"
-    "Single point positioning from RINEX observations (2.10/2.11, 3.0x; plain or .gz) and\n"
-    "broadcast navigation files (RINEX 2/3/4, merged). Writes one RTKLIB-style .pos row per\n"
+    "Single point positioning from RINEX observations (2.10/2.11, 3.0x; plain or .gz) or a u-blox\n"
+    "UBX log (RXM-RAWX; told apart by content) and broadcast navigation files (RINEX 2/3/4, merged;\n"
+    "optional for UBX, whose RXM-SFRBX ephemerides are used as they arrive). Writes one RTKLIB-style .pos row per\n"
     "solved epoch, prints progress and a summary to stderr. Precise products among the inputs\n"
     "(SP3-c/d orbits *.sp3, RINEX clocks *.clk, plain or .gz; told apart by their names) replace\n"
     "the broadcast orbits and clocks where they cover a satellite; an ANTEX file (*.atx) moves\n"
@@ -188,7 +190,9 @@ Args parseArgs(int argc, char** argv) {
     return a;
   }
   if (a.out.empty()) usageError("no output file (-o OUT.pos)");
-  if (a.inputs.size() < 2) usageError("need an observation file and at least one navigation file");
+  if (a.inputs.empty() || (a.inputs.size() == 1 && gvins::BaseReader::detect(a.inputs[0]) != gvins::BaseFormat::Ubx)) {
+    usageError("need an observation file and at least one navigation file (a UBX log may come alone: it carries its own)");
+  }
   return a;
 }
 
@@ -287,29 +291,38 @@ int main(int argc, char** argv) {
     printError(e);
     return 1;
   }
-  if (nav.size() == 0) {
-    std::fprintf(stderr, "gvins-spp: error: no usable ephemeris in the navigation files\n");
-    return 1;
-  }
-
-  // Observations.
-  std::optional<RinexObsReader> obs;
-  RinexObsReaderOptions ropt;
-  ropt.skipBadEpochs = !args.strict;
+  // Observations: RINEX or UBX, told apart by content (BaseReader). A UBX log adds the
+  // ephemerides of its RXM-SFRBX subframes to `nav` as they are read.
+  std::unique_ptr<BaseReader> obs;
   try {
-    obs.emplace(args.inputs[0], ropt);
+    if (BaseReader::detect(args.inputs[0]) == BaseFormat::Rtcm) {
+      std::fprintf(stderr, "gvins-spp: error: %s is an RTCM 3 log; convert it with gvins-rtcm to-rinex --date first\n",
+                   args.inputs[0].c_str());
+      return 1;
+    }
+    obs = BaseReader::open(args.inputs[0], GpsTime{}, &nav, !args.strict);
   } catch (const ParseError& e) {
     printError(e);
     return 1;
   }
-  const RinexObsHeader& hdr = obs->header();
+  const bool streamInput = obs->format() == BaseFormat::Ubx;
+  if (nav.size() == 0 && !streamInput) {
+    std::fprintf(stderr, "gvins-spp: error: no usable ephemeris in the navigation files\n");
+    return 1;
+  }
+  static const RinexObsHeader kNoHeader;
+  const RinexObsHeader& hdr = obs->rinexHeader() ? *obs->rinexHeader() : kNoHeader;
+
   // SSR corrections: their times of week resolve against the first observation epoch.
   if (!args.ssr.empty()) {
     GpsTime first;
-    {
-      RinexObsReader peek(args.inputs[0], ropt);
+    try {
+      auto peek = BaseReader::open(args.inputs[0], GpsTime{}, nullptr, !args.strict);
       ObsEpoch e;
-      if (peek.next(e)) first = e.time;
+      if (peek->next(e)) first = e.time;
+    } catch (const ParseError& e) {
+      printError(e);
+      return 1;
     }
     try {
       std::size_t n = 0;
@@ -329,10 +342,10 @@ int main(int argc, char** argv) {
   }
 
   SppSolver solver(nav, cfg);
-  solver.setGlonassChannels(hdr.glonassChannels);
+  solver.setGlonassChannels(obs->glonassChannels());
   // GLONASS channels for the carrier smoothing's wavelengths: the header's, else the navigation
   // records' (as the solver does).
-  GlonassChannels channels = hdr.glonassChannels;
+  GlonassChannels channels = obs->glonassChannels();
   channels.mergeMissing(nav.glonassChannels());
   if (hdr.station.approxPosition) solver.setInitialPosition(*hdr.station.approxPosition);
 
@@ -354,6 +367,7 @@ int main(int argc, char** argv) {
     if (!cfg.systems[i]) continue;
     for (const ObsDescriptor& d : hdr.obsTypes[i]) hasDoppler = hasDoppler || d.type == ObsType::Doppler;
   }
+  hasDoppler = hasDoppler || (streamInput && obs->mayHaveDoppler());
   popt.velocity = cfg.velocity && hasDoppler;
   if (!cfg.velocity) popt.notes.emplace_back("no velocity columns: velocity not estimated (--no-velocity)");
   else if (!hasDoppler) popt.notes.emplace_back("no velocity columns: no Doppler observations in the input");
@@ -410,6 +424,11 @@ int main(int argc, char** argv) {
       break;
     }
     ++epochs;
+    if (streamInput) {  // UBX: GLONASS channels arrive with the observations (RAWX freqId)
+      channels = obs->glonassChannels();
+      channels.mergeMissing(nav.glonassChannels());
+      solver.setGlonassChannels(obs->glonassChannels());
+    }
     doppler.apply(epoch, channels);
     for (; dopplerWarned < doppler.warnings().size(); ++dopplerWarned) {
       std::fprintf(stderr, "%sgvins-spp: warning: %s\n", tty ? "\r" : "", doppler.warnings()[dopplerWarned].c_str());
@@ -463,7 +482,8 @@ int main(int argc, char** argv) {
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
   // Summary.
-  const auto& rs = obs->stats();
+  static const RinexObsReaderStats kNoStats;
+  const RinexObsReaderStats& rs = obs->rinexStats() ? *obs->rinexStats() : kNoStats;
   std::fprintf(stderr, "gvins-spp summary (%s)\n", args.inputs[0].c_str());
   std::fprintf(stderr, "  epochs read            %8ld\n", epochs);
   std::fprintf(stderr, "  solutions              %8ld (%.1f %%)\n", solutions, epochs ? 100.0 * solutions / epochs : 0.0);
@@ -495,9 +515,13 @@ int main(int argc, char** argv) {
                  static_cast<long long>(rs.specialRecords), static_cast<long long>(rs.emptyEpochs));
     for (const auto& m : rs.messages) std::fprintf(stderr, "    %s\n", m.c_str());
   }
-  if (!obs->header().ignoredTypes.empty()) {
+  if (streamInput) {
+    std::fprintf(stderr, "  input: %s; %lld malformed messages skipped\n", obs->describe().c_str(),
+                 static_cast<long long>(obs->skipped()));
+  }
+  if (!hdr.ignoredTypes.empty()) {
     std::fprintf(stderr, "  observation columns not used (unknown or non-measurement codes):");
-    for (const auto& t : obs->header().ignoredTypes) std::fprintf(stderr, " %s;", t.c_str());
+    for (const auto& t : hdr.ignoredTypes) std::fprintf(stderr, " %s;", t.c_str());
     std::fprintf(stderr, "\n");
   }
   std::fprintf(stderr, "  time                   %8.3f s (%.0f epochs/s)\n", wall, wall > 0 ? epochs / wall : 0.0);

@@ -1,7 +1,9 @@
 #include "gvins/gnss/base_reader.hpp"
 
 #include <cmath>
+#include <algorithm>
 #include <cstring>
+#include <span>
 #include <filesystem>
 #include <fstream>
 #include <utility>
@@ -13,6 +15,8 @@
 #include "gvins/base/parse_error.hpp"
 #include "gvins/base/rinex_obs_reader.hpp"
 #include "gvins/rtcm/decoder.hpp"
+#include "gvins/ubx/stream_splitter.hpp"
+#include "gvins/ubx/ubx_decoder.hpp"
 
 namespace gvins {
 
@@ -41,6 +45,16 @@ class RinexBase final : public BaseReader {
     return buf;
   }
   std::int64_t skipped() const override { return reader_.stats().skippedEpochs; }
+  bool mayHaveDoppler() const override {
+    for (const auto& list : reader_.header().obsTypes) {
+      for (const ObsDescriptor& d : list) {
+        if (d.type == ObsType::Doppler) return true;
+      }
+    }
+    return false;
+  }
+  const RinexObsHeader* rinexHeader() const override { return &reader_.header(); }
+  const RinexObsReaderStats* rinexStats() const override { return &reader_.stats(); }
 
  private:
   static RinexObsReaderOptions options(bool skip) {
@@ -118,6 +132,7 @@ class RtcmBase final : public BaseReader {
     return buf;
   }
   std::int64_t skipped() const override { return decoder_.stats().malformed + decoder_.stats().framing.crcFailures; }
+  bool mayHaveDoppler() const override { return true; }
 
  private:
   static rtcm::DecoderOptions options(const std::string& path, const GpsTime& reference) {
@@ -133,19 +148,90 @@ class RtcmBase final : public BaseReader {
   bool done_ = false;
 };
 
+class UbxBase final : public BaseReader {
+ public:
+  UbxBase(const std::string& path, EphemerisStore* nav, bool strict)
+      : in_(path, std::ios::binary), nav_(nav), decoder_(options(path, strict)) {
+    if (!in_) throw ParseError(path, 0, "", "cannot open file");
+    buf_.resize(1 << 16);
+  }
+  bool next(ObsEpoch& e) override {
+    for (;;) {
+      while (auto d = decoder_.poll()) {
+        if (auto* o = std::get_if<ObsEpoch>(&*d)) {
+          e = std::move(*o);
+          return true;
+        }
+        // Ephemerides assembled from the receiver's own SFRBX subframes.
+        if (auto* u = std::get_if<ubx::NavDataUpdate>(&*d); u && nav_) u->addTo(*nav_);
+      }
+      if (done_) return false;
+      in_.read(reinterpret_cast<char*>(buf_.data()), static_cast<std::streamsize>(buf_.size()));
+      const auto n = in_.gcount();
+      if (n > 0) decoder_.feed(std::span<const std::uint8_t>(buf_.data(), static_cast<std::size_t>(n)));
+      if (n <= 0 || !in_) {
+        decoder_.finish();
+        done_ = true;
+      }
+    }
+  }
+  std::optional<Eigen::Vector3d> antennaPosition() const override { return std::nullopt; }
+  GlonassChannels glonassChannels() const override { return decoder_.glonassChannels(); }
+  BaseFormat format() const override { return BaseFormat::Ubx; }
+  // u-blox documents no alignment of the phases of different tracking modes of a band.
+  PhaseAlignments phaseAlignment() const override { return {}; }
+  std::string describe() const override {
+    const auto& s = decoder_.stats();
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "u-blox UBX, %lld frames, %lld checksum failures, %lld epochs, %lld ephemerides from SFRBX",
+                  static_cast<long long>(s.stream.ubxFrames), static_cast<long long>(s.stream.ubxChecksumFailures),
+                  static_cast<long long>(s.epochs), static_cast<long long>(s.ephemerides));
+    return buf;
+  }
+  std::int64_t skipped() const override { return decoder_.stats().malformed + decoder_.stats().stream.ubxChecksumFailures; }
+  bool mayHaveDoppler() const override { return true; }
+
+ private:
+  static ubx::DecoderOptions options(const std::string& path, bool strict) {
+    ubx::DecoderOptions o;
+    o.streamName = path;
+    o.strict = strict;
+    return o;
+  }
+  std::ifstream in_;
+  EphemerisStore* nav_;
+  ubx::Decoder decoder_;
+  std::vector<std::uint8_t> buf_;
+  bool done_ = false;
+};
+
+/// Good UBX frames and good RTCM frames in a byte block (mixed streams hold both).
+std::pair<int, int> countFrames(std::span<const std::uint8_t> head) {
+  ubx::StreamSplitter sp;
+  sp.feed(head);
+  ubx::StreamFrame f;
+  while (sp.next(f)) {
+  }
+  return {static_cast<int>(sp.stats().ubxFrames), static_cast<int>(sp.stats().rtcmFrames)};
+}
+
 }  // namespace
 
 std::optional<BaseFormat> BaseReader::detect(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return std::nullopt;
-  std::vector<unsigned char> head(4096);
+  std::vector<unsigned char> head(1 << 16);
   in.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size()));
   head.resize(static_cast<std::size_t>(in.gcount()));
   if (head.size() >= 2 && head[0] == 0x1f && head[1] == 0x8b) return BaseFormat::Rinex;
-  const std::string text(head.begin(), head.end());
+  const std::size_t textHead = std::min<std::size_t>(head.size(), 4096);
+  const std::string text(head.begin(), head.begin() + static_cast<std::ptrdiff_t>(textHead));
   if (text.find("RINEX VERSION / TYPE") != std::string::npos) return BaseFormat::Rinex;
+  // UBX when its frames (checksums good) are at least as many as the RTCM frames (CRCs good).
+  const auto [ubxFrames, rtcmFrames] = countFrames(head);
+  if (ubxFrames > 0 && ubxFrames >= rtcmFrames) return BaseFormat::Ubx;
   // An RTCM frame header: 0xD3, six zero bits, a 10-bit length.
-  for (std::size_t i = 0; i + 2 < head.size(); ++i) {
+  for (std::size_t i = 0; i + 2 < textHead; ++i) {
     if (head[i] == 0xD3 && (head[i + 1] & 0xFC) == 0) return BaseFormat::Rtcm;
   }
   return std::nullopt;
@@ -154,14 +240,15 @@ std::optional<BaseFormat> BaseReader::detect(const std::string& path) {
 std::unique_ptr<BaseReader> BaseReader::open(const std::string& path, const GpsTime& referenceTime,
                                              EphemerisStore* nav, bool skipBadEpochs) {
   std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw ParseError(path, 0, "", "is a directory, not a base station file");
+  if (std::filesystem::is_directory(path, ec)) throw ParseError(path, 0, "", "is a directory, not an observation file");
   const auto f = detect(path);
   if (!f) {
     std::ifstream probe(path, std::ios::binary);
     if (!probe) throw ParseError(path, 0, "", "cannot open file");
-    throw ParseError(path, 1, "format", "neither RINEX observation data nor an RTCM 3 stream");
+    throw ParseError(path, 1, "format", "neither RINEX observation data nor an RTCM 3 or u-blox UBX stream");
   }
   if (*f == BaseFormat::Rinex) return std::make_unique<RinexBase>(path, skipBadEpochs);
+  if (*f == BaseFormat::Ubx) return std::make_unique<UbxBase>(path, nav, !skipBadEpochs);
   return std::make_unique<RtcmBase>(path, referenceTime, nav);
 }
 

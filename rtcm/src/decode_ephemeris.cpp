@@ -5,6 +5,7 @@
 // IS-QZSS-PNT, Galileo OS SIS ICD table 60).
 #include <cmath>
 
+#include "broadcast_times.hpp"
 #include "decoder_state.hpp"
 #include "gvins/base/constants.hpp"
 #include "gvins/rtcm/accuracy_tables.hpp"
@@ -16,35 +17,6 @@ constexpr double kSc = constants::kPi;  // semicircles to radians (ICD value of 
 
 double sc(std::int64_t v, int e) { return std::ldexp(static_cast<double>(v), e); }
 double uc(std::uint64_t v, int e) { return std::ldexp(static_cast<double>(v), e); }
-
-/// Moves t by whole weeks so that it is within half a week of `near`.
-GpsTime nearWeek(GpsTime t, const GpsTime& near) {
-  const double d = t - near;
-  if (d > kSecondsPerWeek / 2) t -= kSecondsPerWeek * std::round(d / kSecondsPerWeek);
-  else if (d < -kSecondsPerWeek / 2) t += kSecondsPerWeek * std::round(-d / kSecondsPerWeek);
-  return t;
-}
-
-/// GLONASS time of day (Moscow, s) as the GPST instant nearest `near`.
-GpsTime glonassTodNear(double tod, const GpsTime& near) {
-  const std::int64_t leap = leapSecondsAtGpst(near);
-  const std::int64_t glo = near.wholeSeconds() - leap + 10800;
-  const double nearTod = static_cast<double>(((glo % 86400) + 86400) % 86400) + near.fraction();
-  double d = tod - nearTod;
-  if (d >= 43200.0) d -= 86400.0;
-  if (d < -43200.0) d += 86400.0;
-  return near + d;
-}
-
-/// GPS/QZSS LNAV fit interval in hours from the fit interval flag and IODC
-/// (IS-GPS-200 20.3.4.4, table 20-XII).
-double gpsFitHours(bool flag, int iodc) {
-  if (!flag) return 4.0;
-  if (iodc >= 240 && iodc <= 247) return 8.0;
-  if ((iodc >= 248 && iodc <= 255) || iodc == 496) return 14.0;
-  if ((iodc >= 497 && iodc <= 503) || (iodc >= 1021 && iodc <= 1023)) return 26.0;
-  return 6.0;
-}
 
 // Galileo and BeiDou times: full week numbers in the system's own count.
 void finishTimes(Decoder::State& s, KeplerEphemeris& e, int fullWeek, double toe, double toc,

@@ -7,6 +7,23 @@
 
 namespace gvins::rtcm {
 
+FrameCheck checkFrame(std::span<const std::uint8_t> bytes, std::size_t& size) {
+  const std::size_t n = bytes.size();
+  if (n == 0 || bytes[0] != Framer::kPreamble) return FrameCheck::NotPreamble;
+  if (n < 3) return FrameCheck::NeedMore;  // need the header
+  // Reserved bits must be zero (RTCM 10403.3, table 4-1).
+  if ((bytes[1] & 0xFCu) != 0) return FrameCheck::BadHeader;
+  const std::size_t len = (static_cast<std::size_t>(bytes[1] & 0x03u) << 8) | bytes[2];
+  const std::size_t total = len + 6;
+  if (n < total) return FrameCheck::NeedMore;  // wait for the rest
+  const std::uint32_t crc = crc24q(bytes.first(len + 3));
+  const std::uint32_t got = (static_cast<std::uint32_t>(bytes[len + 3]) << 16) |
+                            (static_cast<std::uint32_t>(bytes[len + 4]) << 8) | bytes[len + 5];
+  if (crc != got) return FrameCheck::BadCrc;
+  size = total;
+  return FrameCheck::Good;
+}
+
 void Framer::feed(std::span<const std::uint8_t> bytes) {
   // Drop consumed bytes first so that the buffer never holds more than one partial frame plus
   // this chunk.
@@ -35,33 +52,27 @@ bool Framer::next(Frame& frame) {
       pos_ = next;
       continue;
     }
-    if (n - pos_ < 3) {  // need the header
-      if (!eof_) return false;
-      truncated();
-      continue;
+    std::size_t total = 0;
+    switch (checkFrame({p, n - pos_}, total)) {
+      case FrameCheck::NotPreamble:  // not reached: p[0] is the preamble
+      case FrameCheck::NeedMore:
+        if (!eof_) return false;
+        truncated();
+        continue;
+      case FrameCheck::BadHeader:
+        ++stats_.badHeaders;
+        ++stats_.skippedBytes;
+        ++pos_;
+        continue;
+      case FrameCheck::BadCrc:
+        ++stats_.crcFailures;
+        ++stats_.skippedBytes;
+        ++pos_;
+        continue;
+      case FrameCheck::Good:
+        break;
     }
-    if ((p[1] & 0xFCu) != 0) {       // reserved bits must be zero (RTCM 10403.3, table 4-1)
-      ++stats_.badHeaders;
-      ++stats_.skippedBytes;
-      ++pos_;
-      continue;
-    }
-    const std::size_t len = (static_cast<std::size_t>(p[1] & 0x03u) << 8) | p[2];
-    const std::size_t total = len + 6;
-    if (n - pos_ < total) {  // wait for the rest
-      if (!eof_) return false;
-      truncated();
-      continue;
-    }
-    const std::uint32_t crc = crc24q({p, len + 3});
-    const std::uint32_t got = (static_cast<std::uint32_t>(p[len + 3]) << 16) |
-                              (static_cast<std::uint32_t>(p[len + 4]) << 8) | p[len + 5];
-    if (crc != got) {
-      ++stats_.crcFailures;
-      ++stats_.skippedBytes;
-      ++pos_;
-      continue;
-    }
+    const std::size_t len = total - 6;
     frame.payload = {p + 3, len};
     frame.offset = base_ + static_cast<std::int64_t>(pos_);
     pos_ += total;

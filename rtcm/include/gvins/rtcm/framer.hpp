@@ -37,6 +37,19 @@ struct FramerStats {
   std::int64_t truncatedFrames = 0; ///< frame started but stream ended before its end
 };
 
+/// Outcome of checking the bytes at one position for an RTCM frame.
+enum class FrameCheck {
+  NotPreamble,  ///< the first byte is not 0xD3
+  NeedMore,     ///< a frame may start here but more bytes are needed to tell
+  BadHeader,    ///< reserved bits not zero
+  BadCrc,       ///< complete candidate whose CRC failed
+  Good,         ///< a complete frame; `size` holds its length in bytes (payload + 6)
+};
+
+/// Checks whether `bytes` starts with a complete RTCM frame. Shared by the Framer and the mixed
+/// UBX/RTCM/NMEA stream splitter (gvins/ubx/stream_splitter.hpp).
+FrameCheck checkFrame(std::span<const std::uint8_t> bytes, std::size_t& size);
+
 class Framer {
  public:
   static constexpr std::uint8_t kPreamble = 0xD3;

@@ -1,0 +1,43 @@
+// gvins-ubx: u-blox UBX logs (RXM-RAWX raw observations, mixed with NMEA and RTCM 3 or not).
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "stream_summary.hpp"
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: gvins-ubx <command> ...\n"
+    "  info FILE|-\n"
+    "      one row per UBX message (class-id, count, name), NMEA/RTCM 3 counts of a mixed stream,\n"
+    "      time span and epochs, signals per system, SFRBX count, checksum failures and malformed\n"
+    "      messages\n"
+    "  to-rinex FILE|- -o PREFIX [--max-phase-sigma CYC]\n"
+    "      writes PREFIX.obs (RINEX 3.04) with every RXM-RAWX signal; --max-phase-sigma leaves out\n"
+    "      phases whose reported standard deviation is larger (RTKLIB's convbin: 0.02)\n"
+    "exit status: 0 ok, 1 error (file, decoding), 2 usage\n";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace gvins::rtcm_app;
+  if (argc < 2 || std::string(argv[1]) == "-h" || std::string(argv[1]) == "--help") {
+    std::cerr << kUsage;
+    return argc < 2 ? 2 : 0;
+  }
+  const std::string cmd = argv[1];
+  const std::vector<std::string> args(argv + 2, argv + argc);
+  try {
+    if (cmd == "info") return gvins::ubx_app::runInfo(args);
+    if (cmd == "to-rinex") return gvins::ubx_app::runToRinex(args);
+    throw UsageError("unknown command '" + cmd + "'");
+  } catch (const UsageError& e) {
+    std::cerr << "gvins-ubx: " << e.what() << "\n" << kUsage;
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "gvins-ubx: " << e.what() << "\n";
+    return 1;
+  }
+}

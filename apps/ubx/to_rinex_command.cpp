@@ -1,0 +1,165 @@
+// gvins-ubx to-rinex FILE|- -o PREFIX [--max-phase-sigma CYC]
+// Two passes over the stream (stdin is spooled to a temporary file first): the first collects
+// the observation types, GLONASS channels, epoch span and approximate position for the header,
+// the second writes PREFIX.obs (RINEX 3.04) epoch by epoch with every signal of RXM-RAWX.
+// PREFIX.nav (RINEX 3.04) holds every distinct ephemeris assembled from RXM-SFRBX and the
+// ionosphere parameters last broadcast.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <tuple>
+
+#include "commands.hpp"
+#include "gvins/base/atomic_output_file.hpp"
+#include "gvins/base/constants.hpp"
+#include "gvins/base/geodetic.hpp"
+#include "gvins/base/rinex_obs_writer.hpp"
+#include "gvins/ephemeris/rinex_nav.hpp"
+#include "stream_summary.hpp"
+#include "ubx_summary.hpp"
+
+namespace gvins::ubx_app {
+
+using rtcm_app::UsageError;
+
+int runToRinex(const std::vector<std::string>& args) {
+  std::string path, prefix;
+  ubx::DecoderOptions opt;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    rtcm_app::requireValue(args, i, {"-o", "--max-phase-sigma"});
+    if (args[i] == "-o") {
+      prefix = args[++i];
+    } else if (args[i] == "--max-phase-sigma") {
+      char* end = nullptr;
+      const double v = std::strtod(args[++i].c_str(), &end);
+      if (end == args[i].c_str() || *end != '\0' || !(v > 0.0) || v > 1.0) {
+        throw UsageError("--max-phase-sigma must be a number of cycles in (0, 1], got '" + args[i] + "'");
+      }
+      opt.maxPhaseStdDev = v;
+    } else if (args[i].size() > 1 && args[i][0] == '-') {
+      throw UsageError("to-rinex: unknown option '" + args[i] + "'");
+    } else if (path.empty()) {
+      path = args[i];
+    } else {
+      throw UsageError("to-rinex: more than one input");
+    }
+  }
+  if (path.empty()) throw UsageError("to-rinex: no input (FILE or -)");
+  if (prefix.empty()) throw UsageError("to-rinex: no output prefix (-o PREFIX)");
+  const std::string name = path == "-" ? "<stdin>" : path;
+  opt.streamName = name;
+
+  std::FILE* in = rtcm_app::reopenable(path);
+  // Pass 1: header contents.
+  RinexObsHeader header;
+  std::map<std::int64_t, int> spacing;  // epoch spacing in ms -> count
+  std::optional<GpsTime> prev;
+  std::optional<ubx::NavPvt> fix;
+  NavData nav;
+  std::map<std::tuple<int, int, std::int64_t, int>, bool> seen;  // sat index, message, toe, iode
+  ubx::Decoder scan(opt);
+  decodeAll(in, scan, [&](const ubx::Decoded& item) {
+    if (const auto* e = std::get_if<ObsEpoch>(&item)) {
+      header.addTypesFrom(*e);
+      if (prev && e->time > *prev) ++spacing[std::llround((e->time - *prev) * 1000.0)];
+      prev = e->time;
+    } else if (const auto* p = std::get_if<ubx::NavPvt>(&item)) {
+      if (!fix && p->fixOk() && p->fixType >= 3) fix = *p;
+    } else if (const auto* u = std::get_if<ubx::NavDataUpdate>(&item)) {
+      for (const KeplerEphemeris& k : u->kepler) {
+        const auto key = std::make_tuple(satIndex(k.sat), static_cast<int>(k.message), k.toe.wholeSeconds(), k.iode);
+        if (!seen[key]) nav.kepler.push_back(k);
+        seen[key] = true;
+      }
+      for (const GlonassEphemeris& g : u->glonass) {
+        const auto key = std::make_tuple(satIndex(g.sat), -1, g.toe.wholeSeconds(), g.iode);
+        if (!seen[key]) nav.glonass.push_back(g);
+        seen[key] = true;
+      }
+      if (u->ionosphere.gps) nav.iono.gps = u->ionosphere.gps;
+      if (u->ionosphere.qzss) nav.iono.qzss = u->ionosphere.qzss;
+      if (u->ionosphere.beidou) nav.iono.beidou = u->ionosphere.beidou;
+      if (u->ionosphere.galileo) nav.iono.galileo = u->ionosphere.galileo;
+    }
+  });
+  const ubx::DecoderStats& st = scan.stats();
+  if (st.stream.ubxFrames == 0) {
+    if (in != stdin) std::fclose(in);
+    throw std::runtime_error("to-rinex: " + name + ": no UBX frame with a good checksum in " +
+                             std::to_string(st.stream.bytes) + " bytes; nothing to convert");
+  }
+  if (st.epochs == 0) {
+    if (in != stdin) std::fclose(in);
+    throw std::runtime_error("to-rinex: " + name + ": " + std::to_string(st.stream.ubxFrames) +
+                             " UBX frames but no RXM-RAWX epoch; nothing to convert");
+  }
+  rtcm_app::sortTypes(header);
+  header.station.markerName = std::filesystem::path(path == "-" ? "UBX" : path).stem().string();
+  header.station.receiverType = "u-blox";
+  if (fix) {
+    header.station.approxPosition =
+        geodeticToEcef({fix->latDeg * constants::kDegToRad, fix->lonDeg * constants::kDegToRad, fix->height});
+  }
+  header.glonassChannels = scan.glonassChannels();
+  header.firstObs = st.firstEpoch;
+  header.lastObs = st.lastEpoch;
+  if (!spacing.empty()) {
+    header.interval = static_cast<double>(std::max_element(spacing.begin(), spacing.end(), [](const auto& a, const auto& b) {
+                                            return a.second < b.second;
+                                          })->first) * 1e-3;
+  }
+  header.leapSeconds = st.leapSeconds ? *st.leapSeconds : leapSecondsAtGpst(*st.firstEpoch);
+  header.signalStrengthUnit = "DBHZ";
+  header.comments.push_back("converted from u-blox UBX RXM-RAWX by gvins-ubx (SRI-GVINS)");
+  if (opt.maxPhaseStdDev) {
+    char c[80];
+    std::snprintf(c, sizeof c, "phases with u-blox cpStdev above %.3f cycles left out", *opt.maxPhaseStdDev);
+    header.comments.push_back(c);
+  }
+
+  // Pass 2: observations.
+  std::rewind(in);
+  const std::string obsPath = prefix + ".obs";
+  AtomicOutputFile obsFile(obsPath);
+  RinexObsWriter writer(obsFile.stream(), header, "gvins-ubx");
+  ubx::Decoder dec(opt);
+  SummaryExtras ex;
+  decodeAll(in, dec, [&](const ubx::Decoded& item) {
+    if (const auto* e = std::get_if<ObsEpoch>(&item)) writer.write(*e);
+  });
+  writer.finish();
+  if (in != stdin) std::fclose(in);
+  // Navigation file (only when the log carried SFRBX).
+  const std::string navPath = prefix + ".nav";
+  std::optional<AtomicOutputFile> navFile;
+  if (st.sfrbx > 0) {
+    std::sort(nav.kepler.begin(), nav.kepler.end(), [](const KeplerEphemeris& a, const KeplerEphemeris& b) {
+      return std::make_tuple(a.sat, a.toe) < std::make_tuple(b.sat, b.toe);
+    });
+    std::sort(nav.glonass.begin(), nav.glonass.end(), [](const GlonassEphemeris& a, const GlonassEphemeris& b) {
+      return std::make_tuple(a.sat, a.toe) < std::make_tuple(b.sat, b.toe);
+    });
+    nav.leapSeconds = header.leapSeconds;
+    navFile.emplace(navPath);
+    writeRinexNav(navFile->stream(), nav, "gvins-ubx");
+  }
+  obsFile.commit();
+  if (navFile) navFile->commit();
+  std::cerr << "wrote " << obsPath << " (" << writer.epochsWritten() << " epochs";
+  if (writer.droppedValues() > 0) std::cerr << ", " << writer.droppedValues() << " values not representable";
+  std::cerr << ")";
+  if (navFile) {
+    std::cerr << " and " << navPath << " (" << nav.kepler.size() << " Keplerian + " << nav.glonass.size()
+              << " GLONASS records from " << st.sfrbx << " SFRBX messages)";
+  } else {
+    std::cerr << "; no SFRBX, no navigation file";
+  }
+  std::cerr << "\n";
+  printSummary(std::cerr, dec, ex, name);
+  return 0;
+}
+
+}  // namespace gvins::ubx_app

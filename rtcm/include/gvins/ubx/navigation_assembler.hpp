@@ -1,0 +1,78 @@
+// Assembles broadcast ephemerides from UBX-RXM-SFRBX navigation data: keeps the partial
+// subframes/pages/strings of each satellite and emits a record once all parts with matching issue
+// of data have arrived. GPS/QZSS LNAV (IS-GPS-200), Galileo I/NAV (OS SIS ICD), BeiDou D1/D2
+// (BDS-SIS-ICD B1I), GLONASS L1/L2 OF strings (GLONASS ICD 5.1). SBAS messages are counted and
+// skipped. Records are filled exactly as the RTCM decoder and the RINEX reader fill them.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "gvins/base/gnss_time.hpp"
+#include "gvins/base/satellite.hpp"
+#include "gvins/ephemeris/glonass_ephemeris.hpp"
+#include "gvins/ephemeris/ionosphere_parameters.hpp"
+#include "gvins/ephemeris/kepler_ephemeris.hpp"
+#include "gvins/ubx/sfrbx.hpp"
+
+namespace gvins {
+class EphemerisStore;
+}
+
+namespace gvins::ubx {
+
+/// What one SFRBX message completed (usually nothing).
+struct NavDataUpdate {
+  std::vector<KeplerEphemeris> kepler;
+  std::vector<GlonassEphemeris> glonass;
+  /// Ionosphere parameters completed by this message (only the systems set are new).
+  IonosphereParameters ionosphere;
+
+  bool empty() const;
+  /// Adds the records to the store and sets the ionosphere parameters present here.
+  void addTo(EphemerisStore& store) const;
+};
+
+/// Counters of one system.
+struct NavigationCounts {
+  std::uint64_t messages = 0;         ///< SFRBX messages of the system
+  std::uint64_t parityFailures = 0;   ///< GPS/QZSS parity, BeiDou BCH, GLONASS Hamming failures
+  std::uint64_t crcFailures = 0;      ///< Galileo I/NAV CRC-24Q failures
+  std::uint64_t incompleteSets = 0;   ///< partial sets dropped (issue of data changed before completion)
+  std::uint64_t unknownMessages = 0;  ///< unhandled pages/subframes/strings, bad layout, unknown signals
+  std::uint64_t skipped = 0;          ///< messages not decoded: SBAS, NavIC, GPS/QZSS CNAV,
+                                      ///< Galileo F/NAV and E6, BeiDou B-CNAV1/2, GLONASS CDMA
+  std::uint64_t ephemerides = 0;      ///< complete records emitted
+  std::uint64_t ionosphere = 0;       ///< ionosphere parameter sets emitted
+};
+
+class NavigationAssembler {
+ public:
+  NavigationAssembler();
+  ~NavigationAssembler();
+  NavigationAssembler(NavigationAssembler&&) noexcept;
+  NavigationAssembler& operator=(NavigationAssembler&&) noexcept;
+
+  /// receiveTime: time of the latest RAWX epoch (resolves week/day ambiguities; the message's own
+  /// week numbers are used where they exist). A time before GPS week 1024 (e.g. GpsTime{}) means
+  /// "not known yet": GPS/QZSS and GLONASS sets are then kept until a message arrives with a time.
+  /// Returns the records completed by this message.
+  /// Never throws on bad navigation data: bad parity/CRC and malformed parts are counted.
+  NavDataUpdate add(const SfrbxMessage& msg, const GpsTime& receiveTime);
+
+  const NavigationCounts& counts(System system) const {
+    return counts_[static_cast<std::size_t>(systemIndex(system))];
+  }
+  /// Sum over all systems (messages of an unknown gnssId count as unknown messages).
+  NavigationCounts total() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+  std::array<NavigationCounts, kNumSystems> counts_{};
+  std::uint64_t unknownGnss_ = 0;
+};
+
+}  // namespace gvins::ubx

@@ -1,0 +1,167 @@
+// gvins-ubx end to end: `info` message counts against the independent frame scan on every bundled
+// log (and NMEA counts against a plain text count), `to-rinex` on the walk log read back against
+// RTKLIB's conversion, with the signals convbin drops counted per system.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <map>
+#include <regex>
+#include <sstream>
+
+#include "gvins/base/rinex_obs_reader.hpp"
+#include "gvins/ephemeris/rinex_nav.hpp"
+#include "independent_ubx_scan.hpp"
+
+namespace gvins::ubx {
+namespace {
+
+using testing::dataDir;
+using testing::readBytes;
+
+const std::string kTool = std::string(GVINS_BIN_DIR) + "/gvins-ubx";
+
+std::pair<std::string, int> run(const std::string& cmd) {
+  std::FILE* p = ::popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[4096];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  const int status = ::pclose(p);
+  return {out, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
+}
+
+/// NMEA sentences counted as text: "$" + printable characters + "*hh" + CR LF, checksum right.
+std::int64_t countNmea(const std::vector<std::uint8_t>& d) {
+  const std::string s(d.begin(), d.end());
+  std::int64_t n = 0;
+  static const std::regex re(R"(\$([\x20-\x23\x25-\x29\x2B-\x7E]{5,})\*([0-9A-F]{2})\r\n)");
+  for (auto it = std::sregex_iterator(s.begin(), s.end(), re); it != std::sregex_iterator(); ++it) {
+    unsigned sum = 0;
+    for (char c : (*it)[1].str()) sum ^= static_cast<unsigned char>(c);
+    if (sum == std::stoul((*it)[2].str(), nullptr, 16)) ++n;
+  }
+  return n;
+}
+
+TEST(UbxTool, InfoCountsEqualTheIndependentScan) {
+  for (const auto& path : testing::ubxFiles()) {
+    SCOPED_TRACE(path.string());
+    const auto d = readBytes(path);
+    const auto ref = testing::independentScan(d);
+    const auto [out, rc] = run(kTool + " info " + path.string());
+    ASSERT_EQ(rc, 0) << out;
+    std::map<int, std::int64_t> got;
+    std::istringstream in(out);
+    std::string line;
+    std::int64_t nmea = -1;
+    while (std::getline(in, line)) {
+      unsigned cls = 0, id = 0;
+      long long n = 0;
+      if (std::sscanf(line.c_str(), "  0x%2X-0x%2X %lld", &cls, &id, &n) == 3) got[static_cast<int>(cls * 256 + id)] = n;
+      long long k = 0;
+      if (std::sscanf(line.c_str(), "other %lld NMEA", &k) == 1) nmea = k;
+    }
+    EXPECT_EQ(got, ref.types);
+    EXPECT_EQ(nmea, countNmea(d));
+  }
+  // From stdin as well.
+  const auto [out, rc] = run(kTool + " info - < " + (dataDir() / "ubx/pyubx2_pygpsdata-RXMRAWX.log").string());
+  EXPECT_EQ(rc, 0);
+  EXPECT_NE(out.find("0x02-0x15      14  RXM-RAWX"), std::string::npos) << out;
+  EXPECT_NE(out.find("14 epochs"), std::string::npos) << out;
+}
+
+TEST(UbxTool, ToRinexKeepsEverySignalAndAgreesWithConvbin) {
+  const auto dir = std::filesystem::temp_directory_path() / ("gvins_ubx_tool_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string prefix = (dir / "walk").string();
+  const auto [out, rc] = run(kTool + " to-rinex " + (dataDir() / "ubx/gnss_1730.ubx").string() + " -o " + prefix + " 2>&1");
+  ASSERT_EQ(rc, 0) << out;
+  RinexObsReader ours(prefix + ".obs");
+  RinexObsReader theirs((dataDir() / "reference/rtklib-2.4.3/ubx_gnss_1730_convbin.obs.gz").string());
+  std::map<char, std::int64_t> oursPerSys, theirsPerSys, onlyOurs;
+  std::int64_t epochs = 0, values = 0;
+  double maxC = 0, maxL = 0;
+  ObsEpoch a, b;
+  while (theirs.next(b)) {
+    ASSERT_TRUE(ours.next(a));
+    ASSERT_NEAR(a.time - b.time, 0.0, 1e-7);
+    ++epochs;
+    for (const auto& s : a.sats) {
+      const SatObs* t = b.find(s.sat);
+      for (const auto& g : s.signals) {
+        ++oursPerSys[systemLetter(s.sat.system)];
+        const SignalObs* h = t ? t->find(g.code) : nullptr;
+        if (!h) {
+          ++onlyOurs[systemLetter(s.sat.system)];
+          continue;
+        }
+        if (g.hasCode() && h->hasCode()) maxC = std::max(maxC, std::abs(g.pseudorange - h->pseudorange)), ++values;
+        if (g.hasPhase() && h->hasPhase()) maxL = std::max(maxL, std::abs(g.carrierPhase - h->carrierPhase)), ++values;
+      }
+    }
+    for (const auto& s : b.sats) theirsPerSys[systemLetter(s.sat.system)] += static_cast<std::int64_t>(s.signals.size());
+  }
+  EXPECT_FALSE(ours.next(a));
+  EXPECT_EQ(epochs, 536);
+  // Both files written at 0.001 resolution from the same doubles: equal to the last digit.
+  EXPECT_LE(maxC, 1e-6);
+  EXPECT_LE(maxL, 1e-6);
+  EXPECT_GT(values, 20000);
+  // Signals per system, RAWX blocks of the independent scan (test_ubx_rawx.cpp): GPS 1C+2L+5Q
+  // 3842+4115+3752, Galileo 1C+5Q+6B 3199+4032+2932, BeiDou 6I+1P+5P 5416+4174+4809, SBAS 1579.
+  EXPECT_EQ(oursPerSys['G'], 11709);
+  EXPECT_EQ(oursPerSys['E'], 10163);
+  EXPECT_EQ(oursPerSys['C'], 14399);
+  EXPECT_EQ(oursPerSys['S'], 1579);
+  EXPECT_EQ(theirsPerSys.count('C'), 0u);  // convbin drops every BeiDou signal of this receiver
+  EXPECT_EQ(onlyOurs['G'], 3752);          // GPS L5 Q
+  EXPECT_EQ(onlyOurs['E'], 4032 + 2932);   // E5a Q, E6 B
+  EXPECT_EQ(onlyOurs['C'], 14399);
+  EXPECT_EQ(onlyOurs['S'], 0);
+  std::cerr << "walk log: " << epochs << " epochs; signals ours/convbin G " << oursPerSys['G'] << "/" << theirsPerSys['G']
+            << " E " << oursPerSys['E'] << "/" << theirsPerSys['E'] << " C " << oursPerSys['C'] << "/" << theirsPerSys['C']
+            << " S " << oursPerSys['S'] << "/" << theirsPerSys['S'] << "\n";
+  // The navigation file from the log's own SFRBX: every record convbin assembled is there with the
+  // same orbit (RTKLIB decodes the same subframes independently).
+  const NavData nav = readRinexNav(prefix + ".nav");
+  const NavData ref = readRinexNav((dataDir() / "reference/rtklib-2.4.3/ubx_gnss_1730_convbin.nav").string());
+  int matched = 0;
+  for (const KeplerEphemeris& r : ref.kepler) {
+    for (const KeplerEphemeris& k : nav.kepler) {
+      if (k.sat == r.sat && k.toe == r.toe) {
+        EXPECT_NEAR(k.sqrtA, r.sqrtA, 1e-6) << r.sat.str();
+        EXPECT_NEAR(k.e, r.e, 1e-12) << r.sat.str();
+        ++matched;
+        break;
+      }
+    }
+  }
+  EXPECT_EQ(matched, static_cast<int>(ref.kepler.size()));
+  EXPECT_GE(matched, 12);  // GPS 4 + BeiDou 8 (convbin's SBAS records are not Keplerian)
+  std::cerr << "walk log navigation: " << nav.kepler.size() << " records ours, " << ref.kepler.size()
+            << " convbin, all of convbin's matched\n";
+  std::filesystem::remove_all(dir);
+}
+
+TEST(UbxTool, BadInputsFailCleanly) {
+  EXPECT_EQ(run(kTool + " 2>/dev/null").second, 2);
+  EXPECT_EQ(run(kTool + " info 2>/dev/null").second, 2);
+  EXPECT_EQ(run(kTool + " to-rinex x.ubx 2>/dev/null").second, 2);  // no -o
+  EXPECT_EQ(run(kTool + " info /nonexistent.ubx 2>/dev/null").second, 1);
+  // A file without RAWX: nothing to convert, no output left behind.
+  const auto dir = std::filesystem::temp_directory_path() / ("gvins_ubx_bad_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto [out, rc] = run(kTool + " to-rinex " + (dataDir() / "ubx/gpsd_ublox-x20p.log").string() + " -o " +
+                             (dir / "x").string() + " 2>&1");
+  EXPECT_EQ(rc, 1);
+  EXPECT_NE(out.find("no RXM-RAWX epoch"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir / "x.obs"));
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace gvins::ubx
