@@ -29,6 +29,7 @@
 #include "gvins/gnss/accuracy_statistics.hpp"
 #include "gvins/gnss/base_reader.hpp"
 #include "gvins/gnss/pos_writer.hpp"
+#include "gvins/gnss/solution_outputs.hpp"
 #include "gvins/gnss/rtk.hpp"
 #include "gvins/gnss/rtk_config.hpp"
 #include "gvins/gnss/spp_config.hpp"
@@ -46,6 +47,8 @@ const char* kUsage =
     "(Q=1 fixed, 2 float, 5 single-point fallback), prints progress and a summary to stderr.\n"
     "\n"
     "  -o FILE               output .pos file ('-' for stdout); required\n"
+    "  --nmea FILE           also NMEA 0183 GGA+RMC sentences of the solutions (docs/nmea.md)\n"
+    "  --kml FILE            also a KML track of the solutions\n"
     "  --config F.yaml       options from the 'rtk:' (and 'spp:') sections of a YAML file;\n"
     "                        command-line options override it\n"
     "  --base-xyz X,Y,Z      base antenna reference point, ECEF (m)\n"
@@ -78,6 +81,7 @@ const char* kUsage =
 
 struct Args {
   std::string config, out;
+  std::string nmea, kml;
   std::vector<std::string> inputs;
   std::optional<Eigen::Vector3d> baseXyz, truth;
   std::optional<std::string> mode, dynamics, armode, systems, arSystems, validation;
@@ -121,6 +125,10 @@ Args parseArgs(int argc, char** argv) {
       std::exit(0);
     } else if (o == "-o") {
       a.out = value(i, o);
+    } else if (o == "--nmea") {
+      a.nmea = value(i, o);
+    } else if (o == "--kml") {
+      a.kml = value(i, o);
     } else if (o == "--config") {
       a.config = value(i, o);
     } else if (o == "--base-xyz") {
@@ -315,8 +323,10 @@ int main(int argc, char** argv) {
   // The .pos file is written under a temporary name and renamed only when the run succeeds: a
   // failed run leaves no file that looks valid (and an older file of that name intact).
   std::optional<OutputTarget> output;
+  std::optional<SolutionOutputs> side;
   try {
     output.emplace(args.out);
+    side.emplace(args.nmea, args.kml, "gvins-rtk " + args.inputs[0]);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "gvins-rtk: error: %s\n", e.what());
     return 1;
@@ -453,6 +463,7 @@ int main(int argc, char** argv) {
         writer = std::make_unique<PosWriter>(*out, popt);
       }
       writer->write(sol.toPositionSolution());
+      side->add(sol.toPositionSolution());
       satSum += sol.numSatellites;
       if (sol.quality != SolutionQuality::Single) ageMax = std::max(ageMax, sol.age);
       if (fixStats && sol.quality == SolutionQuality::Fix) {
@@ -489,6 +500,7 @@ int main(int argc, char** argv) {
   const bool toFile = output->isFile();
   try {
     output->finish(exitCode == 0);
+    side->finish(exitCode == 0);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "gvins-rtk: error: %s\n", e.what());
     exitCode = 1;
