@@ -129,6 +129,16 @@ class TcpClientSource final : public StreamSource {
         ::close(fd);
         continue;
       }
+      // A connection to a local port nobody listens on can meet itself (TCP simultaneous open
+      // when the kernel picks the destination port as the source port): refuse it.
+      sockaddr_storage self{}, peer{};
+      socklen_t ls = sizeof self, lp = sizeof peer;
+      if (::getsockname(fd, reinterpret_cast<sockaddr*>(&self), &ls) == 0 && ::getpeername(fd, reinterpret_cast<sockaddr*>(&peer), &lp) == 0 &&
+          ls == lp && std::memcmp(&self, &peer, ls) == 0) {
+        err = "connected to itself (nothing listens there)";
+        ::close(fd);
+        continue;
+      }
       const int one = 1;
       ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
       fd_ = fd;
