@@ -103,8 +103,8 @@ std::string findNavFile(const fs::path& dir) {
 }
 
 struct GnssInputs {
-  std::unique_ptr<RinexObsReader> rover;
-  std::unique_ptr<BaseReader> base;  // RINEX or an RTCM 3 log
+  std::unique_ptr<BaseReader> rover;  // RINEX or a u-blox UBX log
+  std::unique_ptr<BaseReader> base;   // RINEX, an RTCM 3 log or a UBX log
   bool basePositionSet = false;
   EphemerisStore nav;
   ObsEpoch nextRover, nextBase, currentBase;
@@ -369,8 +369,16 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
     std::string basePath = !opt.baseObs.empty() ? opt.baseObs : (gdir / "base.obs").string();
     const std::string navPath = !opt.navFile.empty() ? opt.navFile : findNavFile(gdir);
     if (!fs::exists(roverPath)) throw ParseError(roverPath, 0, "rover", "GNSS mode needs the rover observation file");
-    if (navPath.empty()) throw ParseError(gdir.string(), 0, "navigation", "no navigation file in the gnss folder (use --nav)");
-    g.nav.add(readRinexNav(navPath));
+    // A UBX rover or base brings its own ephemerides (RXM-SFRBX, added as they are read).
+    const auto roverFormat = BaseReader::detect(roverPath);
+    if (roverFormat == BaseFormat::Rtcm) {
+      throw ParseError(roverPath, 0, "rover", "an RTCM 3 rover log needs a date: convert it with gvins-rtcm to-rinex first");
+    }
+    const bool ubxNav = roverFormat == BaseFormat::Ubx || (fs::exists(basePath) && BaseReader::detect(basePath) == BaseFormat::Ubx);
+    if (navPath.empty() && !ubxNav) {
+      throw ParseError(gdir.string(), 0, "navigation", "no navigation file in the gnss folder (use --nav)");
+    }
+    if (!navPath.empty()) g.nav.add(readRinexNav(navPath));
     if (!opt.broadcastOnly) {
       // The folder's files where none were given (an --atx / --bia file replaces the folder's).
       PreciseProductFiles found;
@@ -403,9 +411,7 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
         throw ParseError(clk.front(), 0, "precise clock", "clock files need an SP3 orbit file (use --sp3)");
       }
     }
-    RinexObsReaderOptions ro;
-    ro.skipBadEpochs = true;
-    g.rover = std::make_unique<RinexObsReader>(roverPath, ro);
+    g.rover = BaseReader::open(roverPath, GpsTime{}, &g.nav, true);
     g.haveRover = g.rover->next(g.nextRover);
     // SSR corrections of recorded correction streams; their times of week resolve against the rover.
     for (const std::string& f : opt.ssrFiles) {
@@ -758,12 +764,16 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
   cov.close();
   timing.close();
   sum.files = {(out / "trajectory.tum").string(), (out / "trajectory.cov.csv").string(), timing.path()};
-  if (gnss && g.rover && g.rover->stats().skippedEpochs > 0) {
+  if (gnss && g.rover && g.rover->rinexStats() && g.rover->rinexStats()->skippedEpochs > 0) {
     // Malformed or out-of-order rover epochs were skipped: say which (file:line: reason).
-    const RinexObsReaderStats& rs = g.rover->stats();
+    const RinexObsReaderStats& rs = *g.rover->rinexStats();
     std::fprintf(stderr, "[gvins-replay] warning: %lld rover epochs skipped (%lld out of order or repeated):\n",
                  static_cast<long long>(rs.skippedEpochs), static_cast<long long>(rs.outOfOrderEpochs));
     for (const std::string& m : rs.messages) std::fprintf(stderr, "  %s\n", m.c_str());
+  }
+  if (gnss && g.rover && !g.rover->rinexStats() && g.rover->skipped() > 0) {
+    std::fprintf(stderr, "[gvins-replay] warning: rover %s: %lld malformed messages skipped\n", g.rover->describe().c_str(),
+                 static_cast<long long>(g.rover->skipped()));
   }
   if (gnss) {
     posWriter->finish();

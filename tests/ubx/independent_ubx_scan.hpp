@@ -25,6 +25,7 @@ struct ScanResult {
   std::map<int, std::int64_t> types;  // class << 8 | id -> frames
   std::int64_t frames = 0;
   std::int64_t badCandidates = 0;  // B5 62 + complete frame, checksum wrong
+  std::vector<std::size_t> offsets;  // where each good frame starts
 };
 
 inline ScanResult independentScan(const std::vector<std::uint8_t>& d, std::size_t maxLen = 8192) {
@@ -42,6 +43,7 @@ inline ScanResult independentScan(const std::vector<std::uint8_t>& d, std::size_
         if (a == d[i + 6 + len] && b == d[i + 7 + len]) {
           ++r.types[d[i + 2] * 256 + d[i + 3]];
           ++r.frames;
+          r.offsets.push_back(i);
           i += len + 8;
           continue;
         }

@@ -21,7 +21,7 @@ using testing::decodeLog;
 // 5e-12 of the value.
 void expectPrinted(double ours, double ref, const char* field, SatId sat) {
   EXPECT_LE(std::fabs(ours - ref), 5e-12 * std::fabs(ref) + 1e-300)
-      << field << " of " << systemLetter(sat.system) << sat.prn << ": ours " << ours << ", convbin " << ref;
+      << field << " of " << systemLetter(sat.system) << static_cast<int>(sat.prn) << ": ours " << ours << ", convbin " << ref;
 }
 
 const KeplerEphemeris* findKepler(const std::vector<KeplerEphemeris>& list, const KeplerEphemeris& r) {
@@ -136,6 +136,39 @@ TEST_P(SfrbxVsConvbin, EveryConvbinRecordReproduced) {
   EphemerisStore store;
   for (const NavDataUpdate& u : log.updates) u.addTo(store);
   EXPECT_EQ(store.size(), log.kepler.size() + log.glonass.size());
+}
+
+// Without any receive time the GLONASS set is dated by NT (string 4) and N4 (string 5), and BeiDou
+// and Galileo by their own week numbers: the same records as with the time.
+TEST(SfrbxWithoutTime, GlonassBeidouGalileoDatedByTheirOwnMessages) {
+  const auto path = dataDir() / "ubx" / "gpsd_ublox-zed-f9p-sfrbx.log";
+  const NavData ref = readRinexNav((dataDir() / "reference" / "rtklib-2.4.3" / "ubx_gpsd_ublox-zed-f9p-sfrbx_convbin.nav").string());
+  ASSERT_EQ(ref.glonass.size(), 1u);
+  const auto bytes = testing::readBytes(path);
+  Framer framer;
+  framer.feed(bytes);
+  framer.finish();
+  NavigationAssembler a;
+  std::vector<KeplerEphemeris> kepler;
+  std::vector<GlonassEphemeris> glonass;
+  Frame f;
+  while (framer.next(f)) {
+    if (f.type() != 0x0213) continue;
+    const NavDataUpdate u = a.add(parseSfrbx(f.payload), GpsTime{});
+    kepler.insert(kepler.end(), u.kepler.begin(), u.kepler.end());
+    glonass.insert(glonass.end(), u.glonass.begin(), u.glonass.end());
+  }
+  ASSERT_EQ(glonass.size(), 1u);
+  EXPECT_EQ(glonass[0].toe, ref.glonass[0].toe);
+  compareGlonass(glonass[0], ref.glonass[0]);
+  int matched = 0;
+  for (const KeplerEphemeris& r : ref.kepler) {
+    if (const KeplerEphemeris* e = findKepler(kepler, r)) {
+      compareKepler(*e, r);
+      ++matched;
+    }
+  }
+  EXPECT_EQ(matched, 2);  // E21 and C29
 }
 
 INSTANTIATE_TEST_SUITE_P(Logs, SfrbxVsConvbin,

@@ -217,18 +217,19 @@ TEST(UbxMalformed, LossOfLockFromLocktimeGapsHalfCyclesAndClockResets) {
   add(epoch(101.0, 4000, 0x07));        // 2: continuous
   add(epoch(102.0, 200, 0x07));         // 3: locktime decreased: slip
   add(epoch(103.0, 1200, 0x07));        // 4: continuous
+  add(epoch(103.25, 900, 0x07));        // 4b: locktime decreased, still longer than the gap: slip
   add(epoch(106.0, 2500, 0x07));        // 5: 3 s gap, locktime 2.5 s: re-acquired in the gap
   add(epoch(107.0, 3500, 0x0F));        // 6: half cycle subtracted now: phase jumped half a cycle
   add(epoch(108.0, 4500, 0x0F, 0x03));  // 7: receiver clock reset
   add(epoch(109.0, 5500, 0x0B));        // 8: half cycle no longer valid: bit 1
   Decoder d;
   const auto out = decodeAll(d, s);
-  ASSERT_EQ(out.size(), 8u);
+  ASSERT_EQ(out.size(), 9u);
   std::vector<int> lli;
   for (const auto& x : out) lli.push_back(std::get<ObsEpoch>(x).sats.at(0).signals.at(0).lli);
-  EXPECT_EQ(lli, (std::vector<int>{0, 0, 1, 0, 1, 1, 1, 2}));
+  EXPECT_EQ(lli, (std::vector<int>{0, 0, 1, 0, 1, 1, 1, 1, 2}));
   EXPECT_EQ(d.stats().clockResets, 1);
-  EXPECT_EQ(d.stats().slips, 4);
+  EXPECT_EQ(d.stats().slips, 5);
 }
 
 TEST(UbxMalformed, NavPvtClockAndTimeGps) {

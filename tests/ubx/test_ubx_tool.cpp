@@ -6,7 +6,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <fstream>
 #include <map>
 #include <regex>
 #include <sstream>
@@ -145,6 +147,54 @@ TEST(UbxTool, ToRinexKeepsEverySignalAndAgreesWithConvbin) {
   std::cerr << "walk log navigation: " << nav.kepler.size() << " records ours, " << ref.kepler.size()
             << " convbin, all of convbin's matched\n";
   std::filesystem::remove_all(dir);
+}
+
+TEST(UbxTool, InfoOnAMixedUbxRtcmNmeaStream) {
+  // The F9P log (UBX + NMEA) with an RTCM 3 log spliced in after every 100 kB: the RTCM frames
+  // are counted, the UBX messages and NMEA sentences are all still found.
+  const auto ubx = readBytes(dataDir() / "ubx/gpsd_ublox-zed-f9p_hpg1.11.log");
+  const auto rtcm = readBytes(dataDir() / "rtcm/rtklib_testglo.rtcm3");
+  const auto starts = testing::independentScan(ubx).offsets;
+  std::vector<std::uint8_t> mixed;
+  int splices = 0;
+  for (std::size_t i = 0; i < ubx.size();) {
+    // Cut only where a UBX frame starts (never inside a frame or a sentence).
+    const auto next = std::lower_bound(starts.begin(), starts.end(), i + 100000);
+    const std::size_t j = next == starts.end() ? ubx.size() : *next;
+    mixed.insert(mixed.end(), ubx.begin() + static_cast<std::ptrdiff_t>(i), ubx.begin() + static_cast<std::ptrdiff_t>(j));
+    if (j < ubx.size()) {
+      mixed.insert(mixed.end(), rtcm.begin(), rtcm.end());
+      ++splices;
+    }
+    i = j;
+  }
+  ASSERT_GE(splices, 10);
+  const auto dir = std::filesystem::temp_directory_path() / ("gvins_ubx_mixed_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto path = dir / "mixed.bin";
+  {
+    std::ofstream o(path, std::ios::binary);
+    o.write(reinterpret_cast<const char*>(mixed.data()), static_cast<std::streamsize>(mixed.size()));
+  }
+  const auto [out, rc] = run(kTool + " info - < " + path.string());
+  std::filesystem::remove_all(dir);
+  ASSERT_EQ(rc, 0) << out;
+  long long nmea = -1, rtcmCount = -1;
+  std::istringstream in(out);
+  std::string line;
+  std::map<int, std::int64_t> got;
+  while (std::getline(in, line)) {
+    unsigned cls = 0, id = 0;
+    long long n = 0;
+    if (std::sscanf(line.c_str(), "  0x%2X-0x%2X %lld", &cls, &id, &n) == 3) got[static_cast<int>(cls * 256 + id)] = n;
+    std::sscanf(line.c_str(), "other %lld NMEA sentences, %lld RTCM 3 frames", &nmea, &rtcmCount);
+  }
+  EXPECT_EQ(got, testing::independentScan(ubx).types);
+  EXPECT_EQ(nmea, countNmea(ubx));
+  // rtklib_testglo.rtcm3 holds 429 frames (../shared/data/README.md: 1004 x186, 1012 x186,
+  // 1005/1019/1020 x19), all with good CRCs.
+  EXPECT_EQ(rtcmCount, 429LL * splices);
+  EXPECT_NE(out.find("checksum fail  0 UBX"), std::string::npos) << out;
 }
 
 TEST(UbxTool, BadInputsFailCleanly) {

@@ -80,7 +80,10 @@ void BeidouD1Decoder::add(const SfrbxMessage& msg, SatId sat, const GpsTime& rec
   const NavBits& s3 = *p.subframe[2];
   const int aode = static_cast<int>(s1.u(219, 5));
   const std::uint32_t tocRaw = s1.u(61, 17);
-  if (aode == p.lastAode && tocRaw == p.lastToc) return;
+  if (aode == p.lastAode && tocRaw == p.lastToc) {  // this set was emitted already
+    p.subframe = {};
+    return;
+  }
 
   KeplerEphemeris e;
   e.sat = sat;
@@ -124,6 +127,7 @@ void BeidouD1Decoder::add(const SfrbxMessage& msg, SatId sat, const GpsTime& rec
   e.omega = scaled(s3.s(191, 32), -31) * kSemicircle;
   if (toe >= kSecondsPerWeek || toc >= kSecondsPerWeek || sow1 >= kSecondsPerWeek) {
     ++counts.unknownMessages;
+    p.subframe = {};
     return;
   }
   // Times in BDT (week and SOW of subframe 1, 5.2.4.2-5.2.4.3), converted to GPST.
@@ -137,6 +141,7 @@ void BeidouD1Decoder::add(const SfrbxMessage& msg, SatId sat, const GpsTime& rec
   e.week = toeWeek;
   p.lastAode = aode;
   p.lastToc = tocRaw;
+  p.subframe = {};  // parts of an emitted set never count as incomplete
   ++counts.ephemerides;
   out.kepler.push_back(e);
   out.ionosphere.beidou = k;

@@ -78,7 +78,10 @@ void GalileoInavDecoder::add(const SfrbxMessage& msg, SatId sat, const GpsTime& 
   const NavBits& w5 = *p.word[4];
   const int iod = static_cast<int>(w1.u(6, 10));
   const std::uint32_t toeRaw = w1.u(16, 14);
-  if (iod == p.lastIod && toeRaw == p.lastToe) return;
+  if (iod == p.lastIod && toeRaw == p.lastToe) {  // this set was emitted already
+    p.word = {};
+    return;
+  }
 
   KeplerEphemeris e;
   e.sat = sat;
@@ -126,6 +129,7 @@ void GalileoInavDecoder::add(const SfrbxMessage& msg, SatId sat, const GpsTime& 
   e.codesOnL2 = (e1b ? 1 << 0 : 0) | (e5b ? 1 << 2 : 0) | (1 << 9);
   if (toe >= kSecondsPerWeek || toc >= kSecondsPerWeek || tow >= kSecondsPerWeek) {
     ++counts.unknownMessages;
+    p.word = {};
     return;
   }
   // Times: GST week (12 bits, 5.1.2) placed nearest the receive time; toe/toc nearest the
@@ -147,6 +151,7 @@ void GalileoInavDecoder::add(const SfrbxMessage& msg, SatId sat, const GpsTime& 
   e.week = toeWeek;
   p.lastIod = iod;
   p.lastToe = toeRaw;
+  p.word = {};  // parts of an emitted set never count as incomplete
   ++counts.ephemerides;
   out.kepler.push_back(e);
 }

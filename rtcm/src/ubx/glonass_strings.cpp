@@ -61,20 +61,26 @@ void GlonassDecoder::add(const SfrbxMessage& msg, SatId sat, const GpsTime& rece
   }
   const NavBits& s = *str;
   const int m = static_cast<int>(s.u(1, 4));
-  if (m < 1 || m > 4) return;  // string 5 and the almanac strings
+  if (m < 1 || m > 5) return;  // almanac strings
   Partial& p = sats_[sat];
-  p.string[static_cast<std::size_t>(m - 1)] = s;
-  p.received[static_cast<std::size_t>(m - 1)] = receiveTime;
-  // Strings 1-4 of one frame are sent within 8 s (4.3.2); frames are 30 s apart.
-  bool dropped = false;
-  for (int k = 0; k < 4; ++k) {
-    auto& o = p.string[static_cast<std::size_t>(k)];
-    if (k != m - 1 && o && std::fabs(p.received[static_cast<std::size_t>(k)] - receiveTime) > 10.0) {
-      o.reset();
-      dropped = true;
+  if (m == 5) {
+    // N4, the four-year interval since 1996 (string 5, 4.5): with NT of string 4 it dates the set
+    // when no receive time is known.
+    p.n4 = static_cast<int>(s.u(49, 5));
+  } else {
+    p.string[static_cast<std::size_t>(m - 1)] = s;
+    p.received[static_cast<std::size_t>(m - 1)] = receiveTime;
+    // Strings 1-4 of one frame are sent within 8 s (4.3.2); frames are 30 s apart.
+    bool dropped = false;
+    for (int k = 0; k < 4; ++k) {
+      auto& o = p.string[static_cast<std::size_t>(k)];
+      if (k != m - 1 && o && std::fabs(p.received[static_cast<std::size_t>(k)] - receiveTime) > 10.0) {
+        o.reset();
+        dropped = true;
+      }
     }
+    if (dropped) ++counts.incompleteSets;
   }
-  if (dropped) ++counts.incompleteSets;
   for (const auto& o : p.string)
     if (!o) return;
   const NavBits& s1 = *p.string[0];
@@ -82,14 +88,28 @@ void GlonassDecoder::add(const SfrbxMessage& msg, SatId sat, const GpsTime& rece
   const NavBits& s3 = *p.string[2];
   const NavBits& s4 = *p.string[3];
   const int tb = static_cast<int>(s2.u(9, 7));
-  if (tb == p.lastTb) return;
-  if (receiveTime.week() < kFirstValidWeek) return;  // no time yet for the day: keep the set
+  if (tb == p.lastTb) {  // this set was emitted already
+    p.string = {};
+    return;
+  }
   const int tkH = static_cast<int>(s1.u(9, 5));
   const int tkM = static_cast<int>(s1.u(14, 6));
   const int tkS = static_cast<int>(s1.u(20, 1));
   if (tb < 1 || tb > 96 || tkH > 23 || tkM > 59) {
     ++counts.unknownMessages;
+    p.string = {};
     return;
+  }
+  // The day: from the receive time, else from NT (string 4) and N4 (string 5) as the RTCM 1020
+  // decoder does; neither yet: keep the set.
+  GpsTime reference = receiveTime;
+  if (reference.week() < kFirstValidWeek) {
+    const int nt = static_cast<int>(s4.u(59, 11));
+    if (!p.n4 || *p.n4 < 1 || nt < 1 || nt > 1461) return;
+    CalendarTime c;
+    civilFromDays(daysFromCivil(1996 + 4 * (*p.n4 - 1), 1, 1) + (nt - 1), c.year, c.month, c.day);
+    c.second = tb * 900.0;  // normalised by the conversion
+    reference = glonassToGpst(c);
   }
   GlonassEphemeris g;
   g.sat = sat;
@@ -109,9 +129,10 @@ void GlonassDecoder::add(const SfrbxMessage& msg, SatId sat, const GpsTime& rece
   g.accuracy = rtcm::glonassFtMetres(static_cast<int>(s4.u(52, 4)));
   g.health = bnMsb | ln3;
   g.iode = tb;
-  g.toe = rtcm::glonassTodNear(tb * 900.0, receiveTime);
+  g.toe = rtcm::glonassTodNear(tb * 900.0, reference);
   g.tof = rtcm::glonassTodNear(tkH * 3600.0 + tkM * 60.0 + tkS * 30.0, g.toe);
   p.lastTb = tb;
+  p.string = {};  // parts of an emitted set never count as incomplete
   ++counts.ephemerides;
   out.glonass.push_back(g);
 }

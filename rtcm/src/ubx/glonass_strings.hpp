@@ -1,5 +1,5 @@
-// GLONASS L1/L2 OF navigation strings 1-4 from UBX-RXM-SFRBX with the Hamming (85,77) check;
-// almanac strings are ignored. Not installed.
+// GLONASS L1/L2 OF navigation strings 1-4 (and N4 of string 5) from UBX-RXM-SFRBX with the
+// Hamming (85,77) check; almanac strings are ignored. Not installed.
 #pragma once
 
 #include <array>
@@ -25,6 +25,7 @@ class GlonassDecoder {
     std::array<std::optional<NavBits>, 4> string;
     std::array<GpsTime, 4> received;
     int lastTb = -1;
+    std::optional<int> n4;  // of the latest string 5
   };
   std::unordered_map<SatId, Partial> sats_;
 };

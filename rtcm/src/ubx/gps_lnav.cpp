@@ -109,7 +109,10 @@ void GpsLnavDecoder::add(const SfrbxMessage& msg, SatId sat, const GpsTime& rece
   if (!s1 || !s2 || !s3) return;
   const int iodc = iodcOf(*s1);
   const std::uint32_t toeRaw = s2->u(216, 16);
-  if (iodc == p.lastIodc && toeRaw == p.lastToe) return;  // this set was emitted already
+  if (iodc == p.lastIodc && toeRaw == p.lastToe) {  // this set was emitted already
+    p.subframe = {};
+    return;
+  }
   if (receiveTime.week() < kFirstValidWeek) return;  // no time yet for the 10-bit week: keep the set
 
   KeplerEphemeris e;
@@ -151,6 +154,7 @@ void GpsLnavDecoder::add(const SfrbxMessage& msg, SatId sat, const GpsTime& rece
   e.fitInterval = sat.system == System::Qzss ? (fitFlag ? 0.0 : 2.0) : rtcm::gpsFitHours(fitFlag, iodc);
   if (toe >= kSecondsPerWeek || toc >= kSecondsPerWeek) {
     ++counts.unknownMessages;
+    p.subframe = {};
     return;
   }
   // Times: the week of subframe 1 is the week of transmission modulo 1024 (HOW TOW count = start
@@ -165,6 +169,7 @@ void GpsLnavDecoder::add(const SfrbxMessage& msg, SatId sat, const GpsTime& rece
   e.week = e.toe.week();
   p.lastIodc = iodc;
   p.lastToe = toeRaw;
+  p.subframe = {};  // parts of an emitted set never count as incomplete
   ++counts.ephemerides;
   out.kepler.push_back(e);
 }

@@ -40,7 +40,7 @@ struct NavigationCounts {
   std::uint64_t messages = 0;         ///< SFRBX messages of the system
   std::uint64_t parityFailures = 0;   ///< GPS/QZSS parity, BeiDou BCH, GLONASS Hamming failures
   std::uint64_t crcFailures = 0;      ///< Galileo I/NAV CRC-24Q failures
-  std::uint64_t incompleteSets = 0;   ///< partial sets dropped (issue of data changed before completion)
+  std::uint64_t incompleteSets = 0;   ///< partial sets dropped unused (another issue of data or frame came first)
   std::uint64_t unknownMessages = 0;  ///< unhandled pages/subframes/strings, bad layout, unknown signals
   std::uint64_t skipped = 0;          ///< messages not decoded: SBAS, NavIC, GPS/QZSS CNAV,
                                       ///< Galileo F/NAV and E6, BeiDou B-CNAV1/2, GLONASS CDMA
@@ -57,7 +57,8 @@ class NavigationAssembler {
 
   /// receiveTime: time of the latest RAWX epoch (resolves week/day ambiguities; the message's own
   /// week numbers are used where they exist). A time before GPS week 1024 (e.g. GpsTime{}) means
-  /// "not known yet": GPS/QZSS and GLONASS sets are then kept until a message arrives with a time.
+  /// "not known yet": GPS/QZSS sets are then kept until a message arrives with a time; GLONASS
+  /// sets are dated by NT/N4 once string 5 arrives.
   /// Returns the records completed by this message.
   /// Never throws on bad navigation data: bad parity/CRC and malformed parts are counted.
   NavDataUpdate add(const SfrbxMessage& msg, const GpsTime& receiveTime);
