@@ -101,246 +101,267 @@ std::optional<BaseFormat> decide(const Input& in) {
   return std::nullopt;
 }
 
-}  // namespace
-
-int runLive(const LiveOptions& opt, const RtkConfig& cfg, const SppConfig& sppCfg, EphemerisStore& nav) {
-  struct sigaction sa {};
-  sa.sa_handler = onSignal;
-  ::sigaction(SIGINT, &sa, nullptr);
-  ::sigaction(SIGTERM, &sa, nullptr);
-  const auto wall0 = Clock::now();
-
-  // Outputs, written as solutions come (no temporary file: a live run has no "end of success").
-  std::ofstream posFile, nmeaFile, latFile;
-  std::ostream* posOut = &std::cout;
-  if (opt.out != "-") {
-    posFile.open(opt.out, std::ios::binary);
-    if (!posFile) {
-      std::fprintf(stderr, "gvins-rtk: error: cannot create '%s'\n", opt.out.c_str());
-      return 1;
-    }
-    posOut = &posFile;
+/// One live run: streams, reader threads, the solver and the outputs.
+class LiveSession {
+ public:
+  LiveSession(const LiveOptions& opt, const RtkConfig& cfg, const SppConfig& sppCfg, EphemerisStore& nav)
+      : opt_(opt), nav_(nav), solver_(nav, cfg, sppCfg), basePos_(opt.baseXyz), popt_(opt.pos) {
+    if (basePos_) solver_.setBasePosition(*basePos_);
+    in_[0].role = "rover";
+    in_[1].role = "base";
   }
-  std::unique_ptr<NmeaWriter> nmea;
-  if (!opt.nmea.empty()) {
-    if (opt.nmea != "-") {
-      nmeaFile.open(opt.nmea, std::ios::binary);
-      if (!nmeaFile) {
-        std::fprintf(stderr, "gvins-rtk: error: cannot create '%s'\n", opt.nmea.c_str());
-        return 1;
+
+  int run() {
+    const auto wall0 = Clock::now();
+    if (!openOutputs()) return 1;
+    if (!openStreams()) return 2;
+    std::thread threads[2];
+    for (int i = 0; i < 2; ++i) threads[i] = std::thread(readStream, std::ref(*in_[i].source), i, std::ref(queue_));
+    int exitCode = 0;
+    try {
+      loop();
+    } catch (const ParseError& e) {
+      std::fprintf(stderr, "gvins-rtk: error: %s\n", e.what());
+      exitCode = 1;
+    }
+    const bool signalled = gStop;
+    gStop = true;
+    for (auto& t : threads) t.join();
+    if (!writer_) writer_ = std::make_unique<PosWriter>(*posOut_, popt_);
+    writer_->finish();
+    summary(std::chrono::duration<double>(Clock::now() - wall0).count(), signalled);
+    if (epochs_ == 0 && exitCode == 0) exitCode = 3;
+    return exitCode;
+  }
+
+ private:
+  bool openFile(std::ofstream& f, const std::string& path) {
+    f.open(path, std::ios::binary);
+    if (!f) std::fprintf(stderr, "gvins-rtk: error: cannot create '%s'\n", path.c_str());
+    return static_cast<bool>(f);
+  }
+
+  /// Outputs, written as solutions come (no temporary file: a live run has no "end of success").
+  bool openOutputs() {
+    if (opt_.out != "-") {
+      if (!openFile(posFile_, opt_.out)) return false;
+      posOut_ = &posFile_;
+    }
+    if (!opt_.nmea.empty()) {
+      if (opt_.nmea != "-" && !openFile(nmeaFile_, opt_.nmea)) return false;
+      nmea_ = std::make_unique<NmeaWriter>(opt_.nmea == "-" ? std::cout : nmeaFile_);
+    }
+    if (!opt_.latencyLog.empty()) {
+      if (!openFile(latFile_, opt_.latencyLog)) return false;
+      latFile_ << "# gpst_week,tow [s],quality,latency [ms],base age [s]\n";
+    }
+    return true;
+  }
+
+  bool openStreams() {
+    struct sigaction sa {};
+    sa.sa_handler = onSignal;
+    ::sigaction(SIGINT, &sa, nullptr);
+    ::sigaction(SIGTERM, &sa, nullptr);
+    try {
+      for (int i = 0; i < 2; ++i) {
+        rtcm::StreamOptions so;
+        so.maxOutage = opt_.maxOutage;
+        so.gga = [this] {  // the latest solution, for VRS casters
+          std::lock_guard<std::mutex> l(ggaMutex_);
+          return gga_;
+        };
+        in_[i].source = rtcm::StreamSource::open(rtcm::StreamUrl::parse(i == 0 ? opt_.rover : opt_.base), so);
       }
+    } catch (const rtcm::StreamError& e) {
+      std::fprintf(stderr, "gvins-rtk: error: %s\n", e.what());
+      return false;
     }
-    nmea = std::make_unique<NmeaWriter>(opt.nmea == "-" ? std::cout : nmeaFile);
-  }
-  if (!opt.latencyLog.empty()) {
-    latFile.open(opt.latencyLog, std::ios::binary);
-    if (!latFile) {
-      std::fprintf(stderr, "gvins-rtk: error: cannot create '%s'\n", opt.latencyLog.c_str());
-      return 1;
-    }
-    latFile << "# gpst_week,tow [s],quality,latency [ms],base age [s]\n";
+    return true;
   }
 
-  // The latest solution as GGA for VRS casters.
-  std::mutex ggaMutex;
-  std::string gga;
-  Input inputs[2];
-  inputs[0].role = "rover";
-  inputs[1].role = "base";
-  try {
-    for (int i = 0; i < 2; ++i) {
-      rtcm::StreamOptions so;
-      so.maxOutage = opt.maxOutage;
-      so.gga = [&] {
-        std::lock_guard<std::mutex> l(ggaMutex);
-        return gga;
-      };
-      inputs[i].source = rtcm::StreamSource::open(rtcm::StreamUrl::parse(i == 0 ? opt.rover : opt.base), so);
-    }
-  } catch (const rtcm::StreamError& e) {
-    std::fprintf(stderr, "gvins-rtk: error: %s\n", e.what());
-    return 2;
-  }
-  ChunkQueue queue;
-  std::thread threads[2];
-  for (int i = 0; i < 2; ++i) threads[i] = std::thread(readStream, std::ref(*inputs[i].source), i, std::ref(queue));
-
-  RtkSolver solver(nav, cfg, sppCfg);
-  std::optional<Eigen::Vector3d> basePos = opt.baseXyz;
-  if (basePos) solver.setBasePosition(*basePos);
-  std::unique_ptr<PosWriter> writer;
-  PosWriterOptions popt = opt.pos;
-
-  ObsEpoch roverEpoch, baseEpoch;
-  bool haveRover = false;
-  Clock::time_point roverArrival{};
-  std::optional<GpsTime> lastBaseTime;
-  long epochs = 0, baseEpochs = 0, fixed = 0, floats = 0, singles = 0, none = 0;
-  QuantileHistogram latency, ages;
-  double latencyMax = 0.0;
-  int exitCode = 0;
-  Input& rover = inputs[0];
-  Input& base = inputs[1];
-
-  std::optional<GpsTime> firstRoverTime;
-  auto openIfKnown = [&](Input& in, const GpsTime& ref) {
+  void openIfKnown(Input& in, const GpsTime& ref) {
     if (in.reader) return;
-    if (const auto f = decide(in)) {
-      in.reader = BaseReader::openPushed(*f, in.source->name(), ref, &nav, !opt.strict);
-      in.reader->feed(in.head);
-      in.head.clear();
-      in.head.shrink_to_fit();
-      if (in.ended) {
-        in.reader->finish();
-        in.finished = true;
-      }
-      if (!opt.quiet) {
-        std::fprintf(stderr, "gvins-rtk: %s stream %s: %s\n", in.role.c_str(), in.source->name().c_str(),
-                     *f == BaseFormat::Ubx ? "u-blox UBX" : "RTCM 3");
-      }
+    const auto f = decide(in);
+    if (!f) return;
+    in.reader = BaseReader::openPushed(*f, in.source->name(), ref, &nav_, !opt_.strict);
+    in.reader->feed(in.head);
+    in.head.clear();
+    in.head.shrink_to_fit();
+    if (in.ended) {
+      in.reader->finish();
+      in.finished = true;
     }
-  };
-  auto setBasePosition = [&] {
-    if (!basePos && base.reader) {
-      if (auto p = base.reader->antennaPosition()) {
-        solver.setBasePosition(*p);
-        basePos = p;
-      }
+    if (!opt_.quiet) {
+      std::fprintf(stderr, "gvins-rtk: %s stream %s: %s\n", in.role.c_str(), in.source->name().c_str(),
+                   *f == BaseFormat::Ubx ? "u-blox UBX" : "RTCM 3");
     }
-  };
+  }
 
-  try {
-    for (;;) {
-      if (gStop) break;
-      // 1. The next rover epoch, decoded only when the previous one is solved (as the
-      //    post-processing reads it, so that ephemerides after it are not used before it).
-      if (!haveRover && rover.reader) {
-        // The epoch was completed by the last chunk fed (chunk granularity of the latency).
-        haveRover = rover.reader->next(roverEpoch);
-        if (haveRover) {
-          roverArrival = rover.lastArrival;
-          ++epochs;
-        }
+  void setBasePosition() {
+    if (basePos_ || !in_[1].reader) return;
+    if (auto p = in_[1].reader->antennaPosition()) {
+      solver_.setBasePosition(*p);
+      basePos_ = p;
+    }
+  }
+
+  /// Base epochs up to the rover time and the first one after it, as post-processing feeds them.
+  void feedBase(const GpsTime& t) {
+    Input& base = in_[1];
+    while (!(lastBaseTime_ && *lastBaseTime_ - t > BaseStation::kSyncTolerance)) {
+      if (!base.reader->next(baseEpoch_)) break;
+      ++baseEpochs_;
+      setBasePosition();
+      solver_.setBaseGlonassChannels(base.reader->glonassChannels());
+      solver_.setPhaseAlignment(in_[0].reader->phaseAlignment(), base.reader->phaseAlignment());
+      solver_.addBaseEpoch(baseEpoch_);
+      lastBaseTime_ = baseEpoch_.time;
+    }
+    setBasePosition();
+  }
+
+  void solveAndWrite() {
+    if (in_[0].reader->format() != BaseFormat::Rinex) solver_.setRoverGlonassChannels(in_[0].reader->glonassChannels());
+    const RtkSolution sol = solver_.process(roverEpoch_);
+    switch (sol.quality) {
+      case SolutionQuality::Fix: ++fixed_; break;
+      case SolutionQuality::Float: ++floats_; break;
+      case SolutionQuality::Single: ++singles_; break;
+      default: ++none_; break;
+    }
+    if (!sol.valid()) return;
+    const PositionSolution ps = sol.toPositionSolution();
+    if (!writer_) {
+      if (basePos_) {
+        char b[160];
+        std::snprintf(b, sizeof b, "%.4f %.4f %.4f", (*basePos_)[0], (*basePos_)[1], (*basePos_)[2]);
+        popt_.headerFields.emplace_back("ref pos", b);
       }
-      if (haveRover && !firstRoverTime) {
-        firstRoverTime = roverEpoch.time;
-        openIfKnown(base, *firstRoverTime);
+      writer_ = std::make_unique<PosWriter>(*posOut_, popt_);
+    }
+    writer_->write(ps);
+    posOut_->flush();
+    if (nmea_) nmea_->write(ps);
+    {
+      std::lock_guard<std::mutex> l(ggaMutex_);
+      gga_ = nmeaGga(ps);
+    }
+    const double lat = ms(Clock::now() - roverArrival_);
+    latency_.add(lat);
+    latencyMax_ = std::max(latencyMax_, lat);
+    if (sol.quality != SolutionQuality::Single) ages_.add(sol.age);
+    if (latFile_.is_open()) {
+      char b[160];
+      std::snprintf(b, sizeof b, "%d,%.3f,%d,%.3f,%.2f\n", sol.time.week(), sol.time.tow(), static_cast<int>(sol.quality), lat, sol.age);
+      latFile_ << b;
+    }
+  }
+
+  /// Waits up to `timeout` s for bytes of either stream and feeds them.
+  void takeChunk(double timeout) {
+    Chunk c;
+    if (!queue_.pop(c, timeout)) return;
+    Input& in = in_[c.stream];
+    for (const auto& e : c.events) std::fprintf(stderr, "gvins-rtk: %s\n", e.c_str());
+    if (c.end) in.ended = true;
+    if (!in.reader) in.head.insert(in.head.end(), c.bytes.begin(), c.bytes.end());
+    else if (!c.bytes.empty()) in.reader->feed(c.bytes);
+    if (!c.bytes.empty()) in.lastArrival = c.arrival;
+    openIfKnown(in_[0], GpsTime{});
+    // RTCM times of week of the base are resolved near the rover's first epoch: the base waits
+    // for it (its bytes are kept meanwhile).
+    if (firstRoverTime_ || in_[0].ended || in_[1].head.size() > (1u << 22)) openIfKnown(in_[1], firstRoverTime_.value_or(GpsTime{}));
+    if (in.ended && in.reader && !in.finished) {
+      in.reader->finish();
+      in.finished = true;
+    }
+  }
+
+  void loop() {
+    Input& rover = in_[0];
+    Input& base = in_[1];
+    bool haveRover = false;
+    while (!gStop) {
+      // The next rover epoch, decoded only when the previous one is solved (as post-processing
+      // reads it, so that ephemerides after it are not used before it). It was completed by the
+      // last chunk fed (chunk granularity of the latency).
+      if (!haveRover && rover.reader && rover.reader->next(roverEpoch_)) {
+        haveRover = true;
+        roverArrival_ = rover.lastArrival;
+        ++epochs_;
+      }
+      if (haveRover && !firstRoverTime_) {
+        firstRoverTime_ = roverEpoch_.time;
+        openIfKnown(base, *firstRoverTime_);
       }
       if (!haveRover && rover.ended) break;
-      // 2. Base epochs up to the rover time and the first one after it, as post-processing feeds them.
-      if (haveRover && base.reader) {
-        const GpsTime t = roverEpoch.time;
-        while (!(lastBaseTime && *lastBaseTime - t > BaseStation::kSyncTolerance)) {
-          if (!base.reader->next(baseEpoch)) break;
-          ++baseEpochs;
-          setBasePosition();
-          solver.setBaseGlonassChannels(base.reader->glonassChannels());
-          solver.setPhaseAlignment(rover.reader->phaseAlignment(), base.reader->phaseAlignment());
-          solver.addBaseEpoch(baseEpoch);
-          lastBaseTime = baseEpoch.time;
-        }
-        setBasePosition();
-      }
-      // 3. Solve when the base is there or may not be waited for any longer.
+      if (haveRover && base.reader) feedBase(roverEpoch_.time);
+      // Solve when the base is there or may not be waited for any longer.
       if (haveRover) {
-        const bool baseAfter = lastBaseTime && *lastBaseTime - roverEpoch.time > BaseStation::kSyncTolerance;
-        const bool ready = opt.baseWait <= 0.0 || base.ended || baseAfter ||
-                           std::chrono::duration<double>(Clock::now() - roverArrival).count() > opt.baseWait;
-        if (ready) {
-          if (rover.reader->format() != BaseFormat::Rinex) solver.setRoverGlonassChannels(rover.reader->glonassChannels());
-          const RtkSolution sol = solver.process(roverEpoch);
+        const bool baseAfter = lastBaseTime_ && *lastBaseTime_ - roverEpoch_.time > BaseStation::kSyncTolerance;
+        if (opt_.baseWait <= 0.0 || base.ended || baseAfter ||
+            std::chrono::duration<double>(Clock::now() - roverArrival_).count() > opt_.baseWait) {
+          solveAndWrite();
           haveRover = false;
-          switch (sol.quality) {
-            case SolutionQuality::Fix: ++fixed; break;
-            case SolutionQuality::Float: ++floats; break;
-            case SolutionQuality::Single: ++singles; break;
-            default: ++none; break;
-          }
-          if (sol.valid()) {
-            const PositionSolution ps = sol.toPositionSolution();
-            if (!writer) {
-              if (basePos) {
-                char b[160];
-                std::snprintf(b, sizeof b, "%.4f %.4f %.4f", (*basePos)[0], (*basePos)[1], (*basePos)[2]);
-                popt.headerFields.emplace_back("ref pos", b);
-              }
-              writer = std::make_unique<PosWriter>(*posOut, popt);
-            }
-            writer->write(ps);
-            posOut->flush();
-            if (nmea) nmea->write(ps);
-            {
-              std::lock_guard<std::mutex> l(ggaMutex);
-              gga = nmeaGga(ps);
-            }
-            const double lat = ms(Clock::now() - roverArrival);
-            latency.add(lat);
-            latencyMax = std::max(latencyMax, lat);
-            if (sol.quality != SolutionQuality::Single) ages.add(sol.age);
-            if (latFile.is_open()) {
-              char b[160];
-              std::snprintf(b, sizeof b, "%d,%.3f,%d,%.3f,%.2f\n", sol.time.week(), sol.time.tow(), static_cast<int>(sol.quality), lat, sol.age);
-              latFile << b;
-            }
-          }
           continue;  // the next epoch may already be decoded
         }
       }
-      // 4. More bytes.
-      Chunk c;
-      if (!queue.pop(c, haveRover ? 0.01 : 0.2)) continue;
-      Input& in = inputs[c.stream];
-      for (const auto& e : c.events) std::fprintf(stderr, "gvins-rtk: %s\n", e.c_str());
-      if (c.end) in.ended = true;
-      if (!in.reader) {
-        in.head.insert(in.head.end(), c.bytes.begin(), c.bytes.end());
-      } else if (!c.bytes.empty()) {
-        in.reader->feed(c.bytes);
-      }
-      if (!c.bytes.empty()) in.lastArrival = c.arrival;
-      openIfKnown(rover, GpsTime{});
-      // RTCM times of week of the base are resolved near the rover's first epoch: the base
-      // waits for it (its bytes are kept meanwhile).
-      if (firstRoverTime || rover.ended || base.head.size() > (1u << 22)) openIfKnown(base, firstRoverTime.value_or(GpsTime{}));
-      if (in.ended && in.reader && !in.finished) {
-        in.reader->finish();
-        in.finished = true;
-      }
+      takeChunk(haveRover ? 0.01 : 0.2);
     }
-  } catch (const ParseError& e) {
-    std::fprintf(stderr, "gvins-rtk: error: %s\n", e.what());
-    exitCode = 1;
   }
-  const bool signalled = gStop;
-  gStop = true;
-  for (auto& t : threads) t.join();
-  if (!writer) writer = std::make_unique<PosWriter>(*posOut, popt);
-  writer->finish();
 
-  // Summary.
-  const double wall = std::chrono::duration<double>(Clock::now() - wall0).count();
-  std::fprintf(stderr, "gvins-rtk live summary (rover %s, base %s)\n", rover.source->name().c_str(), base.source->name().c_str());
-  std::fprintf(stderr, "  rover epochs           %8ld (%s)\n", epochs, rover.reader ? rover.reader->describe().c_str() : "no data");
-  std::fprintf(stderr, "  base epochs            %8ld (%s)\n", baseEpochs, base.reader ? base.reader->describe().c_str() : "no data");
-  std::fprintf(stderr, "  fixed / float / single / none  %ld / %ld / %ld / %ld\n", fixed, floats, singles, none);
-  if (latency.count() > 0) {
-    std::fprintf(stderr, "  latency                median %.2f ms  p99 %.2f ms  max %.2f ms (last byte of the epoch to its solution written)\n",
-                 latency.quantile(0.5), latency.quantile(0.99), latencyMax);
-  }
-  if (ages.count() > 0) std::fprintf(stderr, "  base age               median %.2f s  max %.2f s\n", ages.quantile(0.5), ages.quantile(1.0));
-  for (const Input& in : inputs) {
-    const auto& k = in.source->counters();
-    std::fprintf(stderr, "  %-5s stream           %lld bytes, %lld connections, %lld failed attempts, %lld gaps (%.1f s without data)\n",
-                 in.role.c_str(), static_cast<long long>(k.bytes), static_cast<long long>(k.connects),
-                 static_cast<long long>(k.failedAttempts), static_cast<long long>(k.drops), k.gapSeconds);
-    if (in.reader && in.reader->skipped()) {
-      std::fprintf(stderr, "  %-5s input            %lld malformed frames/epochs skipped\n", in.role.c_str(),
-                   static_cast<long long>(in.reader->skipped()));
+  void summary(double wall, bool signalled) const {
+    const Input& rover = in_[0];
+    const Input& base = in_[1];
+    std::fprintf(stderr, "gvins-rtk live summary (rover %s, base %s)\n", rover.source->name().c_str(), base.source->name().c_str());
+    std::fprintf(stderr, "  rover epochs           %8ld (%s)\n", epochs_, rover.reader ? rover.reader->describe().c_str() : "no data");
+    std::fprintf(stderr, "  base epochs            %8ld (%s)\n", baseEpochs_, base.reader ? base.reader->describe().c_str() : "no data");
+    std::fprintf(stderr, "  fixed / float / single / none  %ld / %ld / %ld / %ld\n", fixed_, floats_, singles_, none_);
+    if (latency_.count() > 0) {
+      std::fprintf(stderr, "  latency                median %.2f ms  p99 %.2f ms  max %.2f ms (last byte of the epoch to its solution written)\n",
+                   latency_.quantile(0.5), latency_.quantile(0.99), latencyMax_);
     }
+    if (ages_.count() > 0) std::fprintf(stderr, "  base age               median %.2f s  max %.2f s\n", ages_.quantile(0.5), ages_.quantile(1.0));
+    for (const Input& in : in_) {
+      const auto& k = in.source->counters();
+      std::fprintf(stderr, "  %-5s stream           %lld bytes, %lld connections, %lld failed attempts, %lld gaps (%.1f s without data)\n",
+                   in.role.c_str(), static_cast<long long>(k.bytes), static_cast<long long>(k.connects),
+                   static_cast<long long>(k.failedAttempts), static_cast<long long>(k.drops), k.gapSeconds);
+      if (in.reader && in.reader->skipped()) {
+        std::fprintf(stderr, "  %-5s input            %lld malformed frames/epochs skipped\n", in.role.c_str(),
+                     static_cast<long long>(in.reader->skipped()));
+      }
+    }
+    std::fprintf(stderr, "  time                   %8.1f s%s\n", wall, signalled ? " (stopped by a signal)" : "");
   }
-  std::fprintf(stderr, "  time                   %8.1f s%s\n", wall, signalled ? " (stopped by a signal)" : "");
-  if (epochs == 0 && exitCode == 0) exitCode = 3;
-  return exitCode;
+
+  const LiveOptions& opt_;
+  EphemerisStore& nav_;
+  RtkSolver solver_;
+  std::optional<Eigen::Vector3d> basePos_;
+  PosWriterOptions popt_;
+  std::ofstream posFile_, nmeaFile_, latFile_;
+  std::ostream* posOut_ = &std::cout;
+  std::unique_ptr<NmeaWriter> nmea_;
+  std::unique_ptr<PosWriter> writer_;
+  std::mutex ggaMutex_;
+  std::string gga_;
+  Input in_[2];
+  ChunkQueue queue_;
+  ObsEpoch roverEpoch_, baseEpoch_;
+  Clock::time_point roverArrival_{};
+  std::optional<GpsTime> firstRoverTime_, lastBaseTime_;
+  long epochs_ = 0, baseEpochs_ = 0, fixed_ = 0, floats_ = 0, singles_ = 0, none_ = 0;
+  QuantileHistogram latency_, ages_;
+  double latencyMax_ = 0.0;
+};
+
+}  // namespace
+
+int runLive(const LiveOptions& opt, const RtkConfig& cfg, const SppConfig& sppCfg, EphemerisStore& nav) {
+  LiveSession session(opt, cfg, sppCfg, nav);
+  return session.run();
 }
 
 }  // namespace gvins::rtklive

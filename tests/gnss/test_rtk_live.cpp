@@ -140,3 +140,33 @@ TEST(RtkLive, Str2StrLoopbackEqualsPostProcessingAndSurvivesADrop) {
   EXPECT_EQ(rows(nmea).size(), 2 * a.size());
   for (const auto& f : {base, post, live, nmea, err, e0, e1, e2, e3}) std::filesystem::remove(f);
 }
+
+TEST(RtkLive, DamagedAndHostileStreamsAreSkippedOrRefused) {
+  // The walk log with garbage in front, every 50th kB damaged (a byte flipped) and cut short
+  // mid-frame, as a file stream for rover and base: no crash or hang, malformed frames counted,
+  // solutions still written. A stream of random bytes is refused with a clear error.
+  auto log = readBytes(kData + "/ubx/gnss_1730.ubx");
+  std::vector<std::uint8_t> bad(5000);
+  for (std::size_t i = 0; i < bad.size(); ++i) bad[i] = static_cast<std::uint8_t>((i * 2654435761u) >> 13);
+  for (std::size_t i = 25000; i < log.size(); i += 50000) log[i] ^= 0x5A;
+  log.resize(log.size() - 700);
+  log.insert(log.begin(), bad.begin(), bad.end());
+  const std::string damaged = tmp("damaged.ubx"), noise = tmp("noise.bin"), out = tmp("damaged.pos"), err = tmp("damaged.err");
+  std::ofstream(damaged, std::ios::binary).write(reinterpret_cast<const char*>(log.data()), static_cast<std::streamsize>(log.size()));
+  std::ofstream(noise, std::ios::binary).write(reinterpret_cast<const char*>(bad.data()), static_cast<std::streamsize>(bad.size()));
+  const std::string common = kRtk + " --base-llh " + kBaseLlh + " --base-wait 5 -o " + out + " ";
+  int rc = std::system((common + "--rover-stream file://" + damaged + " --base-stream file://" + damaged + " 2>" + err).c_str());
+  std::string text = readText(err);
+  EXPECT_EQ(WEXITSTATUS(rc), 0) << text;
+  EXPECT_NE(text.find("malformed frames/epochs skipped"), std::string::npos) << text;
+  EXPECT_GT(rows(out).size(), 300u);
+  rc = std::system((common + "--rover-stream " + noise + " --base-stream file://" + damaged + " 2>" + err).c_str());
+  text = readText(err);
+  EXPECT_EQ(WEXITSTATUS(rc), 1) << text;
+  EXPECT_NE(text.find("neither a u-blox UBX nor an RTCM 3 stream"), std::string::npos) << text;
+  rc = std::system((common + "--rover-stream tcpcli://nowhere --base-stream file://" + damaged + " 2>" + err).c_str());
+  text = readText(err);
+  EXPECT_EQ(WEXITSTATUS(rc), 2) << text;
+  EXPECT_NE(text.find("stream path 'tcpcli://nowhere': no ':PORT'"), std::string::npos) << text;
+  for (const auto& f : {damaged, noise, out, err}) std::filesystem::remove(f);
+}
