@@ -15,8 +15,9 @@ constexpr const char* kUsage =
     "      time span and epochs, signals per system, SFRBX count, checksum failures and malformed\n"
     "      messages\n"
     "  to-rinex FILE|- -o PREFIX [--max-phase-sigma CYC]\n"
-    "      writes PREFIX.obs (RINEX 3.04) with every RXM-RAWX signal; --max-phase-sigma leaves out\n"
-    "      phases whose reported standard deviation is larger (RTKLIB's convbin: 0.02)\n"
+    "      writes PREFIX.obs (RINEX 3.04) with every RXM-RAWX signal and PREFIX.nav (RINEX 3.04)\n"
+    "      with the ephemerides of RXM-SFRBX; --max-phase-sigma leaves out phases whose reported\n"
+    "      standard deviation is larger (RTKLIB's convbin: 0.02)\n"
     "exit status: 0 ok, 1 error (file, decoding), 2 usage\n";
 
 }  // namespace

@@ -3,7 +3,7 @@
 // the observation types, GLONASS channels, epoch span and approximate position for the header,
 // the second writes PREFIX.obs (RINEX 3.04) epoch by epoch with every signal of RXM-RAWX.
 // PREFIX.nav (RINEX 3.04) holds every distinct ephemeris assembled from RXM-SFRBX and the
-// ionosphere parameters last broadcast.
+// ionosphere parameters last broadcast. A log with SFRBX but no RAWX gives PREFIX.nav only.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -91,10 +91,10 @@ int runToRinex(const std::vector<std::string>& args) {
     throw std::runtime_error("to-rinex: " + name + ": no UBX frame with a good checksum in " +
                              std::to_string(st.stream.bytes) + " bytes; nothing to convert");
   }
-  if (st.epochs == 0) {
+  if (st.epochs == 0 && nav.kepler.empty() && nav.glonass.empty()) {
     if (in != stdin) std::fclose(in);
     throw std::runtime_error("to-rinex: " + name + ": " + std::to_string(st.stream.ubxFrames) +
-                             " UBX frames but no RXM-RAWX epoch; nothing to convert");
+                             " UBX frames but no RXM-RAWX epoch and no ephemeris from RXM-SFRBX; nothing to convert");
   }
   rtcm_app::sortTypes(header);
   header.station.markerName = std::filesystem::path(path == "-" ? "UBX" : path).stem().string();
@@ -111,7 +111,8 @@ int runToRinex(const std::vector<std::string>& args) {
                                             return a.second < b.second;
                                           })->first) * 1e-3;
   }
-  header.leapSeconds = st.leapSeconds ? *st.leapSeconds : leapSecondsAtGpst(*st.firstEpoch);
+  if (st.leapSeconds) header.leapSeconds = *st.leapSeconds;
+  else if (st.firstEpoch) header.leapSeconds = leapSecondsAtGpst(*st.firstEpoch);
   header.signalStrengthUnit = "DBHZ";
   header.comments.push_back("converted from u-blox UBX RXM-RAWX by gvins-ubx (SRI-GVINS)");
   if (opt.maxPhaseStdDev) {
@@ -120,17 +121,21 @@ int runToRinex(const std::vector<std::string>& args) {
     header.comments.push_back(c);
   }
 
-  // Pass 2: observations.
-  std::rewind(in);
+  // Pass 2: observations (none when the log has SFRBX but no RAWX: navigation file only).
   const std::string obsPath = prefix + ".obs";
-  AtomicOutputFile obsFile(obsPath);
-  RinexObsWriter writer(obsFile.stream(), header, "gvins-ubx");
+  std::optional<AtomicOutputFile> obsFile;
+  std::optional<RinexObsWriter> writer;
   ubx::Decoder dec(opt);
   SummaryExtras ex;
-  decodeAll(in, dec, [&](const ubx::Decoded& item) {
-    if (const auto* e = std::get_if<ObsEpoch>(&item)) writer.write(*e);
-  });
-  writer.finish();
+  if (st.epochs > 0) {
+    std::rewind(in);
+    obsFile.emplace(obsPath);
+    writer.emplace(obsFile->stream(), header, "gvins-ubx");
+    decodeAll(in, dec, [&](const ubx::Decoded& item) {
+      if (const auto* e = std::get_if<ObsEpoch>(&item)) writer->write(*e);
+    });
+    writer->finish();
+  }
   if (in != stdin) std::fclose(in);
   // Navigation file (only when the log carried SFRBX).
   const std::string navPath = prefix + ".nav";
@@ -146,19 +151,23 @@ int runToRinex(const std::vector<std::string>& args) {
     navFile.emplace(navPath);
     writeRinexNav(navFile->stream(), nav, "gvins-ubx");
   }
-  obsFile.commit();
+  if (obsFile) obsFile->commit();
   if (navFile) navFile->commit();
-  std::cerr << "wrote " << obsPath << " (" << writer.epochsWritten() << " epochs";
-  if (writer.droppedValues() > 0) std::cerr << ", " << writer.droppedValues() << " values not representable";
-  std::cerr << ")";
+  if (writer) {
+    std::cerr << "wrote " << obsPath << " (" << writer->epochsWritten() << " epochs";
+    if (writer->droppedValues() > 0) std::cerr << ", " << writer->droppedValues() << " values not representable";
+    std::cerr << ")";
+  } else {
+    std::cerr << "no RXM-RAWX epoch, no observation file";
+  }
   if (navFile) {
-    std::cerr << " and " << navPath << " (" << nav.kepler.size() << " Keplerian + " << nav.glonass.size()
+    std::cerr << "; wrote " << navPath << " (" << nav.kepler.size() << " Keplerian + " << nav.glonass.size()
               << " GLONASS records from " << st.sfrbx << " SFRBX messages)";
   } else {
     std::cerr << "; no SFRBX, no navigation file";
   }
   std::cerr << "\n";
-  printSummary(std::cerr, dec, ex, name);
+  printSummary(std::cerr, writer ? dec : scan, ex, name);
   return 0;
 }
 

@@ -72,7 +72,7 @@ void printSummary(std::ostream& out, const ubx::Decoder& dec, const SummaryExtra
   const ubx::NavigationCounts nc = dec.navigationCounts();
   out << "SFRBX          " << st.sfrbx << " navigation messages: " << st.ephemerides << " ephemerides, "
       << nc.parityFailures << " parity and " << nc.crcFailures << " CRC failures, " << nc.skipped
-      << " of systems not decoded, " << st.sfrbxUndated << " before the first RAWX epoch\n";
+      << " of systems not decoded, " << st.sfrbxUndated << " before the first RAWX epoch (no receive time)\n";
   if (ex.navPvt > 0) {
     out << "NAV-PVT        " << ex.navPvt << " (" << ex.navPvtFixes << " with gnssFixOK)";
     if (ex.lastPvt) {

@@ -64,11 +64,10 @@ struct Decoder::State {
         ++stats.sfrbx;
         if (!opt.decodeNavigation) return;
         const SfrbxMessage msg = parseSfrbx(p);
-        if (!lastEpoch) {
-          ++stats.sfrbxUndated;
-          return;
-        }
-        NavDataUpdate u = navigation.add(msg, *lastEpoch);
+        // Before the first RAWX epoch the assembler gets "time not known yet" (GpsTime{}): it keeps
+        // what it cannot date until a later message brings a time.
+        if (!lastEpoch) ++stats.sfrbxUndated;
+        NavDataUpdate u = navigation.add(msg, lastEpoch.value_or(GpsTime{}));
         if (!u.empty()) {
           stats.ephemerides += static_cast<std::int64_t>(u.kepler.size() + u.glonass.size());
           out.emplace_back(std::move(u));

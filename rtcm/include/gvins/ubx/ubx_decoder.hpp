@@ -20,8 +20,9 @@
 // ESF-MEAS IMU samples (gvins/ubx/esf.hpp) are delivered as decoded. RXM-SFRBX messages go
 // through gvins::ubx::NavigationAssembler (gvins/ubx/navigation_assembler.hpp) with the time of
 // the latest RAWX epoch; the ephemerides and ionosphere parameters they complete are delivered as
-// a NavDataUpdate (SFRBX before the first RAWX epoch cannot be dated and is only counted). Every
-// other message is only counted.
+// a NavDataUpdate (SFRBX before the first RAWX epoch goes in with "time not known yet", which the
+// assembler resolves from the navigation data itself where it can). Every other message is only
+// counted.
 //
 // Errors. Frames with bad checksums are skipped by the splitter and counted. A frame with a good
 // checksum but impossible content (numMeas larger than the payload, rcvTow not a time of week,
@@ -96,7 +97,7 @@ struct DecoderStats {
   std::int64_t slips = 0;                ///< phases flagged LLI bit 0
   std::int64_t halfCycleUnresolved = 0;  ///< phases flagged LLI bit 1
   std::int64_t sfrbx = 0;                ///< SFRBX messages read
-  std::int64_t sfrbxUndated = 0;         ///< SFRBX before the first RAWX epoch (not assembled)
+  std::int64_t sfrbxUndated = 0;         ///< SFRBX before the first RAWX epoch (no receive time)
   std::int64_t ephemerides = 0;          ///< ephemeris records delivered (NavDataUpdate)
   std::int64_t imuSamples = 0;           ///< ESF samples delivered
   std::optional<GpsTime> firstEpoch, lastEpoch;
