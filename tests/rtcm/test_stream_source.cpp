@@ -55,6 +55,12 @@ int listenLocal(int& port) {
 
 void sendAll(int fd, const std::string& s) { ASSERT_EQ(::send(fd, s.data(), s.size(), MSG_NOSIGNAL), static_cast<ssize_t>(s.size())); }
 
+/// accept() with a limit, so that a test whose client gave up does not hang (-1 on timeout).
+int acceptWithin(int lfd, int ms) {
+  pollfd p{lfd, POLLIN, 0};
+  return ::poll(&p, 1, ms) > 0 ? ::accept(lfd, nullptr, nullptr) : -1;
+}
+
 int connectLocal(int port) {
   const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
   sockaddr_in a{};
@@ -147,12 +153,14 @@ TEST(StreamSource, TcpClientReconnectsAndCountsTheGap) {
   int port = 0;
   const int lfd = listenLocal(port);
   std::thread server([lfd] {
-    int c = ::accept(lfd, nullptr, nullptr);
+    int c = acceptWithin(lfd, 5000);
+    if (c < 0) return;
     sendAll(c, "first part;");
     std::this_thread::sleep_for(50ms);
     ::close(c);  // the drop
     std::this_thread::sleep_for(300ms);
-    c = ::accept(lfd, nullptr, nullptr);
+    c = acceptWithin(lfd, 5000);
+    if (c < 0) return;
     sendAll(c, "second part");
     std::this_thread::sleep_for(300ms);
     ::close(c);
@@ -233,7 +241,8 @@ TEST(StreamSource, NtripSendsGgaAndDelivers) {
   const int lfd = listenLocal(port);
   std::string request, later;
   std::thread caster([lfd, &request, &later] {
-    const int c = ::accept(lfd, nullptr, nullptr);
+    const int c = acceptWithin(lfd, 5000);
+    if (c < 0) return;
     char buf[4096];
     while (request.find("\r\n\r\n") == std::string::npos) {
       const ssize_t n = ::recv(c, buf, sizeof buf, 0);
