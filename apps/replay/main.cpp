@@ -41,6 +41,7 @@ const char* kUsage =
     "                         timing.csv, metrics.csv (key figures for scripts); GNSS modes add\n"
     "                         global.pos, global_ecef.csv, track.kml, gnss_epochs.csv; with ground\n"
     "                         truth eval_*.svg\n"
+    "  --nmea FILE            also NMEA 0183 GGA+RMC sentences of the global (GNSS) solutions\n"
     "  --config F.yaml        replay:, estimator: and gnss_fusion: sections (docs/replay.md)\n"
     "  --mode M               vio | vio+gpsvel | vio+dopp | vio+dopp+psr | vio+dopp+dpsr |\n"
     "                         vio+dopp+ddcp | vio+dopp+psr-nointegration | vio+dopp+ppp (float PPP:\n"
@@ -136,6 +137,7 @@ ReplaySummary run(const std::string& dataset, const vio::SriSwfConfig& ec, const
 }  // namespace
 
 int main(int argc, char** argv) {
+  std::string nmeaPath;
   std::string dataset, outDir, configPath, mode = "vio", leverCalib, timeCalib;
   std::optional<double> timeOffset, carrierSmoothing;
   std::string saveTracks;
@@ -160,6 +162,7 @@ int main(int argc, char** argv) {
       std::fputs(kUsage, stdout);
       return 0;
     } else if (a == "-o") outDir = value();
+    else if (a == "--nmea") nmeaPath = value();
     else if (a == "--config") configPath = value();
     else if (a == "--mode") mode = value();
     else if (a == "--float") useFloat = true;
@@ -236,6 +239,7 @@ int main(int argc, char** argv) {
     if (!configPath.empty()) rc = loadReplayConfig(configPath);
     ReplayOptions opt = rc.options;
     opt.outDir = outDir;
+    opt.nmeaPath = nmeaPath;
     opt.modeName = mode;
     opt.progress = !quiet;
     if (start) opt.start_s = *start;

@@ -29,11 +29,13 @@
 #include "gvins/gnss/accuracy_statistics.hpp"
 #include "gvins/gnss/base_reader.hpp"
 #include "gvins/gnss/pos_writer.hpp"
+#include "gvins/gnss/solution_outputs.hpp"
 #include "gvins/gnss/rtk.hpp"
 #include "gvins/gnss/rtk_combination.hpp"
 #include "gvins/gnss/rtk_config.hpp"
 #include "gvins/gnss/rtk_pass.hpp"
 #include "gvins/gnss/spp_config.hpp"
+#include "live.hpp"
 
 namespace {
 
@@ -48,6 +50,8 @@ const char* kUsage =
     "(Q=1 fixed, 2 float, 5 single-point fallback), prints progress and a summary to stderr.\n"
     "\n"
     "  -o FILE               output .pos file ('-' for stdout); required\n"
+    "  --nmea FILE           also NMEA 0183 GGA+RMC sentences of the solutions (docs/nmea.md)\n"
+    "  --kml FILE            also a KML track of the solutions\n"
     "  --config F.yaml       options from the 'rtk:' (and 'spp:') sections of a YAML file;\n"
     "                        command-line options override it\n"
     "  --base-xyz X,Y,Z      base antenna reference point, ECEF (m)\n"
@@ -78,10 +82,22 @@ const char* kUsage =
     "  --truth-llh LAT,LON,H the same as latitude, longitude (deg), ellipsoidal height (m)\n"
     "  --strict              stop at the first malformed epoch (default: skip it and count it)\n"
     "  -q, --quiet           no progress line\n"
+    "\n"
+    "Live mode (docs/rtk.md): gvins-rtk --rover-stream PATH --base-stream PATH [-o OUT] [NAV...]\n"
+    "  --rover-stream PATH   rover UBX or RTCM 3 stream: file://F, tcpcli://HOST:PORT, tcpsvr://:PORT,\n"
+    "                        serial://DEV:BAUD, ntrip://USER:PASS@HOST:PORT/MOUNT, - (stdin)\n"
+    "  --base-stream PATH    base RTCM 3 (or UBX) stream, same paths; NTRIP gets the rover's GGA\n"
+    "  --base-wait S         wait up to S s for the base epoch after each rover epoch, as\n"
+    "                        post-processing pairs them (default 0: solve at once)\n"
+    "  --max-outage S        end a stream after S s without a connection (default 0: retry for ever)\n"
+    "  --latency-log F.csv   per-epoch latency and base age\n"
     "  -h, --help            this text\n";
 
 struct Args {
   std::string config, out;
+  std::string nmea, kml;
+  std::string roverStream, baseStream, latencyLog;
+  double baseWait = 0.0, maxOutage = 0.0;
   std::vector<std::string> inputs;
   std::optional<Eigen::Vector3d> baseXyz, truth;
   std::optional<std::string> mode, dynamics, armode, systems, arSystems, validation;
@@ -126,6 +142,22 @@ Args parseArgs(int argc, char** argv) {
       std::exit(0);
     } else if (o == "-o") {
       a.out = value(i, o);
+    } else if (o == "--rover-stream") {
+      a.roverStream = value(i, o);
+    } else if (o == "--base-stream") {
+      a.baseStream = value(i, o);
+    } else if (o == "--latency-log") {
+      a.latencyLog = value(i, o);
+    } else if (o == "--base-wait") {
+      a.baseWait = parseNumber(o, value(i, o));
+      if (a.baseWait < 0.0 || a.baseWait > 3600.0) usageError("--base-wait must be within 0..3600 s");
+    } else if (o == "--max-outage") {
+      a.maxOutage = parseNumber(o, value(i, o));
+      if (a.maxOutage < 0.0) usageError("--max-outage must not be negative");
+    } else if (o == "--nmea") {
+      a.nmea = value(i, o);
+    } else if (o == "--kml") {
+      a.kml = value(i, o);
     } else if (o == "--config") {
       a.config = value(i, o);
     } else if (o == "--base-xyz") {
@@ -187,6 +219,11 @@ Args parseArgs(int argc, char** argv) {
       a.inputs.push_back(o);
     }
   }
+  if (!a.roverStream.empty() || !a.baseStream.empty()) {
+    if (a.roverStream.empty() || a.baseStream.empty()) usageError("live mode needs --rover-stream and --base-stream");
+    if (a.out.empty()) a.out = "-";
+    return a;  // the inputs are navigation files
+  }
   if (a.out.empty()) usageError("no output file (-o OUT.pos)");
   const bool ubxInput = a.inputs.size() == 2 && (gvins::BaseReader::detect(a.inputs[0]) == gvins::BaseFormat::Ubx ||
                                                  gvins::BaseReader::detect(a.inputs[1]) == gvins::BaseFormat::Ubx);
@@ -202,6 +239,31 @@ std::string systemsText(const std::array<bool, gvins::kNumSystems>& s) {
     if (s[static_cast<std::size_t>(i)]) t += gvins::systemLetter(static_cast<gvins::System>(i));
   }
   return t.empty() ? "-" : t;
+}
+
+bool live(const Args& a) { return !a.roverStream.empty(); }
+
+/// The live mode (live.cpp) with the options of the command line.
+int runLive(const Args& a, const gvins::RtkConfig& cfg, const gvins::SppConfig& sppCfg, gvins::EphemerisStore& nav) {
+  gvins::rtklive::LiveOptions o;
+  o.rover = a.roverStream;
+  o.base = a.baseStream;
+  o.out = a.out;
+  o.nmea = a.nmea;
+  o.latencyLog = a.latencyLog;
+  o.baseWait = a.baseWait;
+  o.maxOutage = a.maxOutage;
+  o.baseXyz = a.baseXyz;
+  o.strict = a.strict;
+  o.quiet = a.quiet;
+  o.pos.coordinates = a.xyz ? gvins::PosCoordinates::Xyz : gvins::PosCoordinates::Llh;
+  o.pos.velocity = !a.noVelocity;
+  o.pos.timeDecimals = a.timeDecimals;
+  o.pos.program = "SRI-GVINS gvins-rtk (live)";
+  o.pos.headerFields.emplace_back("rover", a.roverStream);
+  o.pos.headerFields.emplace_back("base", a.baseStream);
+  if (!a.kml.empty()) usageError("--kml is not available in live mode");
+  return gvins::rtklive::runLive(o, cfg, sppCfg, nav);
 }
 
 void printError(const gvins::ParseError& e) { std::fprintf(stderr, "gvins-rtk: error: %s\n", e.what()); }
@@ -276,11 +338,13 @@ int main(int argc, char** argv) {
   // Navigation data.
   EphemerisStore nav;
   try {
-    for (std::size_t i = 2; i < args.inputs.size(); ++i) nav.add(readRinexNav(args.inputs[i]));
+    for (std::size_t i = live(args) ? 0 : 2; i < args.inputs.size(); ++i) nav.add(readRinexNav(args.inputs[i]));
   } catch (const ParseError& e) {
     printError(e);
     return 1;
   }
+
+  if (live(args)) return runLive(args, cfg, sppCfg, nav);
 
   // Rover and base: RINEX, UBX (rover and base) or RTCM 3 (base), told apart by content
   // (BaseReader). UBX and RTCM add the ephemerides they carry to `nav` as they are read.
@@ -322,8 +386,10 @@ int main(int argc, char** argv) {
   // The .pos file is written under a temporary name and renamed only when the run succeeds: a
   // failed run leaves no file that looks valid (and an older file of that name intact).
   std::optional<OutputTarget> output;
+  std::optional<SolutionOutputs> side;
   try {
     output.emplace(args.out);
+    side.emplace(args.nmea, args.kml, "gvins-rtk " + args.inputs[0]);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "gvins-rtk: error: %s\n", e.what());
     return 1;
@@ -418,6 +484,7 @@ int main(int argc, char** argv) {
         writer = std::make_unique<PosWriter>(*out, popt);
       }
       writer->write(sol.toPositionSolution());
+      if (side) side->add(sol.toPositionSolution());
       satSum += sol.numSatellites;
       if (sol.quality != SolutionQuality::Single) ageMax = std::max(ageMax, sol.age);
       if (fixStats && sol.quality == SolutionQuality::Fix) {
@@ -567,6 +634,7 @@ int main(int argc, char** argv) {
   const bool toFile = output->isFile();
   try {
     output->finish(exitCode == 0);
+    side->finish(exitCode == 0);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "gvins-rtk: error: %s\n", e.what());
     exitCode = 1;

@@ -28,6 +28,7 @@
 #include "gvins/gnss/doppler_consistency.hpp"
 #include "gvins/gnss/pos_reader.hpp"
 #include "gvins/gnss/pos_writer.hpp"
+#include "gvins/gnss/solution_outputs.hpp"
 #include "gvins/gnss/spp.hpp"
 #include "gvins/gnss/spp_config.hpp"
 #include "gvins/rtcm/ssr_file.hpp"
@@ -49,6 +50,8 @@ const char* kUsage =
     "Bias-SINEX code biases (*.bia, *.bsx: OSBs) replace the broadcast group delays with them.\n"
     "\n"
     "  -o FILE            output .pos file ('-' for stdout); required\n"
+    "  --nmea FILE        also NMEA 0183 GGA+RMC sentences of the solutions (docs/nmea.md)\n"
+    "  --kml FILE         also a KML track of the solutions\n"
     "  --config F.yaml    options from the 'spp:' section of a YAML file (see docs); command-line\n"
     "                     options given after it override it\n"
     "  --systems GRECJ    systems to use (G GPS, R GLONASS, E Galileo, C BeiDou, J QZSS, S SBAS,\n"
@@ -85,6 +88,7 @@ const char* kUsage =
 struct Args {
   std::string config;
   std::string out;
+  std::string nmea, kml;
   std::string score;
   std::vector<std::string> inputs;
   std::optional<std::string> systems;
@@ -129,6 +133,10 @@ Args parseArgs(int argc, char** argv) {
       std::exit(0);
     } else if (o == "-o") {
       a.out = value(i, o);
+    } else if (o == "--nmea") {
+      a.nmea = value(i, o);
+    } else if (o == "--kml") {
+      a.kml = value(i, o);
     } else if (o == "--config") {
       a.config = value(i, o);
     } else if (o == "--systems") {
@@ -352,8 +360,10 @@ int main(int argc, char** argv) {
   // The .pos file is written under a temporary name and renamed only when the run succeeds: a
   // failed run leaves no file that looks valid (and an older file of that name intact).
   std::optional<OutputTarget> output;
+  std::optional<SolutionOutputs> side;
   try {
     output.emplace(args.out);
+    side.emplace(args.nmea, args.kml, "gvins-spp " + args.inputs[0]);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "gvins-spp: error: %s\n", e.what());
     return 1;
@@ -448,6 +458,7 @@ int main(int argc, char** argv) {
       if (args.dropFailed && ps.residualTest == ResidualTest::Failed) continue;
       ++written;
       writer.write(ps);
+      side->add(ps, NmeaExtras{sol.dop.valid ? std::optional<double>(sol.dop.hdop) : std::nullopt, std::nullopt});
       if (stats) {
         stats->addPosition(sol.position);
         if (sol.velocity.valid) stats->addVelocity(sol.velocity.velocity);
@@ -472,6 +483,7 @@ int main(int argc, char** argv) {
   const bool toFile = output->isFile();
   try {
     output->finish(exitCode == 0);
+    side->finish(exitCode == 0);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "gvins-spp: error: %s\n", e.what());
     exitCode = 1;

@@ -29,6 +29,8 @@
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "gvins/fusion/replay_feature_tracks.hpp"
 #include "gvins/gnss/base_reader.hpp"
+#include "gvins/gnss/kml_writer.hpp"
+#include "gvins/gnss/nmea_writer.hpp"
 #include "gvins/gnss/pos_writer.hpp"
 #include "gvins/rtcm/ssr_file.hpp"
 #include "gvins/vio/camera_model.hpp"
@@ -111,17 +113,7 @@ struct GnssInputs {
 
 void writeKml(const fs::path& path, const std::vector<Geodetic>& pts, const std::string& name) {
   OutFile f(path);
-  auto& o = f.out();
-  o << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<kml xmlns=\"http://www.opengis.net/kml/2.2\">\n<Document>\n"
-    << "<name>" << name << "</name>\n<Style id=\"track\"><LineStyle><color>ff0000ff</color><width>2</width></LineStyle></Style>\n"
-    << "<Placemark><name>antenna track</name><styleUrl>#track</styleUrl><LineString><altitudeMode>absolute</altitudeMode><coordinates>\n";
-  char b[96];
-  constexpr double kDeg = 180.0 / 3.14159265358979323846;
-  for (const Geodetic& g : pts) {
-    std::snprintf(b, sizeof b, "%.9f,%.9f,%.3f\n", g.lon * kDeg, g.lat * kDeg, g.height);
-    o << b;
-  }
-  o << "</coordinates></LineString></Placemark>\n</Document>\n</kml>\n";
+  writeKmlTrack(f.out(), pts, name);
   f.close();
 }
 
@@ -516,6 +508,12 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
   std::unique_ptr<OutFile> posFile, ecefFile, epochFile;
   std::unique_ptr<PosWriter> posWriter;
   std::vector<Geodetic> kml;
+  std::unique_ptr<OutFile> nmeaFile;
+  std::unique_ptr<NmeaWriter> nmeaWriter;
+  if (gnss && !opt.nmeaPath.empty()) {
+    nmeaFile = std::make_unique<OutFile>(opt.nmeaPath);
+    nmeaWriter = std::make_unique<NmeaWriter>(nmeaFile->out());
+  }
   if (gnss) {
     posFile = std::make_unique<OutFile>(out / "global.pos");
     PosWriterOptions po;
@@ -761,6 +759,7 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
             ps.numSatellites = std::max({o.psrUsed, o.doppUsed, o.dpsrUsed, o.ddcpUsed, o.phaseUsed});
             ps.velocity = o.antennaVelocityEcef;
             posWriter->write(ps);
+            if (nmeaWriter) nmeaWriter->write(ps);
             const Eigen::Vector3d v = o.antennaVelocityEcef ? *o.antennaVelocityEcef : Eigen::Vector3d::Zero();
             std::snprintf(b, sizeof b, "%d,%.3f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%d\n", t.week(), t.tow(), ps.position.x(),
                           ps.position.y(), ps.position.z(), v.x(), v.y(), v.z(), o.rtkFixed ? 1 : 0);
@@ -831,6 +830,10 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
     epochFile->close();
     writeKml(out / "track.kml", kml, "gvins-replay " + opt.modeName);
     sum.files.insert(sum.files.end(), {posFile->path(), ecefFile->path(), (out / "track.kml").string(), epochFile->path()});
+    if (nmeaFile) {
+      nmeaFile->close();
+      sum.files.push_back(nmeaFile->path());
+    }
   }
   const double n = static_cast<double>(std::max<std::size_t>(sum.framesProcessed, 1));
   sum.frontendMsMean = feSum / n;

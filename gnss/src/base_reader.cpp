@@ -67,10 +67,18 @@ class RinexBase final : public BaseReader {
 
 class RtcmBase final : public BaseReader {
  public:
-  RtcmBase(const std::string& path, const GpsTime& reference, EphemerisStore* nav)
-      : in_(path, std::ios::binary), nav_(nav), decoder_(options(path, reference)) {
-    if (!in_) throw ParseError(path, 0, "", "cannot open file");
-    buf_.resize(1 << 16);
+  RtcmBase(const std::string& path, const GpsTime& reference, EphemerisStore* nav, bool fromFile = true)
+      : nav_(nav), decoder_(options(path, reference)), pushed_(!fromFile) {
+    if (fromFile) {
+      in_.open(path, std::ios::binary);
+      if (!in_) throw ParseError(path, 0, "", "cannot open file");
+      buf_.resize(1 << 16);
+    }
+  }
+  void feed(std::span<const std::uint8_t> bytes) override { decoder_.feed(bytes); }
+  void finish() override {
+    decoder_.finish();
+    done_ = true;
   }
   bool next(ObsEpoch& e) override {
     for (;;) {
@@ -85,7 +93,7 @@ class RtcmBase final : public BaseReader {
           else if (auto* s = std::get_if<SsrMessage>(&*d)) nav_->addSsr(*s);  // SSR mixed into the stream
         }
       }
-      if (done_) return false;
+      if (done_ || pushed_) return false;
       in_.read(reinterpret_cast<char*>(buf_.data()), static_cast<std::streamsize>(buf_.size()));
       const auto n = in_.gcount();
       if (n > 0) decoder_.feed(std::span<const std::uint8_t>(buf_.data(), static_cast<std::size_t>(n)));
@@ -137,7 +145,7 @@ class RtcmBase final : public BaseReader {
  private:
   static rtcm::DecoderOptions options(const std::string& path, const GpsTime& reference) {
     rtcm::DecoderOptions o;
-    o.referenceTime = reference;
+    if (reference != GpsTime{}) o.referenceTime = reference;  // else the host clock (live streams)
     o.streamName = path;
     return o;
   }
@@ -146,14 +154,23 @@ class RtcmBase final : public BaseReader {
   rtcm::Decoder decoder_;
   std::vector<std::uint8_t> buf_;
   bool done_ = false;
+  bool pushed_;  // bytes come through feed() (live streams), not from the file
 };
 
 class UbxBase final : public BaseReader {
  public:
-  UbxBase(const std::string& path, EphemerisStore* nav, bool strict)
-      : in_(path, std::ios::binary), nav_(nav), decoder_(options(path, strict)) {
-    if (!in_) throw ParseError(path, 0, "", "cannot open file");
-    buf_.resize(1 << 16);
+  UbxBase(const std::string& path, EphemerisStore* nav, bool strict, bool fromFile = true)
+      : nav_(nav), decoder_(options(path, strict)), pushed_(!fromFile) {
+    if (fromFile) {
+      in_.open(path, std::ios::binary);
+      if (!in_) throw ParseError(path, 0, "", "cannot open file");
+      buf_.resize(1 << 16);
+    }
+  }
+  void feed(std::span<const std::uint8_t> bytes) override { decoder_.feed(bytes); }
+  void finish() override {
+    decoder_.finish();
+    done_ = true;
   }
   bool next(ObsEpoch& e) override {
     for (;;) {
@@ -165,7 +182,7 @@ class UbxBase final : public BaseReader {
         // Ephemerides assembled from the receiver's own SFRBX subframes.
         if (auto* u = std::get_if<ubx::NavDataUpdate>(&*d); u && nav_) u->addTo(*nav_);
       }
-      if (done_) return false;
+      if (done_ || pushed_) return false;
       in_.read(reinterpret_cast<char*>(buf_.data()), static_cast<std::streamsize>(buf_.size()));
       const auto n = in_.gcount();
       if (n > 0) decoder_.feed(std::span<const std::uint8_t>(buf_.data(), static_cast<std::size_t>(n)));
@@ -203,6 +220,7 @@ class UbxBase final : public BaseReader {
   ubx::Decoder decoder_;
   std::vector<std::uint8_t> buf_;
   bool done_ = false;
+  bool pushed_;  // bytes come through feed() (live streams), not from the file
 };
 
 /// Good UBX frames and good RTCM frames in a byte block (mixed streams hold both).
@@ -223,6 +241,10 @@ std::optional<BaseFormat> BaseReader::detect(const std::string& path) {
   std::vector<unsigned char> head(1 << 16);
   in.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size()));
   head.resize(static_cast<std::size_t>(in.gcount()));
+  return detectBytes(head);
+}
+
+std::optional<BaseFormat> BaseReader::detectBytes(std::span<const std::uint8_t> head) {
   if (head.size() >= 2 && head[0] == 0x1f && head[1] == 0x8b) return BaseFormat::Rinex;
   const std::size_t textHead = std::min<std::size_t>(head.size(), 4096);
   const std::string text(head.begin(), head.begin() + static_cast<std::ptrdiff_t>(textHead));
@@ -251,5 +273,15 @@ std::unique_ptr<BaseReader> BaseReader::open(const std::string& path, const GpsT
   if (*f == BaseFormat::Ubx) return std::make_unique<UbxBase>(path, nav, !skipBadEpochs);
   return std::make_unique<RtcmBase>(path, referenceTime, nav);
 }
+
+std::unique_ptr<BaseReader> BaseReader::openPushed(BaseFormat format, const std::string& name, const GpsTime& referenceTime,
+                                                   EphemerisStore* nav, bool skipBadEpochs) {
+  if (format == BaseFormat::Ubx) return std::make_unique<UbxBase>(name, nav, !skipBadEpochs, false);
+  if (format == BaseFormat::Rtcm) return std::make_unique<RtcmBase>(name, referenceTime, nav, false);
+  throw ParseError(name, 0, "format", "RINEX cannot be read from a live stream (UBX or RTCM 3 only)");
+}
+
+void BaseReader::feed(std::span<const std::uint8_t>) { throw std::logic_error("BaseReader::feed on a file reader"); }
+void BaseReader::finish() {}
 
 }  // namespace gvins

@@ -200,4 +200,15 @@ std::size_t NtripClient::read(std::vector<std::uint8_t>& out) {
   }
 }
 
+bool NtripClient::send(const std::string& text) {
+  if (fd_ < 0 || ended_) return false;
+  std::size_t sent = 0;
+  while (sent < text.size()) {
+    const ssize_t n = ::send(fd_, text.data() + sent, text.size() - sent, MSG_NOSIGNAL | MSG_DONTWAIT);
+    if (n <= 0) return false;
+    sent += static_cast<std::size_t>(n);
+  }
+  return true;
+}
+
 }  // namespace gvins::rtcm

@@ -18,6 +18,8 @@
 #include <vector>
 #include <algorithm>
 
+#include "gvins/base/geodetic.hpp"
+#include "gvins/gnss/pos_reader.hpp"
 #include "gvins/sim/dataset_generator.hpp"
 #include "gvins/sim/scenario.hpp"
 #include "generate_scenario.hpp"
@@ -222,6 +224,38 @@ TEST(EvalCli, ResetMarksSelectTheLastState) {
   EXPECT_GT(rmse(last), 0.0);
   EXPECT_LT(rmse(last), 0.02) << last;
   EXPECT_GT(rmse(all), 1.0) << all;
+}
+
+
+TEST(ReplayCli, NmeaHasOneGgaAndRmcPerGlobalSolution) {
+  // --nmea: the GGA of every global.pos row, parsed back independently, gives its position to
+  // < 1 mm (7-decimal minutes; altitude + separation = ellipsoidal height).
+  const fs::path nmea = scratch() / "global.nmea";
+  const CliRun r = replay("nmea", "--mode vio+dopp+psr --nmea " + nmea.string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  const gvins::PosFile pos = gvins::readPosFile((scratch() / "nmea" / "global.pos").string());
+  std::ifstream f(nmea);
+  std::vector<std::string> gga;
+  std::size_t rmc = 0;
+  for (std::string l; std::getline(f, l);) {
+    if (l.rfind("$GNGGA,", 0) == 0) gga.push_back(l);
+    rmc += l.rfind("$GNRMC,", 0) == 0;
+  }
+  ASSERT_GT(pos.solutions.size(), 50u);
+  ASSERT_EQ(gga.size(), pos.solutions.size());
+  EXPECT_EQ(rmc, gga.size());
+  for (std::size_t i = 0; i < gga.size(); ++i) {
+    std::vector<std::string> v(1);
+    for (std::size_t k = 1; k < gga[i].size() && gga[i][k] != '*'; ++k) {
+      if (gga[i][k] == ',') v.emplace_back();
+      else v.back() += gga[i][k];
+    }
+    ASSERT_EQ(v.size(), 15u) << gga[i];
+    const double lat = (std::stod(v[2].substr(0, 2)) + std::stod(v[2].substr(2)) / 60.0) * (v[3] == "S" ? -1 : 1);
+    const double lon = (std::stod(v[4].substr(0, 3)) + std::stod(v[4].substr(3)) / 60.0) * (v[5] == "W" ? -1 : 1);
+    const Eigen::Vector3d p = gvins::geodeticToEcef(gvins::geodeticFromDegrees(lat, lon, std::stod(v[9]) + std::stod(v[11])));
+    EXPECT_LT((p - pos.solutions[i].position).norm(), 1e-3) << gga[i];
+  }
 }
 
 }  // namespace gvins::fusion

@@ -114,6 +114,8 @@ enum class ImuGapPolicy { Error, Warn };
 
 struct ReplayOptions {
   std::string outDir;
+  /// Also NMEA 0183 GGA+RMC sentences of the global (GNSS) solutions to this file (empty: none).
+  std::string nmeaPath;
   vio::FrontendConfig frontend;
   /// Images that cannot be decoded: error (default) or skip the frame and count it.
   bool skipBadImages = false;

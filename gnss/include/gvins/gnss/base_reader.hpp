@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 
 #include <Eigen/Core>
@@ -38,6 +39,16 @@ class BaseReader {
   /// frames with good checksums, at least as many as RTCM frames with good CRCs: UBX; an RTCM
   /// preamble 0xD3 with a valid frame header: RTCM). nullopt if none.
   static std::optional<BaseFormat> detect(const std::string& path);
+  /// The same on the first bytes of a stream (up to 64 KiB are looked at).
+  static std::optional<BaseFormat> detectBytes(std::span<const std::uint8_t> head);
+  /// A reader of a live UBX or RTCM 3 stream whose bytes the caller pushes with feed() (and
+  /// finish() at the end); next() then returns false whenever no complete epoch is decoded yet.
+  /// `name` is used in messages. Throws ParseError for BaseFormat::Rinex.
+  static std::unique_ptr<BaseReader> openPushed(BaseFormat format, const std::string& name, const GpsTime& referenceTime,
+                                                EphemerisStore* nav, bool skipBadEpochs = true);
+  /// Pushed readers: bytes of the stream, any chunk size; finish() at its end.
+  virtual void feed(std::span<const std::uint8_t> bytes);
+  virtual void finish();
 
   /// Next observation epoch (time order as in the file); false at the end. RINEX format errors
   /// throw ParseError unless skipped.

@@ -42,6 +42,13 @@ class NtripClient {
   /// Protocol).
   std::size_t read(std::vector<std::uint8_t>& out);
   void close();
+  /// The wait of the next read() calls (s).
+  void setReadTimeout(double seconds) { opt_.readTimeout = seconds; }
+  /// The GGA sentence sent with the next connect() (VRS casters).
+  void setGga(std::string gga) { opt_.gga = std::move(gga); }
+  /// Sends text on the open connection (an updated GGA sentence for a VRS caster, CR LF
+  /// included by the caller); false if not connected or the send fails.
+  bool send(const std::string& text);
 
   /// The HTTP request that connect() sends (credentials included), for tests and logs.
   std::string request() const;
