@@ -959,10 +959,13 @@ TEST(SriSwfConfig, YamlValuesAndErrorsNameLineAndField) {
   EXPECT_DOUBLE_EQ(t.imu.gyroscope_noise_density, c.imu.gyroscope_noise_density);
   EXPECT_TRUE(t.use_float);  // kept from the defaults
   EXPECT_EQ(parseSriSwfConfig("cameras: [cam0/sensor.yaml]\n", "t.yaml", dir, &c).cameras.size(), 1u);
+  // Defaults without cameras are a camera-less rig (an IMU-only dataset: IMU and GNSS); a file
+  // read without defaults must still name its cameras.
   const SriSwfConfig none;
+  EXPECT_TRUE(parseSriSwfConfig("window: 7\n", "tune.yaml", dir, &none).cameras.empty());
   try {
-    parseSriSwfConfig("window: 7\n", "tune.yaml", dir, &none);
-    ADD_FAILURE() << "defaults without cameras: no error";
+    parseSriSwfConfig("window: 7\n", "alone.yaml", dir, nullptr);
+    ADD_FAILURE() << "no defaults and no cameras: no error";
   } catch (const ParseError& e) {
     EXPECT_EQ(e.field(), "cameras");
   }
