@@ -177,6 +177,14 @@ struct GnssFusionConfig {
   /// is held constant).
   double isbRandomWalk = 0.001;
   double isbRenewalInterval = 30.0;
+  /// A system first seen after the clocks started (its ephemerides arrived later) joins the clock
+  /// state once this many of its satellites have a model (GnssFusion::addLateClockSystems).
+  int lateSystemMinSatellites = 2;
+  /// Tight stage: after every epoch's rows were gated out for reacquireAfter seconds (the state
+  /// drifted beyond its covariance, e.g. through an outage), the rows are applied without the
+  /// gates for reacquireWindow seconds (gnss_gate_recovery.hpp); reacquireAfter <= 0: never.
+  double reacquireAfter = 2.0;
+  double reacquireWindow = 1.0;
   double rowGate = 0.999;
   double epochGate = 0.99999;
   double frameYawSigmaDeg = 3.0;
