@@ -176,6 +176,7 @@ def main():
          "--accel-unit", "g", "--gyro-unit", "deg/s", "-o", os.path.join(ds, "mav0", "imu0", "data.csv")])
     shutil.copy(os.path.join(WALK, "imu0_sensor.yaml"), os.path.join(ds, "mav0", "imu0", "sensor.yaml"))
     rows = []
+    rtklib_nav = None
     ref = read_pos(REF)
     single = os.path.join(out, "single_frequency.yaml")
     with open(single, "w") as f:
@@ -203,6 +204,11 @@ def main():
         rpos = os.path.join(out, "rtklib_spp.pos")
         run(["rnx2rtkp", "-p", "0", "-t", "-sys", "G,R,E,J,C", "-o", rpos, obs, nav])
         rows.append(("RTKLIB SPP (convbin + rnx2rtkp -p 0)", compare(rpos, ref)))
+        sats = {}
+        for line in open(nav):
+            if len(line) > 3 and line[0] in "GRECJ" and line[1:3].isdigit() and line[3] == " ":
+                sats.setdefault(line[0], set()).add(line[:3])
+        rtklib_nav = ", ".join(f"{k} {len(v)}" for k, v in sorted(sats.items())) or "none"
     table = ["| solution | epochs (ref. fixed) | satellites | H RMS [m] | V RMS [m] | H 95 % [m] | V 95 % [m] | vel. RMS [m/s] "
              "| mean error E, N, U [m] | σ H, σ V about the mean [m] |",
              "|---|---|---|---|---|---|---|---|---|---|"]
@@ -240,8 +246,8 @@ def main():
             f.write("Reference: the publisher's RTKLIB RTK track, its fixed epochs (`gnss_1730_sf.pos`, Q = 1).\n")
             f.write("Satellites: mean per compared epoch (fused: pseudorange rows applied, Doppler rows in vio+dopp;\n"
                     "SPP: the .pos `ns` column). The mean error and the spread about it are printed because every\n"
-                    "solution, ours and RTKLIB's, sits at nearly the same offset from the reference while scattering\n"
-                    "by about a metre about it: the RTK track's base coordinates are not published and its datum\n"
+                    "solution, ours and RTKLIB's, sits at nearly the same horizontal offset from the reference while\n"
+                    "scattering by metres at most about it: the RTK track's base coordinates are not published and its datum\n"
                     "is offset by metres, so the RMS columns hold that offset and σ is the part a solution controls.\n\n")
             f.write(text)
             f.write("\nvio+dopp+ppp runs on broadcast orbits and clocks: no precise products (SP3, clock, OSB) of\n"
@@ -251,6 +257,10 @@ def main():
                     "ionosphere-free pair with a broadcast group delay and enters single-frequency (B3I).\n"
                     "GPS and Galileo have no broadcast ionosphere in this log (no GPS page 18 in its 134 s), so the\n"
                     "'broadcast ionosphere' rows correct only BeiDou (its own model, on B3I).\n")
+            if rtklib_nav:
+                f.write(f"RTKLIB's input is convbin's conversion of the log: its navigation file holds the satellites\n"
+                        f"{rtklib_nav} (system letter, satellites with ephemerides) and its observations no BeiDou,\n"
+                        f"so RTKLIB solves with the few GPS satellites it has ephemerides for.\n")
             f.write("\n## GNSS outages of 15 s\n\n")
             f.write("GNSS removed in one window per run (`gvins-replay --gnss-outage START,15`); errors against the\n"
                     "reference's fixed or float epoch at the last epoch before the window and at the window's last\n"
