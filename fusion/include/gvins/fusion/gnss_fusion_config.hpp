@@ -48,6 +48,9 @@
 //                                         # marginalize the frame block (false: keep it as a state)
 //     frame_reanchor_position_sigma: 0.5  # m, ... once the IMU's ENU position σ is below this
 //     outage_reset: 60                    # s without GNSS update: clocks/ambiguities reset
+//     reacquire_after: 2                  # s of epochs with every row gated out: rows ungated ...
+//     reacquire_window: 1                 # ... for this long (re-acquisition; 0: never)
+//     late_system_min_satellites: 2       # satellites of a system first seen after the clocks started
 //     clock_ransac_threshold: 5.0         # m (pseudorange) for the clock RANSAC
 //     base_position: [x, y, z]            # ECEF of the base antenna (dpsr/ddcp)
 //     max_base_age: 2.0                   # s
