@@ -221,19 +221,16 @@ std::vector<TrackEpoch> trackInW(const std::vector<PositionSolution>& track, con
 }
 
 /// Initial attitude: roll and pitch from the mean specific force of the first second, yaw from
-/// a 10-degree grid of the attitude cost.
+/// a 10-degree grid of the attitude cost; biases start at zero (the fit finds them, so a rig
+/// that stands still at first can check the gyro bias against its mean rate then).
 Eigen::Matrix3d initialAttitude(const AttitudeModel& model, const ImuSpan& imu, Eigen::VectorXd& x,
                                 const std::vector<double>& a, const std::vector<double>& b,
                                 const std::vector<Eigen::Vector3d>& dv) {
-  Eigen::Vector3d fm = Eigen::Vector3d::Zero(), wm = Eigen::Vector3d::Zero();
+  Eigen::Vector3d fm = Eigen::Vector3d::Zero();
   int cnt = 0;
-  for (std::size_t k = 0; k < imu.t.size() && imu.t[k] < imu.t.front() + 1.0; ++k, ++cnt) {
-    fm += imu.f[k];
-    wm += imu.w[k];
-  }
+  for (std::size_t k = 0; k < imu.t.size() && imu.t[k] < imu.t.front() + 1.0; ++k, ++cnt) fm += imu.f[k];
   fm /= cnt;
   x.setZero();
-  for (int i = 0; i * 3 + 6 < x.size(); ++i) x.segment<3>(6 + 3 * i) = wm / cnt;
   const Eigen::Matrix3d tilt = Eigen::Quaterniond::FromTwoVectors(fm.normalized(), Eigen::Vector3d::UnitZ()).toRotationMatrix();
   double best = 1e300;
   Eigen::Matrix3d R0 = tilt;

@@ -58,7 +58,7 @@ struct TrackFitReport {
   std::size_t imuSamples = 0;           ///< IMU samples inside the span
   Eigen::Vector3d gyroBias = Eigen::Vector3d::Zero();   ///< rad/s (mean over the span)
   Eigen::Vector3d accelBias = Eigen::Vector3d::Zero();  ///< m/s²
-  double initialYawDeg = 0.0;           ///< heading of the body x axis at t = 0 (from north to east... ENU yaw: from east, counter-clockwise)
+  double initialYawDeg = 0.0;           ///< yaw of the body x axis at t = 0 (ENU: from east, counter-clockwise), deg
   double velocityResidualRms = 0.0;     ///< m/s, velocity increments of the attitude fit (per axis)
   double trackResidualRms = 0.0;        ///< m, fitted antenna against the track epochs used (3-D)
   double trackResidualMax = 0.0;        ///< m
