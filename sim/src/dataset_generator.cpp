@@ -105,7 +105,7 @@ std::vector<fs::path> copyRealGnss(const TrackTrajectoryConfig& c, const fs::pat
 void writeTrackSection(TextFile& f, const TrackTrajectoryConfig& c, const TrackFitReport& r) {
   f << "  pos_file: " << yamlQuoted(c.posFile) << "\n  imu_csv: " << yamlQuoted(c.imuCsv) << "\n  max_quality: ";
   f.integer(c.maxQuality) << "\n  rover_log: " << yamlQuoted(c.roverLog) << "\n  attitude: \"real gyro integrated, R0 and "
-                             "biases fitted to the track's velocity increments (src/track_trajectory.hpp)\"\n  track_epochs: ";
+                             "biases fitted to the track's velocity increments (sim/track_trajectory.hpp)\"\n  track_epochs: ";
   f.integer(static_cast<std::int64_t>(r.trackEpochs)) << "\n  initial_yaw_deg: ";
   f.num(r.initialYawDeg) << "\n  fitted_gyro_bias_radps: ";
   writeList(f, r.gyroBias);
