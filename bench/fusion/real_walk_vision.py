@@ -33,6 +33,7 @@ F = 1.0 / 298.257223563
 MODES = [("vio", "vio", False), ("vio+gpsvel", "vio+gpsvel", False), ("vio+dopp", "vio+dopp", False),
          ("vio+dopp+psr, ionosphere-free", "vio+dopp+psr", False),
          ("vio+dopp+psr, broadcast ionosphere", "vio+dopp+psr", True),
+         ("vio+dopp+psr-nointegration, broadcast ionosphere", "vio+dopp+psr-nointegration", True),
          ("vio+dopp+ppp, broadcast orbits/clocks", "vio+dopp+ppp", False)]
 
 
