@@ -243,7 +243,11 @@ reference (a base position the publisher did not give) cannot be decided from th
 The cameras lower the velocity error in every GNSS mode (0.19 m/s against 0.23-0.30 m/s). One
 row is worse with them: in `vio+dopp` (no absolute position after the frame initialisation) the
 stereo run's vertical error grows from -12.5 m to -40.6 m over the compared epochs while the
-camera-less one stays between -12.5 m and -15.9 m; not investigated yet.
+camera-less one stays between -12.5 m and -15.9 m, although the stereo run's local trajectory is
+right to 6 cm vertically (the drift is in its global anchoring, which Doppler rows observe only
+weakly); not investigated further. The `psr-nointegration` ablation (rows at the newest state, no
+IMU integration to the measurement time) gives the psr figures with stereo, but diverges
+camera-less (its frames are 10 Hz pose clones with nothing else to hold them).
 The camera-less runs are sensitive to where the IMU log starts: this dataset begins at
 17:30:41.5 GPST; started at 17:30:41.0 the camera-less estimator loses its attitude (45 of 526
 GNSS epochs used), with the stereo tracks it does not.
