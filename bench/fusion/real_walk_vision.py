@@ -247,7 +247,7 @@ camera-less one stays between -12.5 m and -15.9 m, although the stereo run's loc
 right to 6 cm vertically (the drift is in its global anchoring, which Doppler rows observe only
 weakly); not investigated further. The `psr-nointegration` ablation (rows at the newest state, no
 IMU integration to the measurement time) gives the psr figures with stereo, but diverges
-camera-less (its frames are 10 Hz pose clones with nothing else to hold them).
+camera-less (203 m horizontal RMS; not investigated).
 The camera-less runs are sensitive to where the IMU log starts: this dataset begins at
 17:30:41.5 GPST; started at 17:30:41.0 the camera-less estimator loses its attitude (45 of 526
 GNSS epochs used), with the stereo tracks it does not.
