@@ -240,7 +240,8 @@ constant horizontal offset ("mean offset"); the spread about it ("H RMS about me
 receiver's code errors and the estimator leave, and there the cameras help most (vio+gpsvel
 0.11 m against 0.54 m). Whether the offset belongs to the receiver's pseudoranges or to the
 reference (a base position the publisher did not give) cannot be decided from these files.
-The cameras lower the velocity error in every GNSS mode (0.19 m/s against 0.23-0.30 m/s). One
+The cameras lower the velocity error in every GNSS mode (0.19-0.22 m/s against 0.23-0.30 m/s
+camera-less, and 8.3 m/s in the diverged camera-less run below). One
 row is worse with them: in `vio+dopp` (no absolute position after the frame initialisation) the
 stereo run's vertical error grows from -12.5 m to -40.6 m over the compared epochs while the
 camera-less one stays between -12.5 m and -15.9 m, although the stereo run's local trajectory is
