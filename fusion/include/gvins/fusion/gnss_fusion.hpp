@@ -82,6 +82,8 @@ struct GnssEpochReport {
   std::vector<std::string> warnings;  ///< new this epoch (Doppler check of the rover and the base)
 };
 
+struct GnssRowSet;  // the rows of an epoch and their noise (internal)
+
 template <typename Scalar>
 class GnssFusion {
  public:
@@ -137,7 +139,42 @@ class GnssFusion {
   std::map<SatId, double> ambiguities(const vio::EstimatorBackend<Scalar>& est) const;
 
  private:
-  struct Pending;
+  struct Epoch;  // one processEpoch call (internal)
+  /// The Doppler check of the rover epoch, its carrier-smoothed codes and the ambiguity arcs
+  /// (every epoch, also before the VIO is ready); returns the epoch the rows use.
+  const ObsEpoch& prepareRover(const ObsEpoch& roverInput, const EphemerisStore& nav, GnssEpochReport& rep);
+  /// The SPP and RTK solvers on `nav` (new ones when it changes).
+  void useNavigation(const EphemerisStore& nav);
+  /// The epoch's SPP solution, solved at the first use.
+  const SppSolution& sppOf(Epoch& e);
+  /// A new base epoch into the RTK module, and the module's run where due.
+  void feedRtk(Epoch& e, const ObsEpoch* base);
+  void runRtk(Epoch& e);
+  /// After an outage: clocks, zenith wet delay and ambiguities start again.
+  void resetAfterOutage(vio::EstimatorBackend<Scalar>& est, GnssEpochReport& rep);
+  /// The measurement time of the epoch (tag minus receiver clock) into e.tMeas and e.t_ns; false
+  /// if it is beyond the newest state.
+  bool measurementTime(const vio::EstimatorBackend<Scalar>& est, Epoch& e);
+  /// Stage kFrameInit: SPP position and velocity rows; kTight once the frame's yaw converged.
+  /// False without an SPP fix.
+  bool frameUpdate(vio::EstimatorBackend<Scalar>& est, Epoch& e, const AntennaKinematics& k);
+  /// Stage kTight: the rows of the configured mode (gnss_fusion_rows.cpp); false if the clocks
+  /// could not be initialised.
+  bool tightUpdate(vio::EstimatorBackend<Scalar>& est, Epoch& e, const GnssStateValues& s, const AntennaKinematics& k);
+  /// The clock (initialised at the first use) and zenith wet delay states at the epoch; the
+  /// models' clock indices and wet delays follow. False if the clocks could not be initialised.
+  bool prepareStates(vio::EstimatorBackend<Scalar>& est, Epoch& e, std::vector<SatelliteModel>& models,
+                     const AntennaKinematics& k);
+  /// vio+dopp+ppp: ionosphere-free phase rows, one float ambiguity state per satellite arc.
+  void addPhaseRows(vio::EstimatorBackend<Scalar>& est, Epoch& e, const std::vector<SatelliteModel>& models,
+                    const AntennaKinematics& k, const Eigen::VectorXd& clk, GnssRowSet& rows);
+  /// A new ambiguity state for the carrier arc of m's satellite.
+  sri::BlockId newAmbiguity(vio::EstimatorBackend<Scalar>& est, const SatelliteModel& m);
+  /// Dpsr and ddcp rows from the RTK module's differences.
+  void addDifferenceRows(Epoch& e, const AntennaKinematics& k, const Eigen::VectorXd& clk, GnssRowSet& rows);
+  /// Applies the tight stage's rows; counts them and restarts ambiguities rejected too often.
+  void applyRows(vio::EstimatorBackend<Scalar>& est, GnssEpochReport& rep, const AntennaKinematics& k,
+                 GnssRowSet& rows);
   bool buildState(const vio::EstimatorBackend<Scalar>& est, std::int64_t t_ns, GnssStateValues& s) const;
   void ensureLever(vio::EstimatorBackend<Scalar>& est);
   bool startFrame(vio::EstimatorBackend<Scalar>& est, const SppSolution& spp, std::int64_t t_ns);
