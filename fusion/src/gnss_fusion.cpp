@@ -107,12 +107,9 @@ std::optional<Eigen::Matrix3d> GnssFusion<Scalar>::antennaCovariance(const vio::
     J.middleCols<3>(n) = k.J_lever.template topRows<3>();
     n += 3;
   }
-  Eigen::MatrixXd P;
-  try {
-    P = est.covariance(std::span<const sri::BlockId>(blocks)).template cast<double>();
-  } catch (const std::exception&) {
-    return std::nullopt;  // a block without information yet (sri_filter.hpp)
-  }
+  const std::span<const sri::BlockId> ids(blocks);
+  if (!est.informed(ids)) return std::nullopt;  // a block without information yet (sri_filter.hpp)
+  const Eigen::MatrixXd P = est.covariance(ids).template cast<double>();
   const auto Jb = J.leftCols(n);
   const Eigen::Matrix<double, 3, 9> Je = k.J_earlier.template topRows<3>();
   const Eigen::Matrix3d C_N = Jb * P * Jb.transpose() + Je * k.integrationCovariance * Je.transpose();
@@ -210,12 +207,8 @@ template <typename Scalar>
 bool GnssFusion<Scalar>::frameKnownInEnu(const vio::EstimatorBackend<Scalar>& est) const {
   const vio::ImuBlocks ib = est.newestImuBlocks();
   const std::array<sri::BlockId, 2> ids{ib.pose, frameBlock_};
-  Eigen::MatrixXd P;
-  try {
-    P = est.covariance(std::span<const sri::BlockId>(ids)).template cast<double>();
-  } catch (const std::exception&) {
-    return false;  // not informed (yet)
-  }
+  if (!est.informed(ids)) return false;  // not informed (yet)
+  const Eigen::MatrixXd P = est.covariance(ids).template cast<double>();
   const Eigen::Matrix3d Rz = yawRotation(static_cast<double>(est.estimate(frameBlock_).vector[0]));
   Eigen::Matrix<double, 3, 10> J = Eigen::Matrix<double, 3, 10>::Zero();  // ∂p_N/∂[δθ δp | ψ p_NW]
   J.block<3, 3>(0, 3) = Rz;
@@ -436,16 +429,10 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
   // Row gate: each row alone against the joint marginal covariance P of those blocks (cheap at
   // the back of the state): χ² = r² / (σ² + J Σ_k Jᵀ + h P hᵀ), the innovation test of the row.
   const bool rowGate = gate && config_.rowGate < 1.0;
+  // A block without information (e.g. a new frame block): rows pass the row gate.
+  const bool haveP = rowGate && est.informed(lay.blocks);
   Eigen::MatrixXd P;
-  bool haveP = false;
-  if (rowGate) {
-    try {
-      P = est.covariance(std::span<const sri::BlockId>(lay.blocks)).template cast<double>();
-      haveP = true;
-    } catch (const std::exception&) {
-      // A block without information (e.g. a new frame block): rows pass the row gate.
-    }
-  }
+  if (haveP) P = est.covariance(lay.blocks).template cast<double>();
   const double q1 = rowGate ? rowGateQuantile_(config_.rowGate, 1) : 0.0;
   // All rows as [h | J] at once; the gate's h P hᵀ and J Σ_k Jᵀ of every row from two products.
   const auto nr = static_cast<Eigen::Index>(rows.size());
@@ -653,25 +640,18 @@ bool GnssFusion<Scalar>::frameUpdate(vio::EstimatorBackend<Scalar>& est, Epoch& 
   GnssRowSet rows;
   addPositionRows(anchor_, spp.position, spp.positionCovariance, k, rows);
   if (spp.velocity.valid) addVelocityRows(anchor_, spp.velocity, k, kFrame, true, rows);
-  bool informed = true;
-  try {
-    const sri::BlockId id = frameBlock_;
-    (void)est.covariance(std::span<const sri::BlockId>(&id, 1));
-  } catch (const std::exception&) {
-    informed = false;
-  }
+  const std::span<const sri::BlockId> frameIds(&frameBlock_, 1);
+  // The rows are gated once the frame block has information.
   std::vector<bool> acc;
-  const auto u = apply(est, rows.rows, rows.noise(), k.integrationCovariance, acc, informed);
+  const auto u = apply(est, rows.rows, rows.noise(), k.integrationCovariance, acc, est.informed(frameIds));
   rep.chi2 = static_cast<double>(u.chi2);
   rep.dof = u.dof;
   for (std::size_t i = 0; i < rows.size(); ++i) (acc[i] ? rep.frame.used : rep.frame.rejected)++;
   rep.updated = u.applied;
-  try {
-    const sri::BlockId id = frameBlock_;
-    const auto P = est.covariance(std::span<const sri::BlockId>(&id, 1));
+  if (est.informed(frameIds)) {
+    const auto P = est.covariance(frameIds);
     const double sth = config_.frameYawSigmaDeg * constants::kDegToRad;
     if (static_cast<double>(P(0, 0)) < sth * sth) stage_ = GnssFusionStage::kTight;
-  } catch (const std::exception&) {
   }
   return true;
 }
