@@ -131,10 +131,8 @@ void GnssFusion<Scalar>::forgetState() {
   frameBlock_ = {};
   worldChange_.reset();
   leverBlock_ = {};
-  clockBlock_ = {};
-  isbBlock_ = {};
+  clocks_.forget();
   zwdBlock_ = {};
-  clockSystems_.clear();
   lastUpdate_.reset();
   ambiguities_.clear();
   ambiguityTime_.reset();
@@ -151,18 +149,8 @@ std::optional<Eigen::Vector4d> GnssFusion<Scalar>::frame(const vio::EstimatorBac
 
 template <typename Scalar>
 std::optional<Eigen::VectorXd> GnssFusion<Scalar>::clocks(const vio::EstimatorBackend<Scalar>& est) const {
-  if (!clockBlock_.valid() || !current(est)) return std::nullopt;
-  return systemClocks(est);
-}
-
-template <typename Scalar>
-Eigen::VectorXd GnssFusion<Scalar>::systemClocks(const vio::EstimatorBackend<Scalar>& est) const {
-  const int n = static_cast<int>(clockSystems_.size());
-  const Eigen::VectorXd c = est.estimate(clockBlock_).vector.template cast<double>();
-  Eigen::VectorXd out = Eigen::VectorXd::Constant(n + 1, c[0]);
-  out[n] = c[1];
-  if (isbBlock_.valid()) out.segment(1, n - 1) += est.estimate(isbBlock_).vector.template cast<double>();
-  return out;
+  if (!clocks_.valid() || !current(est)) return std::nullopt;
+  return clocks_.values(est);
 }
 
 template <typename Scalar>
@@ -218,52 +206,6 @@ bool GnssFusion<Scalar>::frameKnownInEnu(const vio::EstimatorBackend<Scalar>& es
   const double sth = config_.frameYawSigmaDeg * constants::kDegToRad;
   const double sp = config_.frameReanchorPositionSigma;
   return P(6, 6) < sth * sth && Pn.diagonal().maxCoeff() < sp * sp;
-}
-
-template <typename Scalar>
-void GnssFusion<Scalar>::propagateClocks(vio::EstimatorBackend<Scalar>& est, const GpsTime& t) {
-  const double dt = t - clockTime_;
-  if (!clockBlock_.valid() || dt <= 0.0) return;
-  using Mat = typename sri::Propagation<Scalar>::Matrix;
-  Mat phi = Mat::Identity(2, 2);
-  phi(0, 1) = static_cast<Scalar>(dt);
-  // Bias b' = b + d·dt, drift d' = d: white-noise drift q_d and bias random walk q_b over dt
-  // (two-state clock model, e.g. Brown & Hwang, "Introduction to Random Signals and Applied
-  // Kalman Filtering", 4th ed., sec. 9.3). The inter-system biases are constant: only these two
-  // columns are replaced (and swept past the state) per epoch.
-  const double qb = std::pow(config_.clockBiasRandomWalk, 2), qd = std::pow(config_.clockDriftRandomWalk, 2);
-  Eigen::Matrix2d Q;
-  Q << qb * dt + qd * dt * dt * dt / 3.0, qd * dt * dt / 2.0, qd * dt * dt / 2.0, qd * dt;
-  const Eigen::VectorXd x = est.estimate(clockBlock_).vector.template cast<double>();
-  const Eigen::VectorXd xp = phi.template cast<double>() * x;
-  sri::Propagation<Scalar> step;
-  step.addNewBlock(sri::BlockSpec::vector("gnss_clock", 2),
-                   sri::BlockEstimate<Scalar>::fromVector(xp.template cast<Scalar>()));
-  step.setTransition(clockBlock_, phi);
-  step.setNoiseCovariance(Q.template cast<Scalar>());
-  step.marginalizeAfter(clockBlock_);
-  clockBlock_ = est.propagate(step, vio::ClientBlockRegion::kParameters).at(0);
-  clockTime_ = t;
-  // The inter-system biases: a random walk stepped every isbRenewalInterval seconds with the
-  // variance accumulated since the last step (Brown & Hwang, sec. 9.3: a Wiener process sampled
-  // at those instants; no columns swept in between).
-  const double di = t - isbTime_;
-  if (!isbBlock_.valid() || !(config_.isbRandomWalk > 0.0) || di < config_.isbRenewalInterval) return;
-  isbBlock_ = randomWalkStep(est, isbBlock_, "gnss_isb", static_cast<int>(clockSystems_.size()) - 1,
-                             config_.isbRandomWalk * config_.isbRandomWalk * di);
-  isbTime_ = t;
-}
-
-template <typename Scalar>
-sri::BlockId GnssFusion<Scalar>::randomWalkStep(vio::EstimatorBackend<Scalar>& est, sri::BlockId id, const char* name,
-                                                int size, double variance) {
-  using Mat = typename sri::Propagation<Scalar>::Matrix;
-  sri::Propagation<Scalar> step;
-  step.addNewBlock(sri::BlockSpec::vector(name, size), est.estimate(id));
-  step.setTransition(id, Mat::Identity(size, size));
-  step.setNoiseCovariance(Mat::Identity(size, size) * static_cast<Scalar>(variance));
-  step.marginalizeAfter(id);
-  return est.propagate(step, vio::ClientBlockRegion::kParameters).at(0);
 }
 
 template <typename Scalar>
@@ -418,9 +360,9 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
   lay.dim = 15;
   lay.frameAt = lay.add(frameBlock_, 4);
   lay.leverAt = lay.add(leverBlock_, 3);
-  lay.clockAt = lay.add(clockBlock_, 2);
+  lay.clockAt = lay.add(clocks_.clockBlock(), 2);
   // With the clock, one per system after the first.
-  lay.isbAt = lay.add(isbBlock_, static_cast<int>(clockSystems_.size()) - 1);
+  lay.isbAt = lay.add(clocks_.isbBlock(), static_cast<int>(clocks_.systems().size()) - 1);
   lay.zwdAt = lay.add(zwdBlock_, 1);
   lay.ambiguityAt = lay.dim;
   for (const sri::BlockId& id : ambiguities) lay.add(id, 1);
@@ -596,8 +538,7 @@ void GnssFusion<Scalar>::feedRtk(Epoch& e, const ObsEpoch* base) {
 
 template <typename Scalar>
 void GnssFusion<Scalar>::resetAfterOutage(vio::EstimatorBackend<Scalar>& est, GnssEpochReport& rep) {
-  marginalizeBlock(est, clockBlock_);
-  marginalizeBlock(est, isbBlock_);
+  clocks_.marginalize(est);
   marginalizeBlock(est, zwdBlock_);
   if (rtk_) rtk_->reset();
   while (!ambiguities_.empty()) dropAmbiguity(est, ambiguities_.begin()->first);
@@ -610,9 +551,9 @@ template <typename Scalar>
 bool GnssFusion<Scalar>::measurementTime(const vio::EstimatorBackend<Scalar>& est, Epoch& e) {
   // Measurement time: the tag minus the receiver clock (GPS, or the first system estimated).
   double dtr = 0.0;
-  if (clockBlock_.valid()) {
-    const Eigen::VectorXd c = est.estimate(clockBlock_).vector.template cast<double>();
-    dtr = (c[0] + c[1] * (e.rover.time - clockTime_)) / kC;  // [c·dt, c·ḋt]
+  if (clocks_.valid()) {
+    const Eigen::VectorXd c = est.estimate(clocks_.clockBlock()).vector.template cast<double>();
+    dtr = (c[0] + c[1] * (e.rover.time - clocks_.time())) / kC;  // [c·dt, c·ḋt]
   } else if (sppOf(e).valid()) {
     for (const auto& b : sppOf(e).clockBias) {
       if (b) {

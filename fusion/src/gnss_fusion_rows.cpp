@@ -61,13 +61,13 @@ template <typename Scalar>
 bool GnssFusion<Scalar>::prepareStates(vio::EstimatorBackend<Scalar>& est, Epoch& e,
                                        std::vector<SatelliteModel>& models, const AntennaKinematics& k) {
   const bool needClocks = config_.usesDoppler();
-  if (needClocks && !clockBlock_.valid()) {
+  if (needClocks && !clocks_.valid()) {
     if (!initClocks(est, models, k, e.tMeas)) return false;
     e.rep.clocksInitialized = true;
     for (SatelliteModel& m : models) m.clock = clockIndex(m.sat);
   }
-  if (clockBlock_.valid()) propagateClocks(est, e.tMeas);
-  if (clockBlock_.valid() && config_.zwdState()) {
+  if (clocks_.valid()) clocks_.propagate(est, e.tMeas, config_);
+  if (clocks_.valid() && config_.zwdState()) {
     if (!zwdBlock_.valid()) {
       Eigen::Matrix<Scalar, Eigen::Dynamic, 1> z = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>::Zero(1);
       zwdBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_zwd", 1), sri::BlockEstimate<Scalar>::fromVector(z),
@@ -174,7 +174,7 @@ void GnssFusion<Scalar>::addDifferenceRows(Epoch& e, const AntennaKinematics& k,
   }
   if (!e.baseAge || !config_.usesDifferences() || *e.baseAge > config_.maxBaseAge) return;
   const DdEpoch& dd = rtk_->measurements();
-  const int n = static_cast<int>(clockSystems_.size());
+  const int n = static_cast<int>(clocks_.systems().size());
   // Base clock per system: mean base code OMC (clock + errors common to the base).
   std::vector<double> sum(static_cast<std::size_t>(n), 0.0);
   std::vector<int> cnt(static_cast<std::size_t>(n), 0);
@@ -231,13 +231,13 @@ bool GnssFusion<Scalar>::tightUpdate(vio::EstimatorBackend<Scalar>& est, Epoch& 
   std::vector<SatelliteModel> models = satelliteModels(e.rover, e.nav, k.x_E, &e.states);
   if (!prepareStates(est, e, models, k)) return false;
   Eigen::VectorXd clk;
-  if (clockBlock_.valid()) clk = systemClocks(est);
+  if (clocks_.valid()) clk = clocks_.values(est);
   const bool excited = config_.calibrateLeverArm && (s.omegaMeasured - s.newest.bg).norm() >= config_.minRotationRate;
   GnssRowSet rows;
   if (config_.usesDoppler()) addDopplerRows(models, k, clk, excited, rows);
   if (config_.usesPseudorange()) addPseudorangeRows(models, k, clk, rows);
   if (sppVel && sppVel->velocity.valid) addVelocityRows(anchor_, sppVel->velocity, k, kVel, false, rows);
-  if (config_.mode == GnssFusionMode::kDoppPpp && clockBlock_.valid()) addPhaseRows(est, e, models, k, clk, rows);
+  if (config_.mode == GnssFusionMode::kDoppPpp && clocks_.valid()) addPhaseRows(est, e, models, k, clk, rows);
   addDifferenceRows(e, k, clk, rows);
   if (!rows.empty()) applyRows(est, e.rep, k, rows);
   // Ambiguities of satellites without a phase row for a while (set, masked, lost).

@@ -15,17 +15,11 @@ namespace {
 
 constexpr double kC = constants::kSpeedOfLight;
 
-System clockSystemOf(System s) { return s == System::Qzss ? System::Gps : s; }
-
 }  // namespace
 
 template <typename Scalar>
 int GnssFusion<Scalar>::clockIndex(SatId sat) const {
-  const System s = clockSystemOf(sat.system);
-  for (std::size_t i = 0; i < clockSystems_.size(); ++i) {
-    if (clockSystems_[i] == s) return static_cast<int>(i);
-  }
-  return -1;
+  return clocks_.index(sat);
 }
 
 template <typename Scalar>
@@ -146,14 +140,10 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
 template <typename Scalar>
 bool GnssFusion<Scalar>::initClocks(vio::EstimatorBackend<Scalar>& est, const std::vector<SatelliteModel>& models,
                                     const AntennaKinematics& k, const GpsTime& t) {
-  clockSystems_.clear();
-  for (const SatelliteModel& m : models) {
-    const System s = clockSystemOf(m.sat.system);
-    if (std::find(clockSystems_.begin(), clockSystems_.end(), s) == clockSystems_.end()) clockSystems_.push_back(s);
-  }
-  std::sort(clockSystems_.begin(), clockSystems_.end());
-  if (clockSystems_.empty()) return false;
-  const int n = static_cast<int>(clockSystems_.size());
+  std::vector<SatId> sats;
+  for (const SatelliteModel& m : models) sats.push_back(m.sat);
+  if (!clocks_.setSystems(sats)) return false;
+  const int n = static_cast<int>(clocks_.systems().size());
   std::vector<ClockRow> rows;
   for (const SatelliteModel& m : models) {
     // Residuals of the measurement models at zero receiver clock and drift.
@@ -170,31 +160,8 @@ bool GnssFusion<Scalar>::initClocks(vio::EstimatorBackend<Scalar>& est, const st
     sigma[u] = i < n ? std::max(r.sigma[u], 5.0) : std::max(r.sigma[u], 0.3);
     if (r.inliers[u] == 0) sigma[u] = 1e3;
   }
-  // The prior: b_s ~ N(x_s, σ_s²) independently per system and the drift N(x_n, σ_n²), written
-  // on the receiver clock c = b_0 and the inter-system biases i_s = b_s − b_0: a prior on
-  // [c, ḋ] and, for each other system, the row (c + i_s − x_s)/σ_s on both blocks.
-  using Vec = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
-  Vec xc(2), sc(2);
-  xc << static_cast<Scalar>(x[0]), static_cast<Scalar>(x[static_cast<std::size_t>(n)]);
-  sc << static_cast<Scalar>(sigma[0]), static_cast<Scalar>(sigma[static_cast<std::size_t>(n)]);
-  clockBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_clock", 2), sri::BlockEstimate<Scalar>::fromVector(xc),
-                             sri::Prior<Scalar>::stdDevs(sc));
-  if (n > 1) {
-    Vec xi(n - 1);
-    for (int s = 1; s < n; ++s) xi[s - 1] = static_cast<Scalar>(x[static_cast<std::size_t>(s)] - x[0]);
-    isbBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_isb", n - 1), sri::BlockEstimate<Scalar>::fromVector(xi),
-                             sri::Prior<Scalar>::uninformative());
-    sri::Measurement<Scalar> m(n - 1);
-    Vec w(n - 1);
-    for (int s = 1; s < n; ++s) w[s - 1] = static_cast<Scalar>(1.0 / sigma[static_cast<std::size_t>(s)]);
-    m.jacobian(clockBlock_, 2).col(0) = w;  // (each jacobian() call may move the storage)
-    m.jacobian(isbBlock_, n - 1) = w.asDiagonal();
-    m.residual().setZero();  // at the estimates above, c + i_s = x_s
-    m.setWhitened();
-    est.update(m, 1.0);
-    isbTime_ = t;
-  }
-  clockTime_ = t;
+  // The prior on the receiver clock and the inter-system biases (GnssClockStates::create).
+  clocks_.create(est, x, sigma, t);
   return true;
 }
 

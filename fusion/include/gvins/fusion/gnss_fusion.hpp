@@ -34,6 +34,7 @@
 #include "gvins/base/geodetic.hpp"
 #include "gvins/base/observation.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
+#include "gvins/fusion/gnss_clock_states.hpp"
 #include "gvins/fusion/gnss_fusion_config.hpp"
 #include "gvins/fusion/gnss_measurement_models.hpp"
 #include "gvins/gnss/broadcast_record_change.hpp"
@@ -100,7 +101,7 @@ class GnssFusion {
 
   const GnssFusionConfig& config() const { return config_; }
   GnssFusionStage stage() const { return stage_; }
-  bool clocksInitialized() const { return clockBlock_.valid(); }
+  bool clocksInitialized() const { return clocks_.valid(); }
   /// [ψ, p_NW] of the estimator's world frame in local ENU at the anchor: the frame block's
   /// estimate while it is a state, zero once the estimator was re-anchored in ENU
   /// (frameReanchor); nullopt before the frame initialisation.
@@ -118,7 +119,7 @@ class GnssFusion {
   /// Clock estimate [c·dt per clock system..., c·ḋt] (the receiver clock plus each system's
   /// inter-system bias) and the systems (clock indices).
   std::optional<Eigen::VectorXd> clocks(const vio::EstimatorBackend<Scalar>& est) const;
-  const std::vector<System>& clockSystems() const { return clockSystems_; }
+  const std::vector<System>& clockSystems() const { return clocks_.systems(); }
   /// Antenna position/velocity (ECEF) at time t_ns from the current estimates (frame needed).
   std::optional<AntennaKinematics> antennaAt(const vio::EstimatorBackend<Scalar>& est, std::int64_t t_ns) const;
   /// Covariance (ECEF, m²) of the antenna position at t_ns (e.g. GnssEpochReport::t_ns):
@@ -183,15 +184,8 @@ class GnssFusion {
   bool frameKnownInEnu(const vio::EstimatorBackend<Scalar>& est) const;
   bool initClocks(vio::EstimatorBackend<Scalar>& est, const std::vector<SatelliteModel>& models,
                   const AntennaKinematics& k, const GpsTime& t);
-  void propagateClocks(vio::EstimatorBackend<Scalar>& est, const GpsTime& t);
-  /// [c·dt per clock system..., c·ḋt] from the clock and ISB blocks (clockBlock_ valid).
-  Eigen::VectorXd systemClocks(const vio::EstimatorBackend<Scalar>& est) const;
   /// Random walk of the zenith wet delay state to time t.
   void propagateZwd(vio::EstimatorBackend<Scalar>& est, const GpsTime& t);
-  /// One random-walk step of a vector block of `size` (parameter region): the same estimate,
-  /// `variance` added to each component; returns the new block's id.
-  sri::BlockId randomWalkStep(vio::EstimatorBackend<Scalar>& est, sri::BlockId id, const char* name, int size,
-                              double variance);
   /// Gates rows one by one, stacks the accepted ones and applies them; returns the update.
   /// `ambiguities`: the blocks that rows' `ambiguity` indices refer to.
   vio::BackendUpdate<Scalar> apply(vio::EstimatorBackend<Scalar>& est, std::vector<GnssRow>& rows,
@@ -215,16 +209,12 @@ class GnssFusion {
   GnssFusionStage stage_ = GnssFusionStage::kWaitingVio;
   std::uint64_t generation_ = 0;  // estimator generation the ids below belong to
   GnssAnchor anchor_;
-  // clockBlock_: [c·dt, c·ḋt] of clockSystems_[0]; isbBlock_: c·(dt_s − dt_0) of the other
-  // clock systems (none with one system).
-  sri::BlockId frameBlock_, leverBlock_, clockBlock_, isbBlock_, zwdBlock_;
+  sri::BlockId frameBlock_, leverBlock_, zwdBlock_;
+  GnssClockStates<Scalar> clocks_;  // the receiver clock and inter-system bias blocks
   std::optional<vio::WorldFrameChange> worldChange_;  // set when the estimator was re-anchored in ENU
   Eigen::Vector3d leverStart_;                // lever arm before/at the lever block's creation
   std::optional<Eigen::Vector3d> leverLast_;  // the lever block's estimate after the last epoch
   GpsTime zwdTime_;
-  std::vector<System> clockSystems_;
-  GpsTime clockTime_;
-  GpsTime isbTime_;  // last random-walk step of isbBlock_ (or its creation)
   std::optional<GpsTime> lastUpdate_;
   const EphemerisStore* nav_ = nullptr;
   std::unique_ptr<SppSolver> spp_;
