@@ -1,6 +1,7 @@
 #include "gvins/ubx/navigation_assembler.hpp"
 
 #include "beidou_d1.hpp"
+#include "beidou_d2.hpp"
 #include "galileo_inav.hpp"
 #include "glonass_strings.hpp"
 #include "gps_lnav.hpp"
@@ -28,6 +29,7 @@ struct NavigationAssembler::State {
   detail::GpsLnavDecoder lnav;
   detail::GalileoInavDecoder inav;
   detail::BeidouD1Decoder d1;
+  detail::BeidouD2Decoder d2;
   detail::GlonassDecoder glonass;
 };
 
@@ -92,7 +94,12 @@ void NavigationAssembler::dispatch(const SfrbxMessage& msg, System system, const
       // decoded.
       if (msg.words.size() != 10 || !(msg.sigId <= 4 || msg.sigId == 10)) break;
       if (!sat.valid()) return void(++c.unknownMessages);
-      state_->d1.add(msg, sat, receiveTime, out, c);
+      // The message follows the satellite: D2 on GEO satellites, D1 on the others (5.1.1).
+      if (isBeiDouGeo(sat)) {
+        state_->d2.add(msg, sat, out, c);
+      } else {
+        state_->d1.add(msg, sat, out, c);
+      }
       return;
     case System::Glonass:
       if (msg.sigId != 0 && msg.sigId != 2) break;  // L1 OF, L2 OF

@@ -25,7 +25,7 @@ NavigationSourceInfo navigationSourceInfo(const NavigationSource& s) {
       if (s.sigId >= 8 && s.sigId <= 10) return notDecoded("E6 C/NAV");
       break;
     case 3:  // BeiDou: D1 on MEO/IGSO, D2 on GEO satellites, whatever the sigId says
-      if (s.sigId <= 4 || s.sigId == 10) return s.beidouGeo ? notDecoded("D2 (GEO)") : decoded("D1 (MEO/IGSO)");
+      if (s.sigId <= 4 || s.sigId == 10) return s.beidouGeo ? decoded("D2 (GEO)") : decoded("D1 (MEO/IGSO)");
       if (s.sigId == 5 || s.sigId == 6) return notDecoded("B-CNAV1");
       if (s.sigId == 7 || s.sigId == 8) return notDecoded("B-CNAV2");
       break;
