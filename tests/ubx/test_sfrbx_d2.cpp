@@ -191,6 +191,40 @@ void expectPrinted(double ours, double ref, const char* field, SatId sat) {
       << field << " of C" << static_cast<int>(sat.prn) << ": ours " << ours << ", RINEX " << ref;
 }
 
+/// Every field of a decoded record against a reference (RINEX: 12 significant digits).
+void expectSameRecord(const KeplerEphemeris& e, const KeplerEphemeris& ref) {
+  EXPECT_EQ(e.sat, ref.sat);
+  EXPECT_EQ(e.message, NavMessage::BeiDouD2);
+  EXPECT_EQ(e.toc, ref.toc);
+  EXPECT_EQ(e.toe, ref.toe);
+  EXPECT_EQ(e.toeSeconds, ref.toeSeconds);
+  EXPECT_EQ(e.week, ref.week);
+  EXPECT_EQ(e.iode, ref.iode);
+  EXPECT_EQ(e.iodc, ref.iodc);
+  EXPECT_EQ(e.health, ref.health);
+  EXPECT_EQ(e.ura, ref.ura);
+  expectPrinted(e.sqrtA, ref.sqrtA, "sqrtA", ref.sat);
+  expectPrinted(e.e, ref.e, "e", ref.sat);
+  expectPrinted(e.i0, ref.i0, "i0", ref.sat);
+  expectPrinted(e.omega0, ref.omega0, "OMEGA0", ref.sat);
+  expectPrinted(e.omega, ref.omega, "omega", ref.sat);
+  expectPrinted(e.m0, ref.m0, "M0", ref.sat);
+  expectPrinted(e.deltaN, ref.deltaN, "Delta n", ref.sat);
+  expectPrinted(e.omegaDot, ref.omegaDot, "OMEGA DOT", ref.sat);
+  expectPrinted(e.iDot, ref.iDot, "IDOT", ref.sat);
+  expectPrinted(e.cuc, ref.cuc, "Cuc", ref.sat);
+  expectPrinted(e.cus, ref.cus, "Cus", ref.sat);
+  expectPrinted(e.crc, ref.crc, "Crc", ref.sat);
+  expectPrinted(e.crs, ref.crs, "Crs", ref.sat);
+  expectPrinted(e.cic, ref.cic, "Cic", ref.sat);
+  expectPrinted(e.cis, ref.cis, "Cis", ref.sat);
+  expectPrinted(e.af0, ref.af0, "a0", ref.sat);
+  expectPrinted(e.af1, ref.af1, "a1", ref.sat);
+  expectPrinted(e.af2, ref.af2, "a2", ref.sat);
+  expectPrinted(e.tgd[0], ref.tgd[0], "TGD1", ref.sat);
+  expectPrinted(e.tgd[1], ref.tgd[1], "TGD2", ref.sat);
+}
+
 TEST(SfrbxD2, EveryGeoRecordOfARinexFileSurvivesEncodeAndDecode) {
   const std::vector<KeplerEphemeris> records = geoRecords();
   ASSERT_EQ(records.size(), 8u);  // one record each of C01-C05, C59, C60, C62 (measured)
@@ -211,37 +245,8 @@ TEST(SfrbxD2, EveryGeoRecordOfARinexFileSurvivesEncodeAndDecode) {
     }
     ASSERT_EQ(got.size(), 1u);
     const KeplerEphemeris& e = got[0];
-    EXPECT_EQ(e.sat, r.sat);
-    EXPECT_EQ(e.message, NavMessage::BeiDouD2);
-    EXPECT_EQ(e.toc, r.toc);
-    EXPECT_EQ(e.toe, r.toe);
-    EXPECT_EQ(e.toeSeconds, r.toeSeconds);
-    EXPECT_EQ(e.week, r.week);
-    EXPECT_EQ(e.iode, r.iode);
-    EXPECT_EQ(e.iodc, r.iodc);
-    EXPECT_EQ(e.health, r.health);
-    EXPECT_EQ(e.ura, r.ura);
+    expectSameRecord(e, r);
     EXPECT_EQ(e.ttr, bdtToGpst(r.week, sow1));
-    expectPrinted(e.sqrtA, r.sqrtA, "sqrtA", r.sat);
-    expectPrinted(e.e, r.e, "e", r.sat);
-    expectPrinted(e.i0, r.i0, "i0", r.sat);
-    expectPrinted(e.omega0, r.omega0, "OMEGA0", r.sat);
-    expectPrinted(e.omega, r.omega, "omega", r.sat);
-    expectPrinted(e.m0, r.m0, "M0", r.sat);
-    expectPrinted(e.deltaN, r.deltaN, "Delta n", r.sat);
-    expectPrinted(e.omegaDot, r.omegaDot, "OMEGA DOT", r.sat);
-    expectPrinted(e.iDot, r.iDot, "IDOT", r.sat);
-    expectPrinted(e.cuc, r.cuc, "Cuc", r.sat);
-    expectPrinted(e.cus, r.cus, "Cus", r.sat);
-    expectPrinted(e.crc, r.crc, "Crc", r.sat);
-    expectPrinted(e.crs, r.crs, "Crs", r.sat);
-    expectPrinted(e.cic, r.cic, "Cic", r.sat);
-    expectPrinted(e.cis, r.cis, "Cis", r.sat);
-    expectPrinted(e.af0, r.af0, "a0", r.sat);
-    expectPrinted(e.af1, r.af1, "a1", r.sat);
-    expectPrinted(e.af2, r.af2, "a2", r.sat);
-    expectPrinted(e.tgd[0], r.tgd[0], "TGD1", r.sat);
-    expectPrinted(e.tgd[1], r.tgd[1], "TGD2", r.sat);
     // Page 2: the Klobuchar parameters with the ICD scale factors.
     ASSERT_TRUE(last.ionosphere.beidou.has_value());
     const int ae[4] = {-30, -27, -24, -24}, be[4] = {11, 14, 16, 16};
@@ -335,6 +340,54 @@ TEST(SfrbxD2, PagesOfTwoCyclesOrBadPageNumbersGiveNoRecord) {
   }
 }
 
+/// An RXM-SFRBX payload (u-blox interface description: 8-byte header, little-endian U4 words).
+std::vector<std::uint8_t> payloadOf(const SfrbxMessage& m) {
+  std::vector<std::uint8_t> p{m.gnssId, m.svId, m.sigId, 0, static_cast<std::uint8_t>(m.words.size()), 0, 2, 0};
+  for (std::uint32_t w : m.words)
+    for (int b = 0; b < 4; ++b) p.push_back(static_cast<std::uint8_t>(w >> (8 * b)));
+  return p;
+}
+
+void writeIfAsked(const char* variable, const std::vector<std::uint8_t>& bytes) {
+  if (const char* out = std::getenv(variable)) {
+    std::ofstream(out, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  }
+}
+
+// tests/data/ubx_synthetic/beidou_d2_nagoya_geo.ubx: the pages of every GEO record as a UBX log of
+// RXM-SFRBX frames (written when GVINS_WRITE_D2_UBX names an output file, checked against the
+// committed file otherwise). RTKLIB's convbin decodes the same frames independently
+// (reference/rtklib-2.4.3/ubx_beidou_d2_nagoya_geo_convbin.nav): every record equal, every field.
+TEST(SfrbxD2, PagesLogDecodedAsConvbinDecodesIt) {
+  std::vector<std::uint8_t> bytes;
+  double worst = 0.0;
+  for (const KeplerEphemeris& r : geoRecords()) {
+    for (const SfrbxMessage& m : encodeD2(broadcastOf(r, worst), r.sat.prn, cycleStart(r))) {
+      const std::vector<std::uint8_t> f = testing::makeFrame(0x02, 0x13, payloadOf(m));
+      bytes.insert(bytes.end(), f.begin(), f.end());
+    }
+  }
+  writeIfAsked("GVINS_WRITE_D2_UBX", bytes);
+  const auto path = dataDir() / "ubx_synthetic" / "beidou_d2_nagoya_geo.ubx";
+  EXPECT_EQ(testing::readBytes(path), bytes);
+  const auto log = testing::decodeLog(path);
+  const NavData ref =
+      readRinexNav((dataDir() / "reference" / "rtklib-2.4.3" / "ubx_beidou_d2_nagoya_geo_convbin.nav").string());
+  ASSERT_EQ(ref.kepler.size(), 8u);
+  EXPECT_EQ(log.kepler.size(), 8u);
+  for (const KeplerEphemeris& r : ref.kepler) {
+    SCOPED_TRACE("C" + std::to_string(r.sat.prn));
+    const KeplerEphemeris* e = nullptr;
+    for (const auto& o : log.kepler)
+      if (o.sat == r.sat && o.toe == r.toe) e = &o;
+    ASSERT_NE(e, nullptr);
+    expectSameRecord(*e, r);
+    EXPECT_NEAR(e->ttr - r.ttr, 0.0, 1e-6);  // both: the SOW of page 1
+  }
+  EXPECT_EQ(log.assembler.counts(System::BeiDou).parityFailures, 0u);
+  EXPECT_EQ(log.assembler.counts(System::BeiDou).messages, 80u);
+}
+
 // The fuzz seed tests/data/fuzz/sfrbx/geo_beidou_d2.bin: the pages of the first GEO record in the
 // fuzz target's input format (mode byte, then 2-byte length + SFRBX payload records). Written when
 // GVINS_WRITE_D2_SEED names an output file; checked against the committed file otherwise.
@@ -343,17 +396,13 @@ TEST(SfrbxD2, FuzzSeedHoldsTheEncodedPages) {
   double worst = 0.0;
   std::vector<std::uint8_t> seed{0};  // mode 0: no receive time
   for (const SfrbxMessage& m : encodeD2(broadcastOf(r, worst), r.sat.prn, cycleStart(r))) {
-    std::vector<std::uint8_t> p{m.gnssId, m.svId, m.sigId, 0, static_cast<std::uint8_t>(m.words.size()), 0, 2, 0};
-    for (std::uint32_t w : m.words)
-      for (int b = 0; b < 4; ++b) p.push_back(static_cast<std::uint8_t>(w >> (8 * b)));
+    const std::vector<std::uint8_t> p = payloadOf(m);
     EXPECT_EQ(parseSfrbx(p).words, m.words);
     seed.push_back(static_cast<std::uint8_t>(p.size() & 0xff));
     seed.push_back(static_cast<std::uint8_t>(p.size() >> 8));
     seed.insert(seed.end(), p.begin(), p.end());
   }
-  if (const char* out = std::getenv("GVINS_WRITE_D2_SEED")) {
-    std::ofstream(out, std::ios::binary).write(reinterpret_cast<const char*>(seed.data()), static_cast<std::streamsize>(seed.size()));
-  }
+  writeIfAsked("GVINS_WRITE_D2_SEED", seed);
   EXPECT_EQ(testing::readBytes(dataDir() / "fuzz" / "sfrbx" / "geo_beidou_d2.bin"), seed);
 }
 
