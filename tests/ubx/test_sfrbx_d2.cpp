@@ -5,7 +5,9 @@
 // transmission order with the 8 parity bits of each word in place), protected with BCH(15,11,1)
 // computed by the shift register of 5.1.3 (g(x) = x^4 + x + 1), delivered as u-blox does (22
 // information bits, then the 4 + 4 parity bits of each word), and decoded by NavigationAssembler.
-// Every field must come back as the RINEX file has it. Malformed pages are counted, never a record.
+// Every field must come back as the RINEX file has it, and as RTKLIB's convbin decodes the same
+// pages (an independent decoder checking the encoder's layout). Malformed pages are counted, never
+// a record.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -318,8 +320,7 @@ TEST(SfrbxD2, PagesOfTwoCyclesOrBadPageNumbersGiveNoRecord) {
     NavigationAssembler a;
     for (std::uint32_t pnum : {0u, 11u, 15u}) {
       SfrbxMessage m = now[0];
-      // Pnum: information bits 38-41 = bits 12-15 of the 22 information bits of word 2 (bits
-      // 29..8 of the delivered word); recompute word 2's parity.
+      // Pnum: bits 42-45 of the subframe (word 2); its parity recomputed.
       Subframe s;
       for (int w = 0; w < 10; ++w) s.set(30 * w, 30, m.words[static_cast<std::size_t>(w)]);
       s.set(42, 4, pnum);

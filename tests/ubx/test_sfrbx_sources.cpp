@@ -1,8 +1,10 @@
-// SFRBX counters per gnssId/sigId (BeiDou GEO apart): the walk log's messages per source against a
-// tally made by an independent scan of the raw bytes (a short Python UBX frame scanner, checksums
-// verified, counting RXM-SFRBX payload bytes 0 and 2 and svId 1-5/59-63 for BeiDou GEO). No log
-// bundled here holds a BeiDou GEO (D2) subframe.
+// SFRBX counters per gnssId/sigId (BeiDou GEO apart): the walk log's messages per source as counted
+// once by a separate Python frame scanner (the figures below), and every log's against a tally of
+// the raw bytes made here with the independent frame scan (payload bytes 0 gnssId, 1 svId, 2 sigId;
+// svId 1-5 and 59-63 are BeiDou GEO). No real log bundled here holds a BeiDou GEO (D2) subframe.
 #include <gtest/gtest.h>
+
+#include <map>
 
 #include "sfrbx_log.hpp"
 
@@ -46,6 +48,26 @@ TEST(SfrbxSources, WalkLogBreakdownMatchesIndependentTally) {
   EXPECT_EQ(skipped, 1699u);  // the "not decoded" figure of gvins-ubx info
   EXPECT_EQ(ephemerides, log.assembler.total().ephemerides);
   EXPECT_EQ(log.assembler.total().messages, 2328u);
+}
+
+TEST(SfrbxSources, EveryLogMatchesARawByteTally) {
+  for (const auto& path : testing::ubxFiles()) {
+    SCOPED_TRACE(path.string());
+    const std::vector<std::uint8_t> d = testing::readBytes(path);
+    std::map<NavigationSource, std::uint64_t> tally;
+    for (std::size_t at : testing::independentScan(d).offsets) {
+      if (d[at + 2] != 0x02 || d[at + 3] != 0x13) continue;
+      const std::uint8_t* p = d.data() + at + 6;
+      tally[{p[0], p[2], p[0] == 3 && ((p[1] >= 1 && p[1] <= 5) || (p[1] >= 59 && p[1] <= 63))}]++;
+    }
+    const auto log = decodeLog(path);
+    std::map<NavigationSource, std::uint64_t> ours;
+    for (const auto& [src, c] : log.assembler.countsBySource()) ours[src] = c.messages;
+    EXPECT_EQ(ours, tally);
+    bool geo = false;
+    for (const auto& [src, n] : tally) geo = geo || src.beidouGeo;
+    EXPECT_FALSE(geo);  // measured: no GEO subframe in any bundled log
+  }
 }
 
 TEST(SfrbxSources, BeiDouGeoAndUnknownIdsAreTheirOwnRows) {
