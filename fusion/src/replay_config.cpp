@@ -46,12 +46,7 @@ ReplayConfig parseReplayConfig(std::string_view text, const std::string& file, c
   ReplayConfig c;
   c.text = std::string(text);
   c.file = file;
-  YAML::Node root;
-  try {
-    root = YAML::Load(c.text);
-  } catch (const YAML::Exception& e) {
-    throw ParseError(file, e.mark.is_null() ? 0 : e.mark.line + 1, "YAML", e.msg);
-  }
+  const YAML::Node root = YamlReader::loadText(c.text, file);
   if (root.IsNull()) return c;
   if (!root.IsMap()) throw ParseError(file, lineOf(root), "", "expected a YAML mapping at the top level");
   try {
