@@ -12,7 +12,7 @@
 namespace gvins::fusion {
 
 SimDatasetInfo parseSimDatasetInfo(std::string_view yaml, const std::string& file) {
-  const YAML::Node root = YamlReader::loadText(std::string(yaml), file);
+  YAML::Node root = YamlReader::loadText(std::string(yaml), file);
   const YamlReader r(file);
   SimDatasetInfo info;
   if (root.IsNull()) return info;

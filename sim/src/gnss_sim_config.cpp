@@ -482,7 +482,7 @@ GnssSimConfig parseGnssSimConfig(const YAML::Node& gnssSection, const std::strin
 }
 
 GnssSimConfig parseGnssSimConfigText(const std::string& yaml, const std::string& file) {
-  const YAML::Node root = YamlReader::loadText(yaml, file);
+  YAML::Node root = YamlReader::loadText(yaml, file);
   if (root.IsNull()) return GnssSimConfig{};
   if (!root.IsMap()) {
     const auto m = root.Mark();
