@@ -32,11 +32,8 @@ void applyAr(const Reader& r, const YAML::Node& v, const std::string& where, Rtk
     if (k == "systems") c.arSystems = r.systems(x, f);
     else if (k == "elevation_mask_deg") c.arElevationMask = r.number(x, f, 0.0, 90.0) * constants::kDegToRad;
     else if (k == "min_lock") c.arMinLock = r.integer(x, f, 0, 100000);
-    else if (k == "validation") {
-      const std::string t = r.text(x, f);
-      if (const auto rule = parseAmbiguityValidation(t)) c.ar.validation = *rule;
-      else r.fail(x, f, "'" + f + "' must be ratio, success-rate, ratio+success-rate or fixed-failure-rate, not '" + t + "'");
-    } else if (k == "ratio_threshold") c.ar.ratioThreshold = r.number(x, f, 1.0, 1000.0);
+    else if (k == "validation") c.ar.validation = r.choice(x, f, kAmbiguityValidationNames);
+    else if (k == "ratio_threshold") c.ar.ratioThreshold = r.number(x, f, 1.0, 1000.0);
     else if (k == "max_failure_rate") c.ar.maxFailureRate = r.number(x, f, 1e-9, 0.5);
     else if (k == "partial") c.ar.partial = r.boolean(x, f);
     else if (k == "partial_success_rate") c.ar.partialSuccessRate = r.number(x, f, 0.5, 1.0);
@@ -163,7 +160,7 @@ void apply(const Reader& r, const YAML::Node& rtk, RtkConfig& c) {
 RtkConfig parseRtkConfig(std::string_view yaml, std::string_view name, const RtkConfig& base) {
   RtkConfig c = base;
   const Reader r{std::string(name)};
-  const YAML::Node root = YamlReader::loadText(std::string(yaml), std::string(name));
+  YAML::Node root = YamlReader::loadText(std::string(yaml), std::string(name));
   if (root.IsNull()) return c;
   if (!root.IsMap()) r.fail(root, "", "the configuration must be a map with an 'rtk' section");
   try {
