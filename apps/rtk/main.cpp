@@ -18,9 +18,9 @@
 #include <vector>
 
 #include "gvins/base/atomic_output_file.hpp"
+#include "gvins/base/command_line.hpp"
 #include "gvins/base/constants.hpp"
 #include "gvins/base/geodetic.hpp"
-#include "gvins/base/option_values.hpp"
 #include "gvins/base/heap_pages.hpp"
 #include "gvins/base/parse_error.hpp"
 #include "gvins/base/rinex_obs_reader.hpp"
@@ -102,7 +102,11 @@ struct Args {
   double baseWait = 0.0, maxOutage = 0.0;
   std::vector<std::string> inputs;
   std::optional<Eigen::Vector3d> baseXyz, truth;
-  std::optional<std::string> mode, dynamics, armode, systems, arSystems, validation;
+  std::optional<gvins::RtkMode> mode;
+  std::optional<gvins::RtkDynamics> dynamics;
+  std::optional<gvins::AmbiguityMode> armode;
+  std::optional<gvins::AmbiguityValidation> validation;
+  std::optional<std::string> systems, arSystems;
   std::optional<double> ratio, elmask, maxAge, maxFailureRate;
   std::optional<int> freq;
   bool combined = false;
@@ -110,127 +114,57 @@ struct Args {
   int timeDecimals = 3;
 };
 
-[[noreturn]] void usageError(const std::string& msg) {
-  std::fprintf(stderr, "gvins-rtk: %s (see --help)\n", msg.c_str());
-  std::exit(2);
-}
-
-double parseNumber(const std::string& opt, const std::string& s) {
-  char* end = nullptr;
-  const double v = std::strtod(s.c_str(), &end);
-  if (end == s.c_str() || *end != '\0' || !std::isfinite(v)) usageError(opt + " needs a number, not '" + s + "'");
-  return v;
-}
-
-Eigen::Vector3d parsePosition(const std::string& opt, const std::string& s, bool llh) {
-  // A base station near the Earth's surface (base/option_values.hpp).
-  try {
-    return llh ? gvins::optionStationLlh(opt, s) : gvins::optionStationEcef(opt, s);
-  } catch (const gvins::OptionError& e) {
-    usageError(e.what());
-  }
-}
+[[noreturn]] void usageError(const std::string& msg) { gvins::usageError("gvins-rtk", msg); }
 
 Args parseArgs(int argc, char** argv) {
   Args a;
-  auto value = [&](int& i, const std::string& opt) -> std::string {
-    if (i + 1 >= argc) usageError(opt + " needs a value");
-    return argv[++i];
-  };
-  for (int i = 1; i < argc; ++i) {
-    const std::string o = argv[i];
-    if (o == "-h" || o == "--help") {
-      std::fputs(kUsage, stdout);
-      std::exit(0);
-    } else if (o == "-o") {
-      a.out = value(i, o);
-    } else if (o == "--rover-stream") {
-      a.roverStream = value(i, o);
-    } else if (o == "--base-stream") {
-      a.baseStream = value(i, o);
-    } else if (o == "--latency-log") {
-      a.latencyLog = value(i, o);
-    } else if (o == "--base-wait") {
-      a.baseWait = parseNumber(o, value(i, o));
-      if (a.baseWait < 0.0 || a.baseWait > 3600.0) usageError("--base-wait must be within 0..3600 s");
-    } else if (o == "--max-outage") {
-      a.maxOutage = parseNumber(o, value(i, o));
-      if (a.maxOutage < 0.0) usageError("--max-outage must not be negative");
-    } else if (o == "--nmea") {
-      a.nmea = value(i, o);
-    } else if (o == "--kml") {
-      a.kml = value(i, o);
-    } else if (o == "--config") {
-      a.config = value(i, o);
-    } else if (o == "--base-xyz") {
-      a.baseXyz = parsePosition(o, value(i, o), false);
-    } else if (o == "--base-llh") {
-      a.baseXyz = parsePosition(o, value(i, o), true);
-    } else if (o == "--mode") {
-      a.mode = value(i, o);
-    } else if (o == "--dynamics") {
-      a.dynamics = value(i, o);
-    } else if (o == "--armode") {
-      a.armode = value(i, o);
-    } else if (o == "--ratio") {
-      a.ratio = parseNumber(o, value(i, o));
-    } else if (o == "--max-failure-rate") {
-      a.maxFailureRate = parseNumber(o, value(i, o));
-      if (*a.ratio < 1.0) usageError("--ratio must be at least 1");
-    } else if (o == "--validation") {
-      a.validation = value(i, o);
-    } else if (o == "--combined" || o == "-c") {
-      a.combined = true;
-    } else if (o == "--no-partial") {
-      a.noPartial = true;
-    } else if (o == "--systems") {
-      a.systems = value(i, o);
-    } else if (o == "--ar-systems") {
-      a.arSystems = value(i, o);
-    } else if (o == "--freq") {
-      const double f = parseNumber(o, value(i, o));
-      if (f != 1.0 && f != 2.0 && f != 3.0) usageError("--freq must be 1, 2 or 3");
-      a.freq = static_cast<int>(f);
-    } else if (o == "--elmask") {
-      a.elmask = parseNumber(o, value(i, o));
-      if (*a.elmask < -10.0 || *a.elmask > 90.0) usageError("--elmask must be within -10..90 degrees");
-    } else if (o == "--max-age") {
-      a.maxAge = parseNumber(o, value(i, o));
-      if (*a.maxAge < 0.0) usageError("--max-age must not be negative");
-    } else if (o == "--no-interpolation") {
-      a.noInterpolation = true;
-    } else if (o == "--xyz") {
-      a.xyz = true;
-    } else if (o == "--no-velocity") {
-      a.noVelocity = true;
-    } else if (o == "--time-decimals") {
-      const double d = parseNumber(o, value(i, o));
-      if (d < 0 || d > 9 || d != std::floor(d)) usageError("--time-decimals must be 0..9");
-      a.timeDecimals = static_cast<int>(d);
-    } else if (o == "--truth") {
-      a.truth = parsePosition(o, value(i, o), false);
-    } else if (o == "--truth-llh") {
-      a.truth = parsePosition(o, value(i, o), true);
-    } else if (o == "--strict") {
-      a.strict = true;
-    } else if (o == "-q" || o == "--quiet") {
-      a.quiet = true;
-    } else if (o.size() > 1 && o[0] == '-') {
-      usageError("unknown option '" + o + "'");
-    } else {
-      a.inputs.push_back(o);
-    }
+  gvins::CommandLine cl("gvins-rtk", kUsage, argc, argv);
+  while (cl.next()) {
+    if (cl.is("-o")) a.out = cl.value();
+    else if (cl.is("--rover-stream")) a.roverStream = cl.value();
+    else if (cl.is("--base-stream")) a.baseStream = cl.value();
+    else if (cl.is("--latency-log")) a.latencyLog = cl.value();
+    else if (cl.is("--base-wait")) a.baseWait = cl.number(0.0, 3600.0, "s");
+    else if (cl.is("--max-outage")) a.maxOutage = cl.number(0.0, 1e9, "s");
+    else if (cl.is("--nmea")) a.nmea = cl.value();
+    else if (cl.is("--kml")) a.kml = cl.value();
+    else if (cl.is("--config")) a.config = cl.value();
+    // A base station near the Earth's surface (base/option_values.hpp).
+    else if (cl.is("--base-xyz")) a.baseXyz = cl.stationEcef();
+    else if (cl.is("--base-llh")) a.baseXyz = cl.stationLlh();
+    else if (cl.is("--mode")) a.mode = cl.choice(gvins::kRtkModeNames);
+    else if (cl.is("--dynamics")) a.dynamics = cl.choice(gvins::kRtkDynamicsNames);
+    else if (cl.is("--armode")) a.armode = cl.choice(gvins::kAmbiguityModeNames);
+    else if (cl.is("--ratio")) a.ratio = cl.number(1.0, 1000.0);
+    else if (cl.is("--max-failure-rate")) a.maxFailureRate = cl.number(1e-9, 0.5);
+    else if (cl.is("--validation")) a.validation = cl.choice(gvins::kAmbiguityValidationNames);
+    else if (cl.is("--combined", "-c")) a.combined = true;
+    else if (cl.is("--no-partial")) a.noPartial = true;
+    else if (cl.is("--systems")) a.systems = cl.value();
+    else if (cl.is("--ar-systems")) a.arSystems = cl.value();
+    else if (cl.is("--freq")) a.freq = static_cast<int>(cl.integer(1, 3));
+    else if (cl.is("--elmask")) a.elmask = cl.number(-10.0, 90.0, "deg");
+    else if (cl.is("--max-age")) a.maxAge = cl.number(0.0, 1e9, "s");
+    else if (cl.is("--no-interpolation")) a.noInterpolation = true;
+    else if (cl.is("--xyz")) a.xyz = true;
+    else if (cl.is("--no-velocity")) a.noVelocity = true;
+    else if (cl.is("--time-decimals")) a.timeDecimals = static_cast<int>(cl.integer(0, 9));
+    else if (cl.is("--truth")) a.truth = cl.stationEcef();
+    else if (cl.is("--truth-llh")) a.truth = cl.stationLlh();
+    else if (cl.is("--strict")) a.strict = true;
+    else if (cl.is("-q", "--quiet")) a.quiet = true;
+    else a.inputs.push_back(cl.operand());
   }
   if (!a.roverStream.empty() || !a.baseStream.empty()) {
-    if (a.roverStream.empty() || a.baseStream.empty()) usageError("live mode needs --rover-stream and --base-stream");
+    if (a.roverStream.empty() || a.baseStream.empty()) cl.error("live mode needs --rover-stream and --base-stream");
     if (a.out.empty()) a.out = "-";
     return a;  // the inputs are navigation files
   }
-  if (a.out.empty()) usageError("no output file (-o OUT.pos)");
+  if (a.out.empty()) cl.error("no output file (-o OUT.pos)");
   const bool ubxInput = a.inputs.size() == 2 && (gvins::BaseReader::detect(a.inputs[0]) == gvins::BaseFormat::Ubx ||
                                                  gvins::BaseReader::detect(a.inputs[1]) == gvins::BaseFormat::Ubx);
   if (a.inputs.size() < 3 && !ubxInput) {
-    usageError("need a rover observation file, base data and at least one navigation file (not needed with UBX)");
+    cl.error("need a rover observation file, base data and at least one navigation file (not needed with UBX)");
   }
   return a;
 }
@@ -270,19 +204,9 @@ int runLive(const Args& a, const gvins::RtkConfig& cfg, const gvins::SppConfig& 
 
 void printError(const gvins::ParseError& e) { std::fprintf(stderr, "gvins-rtk: error: %s\n", e.what()); }
 
-double pct(long a, long b) { return b > 0 ? 100.0 * static_cast<double>(a) / static_cast<double>(b) : 0.0; }
-
-}  // namespace
-
-int main(int argc, char** argv) {
+/// Configuration: defaults, YAML, command line; 0 or the exit status of a bad configuration file.
+int configuration(const Args& args, gvins::RtkConfig& cfg, gvins::SppConfig& sppCfg) {
   using namespace gvins;
-  keepHeapPages();
-  const Args args = parseArgs(argc, argv);
-  const auto wall0 = std::chrono::steady_clock::now();
-
-  // Configuration: defaults, YAML, command line.
-  RtkConfig cfg;
-  SppConfig sppCfg;
   try {
     if (!args.config.empty()) {
       cfg = loadRtkConfig(args.config, cfg);
@@ -292,32 +216,12 @@ int main(int argc, char** argv) {
     printError(e);
     return 2;
   }
-  if (args.mode) {
-    if (*args.mode == "static") cfg.mode = RtkMode::Static;
-    else if (*args.mode == "kinematic") cfg.mode = RtkMode::Kinematic;
-    else usageError("--mode must be static or kinematic");
-  }
-  if (args.dynamics) {
-    if (*args.dynamics == "random-walk") cfg.dynamics = RtkDynamics::RandomWalk;
-    else if (*args.dynamics == "constant-velocity") cfg.dynamics = RtkDynamics::ConstantVelocity;
-    else usageError("--dynamics must be random-walk or constant-velocity");
-  }
-  if (args.armode) {
-    if (*args.armode == "off") cfg.ambiguityMode = AmbiguityMode::Off;
-    else if (*args.armode == "continuous") cfg.ambiguityMode = AmbiguityMode::Continuous;
-    else if (*args.armode == "instantaneous") cfg.ambiguityMode = AmbiguityMode::Instantaneous;
-    else if (*args.armode == "fix-and-hold") cfg.ambiguityMode = AmbiguityMode::FixAndHold;
-    else usageError("--armode must be off, continuous, instantaneous or fix-and-hold");
-  }
-  if (args.validation) {
-    if (const auto v = parseAmbiguityValidation(*args.validation)) cfg.ar.validation = *v;
-    else usageError("--validation must be fixed-failure-rate, ratio, success-rate or ratio+success-rate");
-  }
+  if (args.mode) cfg.mode = *args.mode;
+  if (args.dynamics) cfg.dynamics = *args.dynamics;
+  if (args.armode) cfg.ambiguityMode = *args.armode;
+  if (args.validation) cfg.ar.validation = *args.validation;
   if (args.ratio) cfg.ar.ratioThreshold = *args.ratio;
-  if (args.maxFailureRate) {
-    if (!(*args.maxFailureRate > 0.0 && *args.maxFailureRate <= 0.5)) usageError("--max-failure-rate must be in (0, 0.5]");
-    cfg.ar.maxFailureRate = *args.maxFailureRate;
-  }
+  if (args.maxFailureRate) cfg.ar.maxFailureRate = *args.maxFailureRate;
   if (args.noPartial) cfg.ar.partial = false;
   try {
     if (args.systems) {
@@ -336,6 +240,22 @@ int main(int argc, char** argv) {
   }
   if (args.maxAge) cfg.maxAge = *args.maxAge;
   if (args.noInterpolation) cfg.interpolateBase = false;
+  return 0;
+}
+
+double pct(long a, long b) { return b > 0 ? 100.0 * static_cast<double>(a) / static_cast<double>(b) : 0.0; }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace gvins;
+  keepHeapPages();
+  const Args args = parseArgs(argc, argv);
+  const auto wall0 = std::chrono::steady_clock::now();
+
+  RtkConfig cfg;
+  SppConfig sppCfg;
+  if (const int rc = configuration(args, cfg, sppCfg)) return rc;
 
   // Navigation data.
   EphemerisStore nav;
