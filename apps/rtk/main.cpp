@@ -245,6 +245,146 @@ int configuration(const Args& args, gvins::RtkConfig& cfg, gvins::SppConfig& spp
 
 double pct(long a, long b) { return b > 0 ? 100.0 * static_cast<double>(a) / static_cast<double>(b) : 0.0; }
 
+/// Counts of a run for the summary.
+struct RunCounts {
+  long epochs = 0, fixed = 0, floats = 0, singles = 0, none = 0, partial = 0, held = 0;
+  std::map<gvins::RtkIssue, long> issues;
+  std::map<gvins::ArStatus, long> arStatus;
+  gvins::QuantileHistogram ratios;
+  double ratioMin = 1e300, ratioMax = 0.0, ratioSum = 0.0;
+  long ratioCount = 0;
+  double satSum = 0.0, ageMax = 0.0;
+  long wrongFixes = 0;  ///< fixed epochs farther than kWrongFix from --truth
+  long baseEpochs = 0;
+  gvins::CombinationCounts combination;
+  double passSeconds[2] = {0.0, 0.0};
+};
+
+/// A fixed epoch farther than this from --truth counts as a wrong fix (3-D, m).
+constexpr double kWrongFix = 0.10;
+
+/// The summary on stderr.
+void printSummary(const Args& args, const gvins::RtkConfig& cfg, gvins::RtkSolver& solver, gvins::BaseReader& rover,
+                  gvins::BaseReader& base, const RunCounts& counts, const std::optional<Eigen::Vector3d>& basePosUsed,
+                  const std::string& baseSource, double wall, const std::optional<gvins::AccuracyStatistics>& fixStats,
+                  const std::optional<gvins::AccuracyStatistics>& rtkStats) {
+  using namespace gvins;
+  const long epochs = counts.epochs, fixed = counts.fixed, floats = counts.floats, singles = counts.singles,
+             none = counts.none, partial = counts.partial, held = counts.held;
+  const auto& issues = counts.issues;
+  const auto& arStatus = counts.arStatus;
+  const QuantileHistogram& ratios = counts.ratios;
+  const double ratioMin = counts.ratioMin, ratioMax = counts.ratioMax, ratioSum = counts.ratioSum;
+  const long ratioCount = counts.ratioCount;
+  const double satSum = counts.satSum, ageMax = counts.ageMax;
+  const long wrongFixes = counts.wrongFixes, baseEpochs = counts.baseEpochs;
+  const CombinationCounts& combination = counts.combination;
+  const double* passSeconds = counts.passSeconds;
+  const long solved = fixed + floats + singles;
+  std::fprintf(stderr, "gvins-rtk summary (%s, base %s)\n", args.inputs[0].c_str(), base.describe().c_str());
+  std::fprintf(stderr, "  mode                   %s, %s, AR %s, ratio %.1f\n", toString(cfg.mode),
+               cfg.mode == RtkMode::Kinematic ? toString(cfg.dynamics) : "static position", toString(cfg.ambiguityMode),
+               cfg.ar.ratioThreshold);
+  if (basePosUsed) {
+    std::fprintf(stderr, "  base position          %.4f %.4f %.4f (%s)\n", (*basePosUsed)[0], (*basePosUsed)[1], (*basePosUsed)[2],
+                 baseSource.c_str());
+  } else {
+    std::fprintf(stderr, "  base position          unknown (no header position, 1005/1006 or --base-xyz)\n");
+  }
+  std::fprintf(stderr, "  rover epochs           %8ld\n", epochs);
+  std::fprintf(stderr, "  base epochs read       %8ld\n", baseEpochs);
+  std::fprintf(stderr, "  fixed   (Q=1)          %8ld  %6.2f %%%s\n", fixed, pct(fixed, epochs),
+               partial ? (" (" + std::to_string(partial) + " partial)").c_str() : "");
+  std::fprintf(stderr, "  float   (Q=2)          %8ld  %6.2f %%\n", floats, pct(floats, epochs));
+  std::fprintf(stderr, "  single  (Q=5)          %8ld  %6.2f %%\n", singles, pct(singles, epochs));
+  std::fprintf(stderr, "  no solution            %8ld  %6.2f %%\n", none, pct(none, epochs));
+  std::fprintf(stderr, "  fix rate               %8.2f %% of epochs, %.2f %% of RTK epochs\n", pct(fixed, epochs),
+               pct(fixed, fixed + floats));
+  if (ratioCount) {
+    std::fprintf(stderr, "  ratio                  min %.2f  median %.2f  mean %.2f  max %.1f  (%ld epochs)\n", ratioMin,
+                 ratios.quantile(0.5), ratioSum / ratioCount, ratioMax, ratioCount);
+  }
+  std::fprintf(stderr, "  mean satellites        %8.1f   max age %.1f s\n", solved ? satSum / solved : 0.0, ageMax);
+  if (held) std::fprintf(stderr, "  fix-and-hold updates   %8ld\n", held);
+  if (args.combined) {
+    const CombinationCounts& k = combination;
+    std::fprintf(stderr, "  combined               forward %lld fixed (%.1f s), backward %lld fixed (%.1f s)\n",
+                 static_cast<long long>(k.forwardFixed), passSeconds[0], static_cast<long long>(k.backwardFixed),
+                 passSeconds[1]);
+    std::fprintf(stderr, "  combined fixes         %8lld  (%lld both, %lld forward only, %lld backward only)\n",
+                 static_cast<long long>(k.combinedFixed), static_cast<long long>(k.bothFixed),
+                 static_cast<long long>(k.forwardOnlyFixed), static_cast<long long>(k.backwardOnlyFixed));
+    std::fprintf(stderr, "  combined to float      %8lld disagreements (both fixed), %lld fixes inconsistent with the other float\n",
+                 static_cast<long long>(k.disagreements), static_cast<long long>(k.fixRejected));
+  }
+  for (const auto& [i, n] : issues) std::fprintf(stderr, "  no RTK: %-30s %6ld\n", toString(i), n);
+  for (const auto& [s, n] : arStatus) {
+    if (s != ArStatus::Fixed && s != ArStatus::PartialFixed) std::fprintf(stderr, "  AR: %-34s %6ld\n", toString(s), n);
+  }
+  const RtkCounters& c = solver.counters();
+  std::fprintf(stderr, "  ambiguities            %lld added, %lld slip resets, %lld outlier resets, %lld removed\n",
+               static_cast<long long>(c.ambiguitiesAdded), static_cast<long long>(c.slipResets),
+               static_cast<long long>(c.phaseOutliers), static_cast<long long>(c.ambiguitiesRemoved));
+  if (c.impreciseFixes || c.inconsistentFixes || c.unconfirmedFixes) {
+    std::fprintf(stderr, "  fixes not used         %lld imprecise (sigma > %.2f m), %lld inconsistent with float, %lld awaiting confirmation\n",
+                 static_cast<long long>(c.impreciseFixes), cfg.maxFixedSigma, static_cast<long long>(c.inconsistentFixes),
+                 static_cast<long long>(c.unconfirmedFixes));
+  }
+  if (c.codeOutliers || c.filterResets || c.rejectedFixes) {
+    std::fprintf(stderr, "  rejected               %lld code DDs, %lld fixes by residual check, %lld filter resets\n",
+                 static_cast<long long>(c.codeOutliers), static_cast<long long>(c.rejectedFixes),
+                 static_cast<long long>(c.filterResets));
+  }
+  auto slipLine = [&](const char* who, const CycleSlipCounts& s) {
+    std::fprintf(stderr, "  %s slips             LLI %lld, geometry-free %lld, Doppler %lld, gap %lld, half-cycle %lld\n", who,
+                 static_cast<long long>(s.lli), static_cast<long long>(s.geometryFree), static_cast<long long>(s.doppler),
+                 static_cast<long long>(s.gaps), static_cast<long long>(s.halfCycle));
+  };
+  slipLine("rover", solver.roverSlipCounts());
+  slipLine("base ", solver.base().slipCounts());
+  for (const DopplerConsistency* d : {&solver.roverDoppler(), &solver.base().doppler()}) {
+    std::fprintf(stderr, "  %-5s Doppler           %s\n", d->label().c_str(), d->countsText().c_str());
+    for (const std::string& line : d->summary()) std::fprintf(stderr, "    %s\n", line.c_str());
+  }
+  const DdFormationStats& ds = solver.differenceStats();
+  if (ds.notAtBase || ds.signalMismatch || ds.noEphemeris || ds.systemDisabled) {
+    std::fprintf(stderr, "  satellite-epochs       %lld not at base, %lld signal mismatches, %lld no ephemeris, %lld below mask\n",
+                 static_cast<long long>(ds.notAtBase), static_cast<long long>(ds.signalMismatch),
+                 static_cast<long long>(ds.noEphemeris), static_cast<long long>(ds.belowMask));
+  }
+  if (ds.crossMode || ds.crossModeRefused) {
+    std::fprintf(stderr, "  signal pairs           %lld across tracking modes (%s matching), %lld refused (strict, or phase alignment unknown)\n",
+                 static_cast<long long>(ds.crossMode), toString(cfg.signalMatching),
+                 static_cast<long long>(ds.crossModeRefused));
+  }
+  const BaseStationStats& bs = solver.base().stats();
+  if (bs.outOfOrder || bs.positionChanges) {
+    std::fprintf(stderr, "  base input             %lld epochs out of order, %lld position changes\n",
+                 static_cast<long long>(bs.outOfOrder), static_cast<long long>(bs.positionChanges));
+  }
+  static const RinexObsReaderStats kNoStats;
+  const RinexObsReaderStats& rs = rover.rinexStats() ? *rover.rinexStats() : kNoStats;
+  if (rover.skipped() || base.skipped()) {
+    std::fprintf(stderr, "  input                  %lld malformed rover epochs/frames skipped, %lld base epochs/frames skipped\n",
+                 static_cast<long long>(rover.skipped()), static_cast<long long>(base.skipped()));
+    for (const auto& m : rs.messages) std::fprintf(stderr, "    %s\n", m.c_str());
+  }
+  std::fprintf(stderr, "  time                   %8.3f s (%.0f epochs/s)\n", wall, wall > 0 ? epochs / wall : 0.0);
+  if (fixStats) {
+    std::fprintf(stderr, "  wrong fixes            %8ld of %ld fixed epochs more than %.2f m from the truth\n", wrongFixes, fixed,
+                 kWrongFix);
+  }
+  if (fixStats && fixStats->position().count > 0) {
+    std::fputs("  fixed solutions vs truth:\n", stderr);
+    std::fputs(fixStats->table().c_str(), stderr);
+  }
+  if (rtkStats && rtkStats->position().count > 0) {
+    std::fputs("  fixed and float solutions vs truth:\n", stderr);
+    std::fputs(rtkStats->table().c_str(), stderr);
+  }
+}
+
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -340,22 +480,22 @@ int main(int argc, char** argv) {
   std::unique_ptr<PosWriter> writer;
 
   std::optional<AccuracyStatistics> fixStats, rtkStats;
-  // A fixed epoch farther than this from --truth counts as a wrong fix (3-D, m).
-  constexpr double kWrongFix = 0.10;
-  long wrongFixes = 0;
+  RunCounts counts;
+  long& wrongFixes = counts.wrongFixes;
   if (args.truth) {
     fixStats.emplace(*args.truth);
     rtkStats.emplace(*args.truth);
   }
 
   // Counters.
-  long epochs = 0, fixed = 0, floats = 0, singles = 0, none = 0, partial = 0, held = 0;
-  std::map<RtkIssue, long> issues;
-  std::map<ArStatus, long> arStatus;
-  QuantileHistogram ratios;
-  double ratioMin = 1e300, ratioMax = 0.0, ratioSum = 0.0;
-  long ratioCount = 0;
-  double satSum = 0.0, ageMax = 0.0;
+  long &epochs = counts.epochs, &fixed = counts.fixed, &floats = counts.floats, &singles = counts.singles,
+       &none = counts.none, &partial = counts.partial, &held = counts.held;
+  std::map<RtkIssue, long>& issues = counts.issues;
+  std::map<ArStatus, long>& arStatus = counts.arStatus;
+  QuantileHistogram& ratios = counts.ratios;
+  double &ratioMin = counts.ratioMin, &ratioMax = counts.ratioMax, &ratioSum = counts.ratioSum;
+  long& ratioCount = counts.ratioCount;
+  double &satSum = counts.satSum, &ageMax = counts.ageMax;
   int exitCode = 0;
   const bool tty = isatty(fileno(stderr));
   auto lastProgress = wall0;
@@ -372,7 +512,7 @@ int main(int argc, char** argv) {
   ObsEpoch baseEpoch;
   bool baseDone = false, basePending = false;
   std::optional<GpsTime> lastBaseTime;
-  long baseEpochs = 0;
+  long& baseEpochs = counts.baseEpochs;
   std::optional<Eigen::Vector3d> basePosUsed = args.baseXyz;
 
   // Counts and writes one solution (streamed, or the combined solution of an epoch).
@@ -420,8 +560,8 @@ int main(int argc, char** argv) {
   // Combined mode (post-processing): every rover and base epoch in memory, a forward and a
   // backward pass, and per epoch the combination of the two (rtk_combination.hpp).
   std::optional<RtkSolver> backward;
-  CombinationCounts combination;
-  double passSeconds[2] = {0.0, 0.0};
+  CombinationCounts& combination = counts.combination;
+  double (&passSeconds)[2] = counts.passSeconds;
   if (args.combined) {
     std::vector<ObsEpoch> rovers, bases;
     try {
@@ -566,109 +706,8 @@ int main(int argc, char** argv) {
   if (!args.quiet && tty) std::fprintf(stderr, "\r%90s\r", "");
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
-  // Summary.
+  printSummary(args, cfg, solver, *rover, *base, counts, basePosUsed, baseSource, wall, fixStats, rtkStats);
   const long solved = fixed + floats + singles;
-  std::fprintf(stderr, "gvins-rtk summary (%s, base %s)\n", args.inputs[0].c_str(), base->describe().c_str());
-  std::fprintf(stderr, "  mode                   %s, %s, AR %s, ratio %.1f\n", toString(cfg.mode),
-               cfg.mode == RtkMode::Kinematic ? toString(cfg.dynamics) : "static position", toString(cfg.ambiguityMode),
-               cfg.ar.ratioThreshold);
-  if (basePosUsed) {
-    std::fprintf(stderr, "  base position          %.4f %.4f %.4f (%s)\n", (*basePosUsed)[0], (*basePosUsed)[1], (*basePosUsed)[2],
-                 baseSource.c_str());
-  } else {
-    std::fprintf(stderr, "  base position          unknown (no header position, 1005/1006 or --base-xyz)\n");
-  }
-  std::fprintf(stderr, "  rover epochs           %8ld\n", epochs);
-  std::fprintf(stderr, "  base epochs read       %8ld\n", baseEpochs);
-  std::fprintf(stderr, "  fixed   (Q=1)          %8ld  %6.2f %%%s\n", fixed, pct(fixed, epochs),
-               partial ? (" (" + std::to_string(partial) + " partial)").c_str() : "");
-  std::fprintf(stderr, "  float   (Q=2)          %8ld  %6.2f %%\n", floats, pct(floats, epochs));
-  std::fprintf(stderr, "  single  (Q=5)          %8ld  %6.2f %%\n", singles, pct(singles, epochs));
-  std::fprintf(stderr, "  no solution            %8ld  %6.2f %%\n", none, pct(none, epochs));
-  std::fprintf(stderr, "  fix rate               %8.2f %% of epochs, %.2f %% of RTK epochs\n", pct(fixed, epochs),
-               pct(fixed, fixed + floats));
-  if (ratioCount) {
-    std::fprintf(stderr, "  ratio                  min %.2f  median %.2f  mean %.2f  max %.1f  (%ld epochs)\n", ratioMin,
-                 ratios.quantile(0.5), ratioSum / ratioCount, ratioMax, ratioCount);
-  }
-  std::fprintf(stderr, "  mean satellites        %8.1f   max age %.1f s\n", solved ? satSum / solved : 0.0, ageMax);
-  if (held) std::fprintf(stderr, "  fix-and-hold updates   %8ld\n", held);
-  if (args.combined) {
-    const CombinationCounts& k = combination;
-    std::fprintf(stderr, "  combined               forward %lld fixed (%.1f s), backward %lld fixed (%.1f s)\n",
-                 static_cast<long long>(k.forwardFixed), passSeconds[0], static_cast<long long>(k.backwardFixed),
-                 passSeconds[1]);
-    std::fprintf(stderr, "  combined fixes         %8lld  (%lld both, %lld forward only, %lld backward only)\n",
-                 static_cast<long long>(k.combinedFixed), static_cast<long long>(k.bothFixed),
-                 static_cast<long long>(k.forwardOnlyFixed), static_cast<long long>(k.backwardOnlyFixed));
-    std::fprintf(stderr, "  combined to float      %8lld disagreements (both fixed), %lld fixes inconsistent with the other float\n",
-                 static_cast<long long>(k.disagreements), static_cast<long long>(k.fixRejected));
-  }
-  for (const auto& [i, n] : issues) std::fprintf(stderr, "  no RTK: %-30s %6ld\n", toString(i), n);
-  for (const auto& [s, n] : arStatus) {
-    if (s != ArStatus::Fixed && s != ArStatus::PartialFixed) std::fprintf(stderr, "  AR: %-34s %6ld\n", toString(s), n);
-  }
-  const RtkCounters& c = solver.counters();
-  std::fprintf(stderr, "  ambiguities            %lld added, %lld slip resets, %lld outlier resets, %lld removed\n",
-               static_cast<long long>(c.ambiguitiesAdded), static_cast<long long>(c.slipResets),
-               static_cast<long long>(c.phaseOutliers), static_cast<long long>(c.ambiguitiesRemoved));
-  if (c.impreciseFixes || c.inconsistentFixes || c.unconfirmedFixes) {
-    std::fprintf(stderr, "  fixes not used         %lld imprecise (sigma > %.2f m), %lld inconsistent with float, %lld awaiting confirmation\n",
-                 static_cast<long long>(c.impreciseFixes), cfg.maxFixedSigma, static_cast<long long>(c.inconsistentFixes),
-                 static_cast<long long>(c.unconfirmedFixes));
-  }
-  if (c.codeOutliers || c.filterResets || c.rejectedFixes) {
-    std::fprintf(stderr, "  rejected               %lld code DDs, %lld fixes by residual check, %lld filter resets\n",
-                 static_cast<long long>(c.codeOutliers), static_cast<long long>(c.rejectedFixes),
-                 static_cast<long long>(c.filterResets));
-  }
-  auto slipLine = [&](const char* who, const CycleSlipCounts& s) {
-    std::fprintf(stderr, "  %s slips             LLI %lld, geometry-free %lld, Doppler %lld, gap %lld, half-cycle %lld\n", who,
-                 static_cast<long long>(s.lli), static_cast<long long>(s.geometryFree), static_cast<long long>(s.doppler),
-                 static_cast<long long>(s.gaps), static_cast<long long>(s.halfCycle));
-  };
-  slipLine("rover", solver.roverSlipCounts());
-  slipLine("base ", solver.base().slipCounts());
-  for (const DopplerConsistency* d : {&solver.roverDoppler(), &solver.base().doppler()}) {
-    std::fprintf(stderr, "  %-5s Doppler           %s\n", d->label().c_str(), d->countsText().c_str());
-    for (const std::string& line : d->summary()) std::fprintf(stderr, "    %s\n", line.c_str());
-  }
-  const DdFormationStats& ds = solver.differenceStats();
-  if (ds.notAtBase || ds.signalMismatch || ds.noEphemeris || ds.systemDisabled) {
-    std::fprintf(stderr, "  satellite-epochs       %lld not at base, %lld signal mismatches, %lld no ephemeris, %lld below mask\n",
-                 static_cast<long long>(ds.notAtBase), static_cast<long long>(ds.signalMismatch),
-                 static_cast<long long>(ds.noEphemeris), static_cast<long long>(ds.belowMask));
-  }
-  if (ds.crossMode || ds.crossModeRefused) {
-    std::fprintf(stderr, "  signal pairs           %lld across tracking modes (%s matching), %lld refused (strict, or phase alignment unknown)\n",
-                 static_cast<long long>(ds.crossMode), toString(cfg.signalMatching),
-                 static_cast<long long>(ds.crossModeRefused));
-  }
-  const BaseStationStats& bs = solver.base().stats();
-  if (bs.outOfOrder || bs.positionChanges) {
-    std::fprintf(stderr, "  base input             %lld epochs out of order, %lld position changes\n",
-                 static_cast<long long>(bs.outOfOrder), static_cast<long long>(bs.positionChanges));
-  }
-  static const RinexObsReaderStats kNoStats;
-  const RinexObsReaderStats& rs = rover->rinexStats() ? *rover->rinexStats() : kNoStats;
-  if (rover->skipped() || base->skipped()) {
-    std::fprintf(stderr, "  input                  %lld malformed rover epochs/frames skipped, %lld base epochs/frames skipped\n",
-                 static_cast<long long>(rover->skipped()), static_cast<long long>(base->skipped()));
-    for (const auto& m : rs.messages) std::fprintf(stderr, "    %s\n", m.c_str());
-  }
-  std::fprintf(stderr, "  time                   %8.3f s (%.0f epochs/s)\n", wall, wall > 0 ? epochs / wall : 0.0);
-  if (fixStats) {
-    std::fprintf(stderr, "  wrong fixes            %8ld of %ld fixed epochs more than %.2f m from the truth\n", wrongFixes, fixed,
-                 kWrongFix);
-  }
-  if (fixStats && fixStats->position().count > 0) {
-    std::fputs("  fixed solutions vs truth:\n", stderr);
-    std::fputs(fixStats->table().c_str(), stderr);
-  }
-  if (rtkStats && rtkStats->position().count > 0) {
-    std::fputs("  fixed and float solutions vs truth:\n", stderr);
-    std::fputs(rtkStats->table().c_str(), stderr);
-  }
   if (solved == 0 && exitCode == 0) exitCode = 3;
   return exitCode;
 }
