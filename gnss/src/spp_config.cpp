@@ -48,16 +48,9 @@ void apply(const Reader& r, const YAML::Node& spp, SppConfig& c) {
         c.bands[systemIndex(s)] = bands;
       });
     } else if (k == "ionosphere") {
-      const std::string t = r.text(v, full);
-      if (t == "off") c.ionosphere = IonosphereOption::Off;
-      else if (t == "broadcast") c.ionosphere = IonosphereOption::Broadcast;
-      else if (t == "dual-frequency") c.ionosphere = IonosphereOption::DualFrequency;
-      else r.fail(v, full, "'" + full + "' must be off, broadcast or dual-frequency, not '" + t + "'");
+      c.ionosphere = r.choice(v, full, kIonosphereOptionNames);
     } else if (k == "troposphere") {
-      const std::string t = r.text(v, full);
-      if (t == "off") c.troposphere = TroposphereOption::Off;
-      else if (t == "saastamoinen") c.troposphere = TroposphereOption::Saastamoinen;
-      else r.fail(v, full, "'" + full + "' must be off or saastamoinen, not '" + t + "'");
+      c.troposphere = r.choice(v, full, kTroposphereOptionNames);
     } else if (k == "meteo") {
       const std::string t = r.text(v, full);
       if (t == "climatology") c.climatologicalMeteo = true;

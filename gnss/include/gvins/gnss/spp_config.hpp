@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "gvins/base/constants.hpp"
+#include "gvins/base/enum_names.hpp"
 #include "gvins/base/satellite.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/gnss/fault_exclusion.hpp"
@@ -21,7 +22,12 @@ enum class IonosphereOption {
   DualFrequency,  ///< ionosphere-free pseudoranges where two bands exist, Broadcast otherwise
 };
 
+inline constexpr EnumName<IonosphereOption> kIonosphereOptionNames[] = {
+    {IonosphereOption::Off, "off"}, {IonosphereOption::Broadcast, "broadcast"}, {IonosphereOption::DualFrequency, "dual-frequency"}};
+
 enum class TroposphereOption { Off, Saastamoinen };
+inline constexpr EnumName<TroposphereOption> kTroposphereOptionNames[] = {{TroposphereOption::Off, "off"},
+                                                                          {TroposphereOption::Saastamoinen, "saastamoinen"}};
 
 /// Robust re-weighting of pseudoranges after fault exclusion (IGG-III equivalent weights).
 struct RobustEstimation {
