@@ -11,18 +11,20 @@ limitation, written before any run.
 import math
 
 # Navigation files of the real recordings (copies under tests/data, provenance in their folders):
-# the place is the recording's station, the window [first, last) the start times whose flights
-# stay within the file's ephemerides (hours of the day, GPST).
+# the place is the recording's station, the window [first, last) the start times (hours of the day,
+# GPST) at which every system of the file has valid records (read off the files' epochs: the
+# Nagoya file holds the records broadcast around 08:00-08:25, GLONASS for about 08:15 only; Kamakura
+# GPS 12:00/14:00 and Galileo 10:40-12:40; testglo GPS 00:00 of the next day and GLONASS 23:15).
 NAVIGATION = {
     "nagoya_2024": {
         "file": "tests/data/gnss/nagoya_static_2024/base.nav.gz",
         "llh": (35.134707705, 136.977577939, 104.853),
-        "date": "2024-06-24", "hours": (5.5, 11.0),
+        "date": "2024-06-24", "hours": (8.0, 9.0),
         "systems": "GPS, Galileo, BeiDou, GLONASS, QZSS"},
     "kamakura_2021": {
         "file": "tests/data/gnss/kamakura_static_2021/SEPT078M.21P.gz",
         "ecef": (-3962108.673, 3381309.574, 3668678.638),
-        "date": "2021-03-19", "hours": (10.0, 13.5),
+        "date": "2021-03-19", "hours": (10.8, 12.8),
         "systems": "GPS, Galileo, QZSS"},
     "geonet_2005": {
         "file": "tests/data/gnss/geonet_0759_3040_2005/30400920.05n.gz",
@@ -32,7 +34,7 @@ NAVIGATION = {
     "testglo_2009": {
         "file": "tests/data/reference/rtklib-2.4.3/rtcm_testglo_convbin.nav",
         "ecef": (-3869297.5138, 3436571.3345, 3717369.3757),
-        "date": "2009-12-18", "hours": (22.5, 23.8),
+        "date": "2009-12-18", "hours": (23.0, 23.4),
         "systems": "GPS, GLONASS (the records of a 3-minute RTCM 3 log)"},
 }
 

@@ -166,10 +166,11 @@ def commit():
 
 def page(results, info):
     families, modes = info["families"], info["modes"]
-    seeds = info["seeds"]
+    seeds = info["seeds"] or [0]
     ok = sum(r["status"] == "ok" for r in results)
     run_s = sum(r.get("run_s", 0.0) for r in results)
-    per_seed = run_s / max(1, len(seeds))
+    scenarios = len({(r["family"], r["seed"]) for r in results})
+    per_seed = run_s / max(1, scenarios) * len(families)  # one seed of every family
     L = ["# Sweep: every mode on many seeds of every scenario family", "",
          "Written by `%s` with the binaries of commit %s on %s, %d cores, --jobs %d. Do not edit by hand: "
          "run the script again. Families, modes and targets: bench/sweep/families.py; each seed draws its own "
@@ -177,8 +178,8 @@ def page(results, info):
          "simulator noise; datasets are feature tracks." % (
              info["command"], commit(), datetime.datetime.utcnow().strftime("%Y-%m-%d %H:%M UTC"),
              info["cores"], info["jobs"]), "",
-         "Seeds %d-%d per family; %d runs, %d ok, %d failed." % (seeds[0], seeds[-1], len(results), ok,
-                                                                len(results) - ok), "",
+         "Seeds %s (the seeds column says how many each family has); %d runs, %d ok, %d failed." % (
+             ", ".join(str(s) for s in seeds), len(results), ok, len(results) - ok), "",
          "## Families", "", "| family | scenario | navigation file (systems) | open sky | known limitation |",
          "|---|---|---|---|---|"]
     for f in families:
@@ -210,10 +211,10 @@ def page(results, info):
         for r in sorted(failures, key=lambda r: (r["family"], r["seed"], r["mode"])):
             L.append("| %s | %d | %s | %s |" % (r["family"], r["seed"], r["mode"], (r["error"] or "").replace("|", "/")))
     L += ["", "## Run time", "",
-          "Sum of the run times (simulation + replay, wall clock of each run): %.0f s for %d seeds, %.0f s per seed "
-          "of all families. This invocation computed %d runs in %.0f s wall clock (the rest came from the cache). "
+          "Sum of the run times (simulation + replay, wall clock of each run): %.0f s for %d family seeds, %.0f s "
+          "per seed of all %d families. This invocation computed %d runs in %.0f s wall clock (the rest came from the cache). "
           "Projected for 20 seeds: %.1f h with --jobs 1, about %.1f h with --jobs 2 on an otherwise idle 2-core "
           "machine (each replay also runs a front-end thread, so two jobs do not halve the time exactly)." % (
-              run_s, len(seeds), per_seed, info["computed"], info["wall_s"], 20 * per_seed / 3600,
+              run_s, scenarios, per_seed, len(families), info["computed"], info["wall_s"], 20 * per_seed / 3600,
               20 * per_seed / 3600 / 2), ""]
     return "\n".join(L)

@@ -14,7 +14,8 @@ Cache: every run leaves WORK/runs/FAMILY/SEED/MODE/result.json, keyed by the sce
 replay arguments and the digests of the gvins-sim and gvins-replay binaries; a repeated or
 interrupted sweep computes only the runs whose key is new (a rebuilt binary reruns everything).
 A failed simulation or replay is recorded as a failed run (with its message) and the sweep goes
-on; --retry-failed runs the failed ones again. Datasets are deleted once all modes of a seed are
+on; --retry-failed runs the failed ones again; --report-only writes the page from the cache alone
+(e.g. after stopping a sweep). Datasets are deleted once all modes of a seed are
 done (--keep-data keeps them). Progress lines (done/total, ETA) go to stderr.
 """
 import argparse
@@ -159,6 +160,9 @@ def run_seed(a, family, seed, modes, progress):
                 results.append(old)
                 progress.tick("%s seed %d %s: cached %s" % (family["name"], seed, mode, old["status"]), 0.0, False)
                 continue
+        if a.report_only:
+            progress.tick("%s seed %d %s: not run" % (family["name"], seed, mode), 0.0, False)
+            continue
         t0 = time.time()
         if sim_error is None and not os.path.exists(os.path.join(data, "dataset.yaml")):
             sim_error, sim_s = simulate(a, text, data)
@@ -185,7 +189,7 @@ def run_seed(a, family, seed, modes, progress):
         os.replace(res_path + ".tmp", res_path)
         results.append(res)
         progress.tick("%s seed %d %s: %s" % (family["name"], seed, mode, res["status"]), res["run_s"], True)
-    if not a.keep_data:
+    if not a.keep_data and not a.report_only:
         shutil.rmtree(data, ignore_errors=True)
     return results
 
@@ -218,6 +222,8 @@ def parse_args():
     ap.add_argument("--csv", default=None, help="one line per run (e.g. docs/results/sweep.csv)")
     ap.add_argument("--retry-failed", action="store_true")
     ap.add_argument("--keep-data", action="store_true")
+    ap.add_argument("--report-only", action="store_true",
+                    help="compute nothing: write the page and CSV from the runs in the cache")
     a = ap.parse_args()
     known = {f["name"]: f for f in fam.FAMILIES}
     a.family_list = []
@@ -254,7 +260,7 @@ def main():
     wall = time.time() - t0
     info = {"command": "bench/sweep/sweep.py " + " ".join(
                 os.path.relpath(x, ROOT) if x.startswith(ROOT + os.sep) else x for x in sys.argv[1:]),
-            "seeds": list(seeds), "jobs": a.jobs, "cores": os.cpu_count(), "wall_s": wall,
+            "seeds": sorted({r["seed"] for r in results}), "jobs": a.jobs, "cores": os.cpu_count(), "wall_s": wall,
             "computed": progress.computed, "families": a.family_list, "modes": a.mode_list}
     if a.csv:
         report.write_csv(a.csv, results)
