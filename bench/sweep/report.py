@@ -171,13 +171,16 @@ def page(results, info):
     run_s = sum(r.get("run_s", 0.0) for r in results)
     scenarios = len({(r["family"], r["seed"]) for r in results})
     per_seed = run_s / max(1, scenarios) * len(families)  # one seed of every family
+    jobs = sorted({r.get("jobs", info["jobs"]) for r in results}) or [info["jobs"]]
+    origin = (", from the run cache, whose runs were computed with --jobs %s" % "/".join(map(str, jobs))
+              if info.get("report_only") else ", --jobs %d" % info["jobs"])
     L = ["# Sweep: every mode on many seeds of every scenario family", "",
-         "Written by `%s` with the binaries of commit %s on %s, %d cores, --jobs %d. Do not edit by hand: "
+         "Written by `%s` with the binaries of commit %s on %s, %d cores%s. Do not edit by hand: "
          "run the script again. Families, modes and targets: bench/sweep/families.py; each seed draws its own "
          "variant (height, speed, length, pattern, heading, start time, base distance and direction) and "
          "simulator noise; datasets are feature tracks." % (
              info["command"], commit(), datetime.datetime.utcnow().strftime("%Y-%m-%d %H:%M UTC"),
-             info["cores"], info["jobs"]), "",
+             info["cores"], origin), "",
          "Seeds %s (the seeds column says how many each family has); %d runs, %d ok, %d failed." % (
              ", ".join(str(s) for s in seeds), len(results), ok, len(results) - ok), "",
          "## Families", "", "| family | scenario | navigation file (systems) | open sky | known limitation |",

@@ -167,7 +167,7 @@ def run_seed(a, family, seed, modes, progress):
         if sim_error is None and not os.path.exists(os.path.join(data, "dataset.yaml")):
             sim_error, sim_s = simulate(a, text, data)
         res = {"key": key, "family": family["name"], "seed": seed, "mode": mode, "variant": v,
-               "sim_s": sim_s, "status": "failed", "error": sim_error, "metrics": {}}
+               "sim_s": sim_s, "status": "failed", "error": sim_error, "metrics": {}, "jobs": a.jobs}
         sim_s = 0.0  # the simulation is counted once, with the first run that needed it
         if sim_error is None:
             shutil.rmtree(out, ignore_errors=True)
@@ -261,7 +261,7 @@ def main():
     info = {"command": "bench/sweep/sweep.py " + " ".join(
                 os.path.relpath(x, ROOT) if x.startswith(ROOT + os.sep) else x for x in sys.argv[1:]),
             "seeds": sorted({r["seed"] for r in results}), "jobs": a.jobs, "cores": os.cpu_count(), "wall_s": wall,
-            "computed": progress.computed, "families": a.family_list, "modes": a.mode_list}
+            "computed": progress.computed, "report_only": a.report_only, "families": a.family_list, "modes": a.mode_list}
     if a.csv:
         report.write_csv(a.csv, results)
     page = report.page(results, info)
