@@ -12,7 +12,7 @@ NAN = float("nan")
 METRIC_COLUMNS = ["global_position_rmse_m", "local_start_aligned_position_rmse_m", "local_position_rmse_m",
                   "local_drift_percent", "local_position_nees_first_pose", "local_orientation_nees_first_pose",
                   "local_body_velocity_rmse_mps", "gnss_epochs", "gnss_epochs_fixed", "frames",
-                  "frames_initialized", "frame_init_s", "wall_s"]
+                  "frames_initialized", "frame_init_s", "gnss_rows_per_epoch", "local_path_m", "wall_s"]
 VARIANT_COLUMNS = ["start_gpst", "height_m", "speed_mps", "length_m", "pattern", "heading_deg", "base_km",
                    "base_azimuth_deg", "rig"]
 LABELS = {"vio": "VIO", "vio_float": "VIO float", "gpsvel": "VIO+Gps_vel", "dopp": "VIO+Dopp",
@@ -58,12 +58,18 @@ def by(results, family, mode):
 
 
 def variant_text(r):
-    v = r["variant"]
+    v, m = r["variant"], r["metrics"]
     if "height_m" in v:
-        return "seed %d: %s %g m, %g m/s, %g m, base %g km, %s" % (
+        text = "seed %d: %s %g m, %g m/s, %g m, base %g km, %s" % (
             r["seed"], v["pattern"].replace("_", "-"), v["height_m"], v["speed_mps"], v["length_m"],
             v["base_km"], v["start_gpst"])
-    return "seed %d: %g m, %s" % (r["seed"], v["length_m"], v["start_gpst"])
+    else:
+        text = "seed %d: %g m, %s" % (r["seed"], v["length_m"], v["start_gpst"])
+    if math.isfinite(m.get("gnss_rows_per_epoch", NAN)):
+        text += "; %.1f code/phase rows per epoch" % m["gnss_rows_per_epoch"]
+    if r["mode"] == "vio" and math.isfinite(m.get("local_path_m", NAN)):
+        text += "; path %.0f m" % m["local_path_m"]
+    return text
 
 
 def target_rows(results, families, modes):

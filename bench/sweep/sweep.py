@@ -136,6 +136,25 @@ def read_metrics(path):
     return out
 
 
+def gnss_rows(path):
+    """Mean code/phase rows (satellites or satellite pairs) per updated epoch of gnss_epochs.csv:
+    the geometry behind a GNSS mode's accuracy."""
+    if not os.path.exists(path):
+        return {}
+    header, rows = None, []
+    with open(path) as f:
+        for line in f:
+            cells = [c.strip() for c in line.lstrip("# ").strip().split(",")]
+            if header is None:
+                header = [c.split(" ")[0] for c in cells]
+                continue
+            row = dict(zip(header, cells))
+            if row.get("updated") == "1":
+                rows.append(sum(float(row.get(k, 0) or 0) for k in
+                                ("psr_used", "dpsr_used", "ddcp_used", "phase_used")))
+    return {"gnss_rows_per_epoch": sum(rows) / len(rows)} if rows else {}
+
+
 def tail(text, n=3):
     lines = [l for l in text.strip().splitlines() if l.strip()]
     return " | ".join(lines[-n:])[-400:]
@@ -176,6 +195,7 @@ def run_seed(a, family, seed, modes, progress):
             mpath = os.path.join(out, "metrics.csv")
             if p.returncode == 0 and os.path.exists(mpath):
                 res.update(status="ok", error=None, metrics=read_metrics(mpath))
+                res["metrics"].update(gnss_rows(os.path.join(out, "gnss_epochs.csv")))
             else:
                 res["error"] = "gvins-replay exit %d: %s" % (p.returncode, tail(p.stdout))
             for f in os.listdir(out) if os.path.isdir(out) else []:  # keep only what the page needs
