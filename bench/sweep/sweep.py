@@ -217,15 +217,18 @@ def run_seed(a, family, seed, modes, progress):
 def simulate(a, text, data):
     """Writes the scenario and simulates it; returns (error or None, seconds)."""
     t0 = time.time()
-    shutil.rmtree(data, ignore_errors=True)
+    partial = data + ".partial"  # renamed when complete: an interrupted simulation is never used
+    for d in (data, partial):
+        shutil.rmtree(d, ignore_errors=True)
     os.makedirs(os.path.dirname(data), exist_ok=True)
     with open(data + ".yaml", "w") as f:
         f.write(text)
     p = subprocess.run([os.path.join(a.bin, "gvins-sim"), "--config", data + ".yaml", "--features-only",
-                        "--threads", "1", "-o", data],
+                        "--threads", "1", "-o", partial],
                        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     if p.returncode != 0:
         return "gvins-sim exit %d: %s" % (p.returncode, tail(p.stdout)), time.time() - t0
+    os.rename(partial, data)
     return None, time.time() - t0
 
 
