@@ -96,7 +96,7 @@ def target_rows(results, families, modes):
                          mean <= fam.DRIFT_TARGET_PERCENT, worst))
             ratio = stats(r["metrics"].get("local_position_nees_first_pose", NAN) / 3.0 for r in vio)[0]
             lo, hi = fam.NEES_RATIO_RANGE
-            rows.append((n, "VIO position NEES / 3 (mean) in [%.1f, %.1f]" % (lo, hi), fmt(ratio, 2),
+            rows.append((n, "VIO position NEES / 3 (mean) in [%.1f, %.1f]" % (lo, hi), fmt(ratio, 3),
                          lo <= ratio <= hi, None))
         for fl, dbl in fam.FLOAT_PAIRS.items():
             worst, worst_run = float_gap(results, n, fl, dbl)
