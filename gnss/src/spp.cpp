@@ -17,6 +17,7 @@
 #include "gvins/gnss/satellite_observation_model.hpp"
 #include "gvins/gnss/zero_difference.hpp"
 #include "normal_equations.hpp"
+#include "spp_reported_covariance.hpp"
 
 namespace gvins {
 
@@ -81,6 +82,7 @@ struct SppSolver::Measurement {
   // Model values of the last iteration.
   AzEl azel{0.0, 0.5 * constants::kPi};
   double iono = 0.0, tropo = 0.0, variance = 1.0;
+  double errorVariance = 1.0;  // of the reported covariance's error model (ReportedErrorModel)
   bool active = true;  // above the mask in the last iteration
   double inflation = 1.0;  // variance factor from robust re-weighting
   double ionoMap = 0.0;    // partial of the delay w.r.t. a zenith L1 ionosphere correction
@@ -271,8 +273,9 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
         m.azel = AzEl{0.0, 0.5 * constants::kPi};
         m.active = true;
       }
-      double var = cfg.weighting.codeVariance(m.sat.system, m.azel.elevation, m.snr) * m.noiseFactor * m.noiseFactor;
-      var += ionoVar + tropoVar;
+      const double noiseVar =
+          cfg.weighting.codeVariance(m.sat.system, m.azel.elevation, m.snr) * m.noiseFactor * m.noiseFactor;
+      double var = noiseVar + ionoVar + tropoVar;
       double eph = m.state.precise || m.state.ssr ? cfg.preciseEphemerisError[systemIndex(m.sat.system)]
                                    : cfg.ephemerisError[systemIndex(m.sat.system)];
       if (!m.state.precise && !m.state.ssr && m.state.accuracy > cfg.ephemerisAlarmAccuracy && cfg.ephemerisAlarmAccuracy > 0.0) {
@@ -280,6 +283,9 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
       }
       var += eph * eph;
       m.variance = var * m.inflation;
+      const ReportedErrorModel& re = cfg.reportedError;
+      m.errorVariance = re.noiseScale * re.noiseScale * noiseVar + re.ionosphereScale * re.ionosphereScale * ionoVar +
+                        re.modelScale * re.modelScale * (tropoVar + eph * eph);
     }
   };
 
@@ -628,6 +634,30 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
     ++sol.numSatellites;
     losEnu.push_back(rEnu * (m.state.position - x).normalized());
     clockIdx.push_back(col[m.sys]);
+  }
+  if (cfg.reportedError.enabled) {
+    // The reported covariance under the calibrated error model (ReportedErrorModel).
+    const int nc = static_cast<int>(colSystems.size());
+    const int nu = static_cast<int>(last.cov.rows());
+    std::vector<detail::ReportedRow> rr;
+    for (int i = 0; i < n; ++i) {
+      if (!use[i]) continue;
+      detail::ReportedRow row{Eigen::VectorXd::Zero(nu), meas[i].variance, meas[i].errorVariance,
+                              sol.satellites[meas[i].result].residual};
+      row.h.head<3>() = -(meas[i].state.position - x).normalized();
+      row.h[3 + col[meas[i].sys]] = 1.0;
+      if (estIono) row.h[3 + nc] = meas[i].ionoMap;
+      rr.push_back(std::move(row));
+    }
+    if (estIono) {  // the prior of the zenith correction, an error budget like the others
+      const double f = cfg.reportedError.ionosphereScale;
+      rr.push_back(detail::ReportedRow{Eigen::VectorXd::Unit(nu, 3 + nc), ionoPriorVar, f * f * ionoPriorVar, -ion});
+    }
+    const detail::ReportedCovariance rc = detail::reportedCovariance(last.cov, rr, sol.dof, cfg.covarianceScaling);
+    sol.varianceFactor = rc.varianceFactor;
+    sol.positionCovariance = rc.covariance.topLeftCorner<3, 3>();
+    for (int c = 0; c < nc; ++c) sol.clockBiasVariance[colSystems[c]] = rc.covariance(3 + c, 3 + c);
+    if (cfg.qzssUsesGpsClock && sol.clockBias[gi]) sol.clockBiasVariance[ji] = sol.clockBiasVariance[gi];
   }
   sol.dop = computeDop(losEnu, clockIdx, static_cast<int>(colSystems.size()));
   if (!sol.dop.valid || sol.dop.gdop > cfg.maxGdop) {

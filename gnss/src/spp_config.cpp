@@ -26,11 +26,21 @@ namespace {
 
 using Reader = YamlReader;
 
+void applyReportedError(const Reader& r, const YAML::Node& v, const std::string& full, ReportedErrorModel& m) {
+  static const std::set<std::string> kE = {"enabled", "noise_scale", "ionosphere_scale", "model_scale"};
+  r.map(v, full, kE, [&](const std::string& ek, const std::string& ef, const YAML::Node& ev) {
+    if (ek == "enabled") m.enabled = r.boolean(ev, ef);
+    else if (ek == "noise_scale") m.noiseScale = r.number(ev, ef, 0.0, 100.0);
+    else if (ek == "ionosphere_scale") m.ionosphereScale = r.number(ev, ef, 0.0, 100.0);
+    else m.modelScale = r.number(ev, ef, 0.0, 100.0);
+  });
+}
+
 void apply(const Reader& r, const YAML::Node& spp, SppConfig& c) {
   static const std::set<std::string> kKeys = {
       "systems", "elevation_mask_deg", "snr_mask_dbhz", "frequencies", "bands", "ionosphere", "troposphere",
       "relative_humidity", "meteo", "weighting", "ionosphere_model_error", "troposphere_zenith_error_m",
-      "ephemeris_error_m", "ephemeris_alarm_accuracy_m", "precise_ephemeris_error_m", "fault_exclusion", "robust", "ionosphere_estimation", "covariance_scaling", "max_gdop", "isb_prior_sigma_m", "isb_random_walk_m2ps", "qzss_gps_clock",
+      "ephemeris_error_m", "ephemeris_alarm_accuracy_m", "precise_ephemeris_error_m", "fault_exclusion", "robust", "ionosphere_estimation", "covariance_scaling", "reported_error", "max_gdop", "isb_prior_sigma_m", "isb_random_walk_m2ps", "qzss_gps_clock",
       "max_iterations", "velocity", "carrier_smoothing_s", "allow_unhealthy"};
   r.map(spp, "spp", kKeys, [&](const std::string& k, const std::string& full, const YAML::Node& v) {
     if (k == "systems") {
@@ -137,6 +147,8 @@ void apply(const Reader& r, const YAML::Node& spp, SppConfig& c) {
         if (ck == "enabled") c.covarianceScaling.enabled = r.boolean(cv, cf);
         else c.covarianceScaling.priorDof = r.number(cv, cf, 0.0, 1000.0);
       });
+    } else if (k == "reported_error") {
+      applyReportedError(r, v, full, c.reportedError);
     } else if (k == "max_gdop") {
       c.maxGdop = r.number(v, full, 1.0, 1e6);
     } else if (k == "isb_prior_sigma_m") {

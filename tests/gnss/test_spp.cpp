@@ -314,6 +314,45 @@ TEST(Spp, VarianceFactorScalesTheCovarianceWhenTheWeightsAreOptimistic) {
   EXPECT_NEAR(nees, 3.0, 0.6);
 }
 
+TEST(Spp, ReportedErrorModelGivesTheCovarianceOfTheWeightedSolutionUnderOtherErrors) {
+  // The weights assume 0.6 m, the simulated noise is 0.3 m: the a-priori covariance is 4x too
+  // large (NEES ~0.75). The reported-error model with noise_scale 0.5 describes the true noise:
+  // the covariance of the same weighted solution under it gives NEES ~3. The solution does not
+  // change.
+  SppConfig c = simulationNoiseConfig();
+  c.weighting.a = 0.6;
+  c.covarianceScaling.enabled = false;
+  SppConfig rep = c;
+  rep.reportedError.enabled = true;
+  rep.reportedError.noiseScale = 0.5;
+  SimOptions o;
+  o.position = kNagoyaRover;
+  o.noise = 0.3;
+  std::mt19937 rng(11);
+  o.rng = &rng;
+  const int trials = 300;
+  double nees = 0.0, neesPrior = 0.0;
+  for (int i = 0; i < trials; ++i) {
+    const ObsEpoch e = simulate(nagoyaNav(), kNagoyaTime + i * 10.0, o);
+    SppSolver a(nagoyaNav(), c), b(nagoyaNav(), rep);
+    a.setInitialPosition(kNagoyaRover);
+    b.setInitialPosition(kNagoyaRover);
+    const SppSolution s = a.solve(e), r = b.solve(e);
+    ASSERT_TRUE(s.valid());
+    ASSERT_TRUE(r.valid());
+    EXPECT_EQ(s.position, r.position);
+    // A scale on the noise alone scales the covariance by its square.
+    EXPECT_LT((r.positionCovariance - 0.25 * s.positionCovariance).norm(), 1e-9 * s.positionCovariance.norm());
+    const Eigen::Vector3d d = r.position - o.position;
+    nees += d.dot(r.positionCovariance.ldlt().solve(d));
+    neesPrior += d.dot(s.positionCovariance.ldlt().solve(d));
+  }
+  nees /= trials;
+  neesPrior /= trials;
+  EXPECT_NEAR(neesPrior, 0.75, 0.2);
+  EXPECT_NEAR(nees, 3.0, 0.5);
+}
+
 TEST(Spp, DopplerVelocityAndClockDriftFromFiniteDifferenceRanges) {
   SimOptions o;
   o.position = kNagoyaRover;

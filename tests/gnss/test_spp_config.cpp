@@ -36,7 +36,8 @@ TEST(SppConfig, ParsesEveryKey) {
       "  max_iterations: 12\n"
       "  velocity: false\n"
       "  carrier_smoothing_s: 60\n"
-      "  allow_unhealthy: true\n";
+      "  allow_unhealthy: true\n"
+      "  reported_error: {enabled: true, noise_scale: 0.5, ionosphere_scale: 0.75, model_scale: 0.2}\n";
   const SppConfig c = parseSppConfig(y, "all.yaml");
   EXPECT_TRUE(c.useSystem(System::Gps) && c.useSystem(System::Galileo) && c.useSystem(System::BeiDou));
   EXPECT_FALSE(c.useSystem(System::Glonass) || c.useSystem(System::Qzss));
@@ -116,6 +117,8 @@ TEST(SppConfig, ErrorsNameFileLineAndKey) {
   expectError("spp:\n  bands: {X: \"1\"}\n", 2, "spp.bands.X", "unknown system");
   expectError("spp:\n  robust: {k0: 3, k1: 2}\n", 2, "spp.robust", "larger");
   expectError("spp:\n  velocity: maybe\n", 2, "spp.velocity", "wrong type");
+  expectError("spp:\n  reported_error: {noise_scale: -1}\n", 2, "spp.reported_error.noise_scale", "outside");
+  expectError("spp:\n  reported_error: {scale: 1}\n", 2, "spp.reported_error.scale", "unknown key");
   expectError("spp:\n  carrier_smoothing_s: -1\n", 2, "spp.carrier_smoothing_s", "");
   expectError("spp: [1, 2\n", 2, "YAML", "");
   expectError("- a\n- b\n", 1, "", "map");
