@@ -567,13 +567,14 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
       }
       std::nth_element(u.begin(), u.begin() + static_cast<long>(u.size() / 2), u.end());
       const double scale = std::max(1.4826 * u[u.size() / 2], rb.minScale);
+      const double k0 = sol.testPassed ? rb.k0 : rb.k0Failed, k1 = sol.testPassed ? rb.k1 : rb.k1Failed;
       bool changed = false;
       for (int i = 0; i < n; ++i) {
         if (!use[i]) continue;
         const double z = last.normResidual[i] * std::sqrt(meas[i].inflation) / scale;
         double w = 1.0;
-        if (z > rb.k1) w = 1e-4;
-        else if (z > rb.k0) w = std::max(1e-4, rb.k0 / z * std::pow((rb.k1 - z) / (rb.k1 - rb.k0), 2));
+        if (z > k1) w = 1e-4;
+        else if (z > k0) w = std::max(1e-4, k0 / z * std::pow((k1 - z) / (k1 - k0), 2));
         const double infl = 1.0 / w;
         if (std::abs(infl - meas[i].inflation) > 0.05 * meas[i].inflation) changed = true;
         meas[i].variance *= infl / meas[i].inflation;

@@ -125,15 +125,19 @@ void apply(const Reader& r, const YAML::Node& spp, SppConfig& c) {
         else c.faultExclusion.minRedundancy = r.integer(fv, ff, 0, 100);
       });
     } else if (k == "robust") {
-      static const std::set<std::string> kR = {"enabled", "k0", "k1", "min_scale", "max_iterations"};
+      static const std::set<std::string> kR = {"enabled", "k0", "k1", "k0_failed", "k1_failed", "min_scale",
+                                               "max_iterations"};
       r.map(v, full, kR, [&](const std::string& rk, const std::string& rf, const YAML::Node& rv) {
         if (rk == "enabled") c.robust.enabled = r.boolean(rv, rf);
         else if (rk == "k0") c.robust.k0 = r.number(rv, rf, 0.1, 100.0);
         else if (rk == "k1") c.robust.k1 = r.number(rv, rf, 0.2, 1000.0);
+        else if (rk == "k0_failed") c.robust.k0Failed = r.number(rv, rf, 0.1, 100.0);
+        else if (rk == "k1_failed") c.robust.k1Failed = r.number(rv, rf, 0.2, 1000.0);
         else if (rk == "min_scale") c.robust.minScale = r.number(rv, rf, 0.0, 100.0);
         else c.robust.maxIterations = r.integer(rv, rf, 1, 100);
       });
       if (c.robust.k1 <= c.robust.k0) r.fail(v, full, "robust.k1 must be larger than robust.k0");
+      if (c.robust.k1Failed <= c.robust.k0Failed) r.fail(v, full, "robust.k1_failed must be larger than robust.k0_failed");
     } else if (k == "ionosphere_estimation") {
       static const std::set<std::string> kI = {"enabled", "prior_fraction", "min_prior_sigma_m"};
       r.map(v, full, kI, [&](const std::string& ik, const std::string& iff, const YAML::Node& iv) {
