@@ -637,28 +637,8 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
     clockIdx.push_back(col[m.sys]);
   }
   if (cfg.reportedError.enabled) {
-    // The reported covariance under the calibrated error model (ReportedErrorModel).
-    const int nc = static_cast<int>(colSystems.size());
-    const int nu = static_cast<int>(last.cov.rows());
-    std::vector<detail::ReportedRow> rr;
-    for (int i = 0; i < n; ++i) {
-      if (!use[i]) continue;
-      detail::ReportedRow row{Eigen::VectorXd::Zero(nu), meas[i].variance, meas[i].errorVariance,
-                              sol.satellites[meas[i].result].residual};
-      row.h.head<3>() = -(meas[i].state.position - x).normalized();
-      row.h[3 + col[meas[i].sys]] = 1.0;
-      if (estIono) row.h[3 + nc] = meas[i].ionoMap;
-      rr.push_back(std::move(row));
-    }
-    if (estIono) {  // the prior of the zenith correction, an error budget like the others
-      const double f = cfg.reportedError.ionosphereScale;
-      rr.push_back(detail::ReportedRow{Eigen::VectorXd::Unit(nu, 3 + nc), ionoPriorVar, f * f * ionoPriorVar, -ion});
-    }
-    const detail::ReportedCovariance rc = detail::reportedCovariance(last.cov, rr, sol.dof, cfg.covarianceScaling);
-    sol.varianceFactor = rc.varianceFactor;
-    sol.positionCovariance = rc.covariance.topLeftCorner<3, 3>();
-    for (int c = 0; c < nc; ++c) sol.clockBiasVariance[colSystems[c]] = rc.covariance(3 + c, 3 + c);
-    if (cfg.qzssUsesGpsClock && sol.clockBias[gi]) sol.clockBiasVariance[ji] = sol.clockBiasVariance[gi];
+    const std::optional<double> ionoPrior = estIono ? std::optional<double>(ionoPriorVar) : std::nullopt;
+    reportCovariance(sol, meas, use, x, col, colSystems, last.cov, ionoPrior, ion);
   }
   sol.dop = computeDop(losEnu, clockIdx, static_cast<int>(colSystems.size()));
   if (!sol.dop.valid || sol.dop.gdop > cfg.maxGdop) {
@@ -693,6 +673,34 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
     if (rr.size() >= 4) sol.velocity = solveDopplerVelocity(rr, x, cfg.faultExclusion);
   }
   return sol;
+}
+
+void SppSolver::reportCovariance(SppSolution& sol, const std::vector<Measurement>& meas, const std::vector<char>& use,
+                                 const Eigen::Vector3d& x, const std::array<int, kNumSystems>& col,
+                                 const std::vector<int>& colSystems, const Eigen::MatrixXd& cov,
+                                 std::optional<double> ionoPriorVar, double ion) const {
+  const int nc = static_cast<int>(colSystems.size());
+  const int nu = static_cast<int>(cov.rows());
+  std::vector<detail::ReportedRow> rr;
+  for (std::size_t i = 0; i < meas.size(); ++i) {
+    if (!use[i]) continue;
+    const Measurement& m = meas[i];
+    detail::ReportedRow row{Eigen::VectorXd::Zero(nu), m.variance, m.errorVariance, sol.satellites[m.result].residual};
+    row.h.head<3>() = -(m.state.position - x).normalized();
+    row.h[3 + col[m.sys]] = 1.0;
+    if (ionoPriorVar) row.h[3 + nc] = m.ionoMap;
+    rr.push_back(std::move(row));
+  }
+  if (ionoPriorVar) {  // the prior of the zenith correction, an error budget like the others
+    const double f = config_.reportedError.ionosphereScale;
+    rr.push_back(detail::ReportedRow{Eigen::VectorXd::Unit(nu, 3 + nc), *ionoPriorVar, f * f * *ionoPriorVar, -ion});
+  }
+  const detail::ReportedCovariance rc = detail::reportedCovariance(cov, rr, sol.dof, config_.covarianceScaling);
+  sol.varianceFactor = rc.varianceFactor;
+  sol.positionCovariance = rc.covariance.topLeftCorner<3, 3>();
+  for (int c = 0; c < nc; ++c) sol.clockBiasVariance[colSystems[c]] = rc.covariance(3 + c, 3 + c);
+  const int gi = systemIndex(System::Gps), ji = systemIndex(System::Qzss);
+  if (config_.qzssUsesGpsClock && sol.clockBias[gi]) sol.clockBiasVariance[ji] = sol.clockBiasVariance[gi];
 }
 
 void SppSolver::updateIsb(const SppSolution& sol, const Eigen::MatrixXd& cov, const std::vector<int>& clockSystems) {
