@@ -23,13 +23,14 @@ import shutil
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from real_walk import enu, llh_to_ecef  # noqa: E402  (one geodesy for both pages)
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DATA = os.path.join(ROOT, "tests", "data")
 WALK = os.path.join(DATA, "gnss_imu", "walk_0827")
 REF = os.path.join(WALK, "gnss_1730_sf.pos")
 CONFIG = os.path.join(ROOT, "config", "real_walk_0827_vision.yaml")
-A = 6378137.0
-F = 1.0 / 298.257223563
 MODES = [("vio", "vio", False), ("vio+gpsvel", "vio+gpsvel", False), ("vio+dopp", "vio+dopp", False),
          ("vio+dopp+psr, ionosphere-free", "vio+dopp+psr", False),
          ("vio+dopp+psr, broadcast ionosphere", "vio+dopp+psr", True),
@@ -44,21 +45,6 @@ def note(msg):
 def run(cmd):
     note(" ".join(cmd))
     return subprocess.run(cmd, check=True, capture_output=True, text=True)
-
-
-def llh_to_ecef(lat, lon, h):
-    e2 = F * (2 - F)
-    la, lo = math.radians(lat), math.radians(lon)
-    n = A / math.sqrt(1 - e2 * math.sin(la) ** 2)
-    return ((n + h) * math.cos(la) * math.cos(lo), (n + h) * math.cos(la) * math.sin(lo), (n * (1 - e2) + h) * math.sin(la))
-
-
-def enu(d, lat, lon):
-    la, lo = math.radians(lat), math.radians(lon)
-    e = -math.sin(lo) * d[0] + math.cos(lo) * d[1]
-    n = -math.sin(la) * math.cos(lo) * d[0] - math.sin(la) * math.sin(lo) * d[1] + math.cos(la) * d[2]
-    u = math.cos(la) * math.cos(lo) * d[0] + math.cos(la) * math.sin(lo) * d[1] + math.sin(la) * d[2]
-    return e, n, u
 
 
 def read_pos(path):

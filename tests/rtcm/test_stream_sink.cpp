@@ -16,23 +16,14 @@
 #include <string>
 #include <thread>
 
+#include "local_tcp.hpp"
 #include "gvins/rtcm/stream_sink.hpp"
 
 using namespace gvins::rtcm;
+using namespace gvins::testing;
 using namespace std::chrono_literals;
 
 namespace {
-
-int connectLocal(int port, int receiveBuffer = 0) {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  if (receiveBuffer > 0) ::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &receiveBuffer, sizeof receiveBuffer);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  a.sin_port = htons(static_cast<std::uint16_t>(port));
-  EXPECT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
-  return fd;
-}
 
 /// What arrives on `fd` until `want` bytes or 3 s of silence.
 std::string receive(int fd, std::size_t want) {
@@ -46,26 +37,6 @@ std::string receive(int fd, std::size_t want) {
     got.append(buf, static_cast<std::size_t>(n));
   }
   return got;
-}
-
-int listenLocal(int& port) {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  const int one = 1;
-  ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  EXPECT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
-  EXPECT_EQ(::listen(fd, 4), 0);
-  socklen_t len = sizeof a;
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
-  port = ntohs(a.sin_port);
-  return fd;
-}
-
-int acceptWithin(int lfd, int ms) {
-  pollfd p{lfd, POLLIN, 0};
-  return ::poll(&p, 1, ms) > 0 ? ::accept(lfd, nullptr, nullptr) : -1;
 }
 
 bool anyEventHas(StreamSink& s, const std::string& what) {

@@ -21,9 +21,11 @@
 #include <thread>
 #include <vector>
 
+#include "local_tcp.hpp"
 #include "gvins/rtcm/stream_source.hpp"
 
 using namespace gvins::rtcm;
+using namespace gvins::testing;
 using namespace std::chrono_literals;
 
 namespace {
@@ -37,39 +39,7 @@ std::string readAll(StreamSource& s, std::size_t want, double limit = 10.0) {
   return std::string(b.begin(), b.end());
 }
 
-/// A listening socket on 127.0.0.1 with a free port.
-int listenLocal(int& port) {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  const int one = 1;
-  ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  EXPECT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
-  EXPECT_EQ(::listen(fd, 4), 0);
-  socklen_t len = sizeof a;
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
-  port = ntohs(a.sin_port);
-  return fd;
-}
-
 void sendAll(int fd, const std::string& s) { ASSERT_EQ(::send(fd, s.data(), s.size(), MSG_NOSIGNAL), static_cast<ssize_t>(s.size())); }
-
-/// accept() with a limit, so that a test whose client gave up does not hang (-1 on timeout).
-int acceptWithin(int lfd, int ms) {
-  pollfd p{lfd, POLLIN, 0};
-  return ::poll(&p, 1, ms) > 0 ? ::accept(lfd, nullptr, nullptr) : -1;
-}
-
-int connectLocal(int port) {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  a.sin_port = htons(static_cast<std::uint16_t>(port));
-  for (int i = 0; i < 100 && ::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0; ++i) std::this_thread::sleep_for(20ms);
-  return fd;
-}
 
 }  // namespace
 
