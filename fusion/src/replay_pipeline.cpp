@@ -714,7 +714,7 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
       const std::int64_t tState = init ? est.newestImuState().t_ns : frame->t_ns;
       const GpsTime limit = gpsFromNs(tState + opt.sensorToGpst_ns);
       while (g.haveRover && g.nextRover.time <= limit) {
-        if (!init) {
+        if (!init && !gnss->startsEstimator()) {
           ++sum.gnssEpochsSkipped;
         } else {
           while (g.haveBase && g.nextBase.time <= g.nextRover.time) {
@@ -736,6 +736,7 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
           gnssMs += ms;
           ++gnssCount;
           ++sum.gnssEpochs;
+          if (!init && o.stage != "tight") ++sum.gnssEpochsSkipped;  // the GNSS/INS start has not started it yet
           if (o.updated) ++sum.gnssEpochsUpdated;
           sum.phaseRowsUsed += static_cast<std::size_t>(o.phaseUsed);
           sum.phaseRowsRejected += static_cast<std::size_t>(o.phaseRejected);

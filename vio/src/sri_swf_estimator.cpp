@@ -314,10 +314,10 @@ struct SriSwfEstimator<Scalar>::Impl {
   bool imuCovers(std::int64_t t0, std::int64_t t1) const { return vio::imuCovers(imuSpan(), t0, t1); }
 
   // ------------------------------------------------------------------ initialisation
-  void createState(const ImuState& s, const Eigen::Matrix3d& Ptheta_world, double sigma_v, double sigma_bg) {
-    Eigen::Matrix<double, 6, 6> P = Eigen::Matrix<double, 6, 6>::Zero();
-    P.topLeftCorner<3, 3>() = s.R_WI.transpose() * Ptheta_world * s.R_WI;  // body-frame δθ
-    P.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() * cfg.init_position_sigma * cfg.init_position_sigma;
+  /// P: covariance in ImuErr order (external_initial_state.hpp); the per-block priors drop the
+  /// correlations between pose, velocity and bias.
+  void createState(const ImuState& s, const Matrix15d& Pimu) {
+    const Eigen::Matrix<double, 6, 6> P = Pimu.topLeftCorner<6, 6>();
     const BlockId pid = f.addBlock(BlockSpec::pose("imu_pose"), poseEstimate<Scalar>(s.R_WI, s.p_WI),
                                    sri::Prior<Scalar>::covariance(P.cast<Scalar>()));
     setExact(pid, poseEstimate<double>(s.R_WI, s.p_WI));
@@ -341,17 +341,16 @@ struct SriSwfEstimator<Scalar>::Impl {
       setExact(td_id, BlockEstimate<double>::fromVector(Eigen::Matrix<double, 1, 1>(frame_td)));
     }
     const Eigen::Matrix<double, 6, 1> xb = biasVector(s);
-    Eigen::Matrix<double, 6, 1> sdb;
-    sdb << Eigen::Vector3d::Constant(sigma_bg), Eigen::Vector3d::Constant(cfg.init_accel_bias_sigma);
-    const Eigen::Vector3d sdv = Eigen::Vector3d::Constant(sigma_v);
+    const Eigen::Matrix<double, 6, 6> Pb = Pimu.bottomRightCorner<6, 6>();
+    const Eigen::Matrix3d Pv = Pimu.block<3, 3>(ImuErr::kVel, ImuErr::kVel);
     // Bias, then velocity: with the extra last that is their order at the back; first, the
     // velocity goes in front of the bias.
     const BlockId bid = f.addBlock(BlockSpec::vector("imu_bias", 6), BlockEstimate<Scalar>::fromVector(xb.cast<Scalar>()),
-                                   sri::Prior<Scalar>::stdDevs(sdb.cast<Scalar>()), extraPlacement());
+                                   sri::Prior<Scalar>::covariance(Pb.cast<Scalar>()), extraPlacement());
     setExact(bid, BlockEstimate<double>::fromVector(xb));
     const BlockId vid = f.addBlock(BlockSpec::vector("imu_velocity", 3),
                                    BlockEstimate<Scalar>::fromVector(s.v_WI.cast<Scalar>()),
-                                   sri::Prior<Scalar>::stdDevs(sdv.cast<Scalar>()), extraPlacement());
+                                   sri::Prior<Scalar>::covariance(Pv.cast<Scalar>()), extraPlacement());
     setExact(vid, BlockEstimate<double>::fromVector(s.v_WI));
     newest = {pid, vid, bid};
     t_bias = s.t_ns;
@@ -368,7 +367,7 @@ struct SriSwfEstimator<Scalar>::Impl {
   bool tryInitialize(const FeatureFrame& frame) {
     const std::optional<InitialState> s = initializer.tryInitialize(frame, imuSpan(), ext_fixed);
     if (!s) return false;
-    createState(s->state, s->P_theta_world, s->sigma_v, s->sigma_bg);
+    createState(s->state, initialStateCovariance(*s, cfg));
     clearCaches();
     addObservations(frame);
     return true;
@@ -1260,6 +1259,20 @@ SriSwfEstimator<Scalar>::~SriSwfEstimator() = default;
 template <typename Scalar>
 void SriSwfEstimator<Scalar>::addImu(const ImuSample& sample) {
   impl_->addImu(sample);
+}
+
+template <typename Scalar>
+bool SriSwfEstimator<Scalar>::initializeFrom(const ExternalInitialState& s) {
+  if (impl_->initialized || !externalInitialStateError(s).empty() || !impl_->imuCovers(s.state.t_ns, s.state.t_ns)) return false;
+  impl_->createState(s.state, s.covariance);
+  impl_->initializer.clear();
+  impl_->clearCaches();
+  return true;
+}
+
+template <typename Scalar>
+std::span<const ImuSample> SriSwfEstimator<Scalar>::bufferedImu() const {
+  return impl_->imuSpan();
 }
 
 template <typename Scalar>

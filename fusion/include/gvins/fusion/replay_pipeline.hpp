@@ -108,6 +108,9 @@ class ReplayGnss {
   /// local outputs (trajectory.tum, covariances, the local evaluation) undo it, so that they stay
   /// in the VIO world frame of the start.
   virtual std::optional<vio::WorldFrameChange> worldChange() const { return std::nullopt; }
+  /// Whether the client may start the estimator itself (GnssFusionConfig::insStart): then it gets
+  /// the epochs before the estimator is initialised too.
+  virtual bool startsEstimator() const { return false; }
 };
 
 enum class ImuGapPolicy { Error, Warn };

@@ -74,6 +74,7 @@ class GnssFusionReplayClient final : public ReplayGnss {
   }
   std::optional<Eigen::Vector3d> leverArm() const override { return fusion_.leverArm(est_); }
   std::optional<vio::WorldFrameChange> worldChange() const override { return fusion_.worldChange(est_); }
+  bool startsEstimator() const override { return fusion_.config().insStart && fusion_.config().mode != GnssFusionMode::kVio; }
   GnssFusion<Scalar>& fusion() { return fusion_; }
 
  private:
