@@ -1,9 +1,6 @@
 // GnssFusion before the estimator is initialised: the GNSS/INS start (gnss_ins_alignment.hpp,
 // docs/gnss_fusion.md "Starting from GNSS/INS").
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
-#include <string>
 
 #include "gvins/base/constants.hpp"
 #include "gvins/fusion/gnss_fusion.hpp"
@@ -32,10 +29,9 @@ void GnssFusion<Scalar>::startFromGnss(vio::EstimatorBackend<Scalar>& est, const
   if (!(std::abs(dtr) < 0.01)) dtr = 0.0;
   const GpsTime t = rover.time - dtr;
   const std::int64_t t_ns = t.wholeSeconds() * 1000000000LL + std::llround(t.fraction() * 1e9);
-  if (t_ns < imu.front().t_ns || t_ns > imu.back().t_ns) return;
+  if (t_ns < imu.front().t_ns) return;
   const std::optional<vio::ExternalInitialState> s = insAlign_->add(t_ns, spp, imu, leverStart_);
   rep.insStart = insAlign_->status();
-  if (std::getenv("GI_DEBUG")) std::fprintf(stderr, "ins %.2f %s yaw %.2f tilt %.2f\n", t_ns*1e-9, std::string(gnssInsStatusText(*rep.insStart)).c_str(), insAlign_->yawSigmaDeg(), insAlign_->tiltSigmaDeg());
   rep.t_ns = t_ns;
   if (!s || !est.initializeFrom(*s)) return;
   // The estimator now runs in ENU at the alignment's anchor: no frame block to estimate, the

@@ -39,6 +39,7 @@ GnssInsAlignment::GnssInsAlignment(const GnssInsAlignmentConfig& cfg, const vio:
 
 void GnssInsAlignment::clear() {
   epochs_.clear();
+  pending_.clear();
   status_ = GnssInsStatus::kCollecting;
   yawSigmaDeg_ = tiltSigmaDeg_ = std::numeric_limits<double>::quiet_NaN();
 }
@@ -49,9 +50,15 @@ void GnssInsAlignment::dropOldest() {
   // Re-base the IMU terms on the new first epoch j: R_jk = R_0jᵀ R_0k, β_jk = R_0jᵀ (β_0k − β_0j).
   const Eigen::Matrix3d Rj = epochs_.front().R_0k;
   const Eigen::Vector3d bj = epochs_.front().beta_0k;
+  const Eigen::Matrix3d Jtj = epochs_.front().Jth_g, Jgj = epochs_.front().Jb_g, Jaj = epochs_.front().Jb_a;
   for (Epoch& e : epochs_) {
+    // R_jk = R_0jᵀ R_0k: θ_jk = θ_0k − R_0kᵀ R_0j θ_0j to first order; β_jk = R_0jᵀ (β_0k − β_0j).
+    const Eigen::Vector3d db = e.beta_0k - bj;
+    e.Jb_g = Rj.transpose() * (e.Jb_g - Jgj) + vio::so3::skew(Rj.transpose() * db) * Jtj;
+    e.Jb_a = Rj.transpose() * (e.Jb_a - Jaj);
+    e.Jth_g = e.Jth_g - e.R_0k.transpose() * Rj * Jtj;
     e.R_0k = Rj.transpose() * e.R_0k;
-    e.beta_0k = Rj.transpose() * (e.beta_0k - bj);
+    e.beta_0k = Rj.transpose() * db;
   }
 }
 
@@ -66,37 +73,108 @@ std::optional<vio::ExternalInitialState> GnssInsAlignment::add(std::int64_t t_ns
     status_ = GnssInsStatus::kNoDoppler;
     return std::nullopt;
   }
-  if (!epochs_.empty() && t_ns <= epochs_.back().t_ns) return std::nullopt;
+  const std::int64_t lastT = !pending_.empty() ? pending_.back().t_ns : !epochs_.empty() ? epochs_.back().t_ns : 0;
+  if (t_ns <= lastT) return std::nullopt;
   Epoch e;
   e.t_ns = t_ns;
   e.p_N = spp.position;  // ECEF here; converted at the fit (ENU at the window's first epoch)
   e.v_N = spp.velocity.velocity;
   e.Cp = spp.positionCovariance;
   e.Cv = spp.velocity.covariance;
-  e.R_0k.setIdentity();
-  e.beta_0k.setZero();
-  if (!epochs_.empty()) {
-    const Epoch& last = epochs_.back();
-    vio::ImuIntegration integ(noise_, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
-    try {
-      integ.integrate(imu, last.t_ns, t_ns);
-    } catch (const std::invalid_argument&) {
-      clear();
-      epochs_.push_back(e);
-      status_ = GnssInsStatus::kNoImu;
-      return std::nullopt;
-    }
-    e.R_0k = last.R_0k * integ.gamma();
-    e.beta_0k = last.beta_0k + last.R_0k * integ.beta();
+  pending_.push_back(e);
+  // Epochs enter the window once the IMU covers them (an epoch's time may lie a little past the
+  // newest sample: its receiver clock).
+  bool added = false;
+  while (!pending_.empty() && !imu.empty() && pending_.front().t_ns <= imu.back().t_ns) {
+    added = true;
+    if (!integrateInto(pending_.front(), imu)) status_ = GnssInsStatus::kNoImu;
+    pending_.pop_front();
   }
-  epochs_.push_back(e);
-  while (epochs_.size() > 2 && static_cast<double>(t_ns - epochs_.front().t_ns) * 1e-9 > cfg_.window) dropOldest();
+  if (!added || status_ == GnssInsStatus::kNoImu) return std::nullopt;
+  while (epochs_.size() > 2 &&
+         static_cast<double>(epochs_.back().t_ns - epochs_.front().t_ns) * 1e-9 > cfg_.window) dropOldest();
   if (epochs_.size() < 2) {
     status_ = GnssInsStatus::kCollecting;
     return std::nullopt;
   }
   return fit(imu, lever);
 }
+
+bool GnssInsAlignment::integrateInto(Epoch e, std::span<const vio::ImuSample> imu) {
+  e.R_0k.setIdentity();
+  e.beta_0k.setZero();
+  e.Jth_g.setZero();
+  e.Jb_g.setZero();
+  e.Jb_a.setZero();
+  if (epochs_.empty()) {
+    epochs_.push_back(e);
+    return true;
+  }
+  const Epoch& last = epochs_.back();
+  vio::ImuIntegration integ(noise_, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());
+  try {
+    integ.integrate(imu, last.t_ns, e.t_ns);
+  } catch (const std::invalid_argument&) {
+    epochs_.clear();  // a gap: the window starts again here
+    epochs_.push_back(e);
+    return false;
+  }
+  const Eigen::Matrix<double, 9, 6>& J = integ.biasJacobian();  // rows [γ α β], columns [bg ba]
+  e.R_0k = last.R_0k * integ.gamma();
+  e.beta_0k = last.beta_0k + last.R_0k * integ.beta();
+  e.Jth_g = integ.gamma().transpose() * last.Jth_g + J.block<3, 3>(0, 0);
+  e.Jb_g = last.Jb_g - last.R_0k * vio::so3::skew(integ.beta()) * last.Jth_g + last.R_0k * J.block<3, 3>(6, 0);
+  e.Jb_a = last.Jb_a + last.R_0k * J.block<3, 3>(6, 3);
+  epochs_.push_back(e);
+  return true;
+}
+
+namespace {
+
+/// The pairs of the fit: b_k (N) = R_NI0 (β_0k + Jg_k bg + Ja_k ba), weight w_k.
+struct Pair {
+  Eigen::Vector3d b, beta;
+  Eigen::Matrix3d Jg, Ja;
+  double w = 0.0;
+};
+
+/// Gauss-Newton on [δθ (world), bg, ba] from R (Wahba) and zero biases, with the bias priors;
+/// returns the 9×9 covariance (data information halved for the shared first velocity) and the
+/// weighted residual sum.
+Eigen::Matrix<double, 9, 9> refine(const std::vector<Pair>& pairs, double sbg, double sba, Eigen::Matrix3d& R,
+                                   Eigen::Vector3d& bg, Eigen::Vector3d& ba, double& chi2) {
+  using M9 = Eigen::Matrix<double, 9, 9>;
+  using V9 = Eigen::Matrix<double, 9, 1>;
+  M9 H;
+  for (int it = 0; it < 5; ++it) {
+    M9 Hd = M9::Zero();
+    V9 g = V9::Zero();
+    chi2 = 0.0;
+    for (const Pair& p : pairs) {
+      const Eigen::Vector3d bt = p.beta + p.Jg * bg + p.Ja * ba;
+      const Eigen::Vector3d r = p.b - R * bt;
+      Eigen::Matrix<double, 3, 9> A;
+      A << vio::so3::skew(R * bt), -R * p.Jg, -R * p.Ja;
+      Hd += p.w * A.transpose() * A;
+      g -= p.w * A.transpose() * r;
+      chi2 += p.w * r.squaredNorm();
+    }
+    M9 prior = M9::Zero();
+    prior.block<3, 3>(3, 3).diagonal().setConstant(1.0 / (sbg * sbg));
+    prior.block<3, 3>(6, 6).diagonal().setConstant(1.0 / (sba * sba));
+    g.segment<3>(3) -= bg / (sbg * sbg);
+    g.segment<3>(6) -= ba / (sba * sba);
+    H = 0.5 * Hd + prior;
+    const V9 d = (Hd + prior).ldlt().solve(g);
+    R = vio::so3::exp(d.head<3>()) * R;
+    bg += d.segment<3>(3);
+    ba += d.segment<3>(6);
+    if (d.norm() < 1e-9) break;
+  }
+  return H.ldlt().solve(M9::Identity());
+}
+
+}  // namespace
 
 std::optional<vio::ExternalInitialState> GnssInsAlignment::fit(std::span<const vio::ImuSample> imu,
                                                                const Eigen::Vector3d& lever) {
@@ -109,48 +187,26 @@ std::optional<vio::ExternalInitialState> GnssInsAlignment::fit(std::span<const v
     return (R_NE * e.Cv * R_NE.transpose()).trace() / 3.0 + cfg_.velocityFloor * cfg_.velocityFloor;
   };
   const double var0 = velVar(e0);
-  // Pairs b_k (N) = R_NI0 a_k (I0) with scalar weights.
-  const std::size_t n = epochs_.size() - 1;
-  std::vector<Eigen::Vector3d> b(n), a(n);
-  std::vector<double> w(n);
+  std::vector<Pair> pairs;
   Eigen::Matrix3d B = Eigen::Matrix3d::Zero();
-  for (std::size_t k = 0; k < n; ++k) {
-    const Epoch& e = epochs_[k + 1];
+  for (std::size_t k = 1; k < epochs_.size(); ++k) {
+    const Epoch& e = epochs_[k];
     const double dt = static_cast<double>(e.t_ns - e0.t_ns) * 1e-9;
-    b[k] = R_NE * e.v_N - v0 - g_N * dt;
-    a[k] = e.beta_0k;
-    // Velocity noise of both epochs, accelerometer white noise and bias over dt, and the
-    // rotation the gyro bias leaves in R_0k (about half the window's on average).
     const double na = noise_.accelerometer_noise_density;
-    const double rot = cfg_.gyroBiasSigma * dt * 0.5 * a[k].norm();
-    const double var = var0 + velVar(e) + na * na * dt + std::pow(cfg_.accelBiasSigma * dt, 2) + rot * rot;
-    w[k] = 1.0 / var;
-    B += w[k] * b[k] * a[k].transpose();
+    // Velocity noise of both epochs and the accelerometer white noise over dt.
+    pairs.push_back({R_NE * e.v_N - v0 - g_N * dt, e.beta_0k, e.Jb_g, e.Jb_a, 1.0 / (var0 + velVar(e) + na * na * dt)});
+    B += pairs.back().w * pairs.back().b * e.beta_0k.transpose();
   }
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(B, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
   D(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
-  const Eigen::Matrix3d R_NI0 = svd.matrixU() * D * svd.matrixV().transpose();
-  // Information of a world-frame rotation error and the residual test.
-  Eigen::Matrix3d info = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d R_NI0 = svd.matrixU() * D * svd.matrixV().transpose();
+  Eigen::Vector3d bg = Eigen::Vector3d::Zero(), ba = Eigen::Vector3d::Zero();
   double chi2 = 0.0;
-  for (std::size_t k = 0; k < n; ++k) {
-    const Eigen::Matrix3d J = vio::so3::skew(R_NI0 * a[k]);
-    info += w[k] * J.transpose() * J;
-    chi2 += w[k] * (b[k] - R_NI0 * a[k]).squaredNorm();
-  }
-  // The attitude covariance (world frame). Every pair shares the first epoch's velocity, whose
-  // error the scalar weights count as independent per pair: the information is halved for it.
-  info *= 0.5;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(info);
-  const double inf = std::numeric_limits<double>::infinity();
-  Eigen::Matrix3d P = Eigen::Matrix3d::Constant(inf);
-  if (eig.eigenvalues().minCoeff() > 1e-12 * std::max(1.0, eig.eigenvalues().maxCoeff())) {
-    P = eig.eigenvectors() * eig.eigenvalues().cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
-  }
+  const Eigen::Matrix<double, 9, 9> P = refine(pairs, cfg_.gyroBiasSigma, cfg_.accelBiasSigma, R_NI0, bg, ba, chi2);
   yawSigmaDeg_ = std::sqrt(P(2, 2)) * kRadToDeg;
   tiltSigmaDeg_ = std::sqrt(std::max(P(0, 0), P(1, 1))) * kRadToDeg;
-  const int dof = static_cast<int>(3 * n) - 3;
+  const int dof = static_cast<int>(3 * pairs.size()) - 3;
   if (dof > 0 && chi2 > sri::chiSquareQuantile(cfg_.gate, dof)) {
     status_ = GnssInsStatus::kInconsistent;
     return std::nullopt;
@@ -159,26 +215,30 @@ std::optional<vio::ExternalInitialState> GnssInsAlignment::fit(std::span<const v
     status_ = GnssInsStatus::kNoAcceleration;
     return std::nullopt;
   }
-  // The IMU state at the newest epoch K.
+  // The IMU state at the newest epoch K: R_NIK = R_NI0 R_0K(bg).
   const Epoch& eK = epochs_.back();
-  const double T = static_cast<double>(eK.t_ns - e0.t_ns) * 1e-9;
   vio::ExternalInitialState out;
   vio::ImuState& s = out.state;
   s.t_ns = eK.t_ns;
-  s.R_WI = R_NI0 * eK.R_0k;
-  const Eigen::Vector3d omega = vio::interpolateImu(imu, eK.t_ns).gyro;
+  s.R_WI = R_NI0 * eK.R_0k * vio::so3::exp(eK.Jth_g * bg);
+  s.bg = bg;
+  s.ba = ba;
+  const Eigen::Vector3d omega = vio::interpolateImu(imu, eK.t_ns).gyro - bg;
   s.p_WI = R_NE * (eK.p_N - anchor_.ecef) - s.R_WI * lever;
   s.v_WI = R_NE * eK.v_N - s.R_WI * omega.cross(lever);
   vio::Matrix15d& C = out.covariance;
   C.setZero();
-  const Eigen::Matrix3d Pw = P + Eigen::Matrix3d::Identity() * std::pow(cfg_.gyroBiasSigma * T, 2);
+  // Attitude at K: the fit's at t_0 carried by R_0K (world frame; its bias part is in P's bg).
+  const Eigen::Matrix3d Jk = R_NI0 * eK.R_0k * eK.Jth_g;  // world-frame rotation per bg
+  Eigen::Matrix<double, 3, 9> T;
+  T << Eigen::Matrix3d::Identity(), Jk, Eigen::Matrix3d::Zero();
+  const Eigen::Matrix3d Pw = T * P * T.transpose();
   C.block<3, 3>(vio::ImuErr::kTheta, vio::ImuErr::kTheta) = s.R_WI.transpose() * Pw * s.R_WI;  // body frame
   C.block<3, 3>(vio::ImuErr::kPos, vio::ImuErr::kPos) =
       R_NE * eK.Cp * R_NE.transpose() + Eigen::Matrix3d::Identity() * cfg_.positionFloor * cfg_.positionFloor;
   C.block<3, 3>(vio::ImuErr::kVel, vio::ImuErr::kVel) =
       R_NE * eK.Cv * R_NE.transpose() + Eigen::Matrix3d::Identity() * cfg_.velocityFloor * cfg_.velocityFloor;
-  C.block<3, 3>(vio::ImuErr::kBg, vio::ImuErr::kBg).diagonal().setConstant(cfg_.gyroBiasSigma * cfg_.gyroBiasSigma);
-  C.block<3, 3>(vio::ImuErr::kBa, vio::ImuErr::kBa).diagonal().setConstant(cfg_.accelBiasSigma * cfg_.accelBiasSigma);
+  C.block<6, 6>(vio::ImuErr::kBg, vio::ImuErr::kBg) = P.bottomRightCorner<6, 6>();
   C = 0.5 * (C + C.transpose()).eval();
   status_ = GnssInsStatus::kAligned;
   epochs_.clear();

@@ -9,10 +9,12 @@
 //   v_N(t_k) − v_N(t_0) − g_N (t_k − t_0) = R_NI0 β_0k.
 // Every epoch pairs a known vector in N with one in I0: R_NI0 solves Wahba's problem (weighted
 // SVD; Markley, "Attitude determination using vector observations and the singular value
-// decomposition", J. Astronaut. Sci. 36(3), 1988). The gravity term makes the tilt observable at
-// once; the yaw needs a horizontal velocity change (acceleration, a turn). The attitude's
-// information is Σ_k w_k [R β_0k]×ᵀ[R β_0k]× (small world-frame rotations), w_k from the
-// Doppler velocity covariances, the accelerometer noise and bias and the gyro bias over Δt_k.
+// decomposition", J. Astronaut. Sci. 36(3), 1988), the start of a Gauss-Newton fit of R_NI0 and
+// the gyro and accelerometer biases (β_0k first order in them, priors σ_bg, σ_ba): a gyro bias
+// tilts the integrated terms by bg Δt, which the Doppler velocities see as g bg Δt²/2. The
+// gravity term makes the tilt observable at once; the yaw needs a horizontal velocity change
+// (acceleration, a turn). Weights w_k from the Doppler velocity covariances and the
+// accelerometer noise over Δt_k.
 // Observability test: the window is accepted when the yaw and tilt σ from that information are
 // below the configured limits and the weighted residuals pass a χ² test; otherwise status()
 // says what is missing.
@@ -79,15 +81,20 @@ class GnssInsAlignment {
     Eigen::Matrix3d Cp, Cv;      // ENU covariances
     Eigen::Matrix3d R_0k;        // IMU rotation since the window's first epoch (I_k in I_0)
     Eigen::Vector3d beta_0k;     // IMU velocity change since the first epoch, in I_0
+    Eigen::Matrix3d Jth_g;       // ∂θ_0k/∂bg (right perturbation of R_0k)
+    Eigen::Matrix3d Jb_g, Jb_a;  // ∂β_0k/∂bg, ∂β_0k/∂ba
   };
   std::optional<vio::ExternalInitialState> fit(std::span<const vio::ImuSample> imu, const Eigen::Vector3d& lever);
   void dropOldest();
+  /// Appends `e` with its IMU terms since the last epoch; false (window restarted at e) on a gap.
+  bool integrateInto(Epoch e, std::span<const vio::ImuSample> imu);
 
   GnssInsAlignmentConfig cfg_;
   vio::ImuNoise noise_;
   double gravity_;
   GnssAnchor anchor_;
   std::deque<Epoch> epochs_;
+  std::deque<Epoch> pending_;  // not yet covered by the IMU
   GnssInsStatus status_ = GnssInsStatus::kCollecting;
   double yawSigmaDeg_, tiltSigmaDeg_;
 };
