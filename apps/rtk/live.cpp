@@ -20,6 +20,7 @@
 #include "gvins/gnss/base_station.hpp"
 #include "gvins/gnss/nmea_writer.hpp"
 #include "gvins/gnss/rtk.hpp"
+#include "gvins/rtcm/stream_sink.hpp"
 #include "gvins/rtcm/stream_source.hpp"
 
 namespace gvins::rtklive {
@@ -101,6 +102,13 @@ std::optional<BaseFormat> decide(const Input& in) {
   return std::nullopt;
 }
 
+/// One output of the run: its sink and the std::ostream the writers use.
+struct Output {
+  const char* what = "";
+  std::unique_ptr<rtcm::StreamSink> sink;
+  std::unique_ptr<rtcm::SinkOstream> stream;
+};
+
 /// One live run: streams, reader threads, the solver and the outputs.
 class LiveSession {
  public:
@@ -127,35 +135,57 @@ class LiveSession {
     const bool signalled = gStop;
     gStop = true;
     for (auto& t : threads) t.join();
-    if (!writer_) writer_ = std::make_unique<PosWriter>(*posOut_, popt_);
+    if (!writer_) writer_ = std::make_unique<PosWriter>(*posOut_.stream, popt_);
     writer_->finish();
+    posOut_.stream->flush();
+    for (Output* o : {&posOut_, &nmeaOut_}) {
+      if (o->sink) o->sink->drain(5.0);
+    }
+    reportOutputEvents();
     summary(std::chrono::duration<double>(Clock::now() - wall0).count(), signalled);
     if (epochs_ == 0 && exitCode == 0) exitCode = 3;
     return exitCode;
   }
 
  private:
-  bool openFile(std::ofstream& f, const std::string& path) {
-    f.open(path, std::ios::binary);
-    if (!f) std::fprintf(stderr, "gvins-rtk: error: cannot create '%s'\n", path.c_str());
-    return static_cast<bool>(f);
+  /// Outputs, written and flushed as solutions come (no temporary file: a live run has no "end of
+  /// success"): files, standard output, or TCP server/client streams (stream_sink.hpp).
+  bool openSink(const std::string& path, const char* what, Output& o) {
+    try {
+      o.sink = rtcm::StreamSink::open(rtcm::StreamUrl::parse(path));
+    } catch (const rtcm::StreamError& e) {
+      std::fprintf(stderr, "gvins-rtk: error: %s output: %s\n", what, e.what());
+      return false;
+    }
+    o.stream = std::make_unique<rtcm::SinkOstream>(*o.sink);
+    o.what = what;
+    if (o.sink->boundPort() > 0) std::fprintf(stderr, "gvins-rtk: %s served on TCP port %d\n", what, o.sink->boundPort());
+    return true;
   }
 
-  /// Outputs, written as solutions come (no temporary file: a live run has no "end of success").
   bool openOutputs() {
-    if (opt_.out != "-") {
-      if (!openFile(posFile_, opt_.out)) return false;
-      posOut_ = &posFile_;
-    }
+    if (!openSink(opt_.out, "solutions", posOut_)) return false;
     if (!opt_.nmea.empty()) {
-      if (opt_.nmea != "-" && !openFile(nmeaFile_, opt_.nmea)) return false;
-      nmea_ = std::make_unique<NmeaWriter>(opt_.nmea == "-" ? std::cout : nmeaFile_);
+      if (!openSink(opt_.nmea, "NMEA", nmeaOut_)) return false;
+      nmea_ = std::make_unique<NmeaWriter>(*nmeaOut_.stream);
     }
     if (!opt_.latencyLog.empty()) {
-      if (!openFile(latFile_, opt_.latencyLog)) return false;
+      latFile_.open(opt_.latencyLog, std::ios::binary);
+      if (!latFile_) {
+        std::fprintf(stderr, "gvins-rtk: error: cannot create '%s'\n", opt_.latencyLog.c_str());
+        return false;
+      }
       latFile_ << "# gpst_week,tow [s],quality,latency [ms],base age [s]\n";
     }
     return true;
+  }
+
+  /// Connection events of the outputs, as they happen.
+  void reportOutputEvents() {
+    for (Output* o : {&posOut_, &nmeaOut_}) {
+      if (!o->sink) continue;
+      for (const auto& e : o->sink->takeEvents()) std::fprintf(stderr, "gvins-rtk: %s\n", e.c_str());
+    }
   }
 
   bool openStreams() {
@@ -238,11 +268,15 @@ class LiveSession {
         std::snprintf(b, sizeof b, "%.4f %.4f %.4f", (*basePos_)[0], (*basePos_)[1], (*basePos_)[2]);
         popt_.headerFields.emplace_back("ref pos", b);
       }
-      writer_ = std::make_unique<PosWriter>(*posOut_, popt_);
+      writer_ = std::make_unique<PosWriter>(*posOut_.stream, popt_);
     }
     writer_->write(ps);
-    posOut_->flush();
-    if (nmea_) nmea_->write(ps);
+    posOut_.stream->flush();
+    if (nmea_) {
+      nmea_->write(ps);
+      nmeaOut_.stream->flush();
+    }
+    reportOutputEvents();
     {
       std::lock_guard<std::mutex> l(ggaMutex_);
       gga_ = nmeaGga(ps);
@@ -333,6 +367,13 @@ class LiveSession {
                      static_cast<long long>(in.reader->skipped()));
       }
     }
+    for (const Output* o : {&posOut_, &nmeaOut_}) {
+      if (!o->sink || (o->sink->boundPort() == 0 && o->sink->counters().clients == 0)) continue;
+      const auto& k = o->sink->counters();
+      std::fprintf(stderr, "  %-9s output       %s: %lld bytes, %lld clients, %lld dropped, %lld bytes nobody received\n", o->what,
+                   o->sink->name().c_str(), static_cast<long long>(k.bytes), static_cast<long long>(k.clients),
+                   static_cast<long long>(k.drops), static_cast<long long>(k.discarded));
+    }
     std::fprintf(stderr, "  time                   %8.1f s%s\n", wall, signalled ? " (stopped by a signal)" : "");
   }
 
@@ -341,8 +382,8 @@ class LiveSession {
   RtkSolver solver_;
   std::optional<Eigen::Vector3d> basePos_;
   PosWriterOptions popt_;
-  std::ofstream posFile_, nmeaFile_, latFile_;
-  std::ostream* posOut_ = &std::cout;
+  Output posOut_, nmeaOut_;
+  std::ofstream latFile_;
   std::unique_ptr<NmeaWriter> nmea_;
   std::unique_ptr<PosWriter> writer_;
   std::mutex ggaMutex_;

@@ -17,8 +17,8 @@ namespace gvins::rtklive {
 
 struct LiveOptions {
   std::string rover, base;      ///< stream paths
-  std::string out = "-";        ///< .pos output ('-': standard output), written as solutions come
-  std::string nmea;             ///< NMEA GGA+RMC output (empty: none; '-': standard output)
+  std::string out = "-";        ///< .pos output: a file, - (standard output), tcpsvr://:PORT or tcpcli://HOST:PORT
+  std::string nmea;             ///< NMEA GGA+RMC output, the same kinds of path (empty: none)
   std::string latencyLog;       ///< CSV of per-epoch latency and base age (empty: none)
   /// s a rover epoch may wait for the base epoch after it (as post-processing pairs them);
   /// 0: solve at once with the latest base (real-time).

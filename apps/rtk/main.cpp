@@ -91,6 +91,8 @@ const char* kUsage =
     "                        post-processing pairs them (default 0: solve at once)\n"
     "  --max-outage S        end a stream after S s without a connection (default 0: retry for ever)\n"
     "  --latency-log F.csv   per-epoch latency and base age\n"
+    "  -o OUT, --nmea OUT    in live mode also tcpsvr://[ADDR]:PORT (solutions served to every TCP\n"
+    "                        client connected) or tcpcli://HOST:PORT (sent to a TCP server)\n"
     "  -h, --help            this text\n";
 
 struct Args {

@@ -16,27 +16,19 @@
 #include <unistd.h>
 
 #include "gvins/rtcm/ntrip_client.hpp"
+#include "tcp_socket.hpp"
 
 namespace gvins::rtcm {
 
 namespace {
 
+using detail::closeFd;
+using detail::pollMs;
+using detail::waitReadable;
 using Clock = StreamSource::Clock;
 
 double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 Clock::duration duration(double s) { return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s)); }
-
-int pollMs(double s) { return s <= 0.0 ? 0 : static_cast<int>(std::min(s * 1000.0 + 1.0, 2.0e9)); }
-
-/// Waits until `fd` is readable; false on timeout.
-bool waitReadable(int fd, double timeout) {
-  pollfd p{fd, POLLIN, 0};
-  for (;;) {
-    const int rc = ::poll(&p, 1, pollMs(timeout));
-    if (rc < 0 && errno == EINTR) continue;
-    return rc > 0;
-  }
-}
 
 /// read(2)/recv(2) of what is there: > 0 bytes, 0 timeout, -1 end or error (`why` set).
 long readFd(int fd, std::vector<std::uint8_t>& out, double timeout, bool socket, std::string& why) {
@@ -55,10 +47,6 @@ long readFd(int fd, std::vector<std::uint8_t>& out, double timeout, bool socket,
   }
 }
 
-void closeFd(int& fd) {
-  if (fd >= 0) ::close(fd);
-  fd = -1;
-}
 
 class FileSource final : public StreamSource {
  public:
@@ -102,49 +90,9 @@ class TcpClientSource final : public StreamSource {
 
  protected:
   void connect(double timeout) override {
-    addrinfo hints{};
-    hints.ai_family = AF_UNSPEC;
-    hints.ai_socktype = SOCK_STREAM;
-    addrinfo* res = nullptr;
-    const int gai = ::getaddrinfo(host_.c_str(), std::to_string(port_).c_str(), &hints, &res);
-    if (gai != 0) throw StreamError("cannot resolve '" + host_ + "': " + gai_strerror(gai));
-    std::string err = "no address";
-    for (addrinfo* a = res; a && fd_ < 0; a = a->ai_next) {
-      const int fd = ::socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC | SOCK_NONBLOCK, a->ai_protocol);
-      if (fd < 0) continue;
-      int rc = ::connect(fd, a->ai_addr, a->ai_addrlen);
-      if (rc != 0 && errno == EINPROGRESS) {
-        pollfd p{fd, POLLOUT, 0};
-        rc = ::poll(&p, 1, pollMs(timeout)) > 0 ? 0 : -1;
-        int e = ETIMEDOUT;
-        if (rc == 0) {
-          socklen_t len = sizeof e;
-          ::getsockopt(fd, SOL_SOCKET, SO_ERROR, &e, &len);
-          rc = e == 0 ? 0 : -1;
-        }
-        errno = e;
-      }
-      if (rc != 0) {
-        err = std::strerror(errno);
-        ::close(fd);
-        continue;
-      }
-      // A connection to a local port nobody listens on can meet itself (TCP simultaneous open
-      // when the kernel picks the destination port as the source port): refuse it.
-      sockaddr_storage self{}, peer{};
-      socklen_t ls = sizeof self, lp = sizeof peer;
-      if (::getsockname(fd, reinterpret_cast<sockaddr*>(&self), &ls) == 0 && ::getpeername(fd, reinterpret_cast<sockaddr*>(&peer), &lp) == 0 &&
-          ls == lp && std::memcmp(&self, &peer, ls) == 0) {
-        err = "connected to itself (nothing listens there)";
-        ::close(fd);
-        continue;
-      }
-      const int one = 1;
-      ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
-      fd_ = fd;
-    }
-    ::freeaddrinfo(res);
-    if (fd_ < 0) throw StreamError("cannot connect to " + host_ + ":" + std::to_string(port_) + ": " + err);
+    std::string err;
+    fd_ = detail::connectTcp(host_, port_, timeout, err);
+    if (fd_ < 0) throw StreamError(err);
   }
   long readSome(std::vector<std::uint8_t>& out, double timeout) override {
     const long n = readFd(fd_, out, timeout, true, why_);
@@ -163,33 +111,10 @@ class TcpClientSource final : public StreamSource {
 class TcpServerSource final : public StreamSource {
  public:
   TcpServerSource(const StreamUrl& u, StreamOptions o) : StreamSource(u.display(), std::move(o), true) {
-    addrinfo hints{};
-    hints.ai_family = AF_UNSPEC;
-    hints.ai_socktype = SOCK_STREAM;
-    hints.ai_flags = AI_PASSIVE;
-    addrinfo* res = nullptr;
-    const int gai = ::getaddrinfo(u.host.empty() ? nullptr : u.host.c_str(), std::to_string(u.port).c_str(), &hints, &res);
-    if (gai != 0) throw StreamError("stream '" + name() + "': cannot resolve '" + u.host + "': " + gai_strerror(gai));
-    std::string err = "no address";
-    for (addrinfo* a = res; a && listen_ < 0; a = a->ai_next) {
-      const int fd = ::socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC, a->ai_protocol);
-      if (fd < 0) continue;
-      const int one = 1;
-      ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
-      if (::bind(fd, a->ai_addr, a->ai_addrlen) != 0 || ::listen(fd, 1) != 0) {
-        err = std::strerror(errno);
-        ::close(fd);
-        continue;
-      }
-      listen_ = fd;
-    }
-    ::freeaddrinfo(res);
-    if (listen_ < 0) throw StreamError("stream '" + name() + "': cannot listen: " + err);
-    sockaddr_storage ss{};
-    socklen_t len = sizeof ss;
-    ::getsockname(listen_, reinterpret_cast<sockaddr*>(&ss), &len);
-    port_ = ntohs(ss.ss_family == AF_INET6 ? reinterpret_cast<sockaddr_in6*>(&ss)->sin6_port
-                                           : reinterpret_cast<sockaddr_in*>(&ss)->sin_port);
+    std::string err;
+    listen_ = detail::listenTcp(u.host, u.port, 1, err);
+    if (listen_ < 0) throw StreamError("stream '" + name() + "': " + err);
+    port_ = detail::boundPort(listen_);
   }
   ~TcpServerSource() override {
     closeFd(fd_);

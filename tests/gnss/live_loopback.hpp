@@ -15,6 +15,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "gvins/rtcm/decoder.hpp"
@@ -78,6 +79,40 @@ inline int freePort() {
   ::close(fd);
   return ntohs(a.sin_port);
 }
+
+/// Everything a TCP client of 127.0.0.1:`port` receives until the server closes (in a thread).
+class TcpCollector {
+ public:
+  explicit TcpCollector(int port) {
+    fd_ = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    a.sin_port = htons(static_cast<std::uint16_t>(port));
+    connected_ = ::connect(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+    if (connected_) {
+      thread_ = std::thread([this] {
+        char buf[4096];
+        for (ssize_t n; (n = ::recv(fd_, buf, sizeof buf, 0)) > 0;) text_.append(buf, static_cast<std::size_t>(n));
+      });
+    }
+  }
+  ~TcpCollector() { finish(); }
+  bool connected() const { return connected_; }
+  /// Waits for the server to close the connection; the bytes received.
+  const std::string& finish() {
+    if (thread_.joinable()) thread_.join();
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = -1;
+    return text_;
+  }
+
+ private:
+  int fd_ = -1;
+  bool connected_ = false;
+  std::thread thread_;
+  std::string text_;
+};
 
 /// A child process with its standard input from a pipe (`writer`) and its standard error (and,
 /// unless `stdoutFile`, output) to `errFile`.

@@ -4,7 +4,8 @@
 // into the str2str processes at twenty times the recording's rate. There is no published base for
 // this log, so the base is the rover's own data (zero baseline). Half-way the rover server is
 // killed and restarted: gvins-rtk must reconnect, report the gap and still give, epoch by epoch,
-// exactly the rows of post-processing the same files.
+// exactly the rows of post-processing the same files. Its NMEA goes to a TCP client through the
+// live tool's TCP server output.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -90,8 +91,15 @@ TEST(RtkLive, Str2StrLoopbackEqualsPostProcessingAndSurvivesADrop) {
   std::this_thread::sleep_for(500ms);
   Child rtk({kRtk, "--base-llh", kBaseLlh, "--rover-stream", "tcpcli://127.0.0.1:" + std::to_string(roverPort), "--base-stream",
              "ntrip://u:p@127.0.0.1:" + std::to_string(casterPort) + "/WALK", "--base-wait", "3", "--max-outage", "2", "-o", live,
-             "--nmea", nmea},
+             "--nmea", "tcpsvr://127.0.0.1:0"},
             err, false);
+  // NMEA served on a TCP port (0: any free one, printed): a client connected before the first row
+  // must receive every sentence.
+  ASSERT_TRUE(waitFor(err, "NMEA served on TCP port ", 1, 10s)) << readText(err);
+  const std::string started = readText(err);
+  const int nmeaPort = std::stoi(started.substr(started.find("NMEA served on TCP port ") + 24));
+  TcpCollector nmeaClient(nmeaPort);
+  ASSERT_TRUE(nmeaClient.connected());
   ASSERT_TRUE(waitFor(err, ": connected", 2, 10s)) << readText(err);
   std::this_thread::sleep_for(300ms);  // str2str notices its clients
 
@@ -136,8 +144,12 @@ TEST(RtkLive, Str2StrLoopbackEqualsPostProcessingAndSurvivesADrop) {
   EXPECT_NE(log.find("reconnected"), std::string::npos);
   EXPECT_NE(log.find("data again"), std::string::npos);
   EXPECT_NE(log.find("2 connections"), std::string::npos) << log;
-  // NMEA: a GGA and an RMC per row.
+  // NMEA over TCP: a GGA and an RMC per row, all received by the client connected at the start.
+  {
+    std::ofstream(nmea, std::ios::binary) << nmeaClient.finish();
+  }
   EXPECT_EQ(rows(nmea).size(), 2 * a.size());
+  EXPECT_NE(log.find("NMEA      output       tcpsvr://127.0.0.1:0"), std::string::npos) << log;
   for (const auto& f : {base, post, live, nmea, err, e0, e1, e2, e3}) std::filesystem::remove(f);
 }
 
