@@ -131,47 +131,46 @@ bool GnssInsAlignment::integrateInto(Epoch e, std::span<const vio::ImuSample> im
 
 namespace {
 
-/// The pairs of the fit: b_k (N) = R_NI0 (β_0k + Jg_k bg + Ja_k ba), weight w_k.
+/// One epoch of the fit: u_k = v_N(t_k) − g_N Δt_k (N) = v_N(t_0) + R_NI0 (β_0k + Jg_k bg + Ja_k ba),
+/// weight w_k (independent per epoch; the first epoch's velocity is an unknown like the others).
 struct Pair {
-  Eigen::Vector3d b, beta;
+  Eigen::Vector3d u, beta;
   Eigen::Matrix3d Jg, Ja;
   double w = 0.0;
 };
 
-/// Gauss-Newton on [δθ (world), bg, ba] from R (Wahba) and zero biases, with the bias priors;
-/// returns the 9×9 covariance (data information halved for the shared first velocity) and the
-/// weighted residual sum.
-Eigen::Matrix<double, 9, 9> refine(const std::vector<Pair>& pairs, double sbg, double sba, Eigen::Matrix3d& R,
-                                   Eigen::Vector3d& bg, Eigen::Vector3d& ba, double& chi2) {
-  using M9 = Eigen::Matrix<double, 9, 9>;
-  using V9 = Eigen::Matrix<double, 9, 1>;
-  M9 H;
-  for (int it = 0; it < 5; ++it) {
-    M9 Hd = M9::Zero();
-    V9 g = V9::Zero();
+/// Gauss-Newton on [δθ (world), bg, ba, v_0] from R (Wahba), zero biases and v0, with the bias
+/// priors; returns the 12×12 covariance and the weighted residual sum.
+Eigen::Matrix<double, 12, 12> refine(const std::vector<Pair>& pairs, double sbg, double sba, Eigen::Matrix3d& R,
+                                     Eigen::Vector3d& bg, Eigen::Vector3d& ba, Eigen::Vector3d& v0, double& chi2) {
+  using M = Eigen::Matrix<double, 12, 12>;
+  using V = Eigen::Matrix<double, 12, 1>;
+  M H;
+  for (int it = 0; it < 6; ++it) {
+    H.setZero();
+    V g = V::Zero();
     chi2 = 0.0;
     for (const Pair& p : pairs) {
       const Eigen::Vector3d bt = p.beta + p.Jg * bg + p.Ja * ba;
-      const Eigen::Vector3d r = p.b - R * bt;
-      Eigen::Matrix<double, 3, 9> A;
-      A << vio::so3::skew(R * bt), -R * p.Jg, -R * p.Ja;
-      Hd += p.w * A.transpose() * A;
+      const Eigen::Vector3d r = p.u - v0 - R * bt;
+      Eigen::Matrix<double, 3, 12> A;  // r(x ⊞ d) ≈ r + A d
+      A << vio::so3::skew(R * bt), -R * p.Jg, -R * p.Ja, -Eigen::Matrix3d::Identity();
+      H += p.w * A.transpose() * A;
       g -= p.w * A.transpose() * r;
       chi2 += p.w * r.squaredNorm();
     }
-    M9 prior = M9::Zero();
-    prior.block<3, 3>(3, 3).diagonal().setConstant(1.0 / (sbg * sbg));
-    prior.block<3, 3>(6, 6).diagonal().setConstant(1.0 / (sba * sba));
+    H.block<3, 3>(3, 3).diagonal().array() += 1.0 / (sbg * sbg);
+    H.block<3, 3>(6, 6).diagonal().array() += 1.0 / (sba * sba);
     g.segment<3>(3) -= bg / (sbg * sbg);
     g.segment<3>(6) -= ba / (sba * sba);
-    H = 0.5 * Hd + prior;
-    const V9 d = (Hd + prior).ldlt().solve(g);
+    const V d = H.ldlt().solve(g);
     R = vio::so3::exp(d.head<3>()) * R;
     bg += d.segment<3>(3);
     ba += d.segment<3>(6);
-    if (d.norm() < 1e-9) break;
+    v0 += d.segment<3>(9);
+    if (d.norm() < 1e-10) break;
   }
-  return H.ldlt().solve(M9::Identity());
+  return H.ldlt().solve(M::Identity());
 }
 
 }  // namespace
@@ -188,25 +187,25 @@ std::optional<vio::ExternalInitialState> GnssInsAlignment::fit(std::span<const v
   };
   const double var0 = velVar(e0);
   std::vector<Pair> pairs;
-  Eigen::Matrix3d B = Eigen::Matrix3d::Zero();
-  for (std::size_t k = 1; k < epochs_.size(); ++k) {
-    const Epoch& e = epochs_[k];
+  Eigen::Matrix3d B = Eigen::Matrix3d::Zero();  // Wahba's start: velocity changes since epoch 0
+  for (const Epoch& e : epochs_) {
     const double dt = static_cast<double>(e.t_ns - e0.t_ns) * 1e-9;
     const double na = noise_.accelerometer_noise_density;
-    // Velocity noise of both epochs and the accelerometer white noise over dt.
-    pairs.push_back({R_NE * e.v_N - v0 - g_N * dt, e.beta_0k, e.Jb_g, e.Jb_a, 1.0 / (var0 + velVar(e) + na * na * dt)});
-    B += pairs.back().w * pairs.back().b * e.beta_0k.transpose();
+    // The velocity noise and the accelerometer white noise over dt.
+    pairs.push_back({R_NE * e.v_N - g_N * dt, e.beta_0k, e.Jb_g, e.Jb_a, 1.0 / (velVar(e) + na * na * dt)});
+    B += (pairs.back().u - v0) * e.beta_0k.transpose() / (var0 + velVar(e));
   }
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(B, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
   D(2, 2) = (svd.matrixU() * svd.matrixV().transpose()).determinant() < 0.0 ? -1.0 : 1.0;
   Eigen::Matrix3d R_NI0 = svd.matrixU() * D * svd.matrixV().transpose();
-  Eigen::Vector3d bg = Eigen::Vector3d::Zero(), ba = Eigen::Vector3d::Zero();
+  Eigen::Vector3d bg = Eigen::Vector3d::Zero(), ba = Eigen::Vector3d::Zero(), v0fit = v0;
   double chi2 = 0.0;
-  const Eigen::Matrix<double, 9, 9> P = refine(pairs, cfg_.gyroBiasSigma, cfg_.accelBiasSigma, R_NI0, bg, ba, chi2);
+  const Eigen::Matrix<double, 12, 12> P =
+      refine(pairs, cfg_.gyroBiasSigma, cfg_.accelBiasSigma, R_NI0, bg, ba, v0fit, chi2);
   yawSigmaDeg_ = std::sqrt(P(2, 2)) * kRadToDeg;
   tiltSigmaDeg_ = std::sqrt(std::max(P(0, 0), P(1, 1))) * kRadToDeg;
-  const int dof = static_cast<int>(3 * pairs.size()) - 3;
+  const int dof = static_cast<int>(3 * pairs.size()) - 6;  // attitude and v_0 free; biases have priors
   if (dof > 0 && chi2 > sri::chiSquareQuantile(cfg_.gate, dof)) {
     status_ = GnssInsStatus::kInconsistent;
     return std::nullopt;
@@ -231,14 +230,14 @@ std::optional<vio::ExternalInitialState> GnssInsAlignment::fit(std::span<const v
   // Attitude at K: the fit's at t_0 carried by R_0K (world frame; its bias part is in P's bg).
   const Eigen::Matrix3d Jk = R_NI0 * eK.R_0k * eK.Jth_g;  // world-frame rotation per bg
   Eigen::Matrix<double, 3, 9> T;
-  T << Eigen::Matrix3d::Identity(), Jk, Eigen::Matrix3d::Zero();
-  const Eigen::Matrix3d Pw = T * P * T.transpose();
+  T << Eigen::Matrix3d::Identity(), Jk, Eigen::Matrix3d::Zero();  // [δθ bg ba] of P
+  const Eigen::Matrix3d Pw = T * P.topLeftCorner<9, 9>() * T.transpose();
   C.block<3, 3>(vio::ImuErr::kTheta, vio::ImuErr::kTheta) = s.R_WI.transpose() * Pw * s.R_WI;  // body frame
   C.block<3, 3>(vio::ImuErr::kPos, vio::ImuErr::kPos) =
       R_NE * eK.Cp * R_NE.transpose() + Eigen::Matrix3d::Identity() * cfg_.positionFloor * cfg_.positionFloor;
   C.block<3, 3>(vio::ImuErr::kVel, vio::ImuErr::kVel) =
       R_NE * eK.Cv * R_NE.transpose() + Eigen::Matrix3d::Identity() * cfg_.velocityFloor * cfg_.velocityFloor;
-  C.block<6, 6>(vio::ImuErr::kBg, vio::ImuErr::kBg) = P.bottomRightCorner<6, 6>();
+  C.block<6, 6>(vio::ImuErr::kBg, vio::ImuErr::kBg) = P.block<6, 6>(3, 3);
   C = 0.5 * (C + C.transpose()).eval();
   status_ = GnssInsStatus::kAligned;
   epochs_.clear();

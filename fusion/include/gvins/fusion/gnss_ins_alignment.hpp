@@ -9,7 +9,7 @@
 //   v_N(t_k) − v_N(t_0) − g_N (t_k − t_0) = R_NI0 β_0k.
 // Every epoch pairs a known vector in N with one in I0: R_NI0 solves Wahba's problem (weighted
 // SVD; Markley, "Attitude determination using vector observations and the singular value
-// decomposition", J. Astronaut. Sci. 36(3), 1988), the start of a Gauss-Newton fit of R_NI0 and
+// decomposition", J. Astronaut. Sci. 36(3), 1988), the start of a Gauss-Newton fit of R_NI0, v_N(t_0) and
 // the gyro and accelerometer biases (β_0k first order in them, priors σ_bg, σ_ba): a gyro bias
 // tilts the integrated terms by bg Δt, which the Doppler velocities see as g bg Δt²/2. The
 // gravity term makes the tilt observable at once; the yaw needs a horizontal velocity change
@@ -49,7 +49,7 @@ std::string_view gnssInsStatusText(GnssInsStatus s);
 
 struct GnssInsAlignmentConfig {
   double window = 5.0;           ///< s of epochs used at most
-  double maxYawSigmaDeg = 2.0;   ///< accepted when the yaw σ is below this ...
+  double maxYawSigmaDeg = 5.0;   ///< accepted when the yaw σ is below this ...
   double maxTiltSigmaDeg = 1.0;  ///< ... and the roll/pitch σ below this
   double velocityFloor = 0.05;   ///< m/s added (in quadrature) to the Doppler velocity σ per axis
   double positionFloor = 1.0;    ///< m added to the SPP position σ per axis
