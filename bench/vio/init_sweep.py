@@ -72,7 +72,9 @@ def run(args, rig, start, height, seed, mode):
     waiting = ""
     for line in p.stdout.splitlines():
         if line.startswith("initialisation"):
-            waiting = line.split("waiting:", 1)[-1].strip()
+            waiting = line.split("waiting:", 1)[-1].strip() + waiting
+        if line.startswith("GNSS/INS start waiting"):
+            waiting += "; GNSS/INS: " + line.split("waiting", 1)[-1].strip()
     m = metrics(os.path.join(out, "metrics.csv")) if os.path.exists(os.path.join(out, "metrics.csv")) else {}
     sys.stderr.write("  %-7s %-8s %4g m seed %d %s: %s\n" % (rig, start, height, seed, mode, "ok" if m else "FAILED"))
     return (mode, rig, start, height, seed, m, waiting)

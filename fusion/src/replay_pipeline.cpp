@@ -313,6 +313,11 @@ void ReplaySummary::print(std::ostream& os) const {
     std::snprintf(k, sizeof k, "%-30s ", "initialisation");
     os << k << w.substr(0, w.size() - 2) << '\n';
   }
+  if (!gnssEpochsWaitingBy.empty()) {
+    std::string w;
+    for (const auto& [why, count] : gnssEpochsWaitingBy) w += why + " " + std::to_string(count) + ", ";
+    row("GNSS/INS start waiting", w.substr(0, w.size() - 2) + " (epochs)");
+  }
   if (gnssEpochs + gnssEpochsSkipped > 0) {
     row("GNSS epochs", std::to_string(gnssEpochs) + " processed (" + std::to_string(gnssEpochsUpdated) + " updated, " +
                            std::to_string(gnssEpochsFixed) + " RTK fixed), " + std::to_string(gnssEpochsSkipped) +
@@ -735,8 +740,12 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
           for (const std::string& w : o.warnings) std::fprintf(stderr, "\n[gvins-replay] warning: %s\n", w.c_str());
           gnssMs += ms;
           ++gnssCount;
-          ++sum.gnssEpochs;
-          if (!init && o.stage != "tight") ++sum.gnssEpochsSkipped;  // the GNSS/INS start has not started it yet
+          if (!init && o.stage != "tight") {  // the GNSS/INS start has not started it yet
+            ++sum.gnssEpochsSkipped;
+            if (!o.insStart.empty()) ++sum.gnssEpochsWaitingBy[o.insStart];
+          } else {
+            ++sum.gnssEpochs;
+          }
           if (o.updated) ++sum.gnssEpochsUpdated;
           sum.phaseRowsUsed += static_cast<std::size_t>(o.phaseUsed);
           sum.phaseRowsRejected += static_cast<std::size_t>(o.phaseRejected);

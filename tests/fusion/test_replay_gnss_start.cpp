@@ -82,8 +82,8 @@ ReplaySummary replay(const std::string& name, double start_s, bool insStart) {
 constexpr double kCruiseStart = 11.7;
 
 // Measured (7 Dec 2026, vio+dopp+psr, seed 3): ground start 1.00 s, global RMSE 0.772 m, local
-// 0.328 m; cruise start 4.20 s after the first frame, 1015 of 1099 frames, global 0.840 m, local
-// 0.341 m; without the GNSS/INS start 52.8 s (the landing hover). 15 s in Release.
+// 0.328 m; cruise start 2.20 s after the first frame, 1055 of 1099 frames, global 0.779 m, local
+// 0.363 m; without the GNSS/INS start 52.8 s (the landing hover). 15 s in Release.
 TEST(GnssStart, CruiseStartInitialisesFromGnssIns) {
   const ReplaySummary ground = replay("ground", 0.0, true);
   const ReplaySummary cruise = replay("cruise", kCruiseStart, true);

@@ -70,6 +70,7 @@ class GnssFusionReplayClient final : public ReplayGnss {
       if (const auto c = fusion_.antennaCovariance(est_, r.t_ns)) o.antennaCovarianceEcef = *c;
     }
     o.warnings = r.warnings;
+    if (r.insStart) o.insStart = std::string(gnssInsStatusText(*r.insStart));
     return o;
   }
   std::optional<Eigen::Vector3d> leverArm() const override { return fusion_.leverArm(est_); }
