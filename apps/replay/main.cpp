@@ -92,6 +92,9 @@ const char* kUsage =
     "  --truth-quality Q      1 (fixed only, default), 2 (and float), 5 (and single)\n"
     "  --camera-less-rate HZ  a dataset without cam0 runs camera-less (IMU and GNSS): frames without\n"
     "                         features at this rate (default 10 Hz)\n"
+    "  --gnss-outage S,LEN    simulated GNSS outage from S s after the first frame for LEN s (repeatable):\n"
+    "                         those rover epochs reach the fusion without satellites, the track goes on\n"
+    "                         from the IMU alone\n"
     "  -q, --quiet            no progress line\n"
     "  -h, --help             this text\n"
     "\n"
@@ -152,6 +155,7 @@ int main(int argc, char** argv) {
   std::string truthPos;
   int truthQuality = 1;
   std::optional<double> cameraLessRate;
+  std::vector<std::pair<double, double>> outages;  // --gnss-outage, s after the first frame
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&]() -> std::string {
@@ -216,7 +220,14 @@ int main(int argc, char** argv) {
     else if (a == "--truth-pos") truthPos = value();
     else if (a == "--truth-quality") truthQuality = static_cast<int>(optionValue([&] { return optionNumber(a, value(), 1, 6); }));
     else if (a == "--camera-less-rate") cameraLessRate = optionValue([&] { return optionNumber(a, value(), 0.5, 100.0, "Hz"); });
-    else if (a == "-q" || a == "--quiet") quiet = true;
+    else if (a == "--gnss-outage") {
+      const std::string v = value();
+      const auto comma = v.find(',');
+      if (comma == std::string::npos) usageError("--gnss-outage takes START,LENGTH (s), not '" + v + "'");
+      const double s0 = optionValue([&] { return optionNumber(a, v.substr(0, comma), 0.0, 1e7, "s"); });
+      const double len = optionValue([&] { return optionNumber(a, v.substr(comma + 1), 0.0, 1e7, "s"); });
+      outages.emplace_back(s0, s0 + len);
+    } else if (a == "-q" || a == "--quiet") quiet = true;
     else if (!a.empty() && a[0] == '-') usageError("unknown option " + a);
     else if (dataset.empty()) dataset = a;
     else usageError("more than one dataset given");
@@ -254,6 +265,7 @@ int main(int argc, char** argv) {
     opt.truthPos = truthPos;
     opt.truthPosMaxQuality = truthQuality;
     if (cameraLessRate) opt.cameraLessRate_hz = *cameraLessRate;
+    opt.gnssOutages = outages;
     if (rover) opt.roverObs = *rover;
     if (base) opt.baseObs = *base;
     if (nav) opt.navFile = *nav;

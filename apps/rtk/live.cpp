@@ -273,13 +273,13 @@ class LiveSession {
     writer_->write(ps);
     posOut_.stream->flush();
     if (nmea_) {
-      nmea_->write(ps);
+      nmea_->write(ps, NmeaExtras{sol.hdop, std::nullopt});
       nmeaOut_.stream->flush();
     }
     reportOutputEvents();
     {
       std::lock_guard<std::mutex> l(ggaMutex_);
-      gga_ = nmeaGga(ps);
+      gga_ = nmeaGga(ps, NmeaExtras{sol.hdop, std::nullopt});
     }
     const double lat = ms(Clock::now() - roverArrival_);
     latency_.add(lat);

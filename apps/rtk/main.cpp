@@ -486,7 +486,7 @@ int main(int argc, char** argv) {
         writer = std::make_unique<PosWriter>(*out, popt);
       }
       writer->write(sol.toPositionSolution());
-      if (side) side->add(sol.toPositionSolution());
+      if (side) side->add(sol.toPositionSolution(), NmeaExtras{sol.hdop, std::nullopt});
       satSum += sol.numSatellites;
       if (sol.quality != SolutionQuality::Single) ageMax = std::max(ageMax, sol.age);
       if (fixStats && sol.quality == SolutionQuality::Fix) {

@@ -25,6 +25,7 @@
 #include "gvins/gnss/accuracy_statistics.hpp"
 #include "gvins/gnss/base_reader.hpp"
 #include "gvins/gnss/carrier_smoothing.hpp"
+#include "gvins/gnss/clock_jump_repair.hpp"
 #include "gvins/gnss/doppler_consistency.hpp"
 #include "gvins/gnss/pos_reader.hpp"
 #include "gvins/gnss/pos_writer.hpp"
@@ -424,6 +425,9 @@ int main(int argc, char** argv) {
   // Doppler that disagrees with the phase/code rate is dropped, each with one warning.
   DopplerConsistency doppler("rover");
   std::size_t dopplerWarned = 0;
+  std::size_t signalWarned = 0;
+  ClockJumpRepair clockJumps("rover");
+  std::size_t jumpWarned = 0;  // primary signals from a fallback band (signal_choice.hpp)
   ObsEpoch epoch;
   for (;;) {
     try {
@@ -439,12 +443,19 @@ int main(int argc, char** argv) {
       channels.mergeMissing(nav.glonassChannels());
       solver.setGlonassChannels(obs->glonassChannels());
     }
+    clockJumps.apply(epoch, channels);  // whole-ms receiver clock jumps, before smoothing
+    for (; jumpWarned < clockJumps.warnings().size(); ++jumpWarned) {
+      std::fprintf(stderr, "%sgvins-spp: warning: %s\n", tty ? "\r" : "", clockJumps.warnings()[jumpWarned].c_str());
+    }
     doppler.apply(epoch, channels);
     for (; dopplerWarned < doppler.warnings().size(); ++dopplerWarned) {
       std::fprintf(stderr, "%sgvins-spp: warning: %s\n", tty ? "\r" : "", doppler.warnings()[dopplerWarned].c_str());
     }
     if (smoother) smoother->apply(epoch, channels);
     const SppSolution sol = solver.solve(epoch);
+    for (; signalWarned < solver.signalNotices().size(); ++signalWarned) {
+      std::fprintf(stderr, "%sgvins-spp: warning: %s\n", tty ? "\r" : "", solver.signalNotices()[signalWarned].c_str());
+    }
     ++statusCount[sol.status];
     for (const auto& s : sol.satellites) ++useCount[static_cast<int>(s.use)];
     for (const auto& s : sol.excluded) ++excludedCount[s];

@@ -152,6 +152,7 @@ void GnssFusion<Scalar>::forgetState() {
   zwdBlock_ = {};
   clockSystems_.clear();
   lastUpdate_.reset();
+  gateRecovery_.reset();
   ambiguities_.clear();
   ambiguityTime_.reset();
   stage_ = GnssFusionStage::kWaitingVio;
@@ -517,6 +518,11 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
   auto finish = [&]() {
     if (leverBlock_.valid() && current(est)) leverLast_ = est.estimate(leverBlock_).vector.template cast<double>();
     rep.stage = stage_;
+    for (; signalWarned_ < signalNotices_.messages().size(); ++signalWarned_)
+      rep.warnings.push_back(signalNotices_.messages()[signalWarned_]);
+    for (; jumpWarned_ < clockJumps_.warnings().size(); ++jumpWarned_) rep.warnings.push_back(clockJumps_.warnings()[jumpWarned_]);
+    for (; clockWarned_ < clockNotices_.size(); ++clockWarned_) rep.warnings.push_back(clockNotices_[clockWarned_]);
+    for (; gateWarned_ < gateRecovery_.warnings().size(); ++gateWarned_) rep.warnings.push_back(gateRecovery_.warnings()[gateWarned_]);
     rep.elapsedMicroseconds =
         std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - wall0).count();
     return rep;
@@ -525,6 +531,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
   // Doppler sanity of the rover stream before any user (doppler_consistency.hpp): flipped signs
   // corrected, bad Dopplers dropped; the base's is checked inside the RTK module.
   checkedRover_ = roverInput;
+  clockJumps_.apply(checkedRover_, nav.glonassChannels());  // whole-ms receiver clock jumps (clock_jump_repair.hpp)
   const std::size_t warned = roverDoppler_.warnings().size();
   roverDoppler_.apply(checkedRover_, nav.glonassChannels());
   rep.warnings.assign(roverDoppler_.warnings().begin() + static_cast<std::ptrdiff_t>(warned), roverDoppler_.warnings().end());
@@ -737,6 +744,10 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
       for (SatelliteModel& m : models) m.clock = clockIndex(m.sat);
     }
     if (clockBlock_.valid()) propagateClocks(est, tMeas);
+    if (clockBlock_.valid() && !rep.clocksInitialized) {  // systems whose ephemerides came later
+      addLateClockSystems(est, models, k, tMeas);
+      for (SatelliteModel& m : models) m.clock = clockIndex(m.sat);
+    }
     if (clockBlock_.valid() && config_.zwdState()) {
       if (!zwdBlock_.valid()) {
         Eigen::Matrix<Scalar, Eigen::Dynamic, 1> z = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>::Zero(1);
@@ -914,7 +925,8 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
     }
     if (!rows.empty()) {
       std::vector<bool> acc;
-      const auto u = apply(est, rows, noise, k.integrationCovariance, acc, true, ambBlocks);
+      const auto u = apply(est, rows, noise, k.integrationCovariance, acc, gateRecovery_.gated(rover.time), ambBlocks);
+      gateRecovery_.outcome(rover.time, u.applied, rows.size());  // re-acquisition (gnss_gate_recovery.hpp)
       rep.chi2 = static_cast<double>(u.chi2);
       rep.dof = u.dof;
       rep.updated = u.applied;

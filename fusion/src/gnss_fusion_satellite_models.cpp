@@ -2,12 +2,15 @@
 // the fusion's weights and band choice) and the receiver clocks started from their residuals.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 #include "gvins/base/constants.hpp"
 #include "gvins/fusion/gnss_clock_init.hpp"
 #include "gvins/fusion/gnss_fusion.hpp"
 #include "gvins/gnss/ionosphere_free.hpp"
 #include "gvins/gnss/satellite_observation_model.hpp"
+#include "gvins/gnss/signal_choice.hpp"
 #include "gvins/gnss/zero_difference.hpp"
 
 namespace gvins::fusion {
@@ -41,13 +44,18 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
   const SatelliteObservationModel model(x, rover.time, options, &nav.ionosphere());
   for (const SatObs& so : rover.sats) {
     if (!so.sat.valid() || !config_.useSystem(so.sat.system)) continue;
-    const char band = primaryBand(so.sat.system);
-    const SignalObs* s = so.bestOnBand(band, SignalObs::kCode);
-    if (!s) continue;
     std::optional<int> channel;
     if (so.sat.system == System::Glonass) channel = nav.glonassChannels().get(so.sat.prn);
-    const auto f = carrierFrequency(so.sat.system, band, channel);
-    if (!f) continue;
+    // The system's primary band, else the next tracked one (signal_choice.hpp: the band order of
+    // `bands` after the primary band, then the system's fallback order), noticed once.
+    const std::string& order = config_.bands[static_cast<std::size_t>(systemIndex(so.sat.system))];
+    const char preferred = primaryBand(so.sat.system);
+    const auto primary = primaryCode(so, std::string(1, preferred) + order, 1, channel);
+    if (!primary) continue;
+    const SignalObs* s = primary->signal;
+    const char band = s->code.band;
+    signalNotices_.record(so.sat.system, preferred, s->code);
+    const std::optional<double> f = primary->frequency;
     const auto tx = transmitState(states, nav, so.sat, rover.time, s->pseudorange);
     if (!tx) continue;
     SatelliteModel m;
@@ -94,7 +102,6 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     // single-band noise times sqrt(a1² + a2²) (2.98 for L1/L2, 2.59 for L1/L5) and it carries no
     // ionospheric model error.
     if (config_.ionosphere == GnssIonosphere::kDualFrequency) {
-      const std::string& order = config_.bands[static_cast<std::size_t>(systemIndex(so.sat.system))];
       if (const auto second = secondCode(so, order, order.size(), band, channel)) {
         const SignalObs* s2 = second->signal;
         const double* f2 = &second->frequency;
@@ -198,13 +205,78 @@ bool GnssFusion<Scalar>::initClocks(vio::EstimatorBackend<Scalar>& est, const st
   return true;
 }
 
+template <typename Scalar>
+void GnssFusion<Scalar>::addLateClockSystems(vio::EstimatorBackend<Scalar>& est, const std::vector<SatelliteModel>& models,
+                                             const AntennaKinematics& k, const GpsTime& t) {
+  // A system whose satellites had no ephemeris yet when the clocks started (a cold start
+  // decoding its own navigation messages: BeiDou and Galileo records take 30 s or more) joins
+  // with its inter-system bias from its code residuals at the current state, instead of never
+  // contributing a pseudorange.
+  std::vector<System> late;
+  for (const SatelliteModel& m : models) {
+    const System s = clockSystemOf(m.sat.system);
+    if (clockIndex(m.sat) < 0 && std::find(late.begin(), late.end(), s) == late.end()) late.push_back(s);
+  }
+  for (const System s : late) {
+    std::vector<double> b;  // c·dt_s implied by each satellite of s (residual at zero clock)
+    for (const SatelliteModel& m : models)
+      if (clockSystemOf(m.sat.system) == s) b.push_back(pseudorangeRow(m, k, 0.0).residual);
+    if (static_cast<int>(b.size()) < config_.lateSystemMinSatellites) continue;
+    std::sort(b.begin(), b.end());
+    const double median = b[b.size() / 2];
+    std::vector<double> dev;
+    for (double x : b) dev.push_back(std::abs(x - median));
+    std::sort(dev.begin(), dev.end());
+    const double sigma = std::max(5.0, 1.4826 * dev[dev.size() / 2]);  // as initClocks: SPP-level position error
+    const Eigen::VectorXd clocks = systemClocks(est);
+    const double isb = median - clocks[0];
+    const int n = static_cast<int>(clockSystems_.size());  // systems so far; the new one is index n
+    using Mat = typename sri::Propagation<Scalar>::Matrix;
+    using Vec = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
+    if (!isbBlock_.valid()) {
+      Vec x(1);
+      x << static_cast<Scalar>(isb);
+      isbBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_isb", 1), sri::BlockEstimate<Scalar>::fromVector(x),
+                               sri::Prior<Scalar>::stdDev(1, static_cast<Scalar>(sigma)));
+    } else {
+      // The ISB block grows by one: x_new = [I; 0] x_old + [0; isb] + w, w ~ N(0, diag(q, σ²)),
+      // q the random walk since the last step (floored at 1 mm²: the step needs a regular Q).
+      const Vec old = est.estimate(isbBlock_).vector;
+      Vec x(n);
+      x.head(n - 1) = old;
+      x[n - 1] = static_cast<Scalar>(isb);
+      Mat phi = Mat::Zero(n, n - 1);
+      phi.topRows(n - 1).setIdentity();
+      const double q = std::max(config_.isbRandomWalk * config_.isbRandomWalk * std::max(t - isbTime_, 0.0), 1e-6);
+      Mat Q = Mat::Identity(n, n) * static_cast<Scalar>(q);
+      Q(n - 1, n - 1) = static_cast<Scalar>(sigma * sigma);
+      sri::Propagation<Scalar> step;
+      step.addNewBlock(sri::BlockSpec::vector("gnss_isb", n), sri::BlockEstimate<Scalar>::fromVector(x));
+      step.setTransition(isbBlock_, phi);
+      step.setNoiseCovariance(Q);
+      step.marginalizeAfter(isbBlock_);
+      isbBlock_ = est.propagate(step, vio::ClientBlockRegion::kParameters).at(0);
+    }
+    isbTime_ = t;
+    clockSystems_.push_back(s);
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "GNSS clocks: %s joins late (%zu satellites; its ephemerides arrived after the clocks started), "
+                  "inter-system bias %.1f m",
+                  std::string(systemName(s)).c_str(), b.size(), isb);
+    clockNotices_.emplace_back(buf);
+  }
+}
+
 #define GVINS_INSTANTIATE(S)                                                                                  \
   template int GnssFusion<S>::clockIndex(SatId) const;                                                        \
   template std::vector<SatelliteModel> GnssFusion<S>::satelliteModels(const ObsEpoch&, const EphemerisStore&,  \
                                                                       const Eigen::Vector3d&, TransmitStates*) \
       const;                                                                                                   \
   template bool GnssFusion<S>::initClocks(vio::EstimatorBackend<S>&, const std::vector<SatelliteModel>&,       \
-                                          const AntennaKinematics&, const GpsTime&);
+                                          const AntennaKinematics&, const GpsTime&);                            \
+  template void GnssFusion<S>::addLateClockSystems(vio::EstimatorBackend<S>&, const std::vector<SatelliteModel>&, \
+                                                   const AntennaKinematics&, const GpsTime&);
 GVINS_INSTANTIATE(float)
 GVINS_INSTANTIATE(double)
 #undef GVINS_INSTANTIATE

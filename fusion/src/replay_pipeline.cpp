@@ -321,7 +321,8 @@ void ReplaySummary::print(std::ostream& os) const {
   if (gnssEpochs + gnssEpochsSkipped > 0) {
     row("GNSS epochs", std::to_string(gnssEpochs) + " processed (" + std::to_string(gnssEpochsUpdated) + " updated, " +
                            std::to_string(gnssEpochsFixed) + " RTK fixed), " + std::to_string(gnssEpochsSkipped) +
-                           " before VIO initialisation");
+                           " before VIO initialisation" +
+                           (gnssEpochsInOutage ? ", " + std::to_string(gnssEpochsInOutage) + " in simulated outages" : ""));
     row("GNSS [ms/epoch]", f("mean %.3f", gnssMsMean) + f(" (%.3f ms per frame)", gnssMsPerFrame));
     std::string products = "broadcast";
     if (folderProductsSkipped)
@@ -734,8 +735,18 @@ ReplaySummary runReplay(const std::string& dataset, ReplayEstimator& est, Replay
               g.basePositionSet = true;
             }
           }
+          // A simulated outage (opt.gnssOutages): the epoch without satellites and no base.
+          const double since = static_cast<double>(gnssStamp(g.nextRover.time) - firstT) * 1e-9;
+          const bool outage = std::any_of(opt.gnssOutages.begin(), opt.gnssOutages.end(),
+                                          [&](const auto& w) { return since >= w.first && since < w.second; });
+          ObsEpoch empty;
+          if (outage) {
+            empty.time = g.nextRover.time;
+            ++sum.gnssEpochsInOutage;
+          }
           const auto t0 = Clock::now();
-          const ReplayGnssOutcome o = gnss->processEpoch(g.nextRover, g.haveCurrentBase ? &g.currentBase : nullptr, g.nav);
+          const ReplayGnssOutcome o = gnss->processEpoch(outage ? empty : g.nextRover,
+                                                         g.haveCurrentBase && !outage ? &g.currentBase : nullptr, g.nav);
           const double ms = msSince(t0);
           for (const std::string& w : o.warnings) std::fprintf(stderr, "\n[gvins-replay] warning: %s\n", w.c_str());
           gnssMs += ms;

@@ -1,4 +1,5 @@
 #include "gvins/gnss/double_difference.hpp"
+#include "gvins/gnss/signal_choice.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -201,7 +202,8 @@ void DoubleDifferenceBuilder::form(const ObsEpoch& rover, const CycleSlipDetecto
     Pick picks[3];
     int np = 0;
     const auto [baseBegin, baseEnd] = baseSignalsOf(base, so.sat);
-    const std::string& bands = config_.bands[static_cast<std::size_t>(systemIndex(sys))];
+    // The configured preference list, then the system's fallback bands (signal_choice.hpp).
+    const std::string bands = bandsWithFallback(config_.bands[static_cast<std::size_t>(systemIndex(sys))], sys);
     for (char band : bands) {
       if (np >= std::clamp(config_.frequencies, 1, 3)) break;
       const auto pick = pickPair(so, band, baseBegin, baseEnd);

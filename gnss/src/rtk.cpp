@@ -487,6 +487,7 @@ RtkSolution RtkSolver::processEpoch(const ObsEpoch& rover, TransmitStates* state
   sol.time = rover.time;
   const SppSolution spp = spp_.solve(rover);
   sol.sppStatus = spp.status;
+  if (spp.dop.valid) sol.hdop = spp.dop.hdop;
   if (spp.valid()) sol.time = spp.solutionTime;
   if (spp.velocity.valid) {
     sol.velocity = spp.velocity.velocity;

@@ -15,6 +15,7 @@
 #include "gvins/gnss/klobuchar.hpp"
 #include "gvins/gnss/sagnac.hpp"
 #include "gvins/gnss/satellite_observation_model.hpp"
+#include "gvins/gnss/signal_choice.hpp"
 #include "gvins/gnss/zero_difference.hpp"
 #include "normal_equations.hpp"
 
@@ -119,7 +120,8 @@ bool SppSolver::gatherMeasurements(const ObsEpoch& epoch, SppSolution& sol, std:
     const std::string& bands = cfg.bands[sys];
     const std::size_t nb = std::min<std::size_t>(bands.size(), static_cast<std::size_t>(std::clamp(cfg.frequencies, 1, 3)));
     std::optional<CodeSignal> c1, c2;
-    for (std::size_t i = 0; i < nb && !c1; ++i) c1 = usableCode(so, bands[i], channel);
+    c1 = primaryCode(so, bands, nb, channel);  // with fallback beyond the list (signal_choice.hpp)
+    if (c1) signalNotices_.record(so.sat.system, bands.empty() ? primaryBand(so.sat.system) : bands[0], c1->signal->code);
     if (c1) c2 = secondCode(so, bands, nb, c1->signal->code.band, channel);
     const SignalObs* s1 = c1 ? c1->signal : nullptr;
     const SignalObs* s2 = c2 ? c2->signal : nullptr;

@@ -86,10 +86,46 @@ std::string yamlQuoted(const std::string& s) {
   return o + "\"";
 }
 
+/// The real rover (and navigation) files of a gnss_track scenario, copied as they are:
+/// gnss/rover.<ext> and gnss/nav.<ext> (gvins-replay tells RINEX and UBX apart by content).
+std::vector<fs::path> copyRealGnss(const TrackTrajectoryConfig& c, const fs::path& gdir) {
+  fs::create_directories(gdir);
+  std::vector<fs::path> out;
+  const auto copy = [&](const std::string& from, const std::string& stem) {
+    const fs::path to = gdir / (stem + fs::path(from).extension().string());
+    fs::copy_file(from, to, fs::copy_options::overwrite_existing);
+    out.push_back(to);
+  };
+  copy(c.roverLog, "rover");
+  if (!c.navigationFile.empty()) copy(c.navigationFile, "nav");
+  return out;
+}
+
+/// dataset.yaml keys of a gnss_track trajectory: its inputs and what the fit found.
+void writeTrackSection(TextFile& f, const TrackTrajectoryConfig& c, const TrackFitReport& r) {
+  f << "  pos_file: " << yamlQuoted(c.posFile) << "\n  imu_csv: " << yamlQuoted(c.imuCsv) << "\n  max_quality: ";
+  f.integer(c.maxQuality) << "\n  rover_log: " << yamlQuoted(c.roverLog) << "\n  attitude: \"real gyro integrated, R0 and "
+                             "biases fitted to the track's velocity increments (sim/track_trajectory.hpp)\"\n  track_epochs: ";
+  f.integer(static_cast<std::int64_t>(r.trackEpochs)) << "\n  initial_yaw_deg: ";
+  f.num(r.initialYawDeg) << "\n  fitted_gyro_bias_radps: ";
+  writeList(f, r.gyroBias);
+  f << "\n  fitted_accel_bias_mps2: ";
+  writeList(f, r.accelBias);
+  f << "\n  velocity_increment_residual_rms_mps: ";
+  f.num(r.velocityResidualRms) << "\n  track_residual_rms_m: ";
+  f.num(r.trackResidualRms) << "\n  track_residual_max_m: ";
+  f.num(r.trackResidualMax) << "\n  accel_residual_rms_mps2: ";
+  f.num(r.accelResidualRms) << "\n  forward_axis_body: ";
+  writeList(f, r.forwardAxis);
+  f << "  # mean direction of travel in B\n";
+}
+
 }  // namespace
 
 std::unique_ptr<Trajectory> buildTrajectory(const Scenario& sc, std::uint64_t seed) {
   if (sc.trajectory == TrajectoryKind::Recorded) return std::make_unique<RecordedTrajectory>(sc.recorded);
+  if (sc.trajectory == TrajectoryKind::Track)
+    return std::make_unique<TrackTrajectory>(sc.track, sc.frame, sc.leverArm, flatGravity(sc.imu, sc.frame));
   FlightSpec f = sc.flight;
   f.gravity = flatGravity(sc.imu, sc.frame);
   return buildFlight(f, seed);
@@ -205,8 +241,10 @@ GenerationSummary generateDataset(const Scenario& sc, const fs::path& dir, const
     sum.imuRate = sc.imu.rateHz;
   } else {
     const auto& rec = static_cast<const RecordedTrajectory&>(*traj);
-    imuSource = "recorded: " + sc.recorded.imuCsv;
-    gravity = 9.81;  // the recording's processing convention (EuRoC)
+    const bool track = sc.trajectory == TrajectoryKind::Track;
+    imuSource = "recorded: " + (track ? sc.track.imuCsv : sc.recorded.imuCsv);
+    // EuRoC's processing convention; a track fit uses the scenario's flat gravity.
+    gravity = track ? flatGravity(sc.imu, sc.frame) : 9.81;
     for (const vio::ImuSample& m : rec.imuSamples()) {
       const std::int64_t off = m.t_ns - rec.startStamp();
       if (off < 0 || static_cast<double>(off) * 1e-9 > duration) continue;
@@ -441,6 +479,9 @@ GenerationSummary generateDataset(const Scenario& sc, const fs::path& dir, const
     g.print(os);
     sum.gnssSummary = os.str();
     gnssFiles = g.files;
+  } else if (sc.trajectory == TrajectoryKind::Track && !sc.track.roverLog.empty() && opt.gnss) {
+    gnssFiles = copyRealGnss(sc.track, dir / "gnss");
+    sum.gnssSummary = "  GNSS                the real rover's files (" + std::to_string(gnssFiles.size()) + ") copied into gnss/\n";
   }
   sum.secondsGnss = since(tGnss);
 
@@ -478,12 +519,16 @@ GenerationSummary generateDataset(const Scenario& sc, const fs::path& dir, const
     f << "lever_arm_m: ";
     writeList(f, sc.leverArm);
     f << "  # GNSS antenna phase centre in the body (IMU) frame\n";
-    f << "trajectory:\n  type: " << (sc.trajectory == TrajectoryKind::Flight ? "flight" : "recorded") << "\n";
+    f << "trajectory:\n  type: "
+      << (sc.trajectory == TrajectoryKind::Flight ? "flight" : sc.trajectory == TrajectoryKind::Track ? "gnss_track" : "recorded")
+      << "\n";
     if (sc.trajectory == TrajectoryKind::Flight) {
       f << "  pattern: " << toString(sc.flight.pattern) << "\n  height_m: ";
       f.num(sc.flight.height) << "\n  length_m: ";
       f.num(sc.flight.length) << "\n  speed_mps: ";
       f.num(sc.flight.speed) << "\n";
+    } else if (sc.trajectory == TrajectoryKind::Track) {
+      writeTrackSection(f, sc.track, static_cast<const TrackTrajectory&>(*traj).report());
     } else {
       f << "  imu_csv: " << yamlQuoted(sc.recorded.imuCsv) << "\n  groundtruth_csv: " << yamlQuoted(sc.recorded.groundTruthCsv) << "\n";
     }

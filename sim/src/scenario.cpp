@@ -201,6 +201,28 @@ void parseRecorded(const Reader& r, const YAML::Node& n, Scenario& sc) {
   if (n["smoothing"]) c.smoothing = r.number(n["smoothing"], "trajectory.smoothing", 0.0, 1e9);
 }
 
+void parseTrack(const Reader& r, const YAML::Node& n, Scenario& sc) {
+  r.map(n, "trajectory", {"type", "pos_file", "imu_csv", "max_quality", "duration_s", "attitude_window_s",
+                          "gyro_bias_interval_s", "knot_interval_s", "accel_sigma_mps2", "track_sigma_floor_m",
+                          "smoothing", "rover_log", "navigation_file"});
+  TrackTrajectoryConfig& c = sc.track;
+  if (!n["pos_file"] || !n["imu_csv"]) r.fail(n, "trajectory", "a gnss_track trajectory needs pos_file and imu_csv");
+  c.posFile = r.path(n["pos_file"], "trajectory.pos_file");
+  c.imuCsv = r.path(n["imu_csv"], "trajectory.imu_csv");
+  if (n["max_quality"]) c.maxQuality = static_cast<int>(r.number(n["max_quality"], "trajectory.max_quality", 1.0, 6.0));
+  if (n["duration_s"]) c.duration = r.number(n["duration_s"], "trajectory.duration_s", 0.0, 1e6);
+  if (n["attitude_window_s"]) c.attitudeWindow = r.number(n["attitude_window_s"], "trajectory.attitude_window_s", 0.1, 10.0);
+  if (n["gyro_bias_interval_s"])
+    c.gyroBiasInterval = r.number(n["gyro_bias_interval_s"], "trajectory.gyro_bias_interval_s", 0.0, 1e6);
+  if (n["knot_interval_s"]) c.knotInterval = r.number(n["knot_interval_s"], "trajectory.knot_interval_s", 0.005, 1.0);
+  if (n["accel_sigma_mps2"]) c.accelSigma = r.number(n["accel_sigma_mps2"], "trajectory.accel_sigma_mps2", 1e-3, 100.0);
+  if (n["track_sigma_floor_m"])
+    c.trackSigmaFloor = r.number(n["track_sigma_floor_m"], "trajectory.track_sigma_floor_m", 1e-4, 100.0);
+  if (n["smoothing"]) c.smoothing = r.number(n["smoothing"], "trajectory.smoothing", 0.0, 1e9);
+  if (n["rover_log"]) c.roverLog = r.path(n["rover_log"], "trajectory.rover_log");
+  if (n["navigation_file"]) c.navigationFile = r.path(n["navigation_file"], "trajectory.navigation_file");
+}
+
 void parseImu(const Reader& r, const YAML::Node& n, Scenario& sc) {
   r.map(n, "imu", {"rate_hz", "gyroscope_noise_density", "gyroscope_random_walk", "accelerometer_noise_density",
                    "accelerometer_random_walk", "white_noise", "bias_random_walk", "gyro_bias_radps", "accel_bias_mps2",
@@ -471,8 +493,11 @@ void parseRoot(const Reader& r, const YAML::Node& root, Scenario& sc) {
     } else if (type == "recorded") {
       sc.trajectory = TrajectoryKind::Recorded;
       parseRecorded(r, t, sc);
+    } else if (type == "gnss_track") {
+      sc.trajectory = TrajectoryKind::Track;
+      parseTrack(r, t, sc);
     } else {
-      r.fail(t["type"], "trajectory.type", "expected flight or recorded");
+      r.fail(t["type"], "trajectory.type", "expected flight, recorded or gnss_track");
     }
   }
   if (const YAML::Node i = root["imu"]) parseImu(r, i, sc);
@@ -490,6 +515,8 @@ void parseRoot(const Reader& r, const YAML::Node& root, Scenario& sc) {
     }
   }
   // Consistency between sections.
+  if (sc.trajectory == TrajectoryKind::Track && !sc.track.roverLog.empty() && sc.gnss)
+    r.fail(root["trajectory"], "trajectory.rover_log", "a real rover log replaces the simulated GNSS: set gnss: none");
   if (sc.structure && sc.output == CameraOutput::Images && !sc.cameras.empty())
     r.fail(root["scene"], "scene.structure", "3-D structure gives feature tracks only: set cameras.output: features");
   if (sc.trajectory == TrajectoryKind::Flight &&

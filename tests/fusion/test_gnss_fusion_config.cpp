@@ -109,6 +109,20 @@ TEST(GnssFusionConfig, InterSystemBiasRandomWalkKeys) {
   EXPECT_THROW(parseGnssFusionConfig("gnss_fusion:\n  isb_renewal_interval: 0\n"), ParseError);
 }
 
+TEST(GnssFusionConfig, ReacquisitionAndLateSystemKeys) {
+  const GnssFusionConfig d;
+  EXPECT_DOUBLE_EQ(d.reacquireAfter, 2.0);
+  EXPECT_EQ(d.lateSystemMinSatellites, 2);
+  const GnssFusionConfig c = parseGnssFusionConfig(
+      "gnss_fusion:\n  reacquire_after: 0\n  reacquire_window: 0.5\n  late_system_min_satellites: 4\n");
+  EXPECT_DOUBLE_EQ(c.reacquireAfter, 0.0);  // never
+  EXPECT_DOUBLE_EQ(c.reacquireWindow, 0.5);
+  EXPECT_EQ(c.lateSystemMinSatellites, 4);
+  EXPECT_THROW(parseGnssFusionConfig("gnss_fusion:\n  reacquire_after: -1\n"), ParseError);
+  EXPECT_THROW(parseGnssFusionConfig("gnss_fusion:\n  reacquire_window: 0\n"), ParseError);
+  EXPECT_THROW(parseGnssFusionConfig("gnss_fusion:\n  late_system_min_satellites: 0\n"), ParseError);
+}
+
 TEST(GnssFusionConfig, ModeNamesRoundTrip) {
   for (const char* n : {"vio", "vio+gpsvel", "vio+dopp", "vio+dopp+psr", "vio+dopp+dpsr", "vio+dopp+ddcp",
                         "vio+dopp+psr-nointegration", "vio+dopp+ppp"}) {

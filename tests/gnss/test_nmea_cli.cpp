@@ -72,6 +72,11 @@ void checkAgainstPos(const std::string& tool, const std::string& args) {
     EXPECT_EQ(q, s.quality == SolutionQuality::Fix ? 4 : s.quality == SolutionQuality::Float ? 5 : 1);
     ++qualities[q > 6 ? 0 : q];
     EXPECT_EQ(std::stoi(g[7]), s.numSatellites);
+    // HDOP of the epoch's SPP geometry: 6-7 GPS satellites over Japan in 2005 give 1.2-1.7; the
+    // 5-satellite stretch of the RTK run a poor geometry (8-14).
+    ASSERT_FALSE(g[8].empty()) << n[2 * i];
+    EXPECT_GT(std::stod(g[8]), 0.8) << n[2 * i];
+    EXPECT_LT(std::stod(g[8]), s.numSatellites >= 6 ? 2.5 : 30.0) << n[2 * i];
     const CalendarTime c = (s.time - 13.0).toCalendar();  // GPST - UTC = 13 s in 2005
     char t[16];
     std::snprintf(t, sizeof t, "%02d%02d%05.2f", c.hour, c.minute, c.second);

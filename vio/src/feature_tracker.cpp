@@ -120,169 +120,25 @@ void FeatureTracker::process(const ImagePyramid& image, const Eigen::Matrix3d* R
   }
   smoothOf_ = nullptr;
   if (!prev_.empty() && !pts_.empty()) {
+    // 1. KLT from the previous image.
     auto t0 = Clock::now();
-    const std::size_t n = pts_.size();
-    // Unpredicted start: the rotation-predicted pixel with a gyro rotation, else the previous
-    // position (trackKlt's default).
-    std::vector<cv::Point2f> start = pts_;
-    if (R_cur_prev) {
-      for (std::size_t i = 0; i < n; ++i) {
-        const Eigen::Vector3d b = *R_cur_prev * cam_.bearing({pts_[i].x, pts_[i].y});
-        const auto px = cam_.project(b);
-        if (px) start[i] = cv::Point2f(static_cast<float>(px->x()), static_cast<float>(px->y()));
-      }
-    }
-    std::vector<cv::Point2f> cur = start;
-    std::vector<unsigned char> status(n, 0);
-    // First pass: the tracks with a prediction through the shallow pyramid.
-    std::vector<std::size_t> idx;
-    std::vector<cv::Point2f> from, to, predicted;
-    // Tracks refined against their template below are verified there (correlation and
-    // correction limits); the KLT backward pass is only for the others.
-    std::vector<unsigned char> backward;
-    const auto needsBackward = [&](std::size_t i) -> unsigned char {
-      return !(cfg_.alignTemplates && cfg_.templatesReplaceBackwardCheck && !templates_[i].empty());
-    };
-    if (cfg_.predictedLevels >= 0 && cfg_.predictedLevels < cfg_.klt.levels) {
-      // With a rotation every track has its prediction. Without, tracks continue their last
-      // image step (constant image motion); new ones take the median step of those when there
-      // are enough of them, else they have no prediction.
-      cv::Point2f median(0.f, 0.f);
-      bool haveMedian = R_cur_prev != nullptr;
-      if (!R_cur_prev) {
-        std::vector<float> dx, dy;
-        dx.reserve(n);
-        dy.reserve(n);
-        for (std::size_t i = 0; i < n; ++i) {
-          if (lengths_[i] < 2) continue;
-          dx.push_back(pts_[i].x - prevPts_[i].x);
-          dy.push_back(pts_[i].y - prevPts_[i].y);
-        }
-        constexpr std::size_t kMinForMedian = 8;
-        if (dx.size() >= kMinForMedian) {
-          const auto mid = static_cast<std::ptrdiff_t>(dx.size() / 2);
-          std::nth_element(dx.begin(), dx.begin() + mid, dx.end());
-          std::nth_element(dy.begin(), dy.begin() + mid, dy.end());
-          median = {dx[static_cast<std::size_t>(mid)], dy[static_cast<std::size_t>(mid)]};
-          haveMedian = true;
-        }
-      }
-      for (std::size_t i = 0; i < n; ++i) {
-        if (R_cur_prev) {
-          to.push_back(start[i]);
-        } else if (lengths_[i] >= 2) {
-          to.push_back(pts_[i] + (pts_[i] - prevPts_[i]));
-        } else if (haveMedian) {
-          to.push_back(pts_[i] + median);
-        } else {
-          continue;
-        }
-        idx.push_back(i);
-        from.push_back(pts_[i]);
-        backward.push_back(needsBackward(i));
-      }
-      if (!idx.empty()) {
-        predicted = to;
-        KltParams p = cfg_.klt;
-        p.levels = cfg_.predictedLevels;
-        std::vector<unsigned char> st;
-        trackKlt(prev_, image, from, to, st, p, true, &backward);
-        // A shallow pyramid can settle on a wrong but forward-backward consistent match far from
-        // its start: only small corrections of the prediction are accepted.
-        const float maxCorr2 = static_cast<float>(cfg_.predictedMaxCorrection * cfg_.predictedMaxCorrection);
-        for (std::size_t k = 0; k < idx.size(); ++k) {
-          const cv::Point2f d = to[k] - predicted[k];
-          if (!st[k] || d.x * d.x + d.y * d.y > maxCorr2) continue;
-          cur[idx[k]] = to[k];
-          status[idx[k]] = 1;
-        }
-      }
-    }
-    // The others (no prediction, or failed above) from the unpredicted start through the whole
-    // pyramid.
-    idx.clear();
-    from.clear();
-    to.clear();
-    backward.clear();
-    for (std::size_t i = 0; i < n; ++i) {
-      if (status[i]) continue;
-      idx.push_back(i);
-      from.push_back(pts_[i]);
-      to.push_back(start[i]);
-      backward.push_back(needsBackward(i));
-    }
-    if (!idx.empty()) {
-      std::vector<unsigned char> st;
-      trackKlt(prev_, image, from, to, st, cfg_.klt, R_cur_prev != nullptr, &backward);
-      for (std::size_t k = 0; k < idx.size(); ++k) {
-        cur[idx[k]] = to[k];
-        status[idx[k]] = st[k];
-      }
-    }
+    std::vector<cv::Point2f> cur;
+    std::vector<unsigned char> status;
+    trackAll(image, R_cur_prev, cur, status);
     tm.tracking += msSince(t0);
 
     t0 = Clock::now();
     std::vector<cv::Point2f> before = pts_;
-    // Drops the tracks with keep[i] == 0 from every per-track vector.
-    auto keepTracks = [&](const std::vector<unsigned char>& keep) {
-      compact(before, keep);
-      compact(cur, keep);
-      compact(ids_, keep);
-      compact(lengths_, keep);
-      compact(travel_, keep);
-      compact(templates_, keep);
-      compact(warps_, keep);
-    };
-    keepTracks(status);
+    keepTracks(before, cur, status);
+    // 2. Template refinement, 3. RANSAC on the epipolar geometry, 4. track length and travel.
     if (cfg_.alignTemplates) {
       const auto ta = Clock::now();
-      const float maxCorr2 = static_cast<float>(cfg_.templateMaxCorrection * cfg_.templateMaxCorrection);
-      std::vector<unsigned char> aligned(cur.size(), 1);
-      for (std::size_t i = 0; i < cur.size(); ++i) {
-        if (templates_[i].empty()) continue;
-        AffineWarp w = warps_[i];
-        if (R_cur_prev) {
-          // The rotation's local image Jacobian at the previous position turns the patch shape.
-          const auto moved = [&](float du, float dv) -> std::optional<Eigen::Vector2d> {
-            const Eigen::Vector3d b = *R_cur_prev * cam_.bearing({before[i].x + du, before[i].y + dv});
-            return cam_.project(b);
-          };
-          const auto px = moved(1.f, 0.f), mx = moved(-1.f, 0.f), py = moved(0.f, 1.f), my = moved(0.f, -1.f);
-          if (px && mx && py && my) {
-            Eigen::Matrix2f J;
-            J.col(0) = (0.5 * (*px - *mx)).cast<float>();
-            J.col(1) = (0.5 * (*py - *my)).cast<float>();
-            w.A = J * w.A;
-          }
-        }
-        w.t = Eigen::Vector2f(cur[i].x, cur[i].y);
-        const PatchAlignResult r = templates_[i].align(smooth_, w, cfg_.patch);
-        const float dx = w.t.x() - cur[i].x, dy = w.t.y() - cur[i].y;
-        if (!r.ok || dx * dx + dy * dy > maxCorr2) {
-          aligned[i] = 0;
-          continue;
-        }
-        cur[i] = cv::Point2f(w.t.x(), w.t.y());
-        warps_[i] = w;
-      }
-      keepTracks(aligned);
+      keepTracks(before, cur, alignTemplates(before, cur, R_cur_prev));
       tm.tracking += msSince(ta);
     }
     if (cfg_.ransac && cur.size() >= 8) {
-      // Undistorted points on a virtual pinhole with the camera's focal length, so that the
-      // threshold is in pixels.
-      const double f = cam_.intrinsics().fx;
-      std::vector<cv::Point2f> a(cur.size()), c(cur.size());
-      for (std::size_t i = 0; i < cur.size(); ++i) {
-        const Eigen::Vector2d na = cam_.undistort({before[i].x, before[i].y}) * f;
-        const Eigen::Vector2d nc = cam_.undistort({cur[i].x, cur[i].y}) * f;
-        a[i] = cv::Point2f(static_cast<float>(na.x()), static_cast<float>(na.y()));
-        c[i] = cv::Point2f(static_cast<float>(nc.x()), static_cast<float>(nc.y()));
-      }
       std::vector<unsigned char> inlier;
-      const cv::Mat F = cv::findFundamentalMat(a, c, cv::FM_RANSAC, cfg_.ransacThreshold, cfg_.ransacConfidence, inlier);
-      // A degenerate configuration (no motion, pure rotation, planar) may give no F: keep all.
-      if (!F.empty() && inlier.size() == cur.size()) keepTracks(inlier);
+      if (epipolarInliers(before, cur, inlier)) keepTracks(before, cur, inlier);
     }
     for (int& l : lengths_) ++l;
     for (std::size_t i = 0; i < cur.size(); ++i) {
@@ -298,7 +154,7 @@ void FeatureTracker::process(const ImagePyramid& image, const Eigen::Matrix3d* R
                   (maxTravel <= 0.0 || lengths_[i] < cfg_.travelMinTrackLength || travel_[i] <= maxTravel);
         any |= !keep[i];
       }
-      if (any) keepTracks(keep);
+      if (any) keepTracks(before, cur, keep);
     }
     pts_ = std::move(cur);
     prevPts_ = std::move(before);
@@ -307,6 +163,7 @@ void FeatureTracker::process(const ImagePyramid& image, const Eigen::Matrix3d* R
     prevPts_ = pts_;
   }
 
+  // 5. New features in the empty cells.
   const auto t0 = Clock::now();
   const std::size_t before = pts_.size();
   detector_.detect(image.image(), pts_);
@@ -322,6 +179,176 @@ void FeatureTracker::process(const ImagePyramid& image, const Eigen::Matrix3d* R
   }
   tm.detection += msSince(t0);
   prev_ = image;
+}
+
+void FeatureTracker::keepTracks(std::vector<cv::Point2f>& before, std::vector<cv::Point2f>& cur,
+                                const std::vector<unsigned char>& keep) {
+  compact(before, keep);
+  compact(cur, keep);
+  compact(ids_, keep);
+  compact(lengths_, keep);
+  compact(travel_, keep);
+  compact(templates_, keep);
+  compact(warps_, keep);
+}
+
+unsigned char FeatureTracker::needsBackwardCheck(std::size_t i) const {
+  return !(cfg_.alignTemplates && cfg_.templatesReplaceBackwardCheck && !templates_[i].empty());
+}
+
+void FeatureTracker::trackAll(const ImagePyramid& image, const Eigen::Matrix3d* R_cur_prev,
+                              std::vector<cv::Point2f>& cur, std::vector<unsigned char>& status) const {
+  const std::size_t n = pts_.size();
+  // Unpredicted start: the rotation-predicted pixel with a gyro rotation, else the previous
+  // position (trackKlt's default).
+  std::vector<cv::Point2f> start = pts_;
+  if (R_cur_prev) {
+    for (std::size_t i = 0; i < n; ++i) {
+      const Eigen::Vector3d b = *R_cur_prev * cam_.bearing({pts_[i].x, pts_[i].y});
+      const auto px = cam_.project(b);
+      if (px) start[i] = cv::Point2f(static_cast<float>(px->x()), static_cast<float>(px->y()));
+    }
+  }
+  cur = start;
+  status.assign(n, 0);
+  // First pass: the tracks with a prediction through the shallow pyramid.
+  if (cfg_.predictedLevels >= 0 && cfg_.predictedLevels < cfg_.klt.levels) {
+    trackPredicted(image, R_cur_prev, start, cur, status);
+  }
+  // The others (no prediction, or failed above) from the unpredicted start through the whole
+  // pyramid. Tracks refined against their template later are verified there (correlation and
+  // correction limits); the KLT backward pass is only for the others.
+  std::vector<std::size_t> idx;
+  std::vector<cv::Point2f> from, to;
+  std::vector<unsigned char> backward;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (status[i]) continue;
+    idx.push_back(i);
+    from.push_back(pts_[i]);
+    to.push_back(start[i]);
+    backward.push_back(needsBackwardCheck(i));
+  }
+  if (!idx.empty()) {
+    std::vector<unsigned char> st;
+    trackKlt(prev_, image, from, to, st, cfg_.klt, R_cur_prev != nullptr, &backward);
+    for (std::size_t k = 0; k < idx.size(); ++k) {
+      cur[idx[k]] = to[k];
+      status[idx[k]] = st[k];
+    }
+  }
+}
+
+void FeatureTracker::trackPredicted(const ImagePyramid& image, const Eigen::Matrix3d* R_cur_prev,
+                                    const std::vector<cv::Point2f>& start, std::vector<cv::Point2f>& cur,
+                                    std::vector<unsigned char>& status) const {
+  const std::size_t n = pts_.size();
+  std::vector<std::size_t> idx;
+  std::vector<cv::Point2f> from, to, predicted;
+  std::vector<unsigned char> backward;
+  // With a rotation every track has its prediction. Without, tracks continue their last
+  // image step (constant image motion); new ones take the median step of those when there
+  // are enough of them, else they have no prediction.
+  cv::Point2f median(0.f, 0.f);
+  bool haveMedian = R_cur_prev != nullptr;
+  if (!R_cur_prev) {
+    std::vector<float> dx, dy;
+    dx.reserve(n);
+    dy.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (lengths_[i] < 2) continue;
+      dx.push_back(pts_[i].x - prevPts_[i].x);
+      dy.push_back(pts_[i].y - prevPts_[i].y);
+    }
+    constexpr std::size_t kMinForMedian = 8;
+    if (dx.size() >= kMinForMedian) {
+      const auto mid = static_cast<std::ptrdiff_t>(dx.size() / 2);
+      std::nth_element(dx.begin(), dx.begin() + mid, dx.end());
+      std::nth_element(dy.begin(), dy.begin() + mid, dy.end());
+      median = {dx[static_cast<std::size_t>(mid)], dy[static_cast<std::size_t>(mid)]};
+      haveMedian = true;
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (R_cur_prev) {
+      to.push_back(start[i]);
+    } else if (lengths_[i] >= 2) {
+      to.push_back(pts_[i] + (pts_[i] - prevPts_[i]));
+    } else if (haveMedian) {
+      to.push_back(pts_[i] + median);
+    } else {
+      continue;
+    }
+    idx.push_back(i);
+    from.push_back(pts_[i]);
+    backward.push_back(needsBackwardCheck(i));
+  }
+  if (idx.empty()) return;
+  predicted = to;
+  KltParams p = cfg_.klt;
+  p.levels = cfg_.predictedLevels;
+  std::vector<unsigned char> st;
+  trackKlt(prev_, image, from, to, st, p, true, &backward);
+  // A shallow pyramid can settle on a wrong but forward-backward consistent match far from
+  // its start: only small corrections of the prediction are accepted.
+  const float maxCorr2 = static_cast<float>(cfg_.predictedMaxCorrection * cfg_.predictedMaxCorrection);
+  for (std::size_t k = 0; k < idx.size(); ++k) {
+    const cv::Point2f d = to[k] - predicted[k];
+    if (!st[k] || d.x * d.x + d.y * d.y > maxCorr2) continue;
+    cur[idx[k]] = to[k];
+    status[idx[k]] = 1;
+  }
+}
+
+std::vector<unsigned char> FeatureTracker::alignTemplates(const std::vector<cv::Point2f>& before,
+                                                          std::vector<cv::Point2f>& cur,
+                                                          const Eigen::Matrix3d* R_cur_prev) {
+  const float maxCorr2 = static_cast<float>(cfg_.templateMaxCorrection * cfg_.templateMaxCorrection);
+  std::vector<unsigned char> aligned(cur.size(), 1);
+  for (std::size_t i = 0; i < cur.size(); ++i) {
+    if (templates_[i].empty()) continue;
+    AffineWarp w = warps_[i];
+    if (R_cur_prev) {
+      // The rotation's local image Jacobian at the previous position turns the patch shape.
+      const auto moved = [&](float du, float dv) -> std::optional<Eigen::Vector2d> {
+        const Eigen::Vector3d b = *R_cur_prev * cam_.bearing({before[i].x + du, before[i].y + dv});
+        return cam_.project(b);
+      };
+      const auto px = moved(1.f, 0.f), mx = moved(-1.f, 0.f), py = moved(0.f, 1.f), my = moved(0.f, -1.f);
+      if (px && mx && py && my) {
+        Eigen::Matrix2f J;
+        J.col(0) = (0.5 * (*px - *mx)).cast<float>();
+        J.col(1) = (0.5 * (*py - *my)).cast<float>();
+        w.A = J * w.A;
+      }
+    }
+    w.t = Eigen::Vector2f(cur[i].x, cur[i].y);
+    const PatchAlignResult r = templates_[i].align(smooth_, w, cfg_.patch);
+    const float dx = w.t.x() - cur[i].x, dy = w.t.y() - cur[i].y;
+    if (!r.ok || dx * dx + dy * dy > maxCorr2) {
+      aligned[i] = 0;
+      continue;
+    }
+    cur[i] = cv::Point2f(w.t.x(), w.t.y());
+    warps_[i] = w;
+  }
+  return aligned;
+}
+
+bool FeatureTracker::epipolarInliers(const std::vector<cv::Point2f>& before, const std::vector<cv::Point2f>& cur,
+                                     std::vector<unsigned char>& inlier) const {
+  // Undistorted points on a virtual pinhole with the camera's focal length, so that the
+  // threshold is in pixels.
+  const double f = cam_.intrinsics().fx;
+  std::vector<cv::Point2f> a(cur.size()), c(cur.size());
+  for (std::size_t i = 0; i < cur.size(); ++i) {
+    const Eigen::Vector2d na = cam_.undistort({before[i].x, before[i].y}) * f;
+    const Eigen::Vector2d nc = cam_.undistort({cur[i].x, cur[i].y}) * f;
+    a[i] = cv::Point2f(static_cast<float>(na.x()), static_cast<float>(na.y()));
+    c[i] = cv::Point2f(static_cast<float>(nc.x()), static_cast<float>(nc.y()));
+  }
+  const cv::Mat F = cv::findFundamentalMat(a, c, cv::FM_RANSAC, cfg_.ransacThreshold, cfg_.ransacConfidence, inlier);
+  // A degenerate configuration (no motion, pure rotation, planar) may give no F: keep all.
+  return !F.empty() && inlier.size() == cur.size();
 }
 
 }  // namespace gvins::vio

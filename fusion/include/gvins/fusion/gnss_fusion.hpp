@@ -35,12 +35,15 @@
 #include "gvins/base/observation.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/fusion/gnss_fusion_config.hpp"
+#include "gvins/fusion/gnss_gate_recovery.hpp"
 #include "gvins/fusion/gnss_ins_alignment.hpp"
 #include "gvins/fusion/gnss_measurement_models.hpp"
 #include "gvins/gnss/broadcast_record_change.hpp"
 #include "gvins/gnss/carrier_smoothing.hpp"
+#include "gvins/gnss/clock_jump_repair.hpp"
 #include "gvins/gnss/doppler_consistency.hpp"
 #include "gvins/gnss/rtk.hpp"
+#include "gvins/gnss/signal_choice.hpp"
 #include "gvins/gnss/spp.hpp"
 #include "gvins/gnss/transmit_states.hpp"
 #include "gvins/sri/chi_square.hpp"
@@ -116,6 +119,8 @@ class GnssFusion {
   const GnssAnchor& anchor() const { return anchor_; }
   /// Doppler sanity of the rover epochs (verdicts, warnings, counters).
   const DopplerConsistency& roverDoppler() const { return roverDoppler_; }
+  /// Whole-millisecond receiver clock jumps removed from the rover epochs.
+  const ClockJumpRepair& clockJumps() const { return clockJumps_; }
   Eigen::Vector3d leverArm(const vio::EstimatorBackend<Scalar>& est) const;
   /// Clock estimate [c·dt per clock system..., c·ḋt] (the receiver clock plus each system's
   /// inter-system bias) and the systems (clock indices).
@@ -153,6 +158,10 @@ class GnssFusion {
   bool frameKnownInEnu(const vio::EstimatorBackend<Scalar>& est) const;
   bool initClocks(vio::EstimatorBackend<Scalar>& est, const std::vector<SatelliteModel>& models,
                   const AntennaKinematics& k, const GpsTime& t);
+  /// Systems seen in `models` without a clock (ephemerides arrived after initClocks): each with
+  /// at least lateSystemMinSatellites satellites joins the ISB block, with a notice.
+  void addLateClockSystems(vio::EstimatorBackend<Scalar>& est, const std::vector<SatelliteModel>& models,
+                           const AntennaKinematics& k, const GpsTime& t);
   void propagateClocks(vio::EstimatorBackend<Scalar>& est, const GpsTime& t);
   /// [c·dt per clock system..., c·ḋt] from the clock and ISB blocks (clockBlock_ valid).
   Eigen::VectorXd systemClocks(const vio::EstimatorBackend<Scalar>& est) const;
@@ -201,6 +210,16 @@ class GnssFusion {
   std::unique_ptr<GnssInsAlignment> insAlign_;  // insStart: before the estimator is initialised
   std::unique_ptr<RtkSolver> rtk_;
   DopplerConsistency roverDoppler_{"rover"};
+  // Primary signals taken from another band than the system's usual one (signal_choice.hpp),
+  // each reported once in the epoch's warnings.
+  mutable SignalFallbackNotices signalNotices_;
+  std::size_t signalWarned_ = 0;
+  ClockJumpRepair clockJumps_{"rover"};  // before the Doppler check
+  std::size_t jumpWarned_ = 0;
+  std::vector<std::string> clockNotices_;  // systems that joined the clocks late
+  std::size_t clockWarned_ = 0;
+  GnssGateRecovery gateRecovery_{config_.reacquireAfter, config_.reacquireWindow};
+  std::size_t gateWarned_ = 0;
   ObsEpoch checkedRover_;      // the rover epoch after the Doppler check
   std::size_t baseWarned_ = 0;  // warnings of rtk_'s base Doppler check already reported
   std::optional<GpsTime> lastBase_;

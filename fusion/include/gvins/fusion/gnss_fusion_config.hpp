@@ -51,6 +51,9 @@
 //                                         # marginalize the frame block (false: keep it as a state)
 //     frame_reanchor_position_sigma: 0.5  # m, ... once the IMU's ENU position σ is below this
 //     outage_reset: 60                    # s without GNSS update: clocks/ambiguities reset
+//     reacquire_after: 2                  # s of epochs with every row gated out: rows ungated ...
+//     reacquire_window: 1                 # ... for this long (re-acquisition; 0: never)
+//     late_system_min_satellites: 2       # satellites of a system first seen after the clocks started
 //     clock_ransac_threshold: 5.0         # m (pseudorange) for the clock RANSAC
 //     base_position: [x, y, z]            # ECEF of the base antenna (dpsr/ddcp)
 //     max_base_age: 2.0                   # s
@@ -180,6 +183,14 @@ struct GnssFusionConfig {
   /// is held constant).
   double isbRandomWalk = 0.001;
   double isbRenewalInterval = 30.0;
+  /// A system first seen after the clocks started (its ephemerides arrived later) joins the clock
+  /// state once this many of its satellites have a model (GnssFusion::addLateClockSystems).
+  int lateSystemMinSatellites = 2;
+  /// Tight stage: after every epoch's rows were gated out for reacquireAfter seconds (the state
+  /// drifted beyond its covariance, e.g. through an outage), the rows are applied without the
+  /// gates for reacquireWindow seconds (gnss_gate_recovery.hpp); reacquireAfter <= 0: never.
+  double reacquireAfter = 2.0;
+  double reacquireWindow = 1.0;
   double rowGate = 0.999;
   double epochGate = 0.99999;
   double frameYawSigmaDeg = 3.0;

@@ -30,6 +30,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -142,6 +143,10 @@ struct ReplayOptions {
   /// (1: fixed); empty: the dataset's truth/groundtruth_ecef.csv.
   std::string truthPos;
   int truthPosMaxQuality = 1;
+  /// Simulated GNSS outages: [start, end) in s after the first frame. Rover epochs inside reach
+  /// the GNSS client without satellites (and without a base epoch), so the antenna track goes on
+  /// from the IMU alone and the error at the end of each window is the outage drift.
+  std::vector<std::pair<double, double>> gnssOutages;
   /// Images mode: also write the front end's tracks as a feature-only dataset in this folder
   /// (FeatureTrackDatasetWriter; empty: no). Replaying that folder runs the estimator on the
   /// same tracks without the front end.
@@ -195,6 +200,7 @@ struct ReplaySummary {
   double frontendMsMean = 0.0, frontendMsMax = 0.0, estimatorMsMean = 0.0, estimatorMsMax = 0.0;
   double gnssMsMean = 0.0;  ///< per epoch
   std::size_t gnssEpochs = 0, gnssEpochsUpdated = 0, gnssEpochsFixed = 0, gnssEpochsSkipped = 0;
+  std::size_t gnssEpochsInOutage = 0;  ///< handed over without satellites (ReplayOptions::gnssOutages)
   /// Satellites with precise products loaded (0: broadcast orbits and clocks only).
   std::size_t preciseSatellites = 0;
   std::size_t antexAntennas = 0;  ///< satellite antenna entries of the ANTEX files used with the products

@@ -91,6 +91,7 @@ struct RtkSolution {
   std::optional<Eigen::Vector3d> velocity;  ///< ECEF, m/s (Doppler, or the constant-velocity state)
   Eigen::Matrix3d velocityCovariance = Eigen::Matrix3d::Zero();
   int numSatellites = 0;   ///< satellites with DD phase (RTK) or used by SPP (single)
+  std::optional<double> hdop;  ///< HDOP of the rover's SPP geometry this epoch (NMEA GGA)
   double age = 0.0;        ///< s, age of the base data
   double ratio = 0.0;      ///< ratio-test value of the accepted set, else of the full set
   double successRate = 0.0;  ///< bootstrapped success rate of the accepted (or full) set

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -16,6 +17,7 @@
 #include "gvins/gnss/dop.hpp"
 #include "gvins/gnss/doppler_velocity.hpp"
 #include "gvins/gnss/position_solution.hpp"
+#include "gvins/gnss/signal_choice.hpp"
 #include "gvins/gnss/spp_config.hpp"
 
 namespace gvins {
@@ -96,6 +98,9 @@ class SppSolver {
 
   SppSolution solve(const ObsEpoch& epoch);
   const SppConfig& config() const { return config_; }
+  /// One message per system and signal used instead of the first band of `bands` (the band was
+  /// not tracked; signal_choice.hpp), in the order they first occurred.
+  const std::vector<std::string>& signalNotices() const { return signalNotices_.messages(); }
 
  private:
   struct Measurement;
@@ -116,6 +121,7 @@ class SppSolver {
   std::optional<Eigen::Vector3d> last_;
   GpsTime lastTime_;
   std::array<Isb, kNumSystems> isb_{};
+  SignalFallbackNotices signalNotices_;
 };
 
 }  // namespace gvins

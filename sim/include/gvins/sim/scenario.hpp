@@ -23,12 +23,15 @@
 #include "gvins/sim/imu_simulator.hpp"
 #include "gvins/sim/local_frame.hpp"
 #include "gvins/sim/recorded_trajectory.hpp"
+#include "gvins/sim/track_trajectory.hpp"
 #include "gvins/sim/urban_structure.hpp"
 #include "gvins/vio/sensor_yaml.hpp"
 
 namespace gvins::sim {
 
-enum class TrajectoryKind { Flight, Recorded };
+/// Flight: simulated motion; Recorded: EuRoC-style ground truth + real IMU; Track: a GNSS
+/// reference track + real IMU (track_trajectory.hpp), with the real rover GNSS files.
+enum class TrajectoryKind { Flight, Recorded, Track };
 enum class CameraOutput { Images, Features };
 
 struct Scenario {
@@ -42,6 +45,7 @@ struct Scenario {
   TrajectoryKind trajectory = TrajectoryKind::Flight;
   FlightSpec flight;
   RecordedTrajectoryConfig recorded;
+  TrackTrajectoryConfig track;
 
   ImuSimConfig imu;
   double cameraRate = 20.0;  ///< Hz

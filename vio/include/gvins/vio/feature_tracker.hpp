@@ -131,6 +131,21 @@ class FeatureTracker {
   const FeatureTrackerConfig& config() const { return cfg_; }
 
  private:
+  // The steps of process(): KLT of every track (trackPredicted: the first, predicted pass),
+  // template refinement, RANSAC; keepTracks drops tracks from every per-track vector.
+  void trackAll(const ImagePyramid& image, const Eigen::Matrix3d* R_cur_prev, std::vector<cv::Point2f>& cur,
+                std::vector<unsigned char>& status) const;
+  void trackPredicted(const ImagePyramid& image, const Eigen::Matrix3d* R_cur_prev,
+                      const std::vector<cv::Point2f>& start, std::vector<cv::Point2f>& cur,
+                      std::vector<unsigned char>& status) const;
+  unsigned char needsBackwardCheck(std::size_t i) const;
+  std::vector<unsigned char> alignTemplates(const std::vector<cv::Point2f>& before, std::vector<cv::Point2f>& cur,
+                                            const Eigen::Matrix3d* R_cur_prev);
+  bool epipolarInliers(const std::vector<cv::Point2f>& before, const std::vector<cv::Point2f>& cur,
+                       std::vector<unsigned char>& inlier) const;
+  void keepTracks(std::vector<cv::Point2f>& before, std::vector<cv::Point2f>& cur,
+                  const std::vector<unsigned char>& keep);
+
   CameraModel cam_;
   FeatureTrackerConfig cfg_;
   GridDetector detector_;
