@@ -24,6 +24,23 @@ std::string_view messageName(int type) {
   return it == kNames.end() ? std::string_view() : it->second;
 }
 
+void printNavigationSources(std::ostream& out, const ubx::NavigationAssembler& nav) {
+  if (nav.countsBySource().empty()) return;
+  out << "  gnssId/sigId  signal             message                     messages  records  check fail  unknown\n";
+  for (const auto& [src, c] : nav.countsBySource()) {
+    const ubx::NavigationSourceInfo info = ubx::navigationSourceInfo(src);
+    char ids[16];
+    std::snprintf(ids, sizeof ids, "%d/%d", src.gnssId, src.sigId);
+    out << "  " << std::left << std::setw(14) << ids << std::setw(19) << ubx::signalName(src.gnssId, src.sigId)
+        << std::setw(26) << info.message << std::right << std::setw(10) << c.messages;
+    if (info.decoded) {
+      out << std::setw(9) << c.ephemerides << std::setw(12) << c.parityFailures + c.crcFailures << std::setw(9)
+          << c.unknownMessages;
+    }
+    out << "\n";
+  }
+}
+
 void printSummary(std::ostream& out, const ubx::Decoder& dec, const SummaryExtras& ex, const std::string& name) {
   const ubx::DecoderStats& st = dec.stats();
   out << "UBX stream " << name << ": " << st.stream.bytes << " bytes\n";
@@ -73,6 +90,7 @@ void printSummary(std::ostream& out, const ubx::Decoder& dec, const SummaryExtra
   out << "SFRBX          " << st.sfrbx << " navigation messages: " << st.ephemerides << " ephemerides, "
       << nc.parityFailures << " parity and " << nc.crcFailures << " CRC failures, " << nc.skipped
       << " of systems not decoded, " << st.sfrbxUndated << " before the first RAWX epoch (no receive time)\n";
+  printNavigationSources(out, dec.navigationAssembler());
   if (ex.navPvt > 0) {
     out << "NAV-PVT        " << ex.navPvt << " (" << ex.navPvtFixes << " with gnssFixOK)";
     if (ex.lastPvt) {

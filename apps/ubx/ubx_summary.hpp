@@ -34,6 +34,10 @@ struct SummaryExtras {
 /// "RXM-RAWX" etc. for the messages a receiver commonly sends; "" otherwise.
 std::string_view messageName(int type);
 
+/// SFRBX navigation messages per gnssId/sigId (BeiDou GEO apart): what each carries, whether it
+/// is decoded, records, check failures and unknown pages.
+void printNavigationSources(std::ostream& out, const ubx::NavigationAssembler& nav);
+
 /// Per-message table, other protocols, time span, signals per system, errors.
 void printSummary(std::ostream& out, const ubx::Decoder& dec, const SummaryExtras& extras, const std::string& name);
 

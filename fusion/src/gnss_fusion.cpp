@@ -11,6 +11,7 @@
 #include "gvins/base/local_frame.hpp"
 #include "gvins/gnss/phase_windup.hpp"
 #include "gvins/sri/chi_square.hpp"
+#include "gnss_fusion_epoch.hpp"
 
 namespace gvins::fusion {
 namespace {
@@ -26,20 +27,6 @@ template <typename Scalar>
 void marginalizeBlock(vio::EstimatorBackend<Scalar>& est, sri::BlockId& id) {
   if (id.valid() && est.contains(id)) est.marginalize(std::span<const sri::BlockId>(&id, 1));
   id = {};
-}
-
-enum RowType : int { kPsr, kDopp, kDpsr, kDdcp, kVel, kFrame, kPhase };
-
-GnssTypeCount& countOf(GnssEpochReport& r, int type) {
-  switch (type) {
-    case kPsr: return r.psr;
-    case kDopp: return r.dopp;
-    case kDpsr: return r.dpsr;
-    case kDdcp: return r.ddcp;
-    case kVel: return r.vel;
-    case kPhase: return r.phase;
-    default: return r.frame;
-  }
 }
 
 }  // namespace
@@ -120,12 +107,9 @@ std::optional<Eigen::Matrix3d> GnssFusion<Scalar>::antennaCovariance(const vio::
     J.middleCols<3>(n) = k.J_lever.template topRows<3>();
     n += 3;
   }
-  Eigen::MatrixXd P;
-  try {
-    P = est.covariance(std::span<const sri::BlockId>(blocks)).template cast<double>();
-  } catch (const std::exception&) {
-    return std::nullopt;  // a block without information yet (sri_filter.hpp)
-  }
+  const std::span<const sri::BlockId> ids(blocks);
+  if (!est.informed(ids)) return std::nullopt;  // a block without information yet (sri_filter.hpp)
+  const Eigen::MatrixXd P = est.covariance(ids).template cast<double>();
   const auto Jb = J.leftCols(n);
   const Eigen::Matrix<double, 3, 9> Je = k.J_earlier.template topRows<3>();
   const Eigen::Matrix3d C_N = Jb * P * Jb.transpose() + Je * k.integrationCovariance * Je.transpose();
@@ -147,10 +131,8 @@ void GnssFusion<Scalar>::forgetState() {
   frameBlock_ = {};
   worldChange_.reset();
   leverBlock_ = {};
-  clockBlock_ = {};
-  isbBlock_ = {};
+  clocks_.forget();
   zwdBlock_ = {};
-  clockSystems_.clear();
   lastUpdate_.reset();
   gateRecovery_.reset();
   ambiguities_.clear();
@@ -169,18 +151,8 @@ std::optional<Eigen::Vector4d> GnssFusion<Scalar>::frame(const vio::EstimatorBac
 
 template <typename Scalar>
 std::optional<Eigen::VectorXd> GnssFusion<Scalar>::clocks(const vio::EstimatorBackend<Scalar>& est) const {
-  if (!clockBlock_.valid() || !current(est)) return std::nullopt;
-  return systemClocks(est);
-}
-
-template <typename Scalar>
-Eigen::VectorXd GnssFusion<Scalar>::systemClocks(const vio::EstimatorBackend<Scalar>& est) const {
-  const int n = static_cast<int>(clockSystems_.size());
-  const Eigen::VectorXd c = est.estimate(clockBlock_).vector.template cast<double>();
-  Eigen::VectorXd out = Eigen::VectorXd::Constant(n + 1, c[0]);
-  out[n] = c[1];
-  if (isbBlock_.valid()) out.segment(1, n - 1) += est.estimate(isbBlock_).vector.template cast<double>();
-  return out;
+  if (!clocks_.valid() || !current(est)) return std::nullopt;
+  return clocks_.values(est);
 }
 
 template <typename Scalar>
@@ -225,12 +197,8 @@ template <typename Scalar>
 bool GnssFusion<Scalar>::frameKnownInEnu(const vio::EstimatorBackend<Scalar>& est) const {
   const vio::ImuBlocks ib = est.newestImuBlocks();
   const std::array<sri::BlockId, 2> ids{ib.pose, frameBlock_};
-  Eigen::MatrixXd P;
-  try {
-    P = est.covariance(std::span<const sri::BlockId>(ids)).template cast<double>();
-  } catch (const std::exception&) {
-    return false;  // not informed (yet)
-  }
+  if (!est.informed(ids)) return false;  // not informed (yet)
+  const Eigen::MatrixXd P = est.covariance(ids).template cast<double>();
   const Eigen::Matrix3d Rz = yawRotation(static_cast<double>(est.estimate(frameBlock_).vector[0]));
   Eigen::Matrix<double, 3, 10> J = Eigen::Matrix<double, 3, 10>::Zero();  // ∂p_N/∂[δθ δp | ψ p_NW]
   J.block<3, 3>(0, 3) = Rz;
@@ -240,52 +208,6 @@ bool GnssFusion<Scalar>::frameKnownInEnu(const vio::EstimatorBackend<Scalar>& es
   const double sth = config_.frameYawSigmaDeg * constants::kDegToRad;
   const double sp = config_.frameReanchorPositionSigma;
   return P(6, 6) < sth * sth && Pn.diagonal().maxCoeff() < sp * sp;
-}
-
-template <typename Scalar>
-void GnssFusion<Scalar>::propagateClocks(vio::EstimatorBackend<Scalar>& est, const GpsTime& t) {
-  const double dt = t - clockTime_;
-  if (!clockBlock_.valid() || dt <= 0.0) return;
-  using Mat = typename sri::Propagation<Scalar>::Matrix;
-  Mat phi = Mat::Identity(2, 2);
-  phi(0, 1) = static_cast<Scalar>(dt);
-  // Bias b' = b + d·dt, drift d' = d: white-noise drift q_d and bias random walk q_b over dt
-  // (two-state clock model, e.g. Brown & Hwang, "Introduction to Random Signals and Applied
-  // Kalman Filtering", 4th ed., sec. 9.3). The inter-system biases are constant: only these two
-  // columns are replaced (and swept past the state) per epoch.
-  const double qb = std::pow(config_.clockBiasRandomWalk, 2), qd = std::pow(config_.clockDriftRandomWalk, 2);
-  Eigen::Matrix2d Q;
-  Q << qb * dt + qd * dt * dt * dt / 3.0, qd * dt * dt / 2.0, qd * dt * dt / 2.0, qd * dt;
-  const Eigen::VectorXd x = est.estimate(clockBlock_).vector.template cast<double>();
-  const Eigen::VectorXd xp = phi.template cast<double>() * x;
-  sri::Propagation<Scalar> step;
-  step.addNewBlock(sri::BlockSpec::vector("gnss_clock", 2),
-                   sri::BlockEstimate<Scalar>::fromVector(xp.template cast<Scalar>()));
-  step.setTransition(clockBlock_, phi);
-  step.setNoiseCovariance(Q.template cast<Scalar>());
-  step.marginalizeAfter(clockBlock_);
-  clockBlock_ = est.propagate(step, vio::ClientBlockRegion::kParameters).at(0);
-  clockTime_ = t;
-  // The inter-system biases: a random walk stepped every isbRenewalInterval seconds with the
-  // variance accumulated since the last step (Brown & Hwang, sec. 9.3: a Wiener process sampled
-  // at those instants; no columns swept in between).
-  const double di = t - isbTime_;
-  if (!isbBlock_.valid() || !(config_.isbRandomWalk > 0.0) || di < config_.isbRenewalInterval) return;
-  isbBlock_ = randomWalkStep(est, isbBlock_, "gnss_isb", static_cast<int>(clockSystems_.size()) - 1,
-                             config_.isbRandomWalk * config_.isbRandomWalk * di);
-  isbTime_ = t;
-}
-
-template <typename Scalar>
-sri::BlockId GnssFusion<Scalar>::randomWalkStep(vio::EstimatorBackend<Scalar>& est, sri::BlockId id, const char* name,
-                                                int size, double variance) {
-  using Mat = typename sri::Propagation<Scalar>::Matrix;
-  sri::Propagation<Scalar> step;
-  step.addNewBlock(sri::BlockSpec::vector(name, size), est.estimate(id));
-  step.setTransition(id, Mat::Identity(size, size));
-  step.setNoiseCovariance(Mat::Identity(size, size) * static_cast<Scalar>(variance));
-  step.marginalizeAfter(id);
-  return est.propagate(step, vio::ClientBlockRegion::kParameters).at(0);
 }
 
 template <typename Scalar>
@@ -346,38 +268,29 @@ void GnssFusion<Scalar>::dropAmbiguity(vio::EstimatorBackend<Scalar>& est, SatId
   ambiguities_.erase(it);
 }
 
-template <typename Scalar>
-vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scalar>& est, std::vector<GnssRow>& rows,
-                                                     const Eigen::MatrixXd& noise,
-                                                     const Eigen::Matrix<double, 9, 9>& intCov,
-                                                     std::vector<bool>& accepted, bool gate,
-                                                     const std::vector<sri::BlockId>& ambiguities) {
-  const vio::ImuBlocks ib = est.newestImuBlocks();
-  accepted.assign(rows.size(), false);
-  // The blocks GNSS rows touch: newest pose, velocity and bias, frame, lever arm, clocks (all at
-  // the back of the state); a row as a vector h over them, in this order.
-  std::vector<sri::BlockId> blocks{ib.pose, ib.velocity, ib.bias};
-  std::vector<int> dims{6, 3, 6};
-  const std::size_t nImu = blocks.size();  // the client blocks follow
-  int dim = 15;
-  auto addBlock = [&](sri::BlockId id, int size) {
+namespace {
+
+/// The blocks GNSS rows touch: newest pose, velocity and bias, frame, lever arm, clocks (all at
+/// the back of the state), then the ambiguities; a row as a vector h over them, in this order.
+struct RowLayout {
+  std::vector<sri::BlockId> blocks;
+  std::vector<int> dims;
+  std::size_t nImu = 0;  // the client blocks follow
+  int dim = 0;
+  int frameAt = -1, leverAt = -1, clockAt = -1, isbAt = -1, zwdAt = -1, ambiguityAt = -1;
+
+  /// Appends a block when valid; returns its column, -1 if not.
+  int add(sri::BlockId id, int size) {
+    if (!id.valid()) return -1;
+    const int at = dim;
     blocks.push_back(id);
     dims.push_back(size);
     dim += size;
-  };
-  const int frameAt = frameBlock_.valid() ? dim : -1;
-  if (frameBlock_.valid()) addBlock(frameBlock_, 4);
-  const int leverAt = leverBlock_.valid() ? dim : -1;
-  if (leverBlock_.valid()) addBlock(leverBlock_, 3);
-  const int clockAt = clockBlock_.valid() ? dim : -1;
-  if (clockBlock_.valid()) addBlock(clockBlock_, 2);
-  const int isbAt = isbBlock_.valid() ? dim : -1;  // with the clock, one per system after the first
-  if (isbBlock_.valid()) addBlock(isbBlock_, static_cast<int>(clockSystems_.size()) - 1);
-  const int zwdAt = zwdBlock_.valid() ? dim : -1;
-  if (zwdBlock_.valid()) addBlock(zwdBlock_, 1);
-  const int ambiguityAt = dim;
-  for (const sri::BlockId& id : ambiguities) addBlock(id, 1);
-  auto rowVector = [&](const GnssRow& r, auto&& h) {
+    return at;
+  }
+  /// h of row r (h.size() == dim).
+  template <typename Row>
+  void fill(const GnssRow& r, Row&& h) const {
     h.setZero();
     h.template head<15>() = r.H_imu;
     if (frameAt >= 0) h.template segment<4>(frameAt) = r.H_frame;
@@ -389,28 +302,88 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
     }
     if (zwdAt >= 0) h[zwdAt] = r.H_tropo;
     if (r.ambiguity >= 0) h[ambiguityAt + r.ambiguity] = 1.0;
-  };
+  }
+};
+
+/// Whitens the rows of A (the kept rows `keep` of Σ_m = noise) by Σ_m^-½: Σ_m is block diagonal
+/// (independent rows; the gpsvel triple and the DD phases correlated among themselves), each
+/// block is whitened by its own Cholesky factor. False if a block is not positive definite.
+bool whitenRows(Eigen::MatrixXd& A, const Eigen::MatrixXd& noise, const std::vector<int>& keep) {
+  const auto nk = static_cast<Eigen::Index>(keep.size());
+  auto sigma = [&](Eigen::Index a, Eigen::Index b) { return noise(keep[static_cast<std::size_t>(a)], keep[static_cast<std::size_t>(b)]); };
+  std::vector<std::pair<Eigen::Index, Eigen::Index>> groups;  // [begin, end) of coupled rows
+  for (Eigen::Index a = 0; a < nk;) {
+    Eigen::Index b = a + 1;
+    for (bool coupled = true; coupled && b < nk;) {
+      coupled = false;
+      for (Eigen::Index c = a; c < b && !coupled; ++c) coupled = sigma(b, c) != 0.0;
+      if (coupled) ++b;
+    }
+    groups.emplace_back(a, b);
+    a = b;
+  }
+  bool blockDiagonal = true;
+  for (const auto& g : groups) {
+    for (Eigen::Index a = g.first; a < g.second && blockDiagonal; ++a)
+      for (Eigen::Index c = g.second; c < nk && blockDiagonal; ++c) blockDiagonal = sigma(a, c) == 0.0;
+  }
+  if (!blockDiagonal) groups.assign(1, {0, nk});  // not expected: whiten with the whole Σ_m
+  for (const auto& [a, b] : groups) {
+    if (b - a == 1) {
+      const double s2 = sigma(a, a);
+      if (!(s2 > 0.0)) return false;
+      A.row(a) /= std::sqrt(s2);
+      continue;
+    }
+    Eigen::MatrixXd S(b - a, b - a);
+    for (Eigen::Index i = a; i < b; ++i)
+      for (Eigen::Index k = a; k < b; ++k) S(i - a, k - a) = sigma(i, k);
+    const Eigen::LLT<Eigen::MatrixXd> llt(S);
+    if (llt.info() != Eigen::Success) return false;
+    llt.matrixL().solveInPlace(A.middleRows(a, b - a));
+  }
+  return true;
+}
+
+}  // namespace
+
+template <typename Scalar>
+vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scalar>& est, std::vector<GnssRow>& rows,
+                                                     const Eigen::MatrixXd& noise,
+                                                     const Eigen::Matrix<double, 9, 9>& intCov,
+                                                     std::vector<bool>& accepted, bool gate,
+                                                     const std::vector<sri::BlockId>& ambiguities) {
+  const vio::ImuBlocks ib = est.newestImuBlocks();
+  accepted.assign(rows.size(), false);
+  RowLayout lay;
+  lay.blocks = {ib.pose, ib.velocity, ib.bias};
+  lay.dims = {6, 3, 6};
+  lay.nImu = lay.blocks.size();
+  lay.dim = 15;
+  lay.frameAt = lay.add(frameBlock_, 4);
+  lay.leverAt = lay.add(leverBlock_, 3);
+  lay.clockAt = lay.add(clocks_.clockBlock(), 2);
+  // With the clock, one per system after the first.
+  lay.isbAt = lay.add(clocks_.isbBlock(), static_cast<int>(clocks_.systems().size()) - 1);
+  lay.zwdAt = lay.add(zwdBlock_, 1);
+  lay.ambiguityAt = lay.dim;
+  for (const sri::BlockId& id : ambiguities) lay.add(id, 1);
+  const int dim = lay.dim;
 
   // Row gate: each row alone against the joint marginal covariance P of those blocks (cheap at
   // the back of the state): χ² = r² / (σ² + J Σ_k Jᵀ + h P hᵀ), the innovation test of the row.
   const bool rowGate = gate && config_.rowGate < 1.0;
+  // A block without information (e.g. a new frame block): rows pass the row gate.
+  const bool haveP = rowGate && est.informed(lay.blocks);
   Eigen::MatrixXd P;
-  bool haveP = false;
-  if (rowGate) {
-    try {
-      P = est.covariance(std::span<const sri::BlockId>(blocks)).template cast<double>();
-      haveP = true;
-    } catch (const std::exception&) {
-      // A block without information (e.g. a new frame block): rows pass the row gate.
-    }
-  }
+  if (haveP) P = est.covariance(lay.blocks).template cast<double>();
   const double q1 = rowGate ? rowGateQuantile_(config_.rowGate, 1) : 0.0;
   // All rows as [h | J] at once; the gate's h P hᵀ and J Σ_k Jᵀ of every row from two products.
   const auto nr = static_cast<Eigen::Index>(rows.size());
   Eigen::MatrixXd HJ(nr, dim + 9);
   for (Eigen::Index i = 0; i < nr; ++i) {
     const GnssRow& r = rows[static_cast<std::size_t>(i)];
-    rowVector(r, HJ.row(i).head(dim));
+    lay.fill(r, HJ.row(i).head(dim));
     HJ.row(i).tail<9>() = r.H_earlier;
   }
   Eigen::VectorXd gateVar(nr);  // σ² + J Σ_k Jᵀ + h P hᵀ per row
@@ -435,12 +408,10 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
   vio::BackendUpdate<Scalar> u;
   if (keep.empty()) return u;
 
-  // Whitening with Σ = Σ_m + J Σ_k Jᵀ (paper Sec. III-C). Σ_m is block diagonal (independent
-  // rows; the gpsvel triple and the DD phases correlated among themselves): each block is
-  // whitened by its own Cholesky factor. The integration error e ~ N(0, Σ_k) of the state at the
-  // measurement time, common to all rows, enters as a 9-column nuisance J L_k (Σ_k = L_k L_kᵀ)
-  // with prior rows I and is projected out: exactly the rows that the full Σ would give, without
-  // the n³ Cholesky of Σ.
+  // Whitening with Σ = Σ_m + J Σ_k Jᵀ (paper Sec. III-C), Σ_m block by block (whitenRows). The
+  // integration error e ~ N(0, Σ_k) of the state at the measurement time, common to all rows,
+  // enters as a 9-column nuisance J L_k (Σ_k = L_k L_kᵀ) with prior rows I and is projected out:
+  // exactly the rows that the full Σ would give, without the n³ Cholesky of Σ.
   const auto nk = static_cast<Eigen::Index>(keep.size());
   Eigen::MatrixXd A(nk, dim + 9 + 1);  // [h | J | r]
   for (Eigen::Index j = 0; j < nk; ++j) {
@@ -448,38 +419,7 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
     A.row(j).head(dim + 9) = HJ.row(static_cast<Eigen::Index>(i));
     A(j, dim + 9) = rows[i].residual;
   }
-  auto sigma = [&](Eigen::Index a, Eigen::Index b) { return noise(keep[static_cast<std::size_t>(a)], keep[static_cast<std::size_t>(b)]); };
-  std::vector<std::pair<Eigen::Index, Eigen::Index>> groups;  // [begin, end) of coupled rows
-  for (Eigen::Index a = 0; a < nk;) {
-    Eigen::Index b = a + 1;
-    for (bool coupled = true; coupled && b < nk;) {
-      coupled = false;
-      for (Eigen::Index c = a; c < b && !coupled; ++c) coupled = sigma(b, c) != 0.0;
-      if (coupled) ++b;
-    }
-    groups.emplace_back(a, b);
-    a = b;
-  }
-  bool blockDiagonal = true;
-  for (const auto& g : groups) {
-    for (Eigen::Index a = g.first; a < g.second && blockDiagonal; ++a)
-      for (Eigen::Index c = g.second; c < nk && blockDiagonal; ++c) blockDiagonal = sigma(a, c) == 0.0;
-  }
-  if (!blockDiagonal) groups.assign(1, {0, nk});  // not expected: whiten with the whole Σ_m
-  for (const auto& [a, b] : groups) {
-    if (b - a == 1) {
-      const double s2 = sigma(a, a);
-      if (!(s2 > 0.0)) return u;
-      A.row(a) /= std::sqrt(s2);
-      continue;
-    }
-    Eigen::MatrixXd S(b - a, b - a);
-    for (Eigen::Index i = a; i < b; ++i)
-      for (Eigen::Index k = a; k < b; ++k) S(i - a, k - a) = sigma(i, k);
-    const Eigen::LLT<Eigen::MatrixXd> llt(S);
-    if (llt.info() != Eigen::Success) return u;
-    llt.matrixL().solveInPlace(A.middleRows(a, b - a));
-  }
+  if (!whitenRows(A, noise, keep)) return u;
   // L_k of the (positive semi-definite) integration covariance.
   // (Pivoted LDLᵀ: Σ_k = Pᵀ L D Lᵀ P, L_k = Pᵀ L D^½; it may be singular. Any L_k with
   // L_k L_kᵀ = Σ_k gives the same projected rows.)
@@ -489,10 +429,11 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
       ldlt.transpositionsP().transpose() * (L * ldlt.vectorD().cwiseMax(0.0).cwiseSqrt().asDiagonal());
   const bool nuisance = Lk.norm() > 0.0;
   sri::Measurement<Scalar> m(static_cast<int>(nk) + (nuisance ? 9 : 0));
-  for (std::size_t bi = 0, col = 0; bi < blocks.size(); col += static_cast<std::size_t>(dims[bi]), ++bi) {
+  for (std::size_t bi = 0, col = 0; bi < lay.blocks.size(); col += static_cast<std::size_t>(lay.dims[bi]), ++bi) {
     const auto c = static_cast<Eigen::Index>(col);
-    if (bi >= nImu && A.middleCols(c, dims[bi]).isZero(0.0)) continue;  // e.g. the lever arm without excitation
-    m.jacobian(blocks[bi], dims[bi]).topRows(nk) = A.middleCols(c, dims[bi]).template cast<Scalar>();
+    const int d = lay.dims[bi];
+    if (bi >= lay.nImu && A.middleCols(c, d).isZero(0.0)) continue;  // e.g. the lever arm without excitation
+    m.jacobian(lay.blocks[bi], d).topRows(nk) = A.middleCols(c, d).template cast<Scalar>();
   }
   m.residual().head(nk) = A.col(dim + 9).template cast<Scalar>();
   if (nuisance) {
@@ -510,24 +451,8 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
 }
 
 template <typename Scalar>
-GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& est, const ObsEpoch& roverInput,
-                                                 const ObsEpoch* base, const EphemerisStore& nav) {
-  const auto wall0 = std::chrono::steady_clock::now();
-  GnssEpochReport rep;
-  rep.time = roverInput.time;
-  auto finish = [&]() {
-    if (leverBlock_.valid() && current(est)) leverLast_ = est.estimate(leverBlock_).vector.template cast<double>();
-    rep.stage = stage_;
-    for (; signalWarned_ < signalNotices_.messages().size(); ++signalWarned_)
-      rep.warnings.push_back(signalNotices_.messages()[signalWarned_]);
-    for (; jumpWarned_ < clockJumps_.warnings().size(); ++jumpWarned_) rep.warnings.push_back(clockJumps_.warnings()[jumpWarned_]);
-    for (; clockWarned_ < clockNotices_.size(); ++clockWarned_) rep.warnings.push_back(clockNotices_[clockWarned_]);
-    for (; gateWarned_ < gateRecovery_.warnings().size(); ++gateWarned_) rep.warnings.push_back(gateRecovery_.warnings()[gateWarned_]);
-    rep.elapsedMicroseconds =
-        std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - wall0).count();
-    return rep;
-  };
-  if (config_.mode == GnssFusionMode::kVio) return finish();
+const ObsEpoch& GnssFusion<Scalar>::prepareRover(const ObsEpoch& roverInput, const EphemerisStore& nav,
+                                                 GnssEpochReport& rep) {
   // Doppler sanity of the rover stream before any user (doppler_consistency.hpp): flipped signs
   // corrected, bad Dopplers dropped; the base's is checked inside the RTK module.
   checkedRover_ = roverInput;
@@ -558,65 +483,151 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
     smoothed_ = roverRaw;
     smoother_->apply(smoothed_, nav.glonassChannels());
   }
-  const ObsEpoch& rover = smoother_ ? smoothed_ : roverRaw;
-  if (nav_ != &nav) {
-    nav_ = &nav;
-    spp_ = std::make_unique<SppSolver>(nav);
-    if (config_.usesDifferences()) {
-      rtk_ = std::make_unique<RtkSolver>(nav);
-      rtk_->setRoverDopplerCheckedByCaller();  // checked at the input below, once
-      baseWarned_ = 0;
-      if (config_.basePosition) rtk_->setBasePosition(*config_.basePosition);
-    }
+  return smoother_ ? smoothed_ : roverRaw;
+}
+
+template <typename Scalar>
+void GnssFusion<Scalar>::useNavigation(const EphemerisStore& nav) {
+  if (nav_ == &nav) return;
+  nav_ = &nav;
+  spp_ = std::make_unique<SppSolver>(nav);
+  if (config_.usesDifferences()) {
+    rtk_ = std::make_unique<RtkSolver>(nav);
+    rtk_->setRoverDopplerCheckedByCaller();  // checked at the input (prepareRover), once
+    baseWarned_ = 0;
+    if (config_.basePosition) rtk_->setBasePosition(*config_.basePosition);
   }
+}
+
+template <typename Scalar>
+const SppSolution& GnssFusion<Scalar>::sppOf(Epoch& e) {
   // SPP only where it is used (frame initialisation, the clock before the clock block exists,
   // vio+gpsvel): in the tight stage with clocks it is not needed.
-  std::optional<SppSolution> sppCache;
-  auto sppNow = [&]() -> const SppSolution& {
-    if (!sppCache) sppCache = spp_->solve(rover);
-    return *sppCache;
-  };
-  // Dpsr needs only the single differences, formed in the tight stage about the antenna
-  // estimate (RtkSolver::differences: no float filter, no ambiguity resolution); Ddcp runs the
-  // whole RTK module for its fixed ambiguities.
-  const bool fullRtk = rtk_ && config_.mode == GnssFusionMode::kDoppDdcp;
-  // Satellite states of this epoch, computed once for the RTK module's differences and the
-  // fusion's satellite models.
-  TransmitStates states(nav, rover.time);
-  std::optional<double> baseAge;
+  if (!e.spp) e.spp = spp_->solve(e.rover);
+  return *e.spp;
+}
+
+template <typename Scalar>
+void GnssFusion<Scalar>::runRtk(Epoch& e) {
+  const RtkSolution rtk = rtk_->process(e.roverRaw, &e.states);
+  e.rep.rtkFixed = rtk.quality == SolutionQuality::Fix;
+  e.baseAge = rtk.age;
+  e.rtkProcessed = true;
+}
+
+template <typename Scalar>
+void GnssFusion<Scalar>::feedRtk(Epoch& e, const ObsEpoch* base) {
   // Ddcp runs the whole RTK module at every epoch until it fixes, then at the base epochs only
   // (no extrapolated base there) and holds the fix in between (RtkSolver::differencesWithHeldFix,
-  // in the tight stage below): the ambiguities are constant along the arcs.
-  bool rtkProcessed = false;
-  // Held and nothing new: a new base epoch within rtk_revalidate_interval of the last run takes
-  // the held fix too (in the tight stage below), unless its DD phases differ from that run's
-  // (a new satellite, a slip, another reference): then the module runs there.
-  bool rtkDeferred = false;
-  auto runRtk = [&] {
-    const RtkSolution rtk = rtk_->process(roverRaw, &states);
-    rep.rtkFixed = rtk.quality == SolutionQuality::Fix;
-    baseAge = rtk.age;
-    rtkProcessed = true;
-  };
-  if (rtk_) {
-    const bool newBase = base && (!lastBase_ || base->time > *lastBase_);
-    if (newBase) {
-      if (baseSmoother_) {
-        ObsEpoch b = *base;
-        baseSmoother_->apply(b, nav.glonassChannels());
-        rtk_->addBaseEpoch(b);
-      } else {
-        rtk_->addBaseEpoch(*base);
-      }
-      lastBase_ = base->time;
-      const std::vector<std::string>& w = rtk_->base().doppler().warnings();  // the base's Doppler check
-      for (; baseWarned_ < w.size(); ++baseWarned_) rep.warnings.push_back(w[baseWarned_]);
+  // in the tight stage): the ambiguities are constant along the arcs.
+  const bool newBase = base && (!lastBase_ || base->time > *lastBase_);
+  if (newBase) {
+    if (baseSmoother_) {
+      ObsEpoch b = *base;
+      baseSmoother_->apply(b, e.nav.glonassChannels());
+      rtk_->addBaseEpoch(b);
+    } else {
+      rtk_->addBaseEpoch(*base);
     }
-    const std::optional<GpsTime> lastRun = rtk_->lastProcessTime();
-    rtkDeferred = fullRtk && newBase && config_.rtkHoldFix && rtk_->hasHeldFix() && lastRun &&
-                  rover.time - *lastRun < config_.rtkRevalidateInterval;
-    if (fullRtk && !rtkDeferred && (newBase || !rtk_->hasHeldFix() || !config_.rtkHoldFix)) runRtk();
+    lastBase_ = base->time;
+    const std::vector<std::string>& w = rtk_->base().doppler().warnings();  // the base's Doppler check
+    for (; baseWarned_ < w.size(); ++baseWarned_) e.rep.warnings.push_back(w[baseWarned_]);
   }
+  const std::optional<GpsTime> lastRun = rtk_->lastProcessTime();
+  e.rtkDeferred = e.fullRtk && newBase && config_.rtkHoldFix && rtk_->hasHeldFix() && lastRun &&
+                  e.rover.time - *lastRun < config_.rtkRevalidateInterval;
+  if (e.fullRtk && !e.rtkDeferred && (newBase || !rtk_->hasHeldFix() || !config_.rtkHoldFix)) runRtk(e);
+}
+
+template <typename Scalar>
+void GnssFusion<Scalar>::resetAfterOutage(vio::EstimatorBackend<Scalar>& est, GnssEpochReport& rep) {
+  clocks_.marginalize(est);
+  marginalizeBlock(est, zwdBlock_);
+  if (rtk_) rtk_->reset();
+  while (!ambiguities_.empty()) dropAmbiguity(est, ambiguities_.begin()->first);
+  ambiguityTime_.reset();
+  rep.reset = true;
+  lastUpdate_.reset();
+}
+
+template <typename Scalar>
+bool GnssFusion<Scalar>::measurementTime(const vio::EstimatorBackend<Scalar>& est, Epoch& e) {
+  // Measurement time: the tag minus the receiver clock (GPS, or the first system estimated).
+  double dtr = 0.0;
+  if (clocks_.valid()) {
+    const Eigen::VectorXd c = est.estimate(clocks_.clockBlock()).vector.template cast<double>();
+    dtr = (c[0] + c[1] * (e.rover.time - clocks_.time())) / kC;  // [c·dt, c·ḋt]
+  } else if (sppOf(e).valid()) {
+    for (const auto& b : sppOf(e).clockBias) {
+      if (b) {
+        dtr = *b / kC;
+        break;
+      }
+    }
+  }
+  if (!(std::abs(dtr) < 0.01)) dtr = 0.0;
+  e.tMeas = e.rover.time - dtr;
+  e.t_ns = toNs(e.tMeas);
+  const std::int64_t newest = est.newestTime();
+  if (e.t_ns > newest) {
+    if (e.t_ns - newest > 10000000) return false;  // the driver sends epochs up to newestTime()
+    e.t_ns = newest;
+  }
+  return true;
+}
+
+template <typename Scalar>
+bool GnssFusion<Scalar>::frameUpdate(vio::EstimatorBackend<Scalar>& est, Epoch& e, const AntennaKinematics& k) {
+  const SppSolution& spp = sppOf(e);
+  if (!spp.valid()) return false;
+  GnssEpochReport& rep = e.rep;
+  GnssRowSet rows;
+  addPositionRows(anchor_, spp.position, spp.positionCovariance, k, rows);
+  if (spp.velocity.valid) addVelocityRows(anchor_, spp.velocity, k, kFrame, true, rows);
+  const std::span<const sri::BlockId> frameIds(&frameBlock_, 1);
+  // The rows are gated once the frame block has information.
+  std::vector<bool> acc;
+  const auto u = apply(est, rows.rows, rows.noise(), k.integrationCovariance, acc, est.informed(frameIds));
+  rep.chi2 = static_cast<double>(u.chi2);
+  rep.dof = u.dof;
+  for (std::size_t i = 0; i < rows.size(); ++i) (acc[i] ? rep.frame.used : rep.frame.rejected)++;
+  rep.updated = u.applied;
+  if (est.informed(frameIds)) {
+    const auto P = est.covariance(frameIds);
+    const double sth = config_.frameYawSigmaDeg * constants::kDegToRad;
+    if (static_cast<double>(P(0, 0)) < sth * sth) stage_ = GnssFusionStage::kTight;
+  }
+  return true;
+}
+
+template <typename Scalar>
+void GnssFusion<Scalar>::reportNotices(GnssEpochReport& rep) {
+  for (; signalWarned_ < signalNotices_.messages().size(); ++signalWarned_) rep.warnings.push_back(signalNotices_.messages()[signalWarned_]);
+  for (; jumpWarned_ < clockJumps_.warnings().size(); ++jumpWarned_) rep.warnings.push_back(clockJumps_.warnings()[jumpWarned_]);
+  for (; clockWarned_ < clockNotices_.size(); ++clockWarned_) rep.warnings.push_back(clockNotices_[clockWarned_]);
+  for (; gateWarned_ < gateRecovery_.warnings().size(); ++gateWarned_) rep.warnings.push_back(gateRecovery_.warnings()[gateWarned_]);
+}
+
+template <typename Scalar>
+GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& est, const ObsEpoch& roverInput,
+                                                 const ObsEpoch* base, const EphemerisStore& nav) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  GnssEpochReport rep;
+  rep.time = roverInput.time;
+  auto finish = [&]() {
+    if (leverBlock_.valid() && current(est)) leverLast_ = est.estimate(leverBlock_).vector.template cast<double>();
+    rep.stage = stage_;
+    reportNotices(rep);
+    rep.elapsedMicroseconds =
+        std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - wall0).count();
+    return rep;
+  };
+  if (config_.mode == GnssFusionMode::kVio) return finish();
+  const ObsEpoch& rover = prepareRover(roverInput, nav, rep);
+  useNavigation(nav);
+  Epoch e(checkedRover_, rover, nav, rep);
+  e.fullRtk = rtk_ && config_.mode == GnssFusionMode::kDoppDdcp;
+  if (rtk_) feedRtk(e, base);
   // A new estimator state (the VIO started again, EstimatorBackend::generation): the client
   // blocks are gone; frame, clocks, lever arm and ambiguities start again.
   if (!current(est)) {
@@ -633,42 +644,14 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
 
   // Outage: clocks and ambiguities start again.
   if (lastUpdate_ && rover.time - *lastUpdate_ > config_.outageReset && stage_ == GnssFusionStage::kTight) {
-    marginalizeBlock(est, clockBlock_);
-    marginalizeBlock(est, isbBlock_);
-    marginalizeBlock(est, zwdBlock_);
-    if (rtk_) rtk_->reset();
-    while (!ambiguities_.empty()) dropAmbiguity(est, ambiguities_.begin()->first);
-    ambiguityTime_.reset();
-    rep.reset = true;
-    lastUpdate_.reset();
+    resetAfterOutage(est, rep);
   }
-
-  // Measurement time: the tag minus the receiver clock (GPS, or the first system estimated).
-  double dtr = 0.0;
-  if (clockBlock_.valid()) {
-    const Eigen::VectorXd c = est.estimate(clockBlock_).vector.template cast<double>();
-    dtr = (c[0] + c[1] * (rover.time - clockTime_)) / kC;  // [c·dt, c·ḋt]
-  } else if (sppNow().valid()) {
-    for (const auto& b : sppNow().clockBias) {
-      if (b) {
-        dtr = *b / kC;
-        break;
-      }
-    }
-  }
-  if (!(std::abs(dtr) < 0.01)) dtr = 0.0;
-  const GpsTime tMeas = rover.time - dtr;
-  std::int64_t t_ns = toNs(tMeas);
-  const std::int64_t newest = est.newestTime();
-  if (t_ns > newest) {
-    if (t_ns - newest > 10000000) return finish();  // the driver sends epochs up to newestTime()
-    t_ns = newest;
-  }
-  rep.t_ns = t_ns;
+  if (!measurementTime(est, e)) return finish();
+  rep.t_ns = e.t_ns;
   ensureLever(est);
 
   if (stage_ == GnssFusionStage::kWaitingFix) {
-    if (!startFrame(est, sppNow(), t_ns)) return finish();
+    if (!startFrame(est, sppOf(e), e.t_ns)) return finish();
     stage_ = GnssFusionStage::kFrameInit;
   }
 
@@ -686,273 +669,15 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
     frameBlock_ = {};
   }
   GnssStateValues s;
-  if (!buildState(est, t_ns, s)) return finish();
+  if (!buildState(est, e.t_ns, s)) return finish();
   AntennaKinematics k = antennaKinematics(s);
-  std::vector<GnssRow> rows;
-  std::vector<int> types;
-  std::vector<double> diag;
-  Eigen::MatrixXd noise;
-
   if (stage_ == GnssFusionStage::kFrameInit) {
-    const SppSolution& spp = sppNow();
-    if (!spp.valid()) return finish();
-    const Eigen::Matrix3d R_NE = anchor_.R_EN.transpose();
-    const Eigen::Vector3d pN = R_NE * (spp.position - anchor_.ecef);
-    const int nv = spp.velocity.valid ? 3 : 0;
-    noise = Eigen::MatrixXd::Zero(3 + nv, 3 + nv);
-    for (int a = 0; a < 3; ++a) {
-      rows.push_back(positionRow(pN, a, k));
-      types.push_back(kFrame);
-    }
-    noise.block<3, 3>(0, 0) = R_NE * spp.positionCovariance * R_NE.transpose() + 0.25 * Eigen::Matrix3d::Identity();
-    if (nv) {
-      const Eigen::Vector3d vN = R_NE * spp.velocity.velocity;
-      for (int a = 0; a < 3; ++a) {
-        rows.push_back(velocityRow(vN, a, k));
-        types.push_back(kFrame);
-      }
-      noise.block<3, 3>(3, 3) = R_NE * spp.velocity.covariance * R_NE.transpose() + 0.0025 * Eigen::Matrix3d::Identity();
-    }
-    bool informed = true;
-    try {
-      const sri::BlockId id = frameBlock_;
-      (void)est.covariance(std::span<const sri::BlockId>(&id, 1));
-    } catch (const std::exception&) {
-      informed = false;
-    }
-    std::vector<bool> acc;
-    const auto u = apply(est, rows, noise, k.integrationCovariance, acc, informed);
-    rep.chi2 = static_cast<double>(u.chi2);
-    rep.dof = u.dof;
-    for (std::size_t i = 0; i < rows.size(); ++i) (acc[i] ? rep.frame.used : rep.frame.rejected)++;
-    rep.updated = u.applied;
-    try {
-      const sri::BlockId id = frameBlock_;
-      const auto P = est.covariance(std::span<const sri::BlockId>(&id, 1));
-      const double sth = config_.frameYawSigmaDeg * constants::kDegToRad;
-      if (static_cast<double>(P(0, 0)) < sth * sth) stage_ = GnssFusionStage::kTight;
-    } catch (const std::exception&) {
-    }
-  } else {
-    // Tight stage.
-    const SppSolution* sppVel = config_.mode == GnssFusionMode::kGpsVel ? &sppNow() : nullptr;
-    const bool needClocks = config_.usesDoppler();
-    std::vector<SatelliteModel> models = satelliteModels(rover, nav, k.x_E, &states);
-    if (needClocks && !clockBlock_.valid()) {
-      if (!initClocks(est, models, k, tMeas)) return finish();
-      rep.clocksInitialized = true;
-      for (SatelliteModel& m : models) m.clock = clockIndex(m.sat);
-    }
-    if (clockBlock_.valid()) propagateClocks(est, tMeas);
-    if (clockBlock_.valid() && !rep.clocksInitialized) {  // systems whose ephemerides came later
-      addLateClockSystems(est, models, k, tMeas);
-      for (SatelliteModel& m : models) m.clock = clockIndex(m.sat);
-    }
-    if (clockBlock_.valid() && config_.zwdState()) {
-      if (!zwdBlock_.valid()) {
-        Eigen::Matrix<Scalar, Eigen::Dynamic, 1> z = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>::Zero(1);
-        zwdBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_zwd", 1), sri::BlockEstimate<Scalar>::fromVector(z),
-                                 sri::Prior<Scalar>::stdDev(1, static_cast<Scalar>(config_.zwdSigma)));
-        zwdTime_ = tMeas;
-      }
-      propagateZwd(est, tMeas);
-      const double zwd = static_cast<double>(est.estimate(zwdBlock_).vector[0]);
-      for (SatelliteModel& m : models) m.troposphere += m.mapWet * zwd;
-    }
-    Eigen::VectorXd clk;
-    if (clockBlock_.valid()) clk = systemClocks(est);
-    const int n = static_cast<int>(clockSystems_.size());
-    const bool excited = config_.calibrateLeverArm &&
-                         (s.omegaMeasured - s.newest.bg).norm() >= config_.minRotationRate;
-    if (config_.usesDoppler()) {
-      for (const SatelliteModel& m : models) {
-        if (!m.hasDoppler) continue;
-        GnssRow r = dopplerRow(m, k, clk[n]);
-        if (!excited) r.H_lever.setZero();
-        rows.push_back(r);
-        types.push_back(kDopp);
-        diag.push_back(r.variance);
-      }
-    }
-    if (config_.usesPseudorange()) {
-      for (const SatelliteModel& m : models) {
-        if (m.clock < 0) continue;
-        GnssRow r = pseudorangeRow(m, k, clk[m.clock]);
-        r.H_lever.setZero();
-        rows.push_back(r);
-        types.push_back(kPsr);
-        diag.push_back(r.variance);
-      }
-    }
-    if (sppVel && sppVel->velocity.valid) {
-      const Eigen::Matrix3d R_NE = anchor_.R_EN.transpose();
-      const Eigen::Vector3d vN = R_NE * sppVel->velocity.velocity;
-      for (int a = 0; a < 3; ++a) {
-        GnssRow r = velocityRow(vN, a, k);
-        r.H_lever.setZero();
-        rows.push_back(r);
-        types.push_back(kVel);
-        diag.push_back(0.0);
-      }
-    }
-    // vio+dopp+ppp: ionosphere-free phase rows, one float ambiguity state per satellite arc.
-    std::vector<sri::BlockId> ambBlocks;
-    std::vector<SatId> ambSats;
-    if (ppp && clockBlock_.valid()) {
-      // Ambiguities of satellites on broadcast orbits and clocks follow their drifting errors.
-      std::vector<SatId> broadcast;
-      for (const SatelliteModel& m : models)
-        if (!m.precise && !m.ssr) broadcast.push_back(m.sat);
-      propagateAmbiguities(est, broadcast, tMeas);
-      // Satellites with a state first, then the others highest first (max_ambiguities).
-      std::vector<const SatelliteModel*> order;
-      for (const SatelliteModel& m : models) order.push_back(&m);
-      std::stable_sort(order.begin(), order.end(), [&](const SatelliteModel* a, const SatelliteModel* b) {
-        const bool ha = ambiguities_.count(a->sat) > 0, hb = ambiguities_.count(b->sat) > 0;
-        if (ha != hb) return ha;
-        return a->azel.elevation > b->azel.elevation;
-      });
-      for (const SatelliteModel* mp : order) {
-        const SatelliteModel& m = *mp;
-        if (!m.hasCarrier || m.clock < 0 || arcs_->samples(m.sat) == 0) continue;
-        const GpsTime start = rover.time - arcs_->arcLength(m.sat);
-        auto it = ambiguities_.find(m.sat);
-        if (it != ambiguities_.end() && std::abs(it->second.arcStart - start) > 1e-3) {
-          dropAmbiguity(est, m.sat);  // new arc: cycle slip, gap or signal change
-          it = ambiguities_.end();
-        }
-        if (it == ambiguities_.end()) {
-          if (config_.maxAmbiguities > 0 && static_cast<int>(ambiguities_.size()) >= config_.maxAmbiguities) continue;
-          // Centred on phase minus code (code model: + c·group delay), which differ by the
-          // ambiguity plus the code error. The arc may be older than the state (epochs before
-          // the VIO or the clocks were ready, a restart after rejections): its carrier-smoothed
-          // code carries those epochs' codes, weighted as the code rows are (each epoch as one
-          // measurement: σ/sqrt(n)) except for the orbit/clock error, a bias per satellite that no
-          // averaging reduces; a new arc starts from the raw code with a loose prior.
-          Eigen::Matrix<Scalar, Eigen::Dynamic, 1> x(1);
-          double code = m.pseudorange, sigma = config_.ambiguitySigma;
-          const SatObs* so = arcSmoothed_.find(m.sat);
-          const SignalObs* s1 = so ? so->find(m.code) : nullptr;
-          const SignalObs* s2 = so ? so->find(m.code2) : nullptr;
-          if (arcs_->samples(m.sat) > 1 && s1 && s2 && s1->hasCode() && s2->hasCode()) {
-            code = m.ifA1 * s1->pseudorange + m.ifA2 * s2->pseudorange;
-            const double nf = arcs_->noiseFactor(m.sat);
-            sigma = std::sqrt((m.codeVariance - m.ephemerisVariance) * nf * nf + m.ephemerisVariance);
-          }
-          x[0] = static_cast<Scalar>(m.carrierRange - (code - kC * m.groupDelay));
-          Ambiguity a;
-          // In front of the state: visual rows never reach those columns, and a state that ends
-          // with its arc is cheap to marginalize there.
-          a.id = est.addBlock(sri::BlockSpec::vector("gnss_ambiguity", 1), sri::BlockEstimate<Scalar>::fromVector(x),
-                              sri::Prior<Scalar>::stdDev(1, static_cast<Scalar>(sigma)), vio::ClientBlockRegion::kFront);
-          a.arcStart = start;
-          it = ambiguities_.emplace(m.sat, a).first;
-        }
-        it->second.lastRow = rover.time;
-        const double nAmb = static_cast<double>(est.estimate(it->second.id).vector[0]);
-        SatelliteModel mc = m;
-        if (config_.broadcastRecordChanges && !m.precise && !m.ssr) {
-          BroadcastRecordContinuity& r = it->second.records;
-          if (r.update(nav, m.sat, rover.time - m.pseudorange / kC, m.transmitTime, k.x_E).changed) ++rep.recordChanges;
-          mc.carrierRange += r.shift();
-        }
-        if (config_.phaseWindup) {
-          const double w = continueWindup(m.windup, it->second.windup);
-          it->second.windup = w;
-          mc.carrierRange -= m.windupWavelength * w;
-        }
-        GnssRow r = carrierPhaseRow(mc, k, clk[m.clock], nAmb);
-        r.H_lever.setZero();
-        r.ambiguity = static_cast<int>(ambBlocks.size());
-        ambBlocks.push_back(it->second.id);
-        ambSats.push_back(m.sat);
-        rows.push_back(r);
-        types.push_back(kPhase);
-        diag.push_back(r.variance);
-      }
-    }
-    const std::size_t nIndependent = rows.size();
-    std::vector<DoubleDifference> phase;
-    if (rtk_ && !fullRtk) baseAge = rtk_->differences(rover, k.x_E, &states);
-    if (fullRtk && !rtkProcessed) {
-      int heldFixed = 0;
-      baseAge = rtk_->differencesWithHeldFix(roverRaw, k.x_E, heldFixed, &states);
-      rep.rtkFixed = heldFixed > 0;
-      if (rtkDeferred && !rtk_->phasePairsAsProcessed()) runRtk();
-    }
-    if (baseAge && config_.usesDifferences() && *baseAge <= config_.maxBaseAge) {
-      const DdEpoch& e = rtk_->measurements();
-      // Base clock per system: mean base code OMC (clock + errors common to the base).
-      std::vector<double> sum(static_cast<std::size_t>(n), 0.0);
-      std::vector<int> cnt(static_cast<std::size_t>(n), 0);
-      for (const SingleDifference& sd : e.sd) {
-        const int c = clockIndex(sd.sat);
-        if (c < 0 || !sd.hasCode) continue;
-        sum[static_cast<std::size_t>(c)] += sd.baseCodeOmc;
-        cnt[static_cast<std::size_t>(c)]++;
-      }
-      for (const SingleDifference& sd : e.sd) {
-        const int c = clockIndex(sd.sat);
-        if (c < 0 || !sd.hasCode || sd.elevation < config_.elevationMaskDeg * constants::kDegToRad) continue;
-        const double cb = sum[static_cast<std::size_t>(c)] / cnt[static_cast<std::size_t>(c)];
-        GnssRow r = sdPseudorangeRow(sd, k, clk[c], cb);
-        r.clockBias = c;
-        rows.push_back(r);
-        types.push_back(kDpsr);
-        diag.push_back(r.variance);
-      }
-      if (config_.mode == GnssFusionMode::kDoppDdcp && rep.rtkFixed) {
-        for (const DoubleDifference& dd : e.phase) {
-          if (dd.ambiguityMeters) phase.push_back(dd);
-        }
-        for (const DoubleDifference& dd : phase) {
-          rows.push_back(ddPhaseRow(e, dd, k));
-          types.push_back(kDdcp);
-        }
-      }
-    }
-    noise = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(rows.size()), static_cast<Eigen::Index>(rows.size()));
-    for (std::size_t i = 0; i < diag.size(); ++i) noise(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)) = diag[i];
-    if (sppVel && sppVel->velocity.valid) {
-      const Eigen::Matrix3d R_NE = anchor_.R_EN.transpose();
-      const Eigen::Index o = static_cast<Eigen::Index>(nIndependent) - 3;
-      noise.block<3, 3>(o, o) = R_NE * sppVel->velocity.covariance * R_NE.transpose() + 0.0025 * Eigen::Matrix3d::Identity();
-    }
-    if (!phase.empty()) {
-      const Eigen::Index o = static_cast<Eigen::Index>(diag.size());
-      const Eigen::Index np = static_cast<Eigen::Index>(phase.size());
-      noise.block(o, o, np, np) = ddCovariance(rtk_->measurements(), phase, true);
-    }
-    if (!rows.empty()) {
-      std::vector<bool> acc;
-      const auto u = apply(est, rows, noise, k.integrationCovariance, acc, gateRecovery_.gated(rover.time), ambBlocks);
-      gateRecovery_.outcome(rover.time, u.applied, rows.size());  // re-acquisition (gnss_gate_recovery.hpp)
-      rep.chi2 = static_cast<double>(u.chi2);
-      rep.dof = u.dof;
-      rep.updated = u.applied;
-      for (std::size_t i = 0; i < rows.size(); ++i) {
-        GnssTypeCount& c = countOf(rep, types[i]);
-        (acc[i] ? c.used : c.rejected)++;
-        if (types[i] != kPhase) continue;
-        // A phase row gated out again and again: the ambiguity no longer fits (undetected slip,
-        // broadcast orbit/clock change); it restarts from phase minus code.
-        const SatId sat = ambSats[static_cast<std::size_t>(rows[i].ambiguity)];
-        Ambiguity& a = ambiguities_.at(sat);
-        a.rejections = acc[i] ? 0 : a.rejections + 1;
-        if (a.rejections >= config_.ambiguityResetRejections) dropAmbiguity(est, sat);
-      }
-    }
-    // Ambiguities of satellites without a phase row for a while (set, masked, lost).
-    for (auto it = ambiguities_.begin(); it != ambiguities_.end();) {
-      const SatId sat = it->first;
-      const bool stale = rover.time - it->second.lastRow > 10.0;
-      ++it;
-      if (stale) dropAmbiguity(est, sat);
-    }
-    rep.ambiguities = static_cast<int>(ambiguities_.size());
+    if (!frameUpdate(est, e, k)) return finish();
+  } else if (!tightUpdate(est, e, s, k)) {
+    return finish();
   }
   if (rep.updated) lastUpdate_ = rover.time;
-  if (buildState(est, t_ns, s)) {
+  if (buildState(est, e.t_ns, s)) {
     k = antennaKinematics(s);
     rep.antennaEcef = k.x_E;
     rep.antennaVelocityEcef = k.u_E;

@@ -18,17 +18,11 @@ namespace {
 
 constexpr double kC = constants::kSpeedOfLight;
 
-System clockSystemOf(System s) { return s == System::Qzss ? System::Gps : s; }
-
 }  // namespace
 
 template <typename Scalar>
 int GnssFusion<Scalar>::clockIndex(SatId sat) const {
-  const System s = clockSystemOf(sat.system);
-  for (std::size_t i = 0; i < clockSystems_.size(); ++i) {
-    if (clockSystems_[i] == s) return static_cast<int>(i);
-  }
-  return -1;
+  return clocks_.index(sat);
 }
 
 template <typename Scalar>
@@ -153,14 +147,10 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
 template <typename Scalar>
 bool GnssFusion<Scalar>::initClocks(vio::EstimatorBackend<Scalar>& est, const std::vector<SatelliteModel>& models,
                                     const AntennaKinematics& k, const GpsTime& t) {
-  clockSystems_.clear();
-  for (const SatelliteModel& m : models) {
-    const System s = clockSystemOf(m.sat.system);
-    if (std::find(clockSystems_.begin(), clockSystems_.end(), s) == clockSystems_.end()) clockSystems_.push_back(s);
-  }
-  std::sort(clockSystems_.begin(), clockSystems_.end());
-  if (clockSystems_.empty()) return false;
-  const int n = static_cast<int>(clockSystems_.size());
+  std::vector<SatId> sats;
+  for (const SatelliteModel& m : models) sats.push_back(m.sat);
+  if (!clocks_.setSystems(sats)) return false;
+  const int n = static_cast<int>(clocks_.systems().size());
   std::vector<ClockRow> rows;
   for (const SatelliteModel& m : models) {
     // Residuals of the measurement models at zero receiver clock and drift.
@@ -177,31 +167,8 @@ bool GnssFusion<Scalar>::initClocks(vio::EstimatorBackend<Scalar>& est, const st
     sigma[u] = i < n ? std::max(r.sigma[u], 5.0) : std::max(r.sigma[u], 0.3);
     if (r.inliers[u] == 0) sigma[u] = 1e3;
   }
-  // The prior: b_s ~ N(x_s, σ_s²) independently per system and the drift N(x_n, σ_n²), written
-  // on the receiver clock c = b_0 and the inter-system biases i_s = b_s − b_0: a prior on
-  // [c, ḋ] and, for each other system, the row (c + i_s − x_s)/σ_s on both blocks.
-  using Vec = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
-  Vec xc(2), sc(2);
-  xc << static_cast<Scalar>(x[0]), static_cast<Scalar>(x[static_cast<std::size_t>(n)]);
-  sc << static_cast<Scalar>(sigma[0]), static_cast<Scalar>(sigma[static_cast<std::size_t>(n)]);
-  clockBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_clock", 2), sri::BlockEstimate<Scalar>::fromVector(xc),
-                             sri::Prior<Scalar>::stdDevs(sc));
-  if (n > 1) {
-    Vec xi(n - 1);
-    for (int s = 1; s < n; ++s) xi[s - 1] = static_cast<Scalar>(x[static_cast<std::size_t>(s)] - x[0]);
-    isbBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_isb", n - 1), sri::BlockEstimate<Scalar>::fromVector(xi),
-                             sri::Prior<Scalar>::uninformative());
-    sri::Measurement<Scalar> m(n - 1);
-    Vec w(n - 1);
-    for (int s = 1; s < n; ++s) w[s - 1] = static_cast<Scalar>(1.0 / sigma[static_cast<std::size_t>(s)]);
-    m.jacobian(clockBlock_, 2).col(0) = w;  // (each jacobian() call may move the storage)
-    m.jacobian(isbBlock_, n - 1) = w.asDiagonal();
-    m.residual().setZero();  // at the estimates above, c + i_s = x_s
-    m.setWhitened();
-    est.update(m, 1.0);
-    isbTime_ = t;
-  }
-  clockTime_ = t;
+  // The prior on the receiver clock and the inter-system biases (GnssClockStates::create).
+  clocks_.create(est, x, sigma, t);
   return true;
 }
 
@@ -228,37 +195,8 @@ void GnssFusion<Scalar>::addLateClockSystems(vio::EstimatorBackend<Scalar>& est,
     for (double x : b) dev.push_back(std::abs(x - median));
     std::sort(dev.begin(), dev.end());
     const double sigma = std::max(5.0, 1.4826 * dev[dev.size() / 2]);  // as initClocks: SPP-level position error
-    const Eigen::VectorXd clocks = systemClocks(est);
-    const double isb = median - clocks[0];
-    const int n = static_cast<int>(clockSystems_.size());  // systems so far; the new one is index n
-    using Mat = typename sri::Propagation<Scalar>::Matrix;
-    using Vec = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
-    if (!isbBlock_.valid()) {
-      Vec x(1);
-      x << static_cast<Scalar>(isb);
-      isbBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_isb", 1), sri::BlockEstimate<Scalar>::fromVector(x),
-                               sri::Prior<Scalar>::stdDev(1, static_cast<Scalar>(sigma)));
-    } else {
-      // The ISB block grows by one: x_new = [I; 0] x_old + [0; isb] + w, w ~ N(0, diag(q, σ²)),
-      // q the random walk since the last step (floored at 1 mm²: the step needs a regular Q).
-      const Vec old = est.estimate(isbBlock_).vector;
-      Vec x(n);
-      x.head(n - 1) = old;
-      x[n - 1] = static_cast<Scalar>(isb);
-      Mat phi = Mat::Zero(n, n - 1);
-      phi.topRows(n - 1).setIdentity();
-      const double q = std::max(config_.isbRandomWalk * config_.isbRandomWalk * std::max(t - isbTime_, 0.0), 1e-6);
-      Mat Q = Mat::Identity(n, n) * static_cast<Scalar>(q);
-      Q(n - 1, n - 1) = static_cast<Scalar>(sigma * sigma);
-      sri::Propagation<Scalar> step;
-      step.addNewBlock(sri::BlockSpec::vector("gnss_isb", n), sri::BlockEstimate<Scalar>::fromVector(x));
-      step.setTransition(isbBlock_, phi);
-      step.setNoiseCovariance(Q);
-      step.marginalizeAfter(isbBlock_);
-      isbBlock_ = est.propagate(step, vio::ClientBlockRegion::kParameters).at(0);
-    }
-    isbTime_ = t;
-    clockSystems_.push_back(s);
+    const double isb = median - clocks_.values(est)[0];
+    clocks_.addSystem(est, s, isb, sigma, t, config_);
     char buf[200];
     std::snprintf(buf, sizeof buf,
                   "GNSS clocks: %s joins late (%zu satellites; its ephemerides arrived after the clocks started), "

@@ -480,6 +480,36 @@ RtkSolution RtkSolver::process(const ObsEpoch& rover, TransmitStates* states) {
   return sol;
 }
 
+Eigen::Vector3d RtkSolver::updateWithOutlierRejection(Eigen::Vector3d x0, RtkSolution& sol) {
+  // Measurement update with post-fit outlier rejection (redone from the saved state). When the
+  // update moves the position by more than kRelinearize (a poor first position, e.g. without SPP)
+  // it is redone about the updated position: ranges are non-linear at that scale.
+  constexpr double kRelinearize = 1.0;
+  const Filter predicted = filter_;
+  const auto predictedAmb = amb_;
+  Filter saved;
+  std::unordered_map<std::uint32_t, Ambiguity> savedAmb;
+  Eigen::Vector3d xf = x0;
+  for (int iteration = 0; iteration < 3; ++iteration) {
+    for (int round = 0;; ++round) {
+      manageAmbiguities(x0, sol);
+      saved = filter_;
+      savedAmb = amb_;
+      measurementUpdate(x0);
+      if (round >= cfg_.maxOutlierRounds || !rejectOutlier(sol)) break;
+      filter_ = saved;
+      amb_ = savedAmb;
+    }
+    xf = positionEstimate();
+    if ((xf - x0).norm() < kRelinearize || iteration == 2) break;
+    filter_ = predicted;
+    amb_ = predictedAmb;
+    filter_.setEstimate(pos_, sri::BlockEstimate<double>::fromVector(xf));
+    x0 = xf;
+  }
+  return xf;
+}
+
 RtkSolution RtkSolver::processEpoch(const ObsEpoch& rover, TransmitStates* states) {
   fixBefore_ = std::move(fixNow_);
   fixNow_.clear();
@@ -534,7 +564,7 @@ RtkSolution RtkSolver::processEpoch(const ObsEpoch& rover, TransmitStates* state
   }
   if (spp.velocity.valid) lastVelocity_ = spp.velocity.velocity;
 
-  Eigen::Vector3d x0 = positionEstimate();
+  const Eigen::Vector3d x0 = positionEstimate();
   builder_.form(rover, roverSlips_, snapshot_, basePos, x0, dd_, states);
 
   // Prefit gate on DD code (gross errors, multipath spikes), widened by the uncertainty of the
@@ -562,32 +592,7 @@ RtkSolution RtkSolver::processEpoch(const ObsEpoch& rover, TransmitStates* state
   }
   if (sats.size() < 4) return single(RtkIssue::NoCommonSatellites);
 
-  // Measurement update with post-fit outlier rejection (redone from the saved state). When the
-  // update moves the position by more than kRelinearize (a poor first position, e.g. without SPP)
-  // it is redone about the updated position: ranges are non-linear at that scale.
-  constexpr double kRelinearize = 1.0;
-  const Filter predicted = filter_;
-  const auto predictedAmb = amb_;
-  Filter saved;
-  std::unordered_map<std::uint32_t, Ambiguity> savedAmb;
-  Eigen::Vector3d xf = x0;
-  for (int iteration = 0; iteration < 3; ++iteration) {
-    for (int round = 0;; ++round) {
-      manageAmbiguities(x0, sol);
-      saved = filter_;
-      savedAmb = amb_;
-      measurementUpdate(x0);
-      if (round >= cfg_.maxOutlierRounds || !rejectOutlier(sol)) break;
-      filter_ = saved;
-      amb_ = savedAmb;
-    }
-    xf = positionEstimate();
-    if ((xf - x0).norm() < kRelinearize || iteration == 2) break;
-    filter_ = predicted;
-    amb_ = predictedAmb;
-    filter_.setEstimate(pos_, sri::BlockEstimate<double>::fromVector(xf));
-    x0 = xf;
-  }
+  const Eigen::Vector3d xf = updateWithOutlierRejection(x0, sol);
 
   if (spp.valid() && (xf - spp.position).norm() > cfg_.maxSppDeviation) {
     ++counters_.filterResets;

@@ -201,294 +201,307 @@ struct LsqResult {
 
 }  // namespace
 
-SppSolution SppSolver::solve(const ObsEpoch& epoch) {
-  SppSolution sol;
-  sol.time = epoch.time;
-  sol.solutionTime = epoch.time;
-  const SppConfig& cfg = config_;
-  std::vector<Measurement> meas;
-  meas.reserve(epoch.sats.size());
-  if (!gatherMeasurements(epoch, sol, meas)) {
-    sol.status = SppStatus::NoObservations;
-    return sol;
-  }
-  const int n = static_cast<int>(meas.size());
+/// One epoch's solution (SppSolver::solve): the model values of the measurements, the clock
+/// columns, the Gauss-Newton iterations, fault exclusion, robust re-weighting and the outputs.
+class SppSolver::Fit {
+ public:
+  using SparseRow = detail::NormalEquations<kMaxUnknowns>::SparseRow;
 
-  // Starting point: last solution within 10 minutes, else the a-priori position, else the centre.
-  Eigen::Vector3d x0 = Eigen::Vector3d::Zero();
-  if (last_ && std::abs(epoch.time - lastTime_) < 600.0) x0 = *last_;
-  else if (initial_) x0 = *initial_;
+  Fit(const SppSolver& solver, const ObsEpoch& epoch, std::vector<Measurement>& meas, SppSolution& sol)
+      : cfg(solver.config_),
+        epoch(epoch),
+        meas(meas),
+        sol(sol),
+        isb(solver.isb_),
+        ionoPar(solver.nav_.ionosphere()),
+        n(static_cast<int>(meas.size())),
+        // Zenith ionosphere correction to the broadcast model as an extra unknown (with a prior).
+        estIono(cfg.ionosphereEstimation.enabled && cfg.ionosphere != IonosphereOption::Off && ionoPar.gps.has_value()) {}
 
-  const IonosphereParameters& ionoPar = nav_.ionosphere();
-  // Zenith ionosphere correction to the broadcast model as an extra unknown (with a prior).
-  const bool estIono = cfg.ionosphereEstimation.enabled && cfg.ionosphere != IonosphereOption::Off && ionoPar.gps.has_value();
+  /// Updates az/el, atmospheric delays, variances and the mask flag of every measurement at x.
+  /// Model values change by < 1 mm when the position moves by less than a metre (elevations by
+  /// < 2e-7 rad), so they are refreshed only after larger moves.
+  void updateModels(const Eigen::Vector3d& x);
+  /// Clock columns for the systems with active measurements.
+  void assignColumns(const std::vector<char>& use);
+  /// Reference clock: GPS when present, else the system with the most measurements.
+  int referenceSystem(const std::vector<char>& use) const;
+  /// One Gauss-Newton step at state (x, clocks) using the frozen model values.
+  /// Returns the increment and the statistics of the linearisation point.
+  LsqResult lsqStep(const Eigen::Vector3d& x, const VecN& clk, double ion, const std::vector<char>& use,
+                    bool wantResiduals);
+  /// Full iteration to convergence for a subset; models are refreshed when `refresh` is set.
+  LsqResult iterate(std::vector<char>& use, bool refresh, int maxIter, Eigen::Vector3d& xs, VecN& clks, double& ion);
+  /// Fault detection and exclusion from the converged solution; false (sol.status set) if the
+  /// solution on the remaining measurements fails.
+  bool excludeFaults();
+  /// Robust re-weighting of the measurements used (RobustEstimation).
+  void reweight();
+  /// Position, covariance, clocks and residuals into sol; false (sol.status set) if the
+  /// geometry is too weak.
+  bool writeSolution();
+  /// Doppler velocity at the solution from the measurements used.
+  void solveVelocity();
+
+  const SppConfig& cfg;
+  const ObsEpoch& epoch;
+  std::vector<Measurement>& meas;
+  SppSolution& sol;
+  const std::array<Isb, kNumSystems>& isb;
+  const IonosphereParameters& ionoPar;
+  const int n;
+  const bool estIono;
   double ionoPriorVar = 1.0;
-
-  // Updates az/el, atmospheric delays, variances and the mask flag of every measurement at x.
-  // Model values change by < 1 mm when the position moves by less than a metre (elevations by
-  // < 2e-7 rad), so they are refreshed only after larger moves.
   std::optional<Eigen::Vector3d> modelPoint;
-  auto updateModels = [&](const Eigen::Vector3d& x) {
-    if (modelPoint && (x - *modelPoint).norm() < 0.5) return;
-    modelPoint = x;
-    const bool surface = nearSurface(x);
-    // Station-dependent parts of the models, computed once for all satellites.
-    std::optional<SatelliteObservationModel> model;
-    if (surface) {
-      ObservationModelOptions mo;
-      mo.troposphere = cfg.troposphere != TroposphereOption::Saastamoinen ? TroposphereMeteo::Off
-                       : cfg.climatologicalMeteo                         ? TroposphereMeteo::Climatology
-                                                                         : TroposphereMeteo::StandardAtmosphere;
-      mo.relativeHumidity = cfg.relativeHumidity;
-      mo.broadcastIonosphere = cfg.ionosphere != IonosphereOption::Off;
-      model.emplace(x, epoch.time, mo, &ionoPar);
-    }
-    if (surface && estIono && ionoPar.gps) {
-      const double iz = klobucharDelayL1(*ionoPar.gps, model->geodetic(), AzEl{0.0, 0.5 * constants::kPi}, epoch.time);
-      ionoPriorVar = std::pow(std::max(cfg.ionosphereEstimation.priorFraction * iz, cfg.ionosphereEstimation.minPriorSigma), 2);
-    }
-    for (Measurement& m : meas) {
-      m.iono = 0.0;
-      m.tropo = 0.0;
-      double ionoVar = 0.0, tropoVar = 0.0;
-      m.ionoMap = 0.0;
-      if (surface) {
-        // An ionosphere-free pseudorange (frequency 0) gets no ionosphere term.
-        const SatelliteModelTerms t = model->terms(m.state.position, m.sat.system, m.ionosphereFree ? 0.0 : m.frequency);
-        m.azel = t.azel;
-        m.active = m.azel.elevation >= cfg.elevationMask;
-        if (model->troposphere().valid()) {
-          m.tropo = t.troposphere.slant;
-          const double e = cfg.troposphereZenithError * t.troposphere.mapHydrostatic;
-          tropoVar = e * e;
-        }
-        if (!m.ionosphereFree && cfg.ionosphere != IonosphereOption::Off) {
-          m.iono = t.ionosphere.slant;
-          const double e = cfg.ionosphereModelError * m.iono;
-          ionoVar = e * e;
-          if (m.iono == 0.0) ionoVar = 25.0;  // no model available: ~5 m slant delay unaccounted
-          m.ionoMap = t.ionosphere.mapL1;  // the obliquity scaled to the frequency
-        }
-      } else {
-        m.azel = AzEl{0.0, 0.5 * constants::kPi};
-        m.active = true;
-      }
-      double var = cfg.weighting.codeVariance(m.sat.system, m.azel.elevation, m.snr) * m.noiseFactor * m.noiseFactor;
-      var += ionoVar + tropoVar;
-      double eph = m.state.precise || m.state.ssr ? cfg.preciseEphemerisError[systemIndex(m.sat.system)]
-                                   : cfg.ephemerisError[systemIndex(m.sat.system)];
-      if (!m.state.precise && !m.state.ssr && m.state.accuracy > cfg.ephemerisAlarmAccuracy && cfg.ephemerisAlarmAccuracy > 0.0) {
-        eph = std::max(eph, std::min(m.state.accuracy, 1000.0));
-      }
-      var += eph * eph;
-      m.variance = var * m.inflation;
-    }
-  };
-
-  // Clock columns for the systems with active measurements.
   std::array<int, kNumSystems> col{};
   std::vector<int> colSystems;
-  auto assignColumns = [&](const std::vector<char>& use) {
-    col.fill(-1);
-    colSystems.clear();
-    for (int i = 0; i < n; ++i) {
-      if (!use[i]) continue;
-      if (col[meas[i].sys] < 0) {
-        col[meas[i].sys] = static_cast<int>(colSystems.size());
-        colSystems.push_back(meas[i].sys);
-      }
-    }
-  };
-  // Reference clock: GPS when present, else the system with the most measurements.
-  auto referenceSystem = [&](const std::vector<char>& use) {
-    if (col[systemIndex(System::Gps)] >= 0) return systemIndex(System::Gps);
-    std::array<int, kNumSystems> cnt{};
-    for (int i = 0; i < n; ++i) cnt[meas[i].sys] += use[i] ? 1 : 0;
-    return static_cast<int>(std::max_element(cnt.begin(), cnt.end()) - cnt.begin());
-  };
-
-  // One Gauss-Newton step at state (x, clocks) using the frozen model values.
-  // Returns the increment and the statistics of the linearisation point.
   detail::NormalEquations<kMaxUnknowns> ne;
-  using SparseRow = detail::NormalEquations<kMaxUnknowns>::SparseRow;
   std::vector<std::pair<SparseRow, double>> rows;  // for residual normalisation
   std::vector<double> resid;
-  auto lsqStep = [&](const Eigen::Vector3d& x, const VecN& clk, double ion, const std::vector<char>& use,
-                     bool wantResiduals) {
-    LsqResult r;
-    const int nc = static_cast<int>(colSystems.size());
-    const int m = 3 + nc + (estIono ? 1 : 0);
-    r.nUnknowns = m;
-    // Normal equations accumulated row by row (rows have 4-5 non-zero entries).
-    ne.reset(m);
-    SparseRow h;
-    rows.clear();
-    resid.assign(wantResiduals ? n : 0, 0.0);
-    double chi2 = 0.0;
-    int nobs = 0;
+  // The solution: position, clocks, zenith ionosphere, the measurements used, the last fit.
+  Eigen::Vector3d x = Eigen::Vector3d::Zero();
+  VecN clk;
+  double ion = 0.0;
+  std::vector<char> use;
+  LsqResult last;
+};
+
+namespace {
+SppStatus statusForFailure(const LsqResult& r) {
+  return r.nObs < r.nUnknowns ? SppStatus::NotEnoughSatellites : SppStatus::NoConvergence;
+}
+}  // namespace
+
+void SppSolver::Fit::updateModels(const Eigen::Vector3d& x) {
+  if (modelPoint && (x - *modelPoint).norm() < 0.5) return;
+  modelPoint = x;
+  const bool surface = nearSurface(x);
+  // Station-dependent parts of the models, computed once for all satellites.
+  std::optional<SatelliteObservationModel> model;
+  if (surface) {
+    ObservationModelOptions mo;
+    mo.troposphere = cfg.troposphere != TroposphereOption::Saastamoinen ? TroposphereMeteo::Off
+                     : cfg.climatologicalMeteo                         ? TroposphereMeteo::Climatology
+                                                                       : TroposphereMeteo::StandardAtmosphere;
+    mo.relativeHumidity = cfg.relativeHumidity;
+    mo.broadcastIonosphere = cfg.ionosphere != IonosphereOption::Off;
+    model.emplace(x, epoch.time, mo, &ionoPar);
+  }
+  if (surface && estIono && ionoPar.gps) {
+    const double iz = klobucharDelayL1(*ionoPar.gps, model->geodetic(), AzEl{0.0, 0.5 * constants::kPi}, epoch.time);
+    ionoPriorVar = std::pow(std::max(cfg.ionosphereEstimation.priorFraction * iz, cfg.ionosphereEstimation.minPriorSigma), 2);
+  }
+  for (Measurement& m : meas) {
+    m.iono = 0.0;
+    m.tropo = 0.0;
+    double ionoVar = 0.0, tropoVar = 0.0;
+    m.ionoMap = 0.0;
+    if (surface) {
+      // An ionosphere-free pseudorange (frequency 0) gets no ionosphere term.
+      const SatelliteModelTerms t = model->terms(m.state.position, m.sat.system, m.ionosphereFree ? 0.0 : m.frequency);
+      m.azel = t.azel;
+      m.active = m.azel.elevation >= cfg.elevationMask;
+      if (model->troposphere().valid()) {
+        m.tropo = t.troposphere.slant;
+        const double e = cfg.troposphereZenithError * t.troposphere.mapHydrostatic;
+        tropoVar = e * e;
+      }
+      if (!m.ionosphereFree && cfg.ionosphere != IonosphereOption::Off) {
+        m.iono = t.ionosphere.slant;
+        const double e = cfg.ionosphereModelError * m.iono;
+        ionoVar = e * e;
+        if (m.iono == 0.0) ionoVar = 25.0;  // no model available: ~5 m slant delay unaccounted
+        m.ionoMap = t.ionosphere.mapL1;  // the obliquity scaled to the frequency
+      }
+    } else {
+      m.azel = AzEl{0.0, 0.5 * constants::kPi};
+      m.active = true;
+    }
+    double var = cfg.weighting.codeVariance(m.sat.system, m.azel.elevation, m.snr) * m.noiseFactor * m.noiseFactor;
+    var += ionoVar + tropoVar;
+    double eph = m.state.precise || m.state.ssr ? cfg.preciseEphemerisError[systemIndex(m.sat.system)]
+                                 : cfg.ephemerisError[systemIndex(m.sat.system)];
+    if (!m.state.precise && !m.state.ssr && m.state.accuracy > cfg.ephemerisAlarmAccuracy && cfg.ephemerisAlarmAccuracy > 0.0) {
+      eph = std::max(eph, std::min(m.state.accuracy, 1000.0));
+    }
+    var += eph * eph;
+    m.variance = var * m.inflation;
+  }
+}
+
+void SppSolver::Fit::assignColumns(const std::vector<char>& use) {
+  col.fill(-1);
+  colSystems.clear();
+  for (int i = 0; i < n; ++i) {
+    if (!use[i]) continue;
+    if (col[meas[i].sys] < 0) {
+      col[meas[i].sys] = static_cast<int>(colSystems.size());
+      colSystems.push_back(meas[i].sys);
+    }
+  }
+}
+
+int SppSolver::Fit::referenceSystem(const std::vector<char>& use) const {
+  if (col[systemIndex(System::Gps)] >= 0) return systemIndex(System::Gps);
+  std::array<int, kNumSystems> cnt{};
+  for (int i = 0; i < n; ++i) cnt[meas[i].sys] += use[i] ? 1 : 0;
+  return static_cast<int>(std::max_element(cnt.begin(), cnt.end()) - cnt.begin());
+}
+
+LsqResult SppSolver::Fit::lsqStep(const Eigen::Vector3d& x, const VecN& clk, double ion, const std::vector<char>& use,
+                                  bool wantResiduals) {
+  LsqResult r;
+  const int nc = static_cast<int>(colSystems.size());
+  const int m = 3 + nc + (estIono ? 1 : 0);
+  r.nUnknowns = m;
+  // Normal equations accumulated row by row (rows have 4-5 non-zero entries).
+  ne.reset(m);
+  SparseRow h;
+  rows.clear();
+  resid.assign(wantResiduals ? n : 0, 0.0);
+  double chi2 = 0.0;
+  int nobs = 0;
+  for (int i = 0; i < n; ++i) {
+    if (!use[i]) continue;
+    const Measurement& mm = meas[i];
+    const Eigen::Vector3d d = mm.state.position - x;
+    const double rho = d.norm();
+    const Eigen::Vector3d e = d / rho;
+    const int c = col[mm.sys];
+    const double pred = rho + sagnacRangeCorrection(mm.state.position, x) + clk[c] - kC * mm.satClock + mm.iono +
+                        mm.ionoMap * ion + mm.tropo;
+    const double v = mm.pseudorange - pred;
+    const double w = 1.0 / mm.variance;
+    h.nnz = 0;
+    h.push(0, -e.x());
+    h.push(1, -e.y());
+    h.push(2, -e.z());
+    h.push(3 + c, 1.0);
+    if (estIono) h.push(3 + nc, mm.ionoMap);
+    ne.addRow(h, v, w);
+    chi2 += w * v * v;
+    ++nobs;
+    if (wantResiduals) {
+      resid[i] = v;
+      rows.emplace_back(h, mm.variance);
+    }
+  }
+  // Inter-system bias priors: clk_s - clk_ref = isb_s - isb_ref.
+  const int ref = referenceSystem(use);
+  const bool refKnown = ref == systemIndex(System::Gps) || isb[ref].known;
+  if (cfg.isbPriorSigma > 0.0 && refKnown) {
+    for (int s : colSystems) {
+      if (s == ref || !isb[s].known) continue;
+      const double dt = std::abs(epoch.time - isb[s].time);
+      double var = isb[s].variance + cfg.isbRandomWalk * dt;
+      double target = isb[s].value;
+      if (ref != systemIndex(System::Gps)) {
+        var += isb[ref].variance + cfg.isbRandomWalk * std::abs(epoch.time - isb[ref].time);
+        target -= isb[ref].value;
+      }
+      var = std::max(var, cfg.isbPriorSigma * cfg.isbPriorSigma);
+      const double v = target - (clk[col[s]] - clk[col[ref]]);
+      const double w = 1.0 / var;
+      h.nnz = 0;
+      if (col[s] < col[ref]) {  // columns ascending
+        h.push(3 + col[s], 1.0);
+        h.push(3 + col[ref], -1.0);
+      } else {
+        h.push(3 + col[ref], -1.0);
+        h.push(3 + col[s], 1.0);
+      }
+      ne.addRow(h, v, w);
+      chi2 += w * v * v;
+      ++nobs;
+    }
+  }
+  if (estIono) {
+    const double v = -ion;
+    const double w = 1.0 / ionoPriorVar;
+    h.nnz = 0;
+    h.push(3 + nc, 1.0);
+    ne.addRow(h, v, w);
+    chi2 += w * v * v;
+    ++nobs;
+  }
+  r.nObs = nobs;
+  r.chi2 = chi2;
+  if (nobs < m) return r;
+  if (!ne.factor(1e-12)) return r;
+  r.x.resize(m);
+  ne.solve(r.x.data());
+  if (!r.x.allFinite()) return r;
+  if (wantResiduals) {
+    // The covariance only with the statistics: the iterations use the increment alone.
+    r.cov.resize(m, m);
+    ne.inverse(r.cov.data(), m);
+    if (!r.cov.allFinite()) return r;
+  }
+  r.ok = true;
+  if (wantResiduals) {
+    // Normalised post-fit residuals of the linearised problem: v_post = v - H dx,
+    // var(v_post) = sigma^2 - h Q h^T.
+    r.normResidual.assign(n, 0.0);
+    int k = 0;
     for (int i = 0; i < n; ++i) {
       if (!use[i]) continue;
-      const Measurement& mm = meas[i];
-      const Eigen::Vector3d d = mm.state.position - x;
-      const double rho = d.norm();
-      const Eigen::Vector3d e = d / rho;
-      const int c = col[mm.sys];
-      const double pred = rho + sagnacRangeCorrection(mm.state.position, x) + clk[c] - kC * mm.satClock + mm.iono +
-                          mm.ionoMap * ion + mm.tropo;
-      const double v = mm.pseudorange - pred;
-      const double w = 1.0 / mm.variance;
-      h.nnz = 0;
-      h.push(0, -e.x());
-      h.push(1, -e.y());
-      h.push(2, -e.z());
-      h.push(3 + c, 1.0);
-      if (estIono) h.push(3 + nc, mm.ionoMap);
-      ne.addRow(h, v, w);
-      chi2 += w * v * v;
-      ++nobs;
-      if (wantResiduals) {
-        resid[i] = v;
-        rows.emplace_back(h, mm.variance);
-      }
+      const auto& [hr, var] = rows[k++];
+      const double post = resid[i] - hr.dot(r.x.data());
+      const double q = var - detail::NormalEquations<kMaxUnknowns>::quadraticForm(hr, r.cov.data(), m);
+      r.normResidual[i] = std::abs(post) / std::sqrt(std::max(q, 1e-6 * var));
     }
-    // Inter-system bias priors: clk_s - clk_ref = isb_s - isb_ref.
-    const int ref = referenceSystem(use);
-    const bool refKnown = ref == systemIndex(System::Gps) || isb_[ref].known;
-    if (cfg.isbPriorSigma > 0.0 && refKnown) {
-      for (int s : colSystems) {
-        if (s == ref || !isb_[s].known) continue;
-        const double dt = std::abs(epoch.time - isb_[s].time);
-        double var = isb_[s].variance + cfg.isbRandomWalk * dt;
-        double target = isb_[s].value;
-        if (ref != systemIndex(System::Gps)) {
-          var += isb_[ref].variance + cfg.isbRandomWalk * std::abs(epoch.time - isb_[ref].time);
-          target -= isb_[ref].value;
-        }
-        var = std::max(var, cfg.isbPriorSigma * cfg.isbPriorSigma);
-        const double v = target - (clk[col[s]] - clk[col[ref]]);
-        const double w = 1.0 / var;
-        h.nnz = 0;
-        if (col[s] < col[ref]) {  // columns ascending
-          h.push(3 + col[s], 1.0);
-          h.push(3 + col[ref], -1.0);
-        } else {
-          h.push(3 + col[ref], -1.0);
-          h.push(3 + col[s], 1.0);
-        }
-        ne.addRow(h, v, w);
-        chi2 += w * v * v;
-        ++nobs;
-      }
-    }
-    if (estIono) {
-      const double v = -ion;
-      const double w = 1.0 / ionoPriorVar;
-      h.nnz = 0;
-      h.push(3 + nc, 1.0);
-      ne.addRow(h, v, w);
-      chi2 += w * v * v;
-      ++nobs;
-    }
-    r.nObs = nobs;
-    r.chi2 = chi2;
-    if (nobs < m) return r;
-    if (!ne.factor(1e-12)) return r;
-    r.x.resize(m);
-    ne.solve(r.x.data());
-    if (!r.x.allFinite()) return r;
-    if (wantResiduals) {
-      // The covariance only with the statistics: the iterations use the increment alone.
-      r.cov.resize(m, m);
-      ne.inverse(r.cov.data(), m);
-      if (!r.cov.allFinite()) return r;
-    }
-    r.ok = true;
-    if (wantResiduals) {
-      // Normalised post-fit residuals of the linearised problem: v_post = v - H dx,
-      // var(v_post) = sigma^2 - h Q h^T.
-      r.normResidual.assign(n, 0.0);
-      int k = 0;
-      for (int i = 0; i < n; ++i) {
-        if (!use[i]) continue;
-        const auto& [hr, var] = rows[k++];
-        const double post = resid[i] - hr.dot(r.x.data());
-        const double q = var - detail::NormalEquations<kMaxUnknowns>::quadraticForm(hr, r.cov.data(), m);
-        r.normResidual[i] = std::abs(post) / std::sqrt(std::max(q, 1e-6 * var));
-      }
-    }
-    return r;
-  };
+  }
+  return r;
+}
 
-  // Full iteration to convergence for a subset; models are refreshed when `refresh` is set.
-  Eigen::Vector3d x = x0;
-  VecN clk;
-  LsqResult last;
-  auto iterate = [&](std::vector<char>& use, bool refresh, int maxIter, Eigen::Vector3d& xs, VecN& clks, double& ion) {
-    LsqResult res;
-    bool converged = false;
-    int it = 0;
-    std::vector<char> active(n);
-    for (; it < maxIter; ++it) {
-      if (refresh) updateModels(xs);
-      for (int i = 0; i < n; ++i) active[i] = use[i] && meas[i].active;
-      // Keep clock estimates of systems that stay; new systems start at 0 m.
-      std::array<double, kNumSystems> prev{};
-      std::array<bool, kNumSystems> had{};
-      for (std::size_t c = 0; c < colSystems.size(); ++c) {
-        if (static_cast<int>(c) < clks.size()) {
-          prev[colSystems[c]] = clks[static_cast<int>(c)];
-          had[colSystems[c]] = true;
-        }
-      }
-      assignColumns(active);
-      clks = VecN::Zero(static_cast<int>(colSystems.size()));
-      for (std::size_t c = 0; c < colSystems.size(); ++c) {
-        if (had[colSystems[c]]) clks[static_cast<int>(c)] = prev[colSystems[c]];
-      }
-      res = lsqStep(xs, clks, ion, active, false);
-      if (!res.ok) break;
-      const int ncol = static_cast<int>(colSystems.size());
-      xs += res.x.head<3>();
-      clks += res.x.segment(3, ncol);
-      if (estIono) ion += res.x[3 + ncol];
-      if (res.x.head<3>().norm() < 1e-4 && (nearSurface(xs) || !refresh)) {
-        converged = true;
-        ++it;
-        break;
+LsqResult SppSolver::Fit::iterate(std::vector<char>& use, bool refresh, int maxIter, Eigen::Vector3d& xs, VecN& clks,
+                                  double& ion) {
+  LsqResult res;
+  bool converged = false;
+  int it = 0;
+  std::vector<char> active(n);
+  for (; it < maxIter; ++it) {
+    if (refresh) updateModels(xs);
+    for (int i = 0; i < n; ++i) active[i] = use[i] && meas[i].active;
+    // Keep clock estimates of systems that stay; new systems start at 0 m.
+    std::array<double, kNumSystems> prev{};
+    std::array<bool, kNumSystems> had{};
+    for (std::size_t c = 0; c < colSystems.size(); ++c) {
+      if (static_cast<int>(c) < clks.size()) {
+        prev[colSystems[c]] = clks[static_cast<int>(c)];
+        had[colSystems[c]] = true;
       }
     }
-    sol.iterations += it;
-    // Without convergence the fit is not used; its size (nObs, nUnknowns) is that of the last step.
-    if (!res.ok || !converged) {
-      res.ok = false;
-      return res;
+    assignColumns(active);
+    clks = VecN::Zero(static_cast<int>(colSystems.size()));
+    for (std::size_t c = 0; c < colSystems.size(); ++c) {
+      if (had[colSystems[c]]) clks[static_cast<int>(c)] = prev[colSystems[c]];
     }
-    // Statistics at the converged point.
-    res = lsqStep(xs, clks, ion, active, true);
-    use = active;
+    res = lsqStep(xs, clks, ion, active, false);
+    if (!res.ok) break;
+    const int ncol = static_cast<int>(colSystems.size());
+    xs += res.x.head<3>();
+    clks += res.x.segment(3, ncol);
+    if (estIono) ion += res.x[3 + ncol];
+    if (res.x.head<3>().norm() < 1e-4 && (nearSurface(xs) || !refresh)) {
+      converged = true;
+      ++it;
+      break;
+    }
+  }
+  sol.iterations += it;
+  // Without convergence the fit is not used; its size (nObs, nUnknowns) is that of the last step.
+  if (!res.ok || !converged) {
+    res.ok = false;
     return res;
-  };
-
-  std::vector<char> use(n, 1);
-  colSystems.clear();
-  clk = VecN();
-  const int maxIter = std::max(cfg.maxIterations, 4) + (nearSurface(x0) ? 0 : 8);
-  double ion = 0.0;
-  last = iterate(use, true, maxIter, x, clk, ion);
-  auto statusForFailure = [&](const LsqResult& r) {
-    return r.nObs < r.nUnknowns ? SppStatus::NotEnoughSatellites : SppStatus::NoConvergence;
-  };
-  if (!last.ok) {
-    sol.status = statusForFailure(last);
-    for (int i = 0; i < n; ++i) {
-      if (!meas[i].active) sol.satellites[meas[i].result].use = SatelliteUse::BelowMask;
-    }
-    return sol;
   }
-  for (int i = 0; i < n; ++i) {
-    if (!use[i] && !meas[i].active) sol.satellites[meas[i].result].use = SatelliteUse::BelowMask;
-  }
+  // Statistics at the converged point.
+  res = lsqStep(xs, clks, ion, active, true);
+  use = active;
+  return res;
+}
 
+bool SppSolver::Fit::excludeFaults() {
   // Fault detection and exclusion with frozen models (geometry re-linearised in each fit).
   const Eigen::Vector3d xConv = x;
   const VecN clkConv = clk;
@@ -539,17 +552,17 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
     last = iterate(use, true, std::max(cfg.maxIterations, 4), x, clk, ion);
     if (!last.ok) {
       sol.status = statusForFailure(last);
-      return sol;
+      return false;
     }
   } else {
     // `last` holds the statistics at x for the active set `use` (nothing changed since: the
     // exclusion fits froze the models); only the clock columns are restored.
     assignColumns(use);
   }
-  sol.chi2 = last.chi2;
-  sol.dof = last.nObs - last.nUnknowns;
-  sol.testPassed = sol.dof < 1 || sol.chi2 <= globalTestThreshold(sol.dof, cfg.faultExclusion.falseAlarmProbability);
+  return true;
+}
 
+void SppSolver::Fit::reweight() {
   // Robust re-weighting (IGG-III, Yang et al. 2002, J. Geodesy 76: equivalent weights from
   // standardised residuals): measurements that disagree with the rest by more than k0 robust
   // scales lose weight progressively, beyond k1 almost all of it. The scale is the median
@@ -588,7 +601,9 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
       last = rr;
     }
   }
+}
 
+bool SppSolver::Fit::writeSolution() {
   // Outputs. The reported covariance is scaled by the a-posteriori variance factor of the
   // residual test's statistic (after fault exclusion, before the robust weights, which shrink it
   // by down-weighting the very residuals that show the weights to be optimistic;
@@ -634,35 +649,79 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
   sol.dop = computeDop(losEnu, clockIdx, static_cast<int>(colSystems.size()));
   if (!sol.dop.valid || sol.dop.gdop > cfg.maxGdop) {
     sol.status = SppStatus::GdopTooLarge;
-    return sol;
+    return false;
   }
   sol.status = sol.testPassed ? SppStatus::Ok : SppStatus::TestFailed;
+  return true;
+}
+
+void SppSolver::Fit::solveVelocity() {
+  std::vector<RangeRateMeasurement> rr;
+  for (int i = 0; i < n; ++i) {
+    const Measurement& m = meas[i];
+    if (!use[i] || !m.hasDoppler) continue;
+    RangeRateMeasurement d;
+    d.sat = m.sat;
+    d.satPosition = m.state.position;
+    d.satVelocity = m.state.velocity;
+    d.satClockDrift = m.state.clockDrift;
+    d.rangeRate = m.rangeRate;
+    d.variance = cfg.weighting.dopplerVariance(m.sat.system, m.azel.elevation, m.snr);
+    rr.push_back(d);
+  }
+  if (rr.size() >= 4) sol.velocity = solveDopplerVelocity(rr, x, cfg.faultExclusion);
+}
+
+SppSolution SppSolver::solve(const ObsEpoch& epoch) {
+  SppSolution sol;
+  sol.time = epoch.time;
+  sol.solutionTime = epoch.time;
+  const SppConfig& cfg = config_;
+  std::vector<Measurement> meas;
+  meas.reserve(epoch.sats.size());
+  if (!gatherMeasurements(epoch, sol, meas)) {
+    sol.status = SppStatus::NoObservations;
+    return sol;
+  }
+  const int n = static_cast<int>(meas.size());
+  Fit fit(*this, epoch, meas, sol);
+
+  // Starting point: last solution within 10 minutes, else the a-priori position, else the centre.
+  Eigen::Vector3d x0 = Eigen::Vector3d::Zero();
+  if (last_ && std::abs(epoch.time - lastTime_) < 600.0) x0 = *last_;
+  else if (initial_) x0 = *initial_;
+
+  fit.x = x0;
+  fit.use.assign(n, 1);
+  const int maxIter = std::max(cfg.maxIterations, 4) + (nearSurface(x0) ? 0 : 8);
+  fit.last = fit.iterate(fit.use, true, maxIter, fit.x, fit.clk, fit.ion);
+  if (!fit.last.ok) {
+    sol.status = statusForFailure(fit.last);
+    for (int i = 0; i < n; ++i) {
+      if (!meas[i].active) sol.satellites[meas[i].result].use = SatelliteUse::BelowMask;
+    }
+    return sol;
+  }
+  for (int i = 0; i < n; ++i) {
+    if (!fit.use[i] && !meas[i].active) sol.satellites[meas[i].result].use = SatelliteUse::BelowMask;
+  }
+  if (!fit.excludeFaults()) return sol;
+  sol.chi2 = fit.last.chi2;
+  sol.dof = fit.last.nObs - fit.last.nUnknowns;
+  sol.testPassed = sol.dof < 1 || sol.chi2 <= globalTestThreshold(sol.dof, cfg.faultExclusion.falseAlarmProbability);
+  fit.reweight();
+  if (!fit.writeSolution()) return sol;
 
   // Inter-system biases for the next epochs (from epochs that pass the test, relative to GPS).
   if (sol.testPassed) {
-    Eigen::MatrixXd cov = last.cov;
-    updateIsb(sol, cov, colSystems);
+    Eigen::MatrixXd cov = fit.last.cov;
+    updateIsb(sol, cov, fit.colSystems);
   }
-  last_ = x;
+  last_ = fit.x;
   lastTime_ = epoch.time;
 
   // Doppler velocity.
-  if (cfg.velocity) {
-    std::vector<RangeRateMeasurement> rr;
-    for (int i = 0; i < n; ++i) {
-      const Measurement& m = meas[i];
-      if (!use[i] || !m.hasDoppler) continue;
-      RangeRateMeasurement d;
-      d.sat = m.sat;
-      d.satPosition = m.state.position;
-      d.satVelocity = m.state.velocity;
-      d.satClockDrift = m.state.clockDrift;
-      d.rangeRate = m.rangeRate;
-      d.variance = cfg.weighting.dopplerVariance(m.sat.system, m.azel.elevation, m.snr);
-      rr.push_back(d);
-    }
-    if (rr.size() >= 4) sol.velocity = solveDopplerVelocity(rr, x, cfg.faultExclusion);
-  }
+  if (cfg.velocity) fit.solveVelocity();
   return sol;
 }
 

@@ -830,6 +830,24 @@ std::optional<typename SriFilter<Scalar>::ConstView> SriFilter<Scalar>::listedTr
 }
 
 template <typename Scalar>
+bool SriFilter<Scalar>::informed(std::span<const BlockId> ids) const {
+  // The conditions under which listedTrailing() throws, without throwing.
+  int c = n_;
+  for (BlockId id : ids) c = std::min(c, layout_.block(id).offset);
+  if (c == n_) return true;  // no columns listed: an empty covariance
+  std::vector<int> keep;
+  RowMatrix<Scalar> copy;
+  if (!informedTrailing(c, keep, copy)) return false;
+  for (BlockId id : ids) {
+    const BlockInfo& b = layout_.block(id);
+    for (int q = b.offset; q < b.offset + b.dim; ++q) {
+      if (rowPtr(q)[q] == Scalar(0)) return false;  // a column informedTrailing() drops
+    }
+  }
+  return true;
+}
+
+template <typename Scalar>
 typename SriFilter<Scalar>::Matrix SriFilter<Scalar>::covariance(
     std::span<const BlockId> ids) const {
   std::vector<int> cols;

@@ -126,6 +126,7 @@ class ImuGnssTestBackend final : public vio::EstimatorBackend<Scalar> {
   bool contains(sri::BlockId id) const override { return filter_.layout().contains(id); }
   const sri::BlockEstimate<Scalar>& estimate(sri::BlockId id) const override { return filter_.estimate(id); }
   Matrix covariance(std::span<const sri::BlockId> ids) const override { return filter_.covariance(ids); }
+  bool informed(std::span<const sri::BlockId> ids) const override { return filter_.informed(ids); }
   std::optional<sri::ChiSquare<Scalar>> chiSquare(const sri::Measurement<Scalar>& m) const override {
     return filter_.chiSquare(m);
   }

@@ -538,6 +538,7 @@ TEST(Measurement, UninformativePriorGivesLeastSquares) {
   probe.jacobian(a, 3).setOnes();
   probe.setWhitened();
   EXPECT_FALSE(f.chiSquare(probe).has_value());
+  EXPECT_FALSE(f.informed(std::vector<BlockId>{a}));
   EXPECT_THROW(f.covariance(std::vector<BlockId>{a}), std::domain_error);
   // Observe only a (6 rows): b stays unobserved.
   const Md H = randm(rng, 6, 3);
@@ -547,6 +548,10 @@ TEST(Measurement, UninformativePriorGivesLeastSquares) {
   z.residual() = y - H * Eigen::Vector3d(1, 1, 1);
   z.whitenStdDev(0.2);
   f.update(z);
+  // informed() answers exactly where covariance() would throw.
+  EXPECT_FALSE(f.informed(std::vector<BlockId>{b}));
+  EXPECT_FALSE(f.informed(std::vector<BlockId>{a, b}));
+  EXPECT_TRUE(f.informed(std::vector<BlockId>{a}));
   EXPECT_THROW(f.covariance(std::vector<BlockId>{b}), std::domain_error);
   f.correct();
   const Vd ls = H.colPivHouseholderQr().solve(y);
@@ -579,6 +584,7 @@ TEST(Measurement, UninformativePriorGivesLeastSquares) {
   tie.jacobian(b, 2) = Eigen::RowVector2d(1, 1);
   tie.setWhitened();
   f.update(tie);
+  EXPECT_FALSE(f.informed(std::vector<BlockId>{a}));
   EXPECT_THROW(f.covariance(std::vector<BlockId>{a}), std::domain_error);
 }
 

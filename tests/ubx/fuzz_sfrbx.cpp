@@ -1,7 +1,8 @@
 // libFuzzer target: parseSfrbx and NavigationAssembler. The input is a sequence of records, each a
 // 2-byte little-endian length and that many payload bytes; byte 0 selects whether a receive time
 // is known (bit 0) and how far it advances per record (other bits). parseSfrbx may throw only
-// SfrbxError; the assembler must never throw, and every record it emits must be finite.
+// SfrbxError; the assembler must never throw, and every record it emits must be finite (BeiDou:
+// D2 records only for GEO satellites). Seed geo_beidou_d2.bin: the D2 pages of test_sfrbx_d2.cpp.
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -29,8 +30,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
     i += n;
     const gvins::ubx::NavDataUpdate u = assembler.add(msg, t);
-    for (const auto& e : u.kepler)
+    for (const auto& e : u.kepler) {
       if (!std::isfinite(e.sqrtA) || !std::isfinite(e.af0) || !std::isfinite(e.toe - t)) std::abort();
+      // BeiDou: D2 records for GEO satellites only, D1 for the others.
+      if (e.sat.system == gvins::System::BeiDou &&
+          (e.message == gvins::NavMessage::BeiDouD2) != gvins::isBeiDouGeo(e.sat)) std::abort();
+    }
     for (const auto& g : u.glonass)
       if (!std::isfinite(g.position.norm()) || !std::isfinite(g.tauN)) std::abort();
     if (mode & 1) t += step;

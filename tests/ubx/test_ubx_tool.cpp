@@ -76,6 +76,26 @@ TEST(UbxTool, InfoCountsEqualTheIndependentScan) {
   EXPECT_NE(out.find("14 epochs"), std::string::npos) << out;
 }
 
+// The SFRBX rows per gnssId/sigId: the walk log's sources not decoded, and BeiDou D2 (GEO) pages
+// (no real log holds them: the synthetic log of test_sfrbx_d2.cpp).
+TEST(UbxTool, InfoBreaksSfrbxDownBySource) {
+  auto row = [](const std::string& out, const std::string& ids) {
+    const auto at = out.find("\n  " + ids + " ");
+    return at == std::string::npos ? std::string() : out.substr(at + 1, out.find('\n', at + 1) - at - 1);
+  };
+  const auto [walk, rc] = run(kTool + " info " + (dataDir() / "ubx/gnss_1730.ubx").string());
+  ASSERT_EQ(rc, 0);
+  EXPECT_NE(walk.find("1699 of systems not decoded"), std::string::npos) << walk;
+  const std::string b2a = row(walk, "3/8");
+  EXPECT_NE(b2a.find("B-CNAV2 (not decoded)"), std::string::npos) << walk;
+  EXPECT_EQ(b2a.substr(b2a.find_last_not_of(' ') - 3), " 364") << walk;  // no records, no checks
+  EXPECT_NE(row(walk, "3/4").find("D1 (MEO/IGSO)                    153        8           0        0"),
+            std::string::npos) << walk;
+  const auto [d2, rc2] = run(kTool + " info " + (dataDir() / "ubx_synthetic/beidou_d2_nagoya_geo.ubx").string());
+  ASSERT_EQ(rc2, 0);
+  EXPECT_NE(row(d2, "3/1").find("D2 (GEO)                          80        8           0        0"), std::string::npos) << d2;
+}
+
 TEST(UbxTool, ToRinexKeepsEverySignalAndAgreesWithConvbin) {
   const auto dir = std::filesystem::temp_directory_path() / ("gvins_ubx_tool_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);

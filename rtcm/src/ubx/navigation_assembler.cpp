@@ -1,10 +1,12 @@
 #include "gvins/ubx/navigation_assembler.hpp"
 
 #include "beidou_d1.hpp"
+#include "beidou_d2.hpp"
 #include "galileo_inav.hpp"
 #include "glonass_strings.hpp"
 #include "gps_lnav.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
+#include "gvins/ubx/ubx_signals.hpp"
 
 namespace gvins::ubx {
 
@@ -27,6 +29,7 @@ struct NavigationAssembler::State {
   detail::GpsLnavDecoder lnav;
   detail::GalileoInavDecoder inav;
   detail::BeidouD1Decoder d1;
+  detail::BeidouD2Decoder d2;
   detail::GlonassDecoder glonass;
 };
 
@@ -35,71 +38,83 @@ NavigationAssembler::~NavigationAssembler() = default;
 NavigationAssembler::NavigationAssembler(NavigationAssembler&&) noexcept = default;
 NavigationAssembler& NavigationAssembler::operator=(NavigationAssembler&&) noexcept = default;
 
+NavigationCounts& NavigationCounts::operator+=(const NavigationCounts& o) {
+  messages += o.messages;
+  parityFailures += o.parityFailures;
+  crcFailures += o.crcFailures;
+  incompleteSets += o.incompleteSets;
+  unknownMessages += o.unknownMessages;
+  skipped += o.skipped;
+  ephemerides += o.ephemerides;
+  ionosphere += o.ionosphere;
+  return *this;
+}
+
 NavDataUpdate NavigationAssembler::add(const SfrbxMessage& msg, const GpsTime& receiveTime) {
   NavDataUpdate out;
-  // u-blox gnssId and sigId (interface description, "GNSS identifiers" and "Signal identifiers").
-  System system;
-  switch (static_cast<UbxGnss>(msg.gnssId)) {
-    case UbxGnss::Gps: system = System::Gps; break;
-    case UbxGnss::Sbas: system = System::Sbas; break;
-    case UbxGnss::Galileo: system = System::Galileo; break;
-    case UbxGnss::BeiDou: system = System::BeiDou; break;
-    case UbxGnss::Qzss: system = System::Qzss; break;
-    case UbxGnss::Glonass: system = System::Glonass; break;
-    case UbxGnss::Navic: system = System::Navic; break;
-    default: {
-      ++unknownGnss_;
-      return out;
-    }
+  NavigationCounts delta;
+  delta.messages = 1;
+  NavigationSource source{msg.gnssId, msg.sigId, false};
+  // u-blox gnssId (interface description, "GNSS identifiers"); IMES and reserved values unknown.
+  const std::optional<System> system = systemOfGnssId(msg.gnssId);
+  if (!system) {
+    ++unknownGnss_;
+    delta.unknownMessages = 1;
+    bySource_[source] += delta;
+    return out;
   }
-  NavigationCounts& c = counts_[static_cast<std::size_t>(systemIndex(system))];
-  ++c.messages;
+  const SatId sat(*system, msg.svId);
+  source.beidouGeo = *system == System::BeiDou && sat.valid() && isBeiDouGeo(sat);
+  dispatch(msg, *system, receiveTime, out, delta);
+  counts_[static_cast<std::size_t>(systemIndex(*system))] += delta;
+  bySource_[source] += delta;
+  return out;
+}
+
+void NavigationAssembler::dispatch(const SfrbxMessage& msg, System system, const GpsTime& receiveTime,
+                                   NavDataUpdate& out, NavigationCounts& c) {
+  // u-blox sigId: interface description, "Signal identifiers".
   const SatId sat(system, msg.svId);
   switch (system) {
     case System::Gps:
     case System::Qzss:
-      // L1 C/A LNAV only (sigId 0); L2C/L5 CNAV and QZSS L1C/A-on-other-signals are not decoded.
+      // L1 C/A LNAV only (sigId 0); L2C/L5 CNAV and QZSS L1S are not decoded.
       if (msg.sigId != 0) break;
-      if (!sat.valid()) return ++c.unknownMessages, out;
+      if (!sat.valid()) return void(++c.unknownMessages);
       state_->lnav.add(msg, sat, receiveTime, out, c);
-      return out;
+      return;
     case System::Galileo:
       // I/NAV on E1-B (sigId 1) and E5b-I (sigId 5); F/NAV (E5a) and E6 are not decoded.
       if (msg.sigId != 1 && msg.sigId != 5) break;
-      if (!sat.valid()) return ++c.unknownMessages, out;
+      if (!sat.valid()) return void(++c.unknownMessages);
       state_->inav.add(msg, sat, receiveTime, out, c);
-      return out;
+      return;
     case System::BeiDou:
       // D1/D2 on B1I (sigId 0, 1), B2I (2, 3) and B3I (4, 10): ten 30-bit words. B-CNAV1/2 are not
       // decoded.
       if (msg.words.size() != 10 || !(msg.sigId <= 4 || msg.sigId == 10)) break;
-      if (!sat.valid()) return ++c.unknownMessages, out;
-      state_->d1.add(msg, sat, receiveTime, out, c);
-      return out;
+      if (!sat.valid()) return void(++c.unknownMessages);
+      // The message follows the satellite: D2 on GEO satellites, D1 on the others (5.1.1).
+      if (isBeiDouGeo(sat)) {
+        state_->d2.add(msg, sat, out, c);
+      } else {
+        state_->d1.add(msg, sat, out, c);
+      }
+      return;
     case System::Glonass:
       if (msg.sigId != 0 && msg.sigId != 2) break;  // L1 OF, L2 OF
-      if (!sat.valid()) return ++c.unknownMessages, out;  // svId 255: slot not yet known
+      if (!sat.valid()) return void(++c.unknownMessages);  // svId 255: slot not yet known
       state_->glonass.add(msg, sat, receiveTime, out, c);
-      return out;
+      return;
     default:
       break;  // SBAS, NavIC: not decoded
   }
   ++c.skipped;
-  return out;
 }
 
 NavigationCounts NavigationAssembler::total() const {
   NavigationCounts t;
-  for (const NavigationCounts& c : counts_) {
-    t.messages += c.messages;
-    t.parityFailures += c.parityFailures;
-    t.crcFailures += c.crcFailures;
-    t.incompleteSets += c.incompleteSets;
-    t.unknownMessages += c.unknownMessages;
-    t.skipped += c.skipped;
-    t.ephemerides += c.ephemerides;
-    t.ionosphere += c.ionosphere;
-  }
+  for (const NavigationCounts& c : counts_) t += c;
   t.unknownMessages += unknownGnss_;
   t.messages += unknownGnss_;
   return t;

@@ -221,6 +221,7 @@ void Decoder::decodeMessage(std::uint8_t msgClass, std::uint8_t msgId, std::span
 const DecoderStats& Decoder::stats() const { return s_->stats; }
 const GlonassChannels& Decoder::glonassChannels() const { return s_->glonass; }
 NavigationCounts Decoder::navigationCounts() const { return s_->navigation.total(); }
+const NavigationAssembler& Decoder::navigationAssembler() const { return s_->navigation; }
 std::optional<GpsTime> Decoder::lastEpochTime() const { return s_->lastEpoch; }
 
 }  // namespace gvins::ubx

@@ -34,6 +34,7 @@
 #include "gvins/base/geodetic.hpp"
 #include "gvins/base/observation.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
+#include "gvins/fusion/gnss_clock_states.hpp"
 #include "gvins/fusion/gnss_fusion_config.hpp"
 #include "gvins/fusion/gnss_gate_recovery.hpp"
 #include "gvins/fusion/gnss_ins_alignment.hpp"
@@ -89,6 +90,8 @@ struct GnssEpochReport {
   std::optional<GnssInsStatus> insStart;
 };
 
+struct GnssRowSet;  // the rows of an epoch and their noise (internal)
+
 template <typename Scalar>
 class GnssFusion {
  public:
@@ -105,7 +108,7 @@ class GnssFusion {
 
   const GnssFusionConfig& config() const { return config_; }
   GnssFusionStage stage() const { return stage_; }
-  bool clocksInitialized() const { return clockBlock_.valid(); }
+  bool clocksInitialized() const { return clocks_.valid(); }
   /// [ψ, p_NW] of the estimator's world frame in local ENU at the anchor: the frame block's
   /// estimate while it is a state, zero once the estimator was re-anchored in ENU
   /// (frameReanchor); nullopt before the frame initialisation.
@@ -125,7 +128,7 @@ class GnssFusion {
   /// Clock estimate [c·dt per clock system..., c·ḋt] (the receiver clock plus each system's
   /// inter-system bias) and the systems (clock indices).
   std::optional<Eigen::VectorXd> clocks(const vio::EstimatorBackend<Scalar>& est) const;
-  const std::vector<System>& clockSystems() const { return clockSystems_; }
+  const std::vector<System>& clockSystems() const { return clocks_.systems(); }
   /// Antenna position/velocity (ECEF) at time t_ns from the current estimates (frame needed).
   std::optional<AntennaKinematics> antennaAt(const vio::EstimatorBackend<Scalar>& est, std::int64_t t_ns) const;
   /// Covariance (ECEF, m²) of the antenna position at t_ns (e.g. GnssEpochReport::t_ns):
@@ -146,7 +149,42 @@ class GnssFusion {
   std::map<SatId, double> ambiguities(const vio::EstimatorBackend<Scalar>& est) const;
 
  private:
-  struct Pending;
+  struct Epoch;  // one processEpoch call (internal)
+  /// The Doppler check of the rover epoch, its carrier-smoothed codes and the ambiguity arcs
+  /// (every epoch, also before the VIO is ready); returns the epoch the rows use.
+  const ObsEpoch& prepareRover(const ObsEpoch& roverInput, const EphemerisStore& nav, GnssEpochReport& rep);
+  /// The SPP and RTK solvers on `nav` (new ones when it changes).
+  void useNavigation(const EphemerisStore& nav);
+  /// The epoch's SPP solution, solved at the first use.
+  const SppSolution& sppOf(Epoch& e);
+  /// A new base epoch into the RTK module, and the module's run where due.
+  void feedRtk(Epoch& e, const ObsEpoch* base);
+  void runRtk(Epoch& e);
+  /// After an outage: clocks, zenith wet delay and ambiguities start again.
+  void resetAfterOutage(vio::EstimatorBackend<Scalar>& est, GnssEpochReport& rep);
+  /// The measurement time of the epoch (tag minus receiver clock) into e.tMeas and e.t_ns; false
+  /// if it is beyond the newest state.
+  bool measurementTime(const vio::EstimatorBackend<Scalar>& est, Epoch& e);
+  /// Stage kFrameInit: SPP position and velocity rows; kTight once the frame's yaw converged.
+  /// False without an SPP fix.
+  bool frameUpdate(vio::EstimatorBackend<Scalar>& est, Epoch& e, const AntennaKinematics& k);
+  /// Stage kTight: the rows of the configured mode (gnss_fusion_rows.cpp); false if the clocks
+  /// could not be initialised.
+  bool tightUpdate(vio::EstimatorBackend<Scalar>& est, Epoch& e, const GnssStateValues& s, const AntennaKinematics& k);
+  /// The clock (initialised at the first use) and zenith wet delay states at the epoch; the
+  /// models' clock indices and wet delays follow. False if the clocks could not be initialised.
+  bool prepareStates(vio::EstimatorBackend<Scalar>& est, Epoch& e, std::vector<SatelliteModel>& models,
+                     const AntennaKinematics& k);
+  /// vio+dopp+ppp: ionosphere-free phase rows, one float ambiguity state per satellite arc.
+  void addPhaseRows(vio::EstimatorBackend<Scalar>& est, Epoch& e, const std::vector<SatelliteModel>& models,
+                    const AntennaKinematics& k, const Eigen::VectorXd& clk, GnssRowSet& rows);
+  /// A new ambiguity state for the carrier arc of m's satellite.
+  sri::BlockId newAmbiguity(vio::EstimatorBackend<Scalar>& est, const SatelliteModel& m);
+  /// Dpsr and ddcp rows from the RTK module's differences.
+  void addDifferenceRows(Epoch& e, const AntennaKinematics& k, const Eigen::VectorXd& clk, GnssRowSet& rows);
+  /// Applies the tight stage's rows; counts them and restarts ambiguities rejected too often.
+  void applyRows(vio::EstimatorBackend<Scalar>& est, GnssEpochReport& rep, const AntennaKinematics& k,
+                 GnssRowSet& rows);
   bool buildState(const vio::EstimatorBackend<Scalar>& est, std::int64_t t_ns, GnssStateValues& s) const;
   void ensureLever(vio::EstimatorBackend<Scalar>& est);
   bool startFrame(vio::EstimatorBackend<Scalar>& est, const SppSolution& spp, std::int64_t t_ns);
@@ -162,15 +200,11 @@ class GnssFusion {
   /// at least lateSystemMinSatellites satellites joins the ISB block, with a notice.
   void addLateClockSystems(vio::EstimatorBackend<Scalar>& est, const std::vector<SatelliteModel>& models,
                            const AntennaKinematics& k, const GpsTime& t);
-  void propagateClocks(vio::EstimatorBackend<Scalar>& est, const GpsTime& t);
-  /// [c·dt per clock system..., c·ḋt] from the clock and ISB blocks (clockBlock_ valid).
-  Eigen::VectorXd systemClocks(const vio::EstimatorBackend<Scalar>& est) const;
+  /// Moves the notices of the signal choice, clock jumps, late clocks and gate recovery not yet
+  /// reported into the epoch's warnings.
+  void reportNotices(GnssEpochReport& rep);
   /// Random walk of the zenith wet delay state to time t.
   void propagateZwd(vio::EstimatorBackend<Scalar>& est, const GpsTime& t);
-  /// One random-walk step of a vector block of `size` (parameter region): the same estimate,
-  /// `variance` added to each component; returns the new block's id.
-  sri::BlockId randomWalkStep(vio::EstimatorBackend<Scalar>& est, sri::BlockId id, const char* name, int size,
-                              double variance);
   /// Gates rows one by one, stacks the accepted ones and applies them; returns the update.
   /// `ambiguities`: the blocks that rows' `ambiguity` indices refer to.
   vio::BackendUpdate<Scalar> apply(vio::EstimatorBackend<Scalar>& est, std::vector<GnssRow>& rows,
@@ -194,16 +228,12 @@ class GnssFusion {
   GnssFusionStage stage_ = GnssFusionStage::kWaitingVio;
   std::uint64_t generation_ = 0;  // estimator generation the ids below belong to
   GnssAnchor anchor_;
-  // clockBlock_: [c·dt, c·ḋt] of clockSystems_[0]; isbBlock_: c·(dt_s − dt_0) of the other
-  // clock systems (none with one system).
-  sri::BlockId frameBlock_, leverBlock_, clockBlock_, isbBlock_, zwdBlock_;
+  sri::BlockId frameBlock_, leverBlock_, zwdBlock_;
+  GnssClockStates<Scalar> clocks_;  // the receiver clock and inter-system bias blocks
   std::optional<vio::WorldFrameChange> worldChange_;  // set when the estimator was re-anchored in ENU
   Eigen::Vector3d leverStart_;                // lever arm before/at the lever block's creation
   std::optional<Eigen::Vector3d> leverLast_;  // the lever block's estimate after the last epoch
   GpsTime zwdTime_;
-  std::vector<System> clockSystems_;
-  GpsTime clockTime_;
-  GpsTime isbTime_;  // last random-walk step of isbBlock_ (or its creation)
   std::optional<GpsTime> lastUpdate_;
   const EphemerisStore* nav_ = nullptr;
   std::unique_ptr<SppSolver> spp_;

@@ -239,6 +239,9 @@ class RtkSolver {
   /// Post-fit test: re-initialises one phase ambiguity or drops one code; true if it changed
   /// something (the update must then be redone).
   bool rejectOutlier(RtkSolution& sol);
+  /// Measurement update about x0 with post-fit outlier rejection, redone about the updated
+  /// position when it moved far; returns the float position.
+  Eigen::Vector3d updateWithOutlierRejection(Eigen::Vector3d x0, RtkSolution& sol);
   void resolve(RtkSolution& sol);
   // Steps of resolve() (rtk_ambiguity.cpp).
   std::vector<ArPair> arPairs(std::vector<int>& arReference) const;

@@ -104,6 +104,7 @@ class SppSolver {
 
  private:
   struct Measurement;
+  class Fit;  // one epoch's least-squares solution (spp.cpp)
   struct Isb {
     bool known = false;
     double value = 0.0;  ///< clock(system) - clock(GPS), m

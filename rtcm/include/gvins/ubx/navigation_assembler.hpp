@@ -6,8 +6,11 @@
 #pragma once
 
 #include <array>
+#include <compare>
 #include <cstdint>
+#include <map>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "gvins/base/gnss_time.hpp"
@@ -46,7 +49,25 @@ struct NavigationCounts {
                                       ///< Galileo F/NAV and E6, BeiDou B-CNAV1/2, GLONASS CDMA
   std::uint64_t ephemerides = 0;      ///< complete records emitted
   std::uint64_t ionosphere = 0;       ///< ionosphere parameter sets emitted
+
+  NavigationCounts& operator+=(const NavigationCounts& o);
 };
+
+/// Where SFRBX navigation data comes from, as the receiver tags it: gnssId and sigId and, for
+/// BeiDou, whether the satellite is a GEO (C01-C05, C59-C63: D2 message) or not (D1).
+struct NavigationSource {
+  std::uint8_t gnssId = 0, sigId = 0;
+  bool beidouGeo = false;
+  friend auto operator<=>(const NavigationSource&, const NavigationSource&) = default;
+};
+
+/// The message a source carries and whether the assembler decodes it: "LNAV", "I/NAV",
+/// "D1 (MEO/IGSO)", "D2 (GEO)", "strings" or e.g. "CNAV (not decoded)", "B-CNAV1 (not decoded)".
+struct NavigationSourceInfo {
+  std::string message;
+  bool decoded = false;
+};
+NavigationSourceInfo navigationSourceInfo(const NavigationSource& source);
 
 class NavigationAssembler {
  public:
@@ -68,11 +89,17 @@ class NavigationAssembler {
   }
   /// Sum over all systems (messages of an unknown gnssId count as unknown messages).
   NavigationCounts total() const;
+  /// The same counters per gnssId/sigId (and BeiDou GEO or not): what was decoded, what not.
+  const std::map<NavigationSource, NavigationCounts>& countsBySource() const { return bySource_; }
 
  private:
+  void dispatch(const SfrbxMessage& msg, System system, const GpsTime& receiveTime, NavDataUpdate& out,
+                NavigationCounts& c);
+
   struct State;
   std::unique_ptr<State> state_;
   std::array<NavigationCounts, kNumSystems> counts_{};
+  std::map<NavigationSource, NavigationCounts> bySource_;
   std::uint64_t unknownGnss_ = 0;
 };
 

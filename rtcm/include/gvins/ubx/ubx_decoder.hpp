@@ -129,6 +129,8 @@ class Decoder {
   const GlonassChannels& glonassChannels() const;
   /// Counters of the navigation message assembler (parity/CRC failures etc.).
   NavigationCounts navigationCounts() const;
+  /// The assembler itself: counters per system and per gnssId/sigId.
+  const NavigationAssembler& navigationAssembler() const;
   /// Time of the latest RAWX epoch.
   std::optional<GpsTime> lastEpochTime() const;
 

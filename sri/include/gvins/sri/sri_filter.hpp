@@ -200,6 +200,11 @@ class SriFilter {
   /// R alone then does not give the covariance (it would need a pseudo-inverse); give such
   /// blocks a weak prior instead of none, or marginalize them.
   Matrix covariance(std::span<const BlockId> ids) const;
+  /// Whether covariance() and covarianceFactor() of the listed blocks are defined (do not
+  /// throw): every listed block carries information and no later column without information is
+  /// coupled to the rest. The query for callers that branch on it, e.g. on a new block with an
+  /// uninformative prior that no row has reached yet.
+  bool informed(std::span<const BlockId> ids) const;
   /// A factor F of the same marginal covariance, P = F Fᵀ, without forming P: the rows of
   /// R_t⁻¹ (R_t the informed trailing part of R from the first listed block, inverted column by
   /// column with forward substitutions, about k³/6 operations for k trailing columns) that belong

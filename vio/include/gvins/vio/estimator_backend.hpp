@@ -135,6 +135,9 @@ class EstimatorBackend {
   virtual const sri::BlockEstimate<Scalar>& estimate(sri::BlockId id) const = 0;
   /// Joint marginal covariance of the listed blocks (sri_filter.hpp's rules apply).
   virtual Matrix covariance(std::span<const sri::BlockId> ids) const = 0;
+  /// Whether covariance(ids) is defined (sri::SriFilter::informed): every listed block carries
+  /// information, e.g. not a block added with an uninformative prior that no row reached yet.
+  virtual bool informed(std::span<const sri::BlockId> ids) const = 0;
 
   // ------------------------------------------------------------------ measurements
   /// Innovation Mahalanobis distance of whitened rows, or nullopt if it cannot be formed.

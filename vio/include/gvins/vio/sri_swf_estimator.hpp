@@ -355,6 +355,7 @@ class SriSwfEstimator final : public EstimatorBackend<Scalar> {
   bool contains(sri::BlockId id) const override;
   const sri::BlockEstimate<Scalar>& estimate(sri::BlockId id) const override;
   Matrix covariance(std::span<const sri::BlockId> ids) const override;
+  bool informed(std::span<const sri::BlockId> ids) const override { return filter().informed(ids); }
   std::optional<sri::ChiSquare<Scalar>> chiSquare(const sri::Measurement<Scalar>& m) const override;
   BackendUpdate<Scalar> update(const sri::Measurement<Scalar>& m, double gate_probability) override;
 

@@ -1,0 +1,278 @@
+// The rows of GnssFusion's stages (gnss_fusion.hpp, steps 2 and 4): one producer per kind of
+// measurement, each with its noise model, and the tight stage that stacks them.
+#include <algorithm>
+#include <cmath>
+
+#include "gnss_fusion_epoch.hpp"
+#include "gvins/base/constants.hpp"
+#include "gvins/gnss/phase_windup.hpp"
+
+namespace gvins::fusion {
+namespace {
+constexpr double kC = constants::kSpeedOfLight;
+}  // namespace
+
+void addPositionRows(const GnssAnchor& anchor, const Eigen::Vector3d& position, const Eigen::Matrix3d& covariance,
+                     const AntennaKinematics& k, GnssRowSet& rows) {
+  const Eigen::Matrix3d R_NE = anchor.R_EN.transpose();
+  const Eigen::Vector3d pN = R_NE * (position - anchor.ecef);
+  std::vector<GnssRow> group;
+  for (int a = 0; a < 3; ++a) group.push_back(positionRow(pN, a, k));
+  const Eigen::Matrix3d c = R_NE * covariance * R_NE.transpose() + 0.25 * Eigen::Matrix3d::Identity();
+  rows.addCorrelated(group, kFrame, c);
+}
+
+void addVelocityRows(const GnssAnchor& anchor, const VelocitySolution& velocity, const AntennaKinematics& k, int type,
+                     bool lever, GnssRowSet& rows) {
+  const Eigen::Matrix3d R_NE = anchor.R_EN.transpose();
+  const Eigen::Vector3d vN = R_NE * velocity.velocity;
+  std::vector<GnssRow> group;
+  for (int a = 0; a < 3; ++a) {
+    GnssRow r = velocityRow(vN, a, k);
+    if (!lever) r.H_lever.setZero();
+    group.push_back(r);
+  }
+  const Eigen::Matrix3d c = R_NE * velocity.covariance * R_NE.transpose() + 0.0025 * Eigen::Matrix3d::Identity();
+  rows.addCorrelated(group, type, c);
+}
+
+void addDopplerRows(const std::vector<SatelliteModel>& models, const AntennaKinematics& k, const Eigen::VectorXd& clk,
+                    bool excited, GnssRowSet& rows) {
+  const Eigen::Index drift = clk.size() - 1;  // [c·dt per clock system..., c·ḋt]
+  for (const SatelliteModel& m : models) {
+    if (!m.hasDoppler) continue;
+    GnssRow r = dopplerRow(m, k, clk[drift]);
+    if (!excited) r.H_lever.setZero();
+    rows.add(r, kDopp, r.variance);
+  }
+}
+
+void addPseudorangeRows(const std::vector<SatelliteModel>& models, const AntennaKinematics& k,
+                        const Eigen::VectorXd& clk, GnssRowSet& rows) {
+  for (const SatelliteModel& m : models) {
+    if (m.clock < 0) continue;
+    GnssRow r = pseudorangeRow(m, k, clk[m.clock]);
+    r.H_lever.setZero();
+    rows.add(r, kPsr, r.variance);
+  }
+}
+
+template <typename Scalar>
+bool GnssFusion<Scalar>::prepareStates(vio::EstimatorBackend<Scalar>& est, Epoch& e,
+                                       std::vector<SatelliteModel>& models, const AntennaKinematics& k) {
+  const bool needClocks = config_.usesDoppler();
+  if (needClocks && !clocks_.valid()) {
+    if (!initClocks(est, models, k, e.tMeas)) return false;
+    e.rep.clocksInitialized = true;
+    for (SatelliteModel& m : models) m.clock = clockIndex(m.sat);
+  }
+  if (clocks_.valid()) clocks_.propagate(est, e.tMeas, config_);
+  if (clocks_.valid() && !e.rep.clocksInitialized) {  // systems whose ephemerides came later
+    addLateClockSystems(est, models, k, e.tMeas);
+    for (SatelliteModel& m : models) m.clock = clockIndex(m.sat);
+  }
+  if (clocks_.valid() && config_.zwdState()) {
+    if (!zwdBlock_.valid()) {
+      Eigen::Matrix<Scalar, Eigen::Dynamic, 1> z = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>::Zero(1);
+      zwdBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_zwd", 1), sri::BlockEstimate<Scalar>::fromVector(z),
+                               sri::Prior<Scalar>::stdDev(1, static_cast<Scalar>(config_.zwdSigma)));
+      zwdTime_ = e.tMeas;
+    }
+    propagateZwd(est, e.tMeas);
+    const double zwd = static_cast<double>(est.estimate(zwdBlock_).vector[0]);
+    for (SatelliteModel& m : models) m.troposphere += m.mapWet * zwd;
+  }
+  return true;
+}
+
+template <typename Scalar>
+sri::BlockId GnssFusion<Scalar>::newAmbiguity(vio::EstimatorBackend<Scalar>& est, const SatelliteModel& m) {
+  // Centred on phase minus code (code model: + c·group delay), which differ by the ambiguity
+  // plus the code error. The arc may be older than the state (epochs before the VIO or the clocks
+  // were ready, a restart after rejections): its carrier-smoothed code carries those epochs'
+  // codes, weighted as the code rows are (each epoch as one measurement: σ/sqrt(n)) except for
+  // the orbit/clock error, a bias per satellite that no averaging reduces; a new arc starts from
+  // the raw code with a loose prior.
+  Eigen::Matrix<Scalar, Eigen::Dynamic, 1> x(1);
+  double code = m.pseudorange, sigma = config_.ambiguitySigma;
+  const SatObs* so = arcSmoothed_.find(m.sat);
+  const SignalObs* s1 = so ? so->find(m.code) : nullptr;
+  const SignalObs* s2 = so ? so->find(m.code2) : nullptr;
+  if (arcs_->samples(m.sat) > 1 && s1 && s2 && s1->hasCode() && s2->hasCode()) {
+    code = m.ifA1 * s1->pseudorange + m.ifA2 * s2->pseudorange;
+    const double nf = arcs_->noiseFactor(m.sat);
+    sigma = std::sqrt((m.codeVariance - m.ephemerisVariance) * nf * nf + m.ephemerisVariance);
+  }
+  x[0] = static_cast<Scalar>(m.carrierRange - (code - kC * m.groupDelay));
+  // In front of the state: visual rows never reach those columns, and a state that ends with its
+  // arc is cheap to marginalize there.
+  return est.addBlock(sri::BlockSpec::vector("gnss_ambiguity", 1), sri::BlockEstimate<Scalar>::fromVector(x),
+                      sri::Prior<Scalar>::stdDev(1, static_cast<Scalar>(sigma)), vio::ClientBlockRegion::kFront);
+}
+
+template <typename Scalar>
+void GnssFusion<Scalar>::addPhaseRows(vio::EstimatorBackend<Scalar>& est, Epoch& e,
+                                      const std::vector<SatelliteModel>& models, const AntennaKinematics& k,
+                                      const Eigen::VectorXd& clk, GnssRowSet& rows) {
+  const ObsEpoch& rover = e.rover;
+  // Ambiguities of satellites on broadcast orbits and clocks follow their drifting errors.
+  std::vector<SatId> broadcast;
+  for (const SatelliteModel& m : models)
+    if (!m.precise && !m.ssr) broadcast.push_back(m.sat);
+  propagateAmbiguities(est, broadcast, e.tMeas);
+  // Satellites with a state first, then the others highest first (max_ambiguities).
+  std::vector<const SatelliteModel*> order;
+  for (const SatelliteModel& m : models) order.push_back(&m);
+  std::stable_sort(order.begin(), order.end(), [&](const SatelliteModel* a, const SatelliteModel* b) {
+    const bool ha = ambiguities_.count(a->sat) > 0, hb = ambiguities_.count(b->sat) > 0;
+    if (ha != hb) return ha;
+    return a->azel.elevation > b->azel.elevation;
+  });
+  for (const SatelliteModel* mp : order) {
+    const SatelliteModel& m = *mp;
+    if (!m.hasCarrier || m.clock < 0 || arcs_->samples(m.sat) == 0) continue;
+    const GpsTime start = rover.time - arcs_->arcLength(m.sat);
+    auto it = ambiguities_.find(m.sat);
+    if (it != ambiguities_.end() && std::abs(it->second.arcStart - start) > 1e-3) {
+      dropAmbiguity(est, m.sat);  // new arc: cycle slip, gap or signal change
+      it = ambiguities_.end();
+    }
+    if (it == ambiguities_.end()) {
+      if (config_.maxAmbiguities > 0 && static_cast<int>(ambiguities_.size()) >= config_.maxAmbiguities) continue;
+      Ambiguity a;
+      a.id = newAmbiguity(est, m);
+      a.arcStart = start;
+      it = ambiguities_.emplace(m.sat, a).first;
+    }
+    it->second.lastRow = rover.time;
+    const double nAmb = static_cast<double>(est.estimate(it->second.id).vector[0]);
+    SatelliteModel mc = m;
+    if (config_.broadcastRecordChanges && !m.precise && !m.ssr) {
+      BroadcastRecordContinuity& r = it->second.records;
+      if (r.update(e.nav, m.sat, rover.time - m.pseudorange / kC, m.transmitTime, k.x_E).changed) ++e.rep.recordChanges;
+      mc.carrierRange += r.shift();
+    }
+    if (config_.phaseWindup) {
+      const double w = continueWindup(m.windup, it->second.windup);
+      it->second.windup = w;
+      mc.carrierRange -= m.windupWavelength * w;
+    }
+    GnssRow r = carrierPhaseRow(mc, k, clk[m.clock], nAmb);
+    r.H_lever.setZero();
+    r.ambiguity = static_cast<int>(rows.ambiguityBlocks.size());
+    rows.ambiguityBlocks.push_back(it->second.id);
+    rows.ambiguitySats.push_back(m.sat);
+    rows.add(r, kPhase, r.variance);
+  }
+}
+
+template <typename Scalar>
+void GnssFusion<Scalar>::addDifferenceRows(Epoch& e, const AntennaKinematics& k, const Eigen::VectorXd& clk,
+                                           GnssRowSet& rows) {
+  if (rtk_ && !e.fullRtk) e.baseAge = rtk_->differences(e.rover, k.x_E, &e.states);
+  if (e.fullRtk && !e.rtkProcessed) {
+    int heldFixed = 0;
+    e.baseAge = rtk_->differencesWithHeldFix(e.roverRaw, k.x_E, heldFixed, &e.states);
+    e.rep.rtkFixed = heldFixed > 0;
+    if (e.rtkDeferred && !rtk_->phasePairsAsProcessed()) runRtk(e);
+  }
+  if (!e.baseAge || !config_.usesDifferences() || *e.baseAge > config_.maxBaseAge) return;
+  const DdEpoch& dd = rtk_->measurements();
+  const int n = static_cast<int>(clocks_.systems().size());
+  // Base clock per system: mean base code OMC (clock + errors common to the base).
+  std::vector<double> sum(static_cast<std::size_t>(n), 0.0);
+  std::vector<int> cnt(static_cast<std::size_t>(n), 0);
+  for (const SingleDifference& sd : dd.sd) {
+    const int c = clockIndex(sd.sat);
+    if (c < 0 || !sd.hasCode) continue;
+    sum[static_cast<std::size_t>(c)] += sd.baseCodeOmc;
+    cnt[static_cast<std::size_t>(c)]++;
+  }
+  for (const SingleDifference& sd : dd.sd) {
+    const int c = clockIndex(sd.sat);
+    if (c < 0 || !sd.hasCode || sd.elevation < config_.elevationMaskDeg * constants::kDegToRad) continue;
+    const double cb = sum[static_cast<std::size_t>(c)] / cnt[static_cast<std::size_t>(c)];
+    GnssRow r = sdPseudorangeRow(sd, k, clk[c], cb);
+    r.clockBias = c;
+    rows.add(r, kDpsr, r.variance);
+  }
+  if (config_.mode != GnssFusionMode::kDoppDdcp || !e.rep.rtkFixed) return;
+  std::vector<DoubleDifference> phase;
+  for (const DoubleDifference& d : dd.phase) {
+    if (d.ambiguityMeters) phase.push_back(d);
+  }
+  if (phase.empty()) return;
+  std::vector<GnssRow> group;
+  for (const DoubleDifference& d : phase) group.push_back(ddPhaseRow(dd, d, k));
+  rows.addCorrelated(group, kDdcp, ddCovariance(dd, phase, true));
+}
+
+template <typename Scalar>
+void GnssFusion<Scalar>::applyRows(vio::EstimatorBackend<Scalar>& est, GnssEpochReport& rep,
+                                   const AntennaKinematics& k, GnssRowSet& rows) {
+  std::vector<bool> acc;
+  const auto u = apply(est, rows.rows, rows.noise(), k.integrationCovariance, acc, gateRecovery_.gated(rep.time),
+                       rows.ambiguityBlocks);
+  gateRecovery_.outcome(rep.time, u.applied, rows.size());  // re-acquisition (gnss_gate_recovery.hpp)
+  rep.chi2 = static_cast<double>(u.chi2);
+  rep.dof = u.dof;
+  rep.updated = u.applied;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    GnssTypeCount& c = countOf(rep, rows.types[i]);
+    (acc[i] ? c.used : c.rejected)++;
+    if (rows.types[i] != kPhase) continue;
+    // A phase row gated out again and again: the ambiguity no longer fits (undetected slip,
+    // broadcast orbit/clock change); it restarts from phase minus code.
+    const SatId sat = rows.ambiguitySats[static_cast<std::size_t>(rows.rows[i].ambiguity)];
+    Ambiguity& a = ambiguities_.at(sat);
+    a.rejections = acc[i] ? 0 : a.rejections + 1;
+    if (a.rejections >= config_.ambiguityResetRejections) dropAmbiguity(est, sat);
+  }
+}
+
+template <typename Scalar>
+bool GnssFusion<Scalar>::tightUpdate(vio::EstimatorBackend<Scalar>& est, Epoch& e, const GnssStateValues& s,
+                                     const AntennaKinematics& k) {
+  const SppSolution* sppVel = config_.mode == GnssFusionMode::kGpsVel ? &sppOf(e) : nullptr;
+  std::vector<SatelliteModel> models = satelliteModels(e.rover, e.nav, k.x_E, &e.states);
+  if (!prepareStates(est, e, models, k)) return false;
+  Eigen::VectorXd clk;
+  if (clocks_.valid()) clk = clocks_.values(est);
+  const bool excited = config_.calibrateLeverArm && (s.omegaMeasured - s.newest.bg).norm() >= config_.minRotationRate;
+  GnssRowSet rows;
+  if (config_.usesDoppler()) addDopplerRows(models, k, clk, excited, rows);
+  if (config_.usesPseudorange()) addPseudorangeRows(models, k, clk, rows);
+  if (sppVel && sppVel->velocity.valid) addVelocityRows(anchor_, sppVel->velocity, k, kVel, false, rows);
+  if (config_.mode == GnssFusionMode::kDoppPpp && clocks_.valid()) addPhaseRows(est, e, models, k, clk, rows);
+  addDifferenceRows(e, k, clk, rows);
+  if (!rows.empty()) applyRows(est, e.rep, k, rows);
+  // Ambiguities of satellites without a phase row for a while (set, masked, lost).
+  for (auto it = ambiguities_.begin(); it != ambiguities_.end();) {
+    const SatId sat = it->first;
+    const bool stale = e.rover.time - it->second.lastRow > 10.0;
+    ++it;
+    if (stale) dropAmbiguity(est, sat);
+  }
+  e.rep.ambiguities = static_cast<int>(ambiguities_.size());
+  return true;
+}
+
+// (The class is declared `extern template` in gnss_fusion.hpp: every member defined here is
+// instantiated explicitly.)
+#define GVINS_INSTANTIATE(S)                                                                                        \
+  template bool GnssFusion<S>::prepareStates(vio::EstimatorBackend<S>&, Epoch&, std::vector<SatelliteModel>&,       \
+                                             const AntennaKinematics&);                                             \
+  template sri::BlockId GnssFusion<S>::newAmbiguity(vio::EstimatorBackend<S>&, const SatelliteModel&);              \
+  template void GnssFusion<S>::addPhaseRows(vio::EstimatorBackend<S>&, Epoch&, const std::vector<SatelliteModel>&,  \
+                                            const AntennaKinematics&, const Eigen::VectorXd&, GnssRowSet&);         \
+  template void GnssFusion<S>::addDifferenceRows(Epoch&, const AntennaKinematics&, const Eigen::VectorXd&,          \
+                                                 GnssRowSet&);                                                      \
+  template void GnssFusion<S>::applyRows(vio::EstimatorBackend<S>&, GnssEpochReport&, const AntennaKinematics&,     \
+                                         GnssRowSet&);                                                              \
+  template bool GnssFusion<S>::tightUpdate(vio::EstimatorBackend<S>&, Epoch&, const GnssStateValues&,               \
+                                           const AntennaKinematics&);
+GVINS_INSTANTIATE(float)
+GVINS_INSTANTIATE(double)
+#undef GVINS_INSTANTIATE
+
+}  // namespace gvins::fusion
