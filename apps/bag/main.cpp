@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "gvins/base/atomic_output_file.hpp"
+#include "gvins/base/command_line.hpp"
 #include "gvins/base/parse_error.hpp"
 #include "gvins/fusion/rosbag_dataset.hpp"
 
@@ -33,10 +34,7 @@ const char* kUsage =
     "\n"
     "Exit status: 0 success, 1 bad input file or write error, 2 bad arguments.\n";
 
-int usageError(const std::string& msg) {
-  std::fprintf(stderr, "gvins-bag: %s\n(gvins-bag --help for usage)\n", msg.c_str());
-  return 2;
-}
+[[noreturn]] int usageError(const std::string& msg) { gvins::usageError("gvins-bag", msg); }
 
 std::string timeText(const gvins::fusion::ros::Time& t) {
   char buf[40];
@@ -89,30 +87,15 @@ int main(int argc, char** argv) {
   std::vector<std::string> positional;
   std::string out, calib, obs, nav;
   gvins::fusion::BagCompression compression = gvins::fusion::BagCompression::None;
-  for (int i = 2; i < argc; ++i) {
-    const std::string a = argv[i];
-    const auto value = [&](std::string& dst) {
-      if (i + 1 >= argc) return false;
-      dst = argv[++i];
-      return true;
-    };
-    if (a == "-o") {
-      if (!value(out)) return usageError("-o needs a value");
-    } else if (a == "--calib-from") {
-      if (!value(calib)) return usageError("--calib-from needs a value");
-    } else if (a == "--obs") {
-      if (!value(obs)) return usageError("--obs needs a value");
-    } else if (a == "--nav") {
-      if (!value(nav)) return usageError("--nav needs a value");
-    } else if (a == "--bz2") {
-      compression = gvins::fusion::BagCompression::Bz2;
-    } else if (a == "--lz4") {
-      compression = gvins::fusion::BagCompression::Lz4;
-    } else if (!a.empty() && a[0] == '-') {
-      return usageError("unknown option " + a);
-    } else {
-      positional.push_back(a);
-    }
+  gvins::CommandLine cl("gvins-bag", kUsage, argc, argv, 2);
+  while (cl.next()) {
+    if (cl.is("-o")) out = cl.value();
+    else if (cl.is("--calib-from")) calib = cl.value();
+    else if (cl.is("--obs")) obs = cl.value();
+    else if (cl.is("--nav")) nav = cl.value();
+    else if (cl.is("--bz2")) compression = gvins::fusion::BagCompression::Bz2;
+    else if (cl.is("--lz4")) compression = gvins::fusion::BagCompression::Lz4;
+    else positional.push_back(cl.operand());
   }
   if (!gvins::fusion::rosbagSupported()) {
     std::fprintf(stderr, "gvins-bag: this build has no ROS bag support (librosbag-storage-dev, GVINS_WITH_ROSBAG)\n");

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "gvins/base/command_line.hpp"
 #include "gvins/base/line_reader.hpp"
-#include "gvins/base/option_values.hpp"
 #include "gvins/base/parse_error.hpp"
 #include "gvins/vio/euroc_csv.hpp"
 #include "gvins/vio/pose_covariance_csv.hpp"
@@ -53,19 +53,6 @@ const char* kUsage =
     "\n"
     "Exit status: 0 success, 1 input or evaluation error, 2 usage error.\n";
 
-[[noreturn]] void usageError(const std::string& msg) {
-  std::fprintf(stderr, "gvins-eval: %s (see --help)\n", msg.c_str());
-  std::exit(2);
-}
-
-double parseNumber(const std::string& s, const char* opt, double lo, double hi) {
-  try {
-    return gvins::optionNumber(opt, s, lo, hi);
-  } catch (const gvins::OptionError& e) {
-    usageError(e.what());
-  }
-}
-
 bool looksLikeAsl(const std::string& path) {
   gvins::LineReader r(path);
   std::string line;
@@ -91,56 +78,34 @@ int main(int argc, char** argv) {
   std::string gtFormat = "auto", covPath, plots;
   bool noCov = false;
   bool whole = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) usageError("option " + a + " needs a value");
-      return argv[++i];
-    };
-    if (a == "-h" || a == "--help") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    } else if (a == "--align") {
-      const std::string v = value();
+  gvins::CommandLine cl("gvins-eval", kUsage, argc, argv);
+  while (cl.next()) {
+    if (cl.is("--align")) {
+      const std::string v = cl.value();
       const auto k = parseAlignmentKind(v);
-      if (!k) usageError("unknown alignment '" + v + "'");
+      if (!k) cl.error("unknown alignment '" + v + "'");
       opt.alignment = *k;
-    } else if (a == "--gt-format") {
-      gtFormat = value();
-      if (gtFormat != "auto" && gtFormat != "asl" && gtFormat != "tum") usageError("unknown --gt-format '" + gtFormat + "'");
-    } else if (a == "--tolerance") {
-      const double ms = parseNumber(value(), "--tolerance", 0.0, 1e6);
-      opt.tolerance_ns = static_cast<std::int64_t>(ms * 1e6);
-    } else if (a == "--segments") {
-      opt.segmentLengths.clear();
-      std::string v = value(), tok;
-      std::size_t start = 0;
-      while (start <= v.size()) {
-        const auto c = v.find(',', start);
-        tok = v.substr(start, c == std::string::npos ? std::string::npos : c - start);
-        const double L = parseNumber(tok, "--segments", 1e-3, 1e7);
-        opt.segmentLengths.push_back(L);
-        if (c == std::string::npos) break;
-        start = c + 1;
-      }
-    } else if (a == "--align-first") {
-      const double n = parseNumber(value(), "--align-first", 2.0, 1e9);
-      opt.alignFirst = static_cast<std::size_t>(n);
-    } else if (a == "--cov") {
-      covPath = value();
-    } else if (a == "--no-cov") {
+    } else if (cl.is("--gt-format")) {
+      gtFormat = cl.choice({"auto", "asl", "tum"});
+    } else if (cl.is("--tolerance")) {
+      opt.tolerance_ns = static_cast<std::int64_t>(cl.number(0.0, 1e6, "ms") * 1e6);
+    } else if (cl.is("--segments")) {
+      opt.segmentLengths = cl.numberList(1e-3, 1e7, "m");
+    } else if (cl.is("--align-first")) {
+      opt.alignFirst = static_cast<std::size_t>(cl.number(2.0, 1e9));
+    } else if (cl.is("--cov")) {
+      covPath = cl.value();
+    } else if (cl.is("--no-cov")) {
       noCov = true;
-    } else if (a == "--whole") {
+    } else if (cl.is("--whole")) {
       whole = true;
-    } else if (a == "--plots") {
-      plots = value();
-    } else if (!a.empty() && a[0] == '-') {
-      usageError("unknown option " + a);
+    } else if (cl.is("--plots")) {
+      plots = cl.value();
     } else {
-      pos.push_back(a);
+      pos.push_back(cl.operand());
     }
   }
-  if (pos.size() != 2) usageError("need EST and GT");
+  if (pos.size() != 2) cl.error("need EST and GT");
   try {
     const std::string estPath = pos[0];
     std::string gtPath = pos[1];

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "gvins/base/option_values.hpp"
+#include "gvins/base/command_line.hpp"
 #include "gvins/base/parse_error.hpp"
 #include "gvins/sim/dataset_writer.hpp"
 #include "gvins/vio/imu_table.hpp"
@@ -37,11 +37,6 @@ const char* kUsage =
     "A cut-off first or last line (a log started or stopped mid-line) is skipped and counted; any\n"
     "other malformed line stops the run naming file, line and field.\n"
     "Exit status: 0 success, 1 bad input file or write error, 2 bad arguments.\n";
-
-int usageError(const std::string& msg) {
-  std::fprintf(stderr, "gvins-imu: %s\n(gvins-imu --help for usage)\n", msg.c_str());
-  return 2;
-}
 
 struct Args {
   std::string command, input, output, tag;
@@ -89,50 +84,30 @@ int main(int argc, char** argv) {
     return args.empty() ? 2 : 0;
   }
   a.command = args[0];
-  if (a.command != "info" && a.command != "convert") return usageError("unknown command '" + a.command + "'");
-  try {
-    for (std::size_t i = 1; i < args.size(); ++i) {
-      const std::string& o = args[i];
-      auto value = [&]() -> const std::string& {
-        if (i + 1 >= args.size()) throw gvins::OptionError(o + " needs a value");
-        return args[++i];
-      };
-      if (o == "-o") a.output = value();
-      else if (o == "--columns" || o == "--time") {
-        const std::string& v = value();
-        try {
-          if (o == "--columns") a.format.columns = parseImuColumns(v);
-          else a.format.time = parseImuTimeKind(v);
-        } catch (const std::invalid_argument& e) {
-          throw gvins::OptionError(o + ": " + e.what());
-        }
+  gvins::CommandLine cl("gvins-imu", kUsage, argc, argv, 2);
+  if (a.command != "info" && a.command != "convert") cl.error("unknown command '" + a.command + "'");
+  while (cl.next()) {
+    if (cl.is("-o")) a.output = cl.value();
+    else if (cl.is("--columns") || cl.is("--time")) {
+      const std::string o = cl.arg(), v = cl.value();
+      try {
+        if (o == "--columns") a.format.columns = parseImuColumns(v);
+        else a.format.time = parseImuTimeKind(v);
+      } catch (const std::invalid_argument& e) {
+        cl.error(o + ": " + e.what());
       }
-      else if (o == "--tag") a.tag = value();
-      else if (o == "--accel-unit") {
-        const std::string& u = value();
-        if (u != "g" && u != "m/s2") throw gvins::OptionError("--accel-unit: '" + u + "' is neither g nor m/s2");
-        a.format.accelScale = u == "g" ? 9.80665 : 1.0;
-      } else if (o == "--gyro-unit") {
-        const std::string& u = value();
-        if (u != "deg/s" && u != "rad/s") throw gvins::OptionError("--gyro-unit: '" + u + "' is neither deg/s nor rad/s");
-        a.format.gyroScale = u == "deg/s" ? M_PI / 180.0 : 1.0;
-      } else if (o == "--rotate") {
-        const Eigen::Vector3d rpy = gvins::optionVector3("--rotate", value(), -360.0, 360.0, "deg");
-        a.format.rotation = rotationFromRollPitchYaw(rpy.x(), rpy.y(), rpy.z());
-      } else if (!o.empty() && o[0] == '-') {
-        throw gvins::OptionError("unknown option '" + o + "'");
-      } else if (a.input.empty()) {
-        a.input = o;
-      } else {
-        throw gvins::OptionError("unexpected argument '" + o + "'");
-      }
-    }
-    if (a.input.empty()) throw gvins::OptionError("no IMU log given");
-    if (a.command == "convert" && a.output.empty()) throw gvins::OptionError("convert needs -o OUT.csv");
-    if (a.format.time == ImuTimeKind::CounterMs && a.tag.empty()) throw gvins::OptionError("--time counter-ms needs --tag FILE");
-  } catch (const std::invalid_argument& e) {
-    return usageError(e.what());
+    } else if (cl.is("--tag")) a.tag = cl.value();
+    else if (cl.is("--accel-unit")) a.format.accelScale = cl.choice({"g", "m/s2"}) == "g" ? 9.80665 : 1.0;
+    else if (cl.is("--gyro-unit")) a.format.gyroScale = cl.choice({"deg/s", "rad/s"}) == "deg/s" ? M_PI / 180.0 : 1.0;
+    else if (cl.is("--rotate")) {
+      const Eigen::Vector3d rpy = cl.vector3(-360.0, 360.0, "deg");
+      a.format.rotation = rotationFromRollPitchYaw(rpy.x(), rpy.y(), rpy.z());
+    } else if (a.input.empty()) a.input = cl.operand();
+    else cl.error(cl.isOption() ? "unknown option '" + cl.arg() + "'" : "unexpected argument '" + cl.arg() + "'");
   }
+  if (a.input.empty()) cl.error("no IMU log given");
+  if (a.command == "convert" && a.output.empty()) cl.error("convert needs -o OUT.csv");
+  if (a.format.time == ImuTimeKind::CounterMs && a.tag.empty()) cl.error("--time counter-ms needs --tag FILE");
   try {
     std::optional<RtklibTimeTag> tag;
     if (!a.tag.empty()) tag = RtklibTimeTag::read(a.tag);

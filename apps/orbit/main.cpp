@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "gvins/base/command_line.hpp"
 #include "gvins/base/parse_error.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/ephemeris/orbit_comparison.hpp"
@@ -64,52 +65,91 @@ bool parseTime(const char* text, gvins::CalendarTime& c) {
   return c.year >= 1980 && c.year < 2200 && gvins::isValidCalendar(c) && c.second < 60.0;
 }
 
+/// --compare: broadcast minus precise, epoch after epoch (CSV rows on stdout, RMS per system on
+/// stderr); the clock differences of each system are referred to their mean at the epoch for the
+/// SISRE.
+int compareOrbits(const gvins::EphemerisStore& store, const std::shared_ptr<gvins::PreciseEphemeris>& precise,
+                  const std::shared_ptr<gvins::AntexData>& antennas, const gvins::EphemerisSelection& policy,
+                  const gvins::GpsTime& t, double duration, double step) {
+  struct Acc {
+    double r2 = 0, a2 = 0, c2 = 0, k2 = 0, s2 = 0;
+    int n = 0;
+  };
+  std::map<int, Acc> acc;
+  gvins::EphemerisStore preciseStore;  // the products with the antenna offsets, if any
+  preciseStore.setPrecise(precise);
+  if (antennas) preciseStore.setSatelliteAntennas(antennas);
+  int epochs = 0;
+  for (double dt = 0.0; dt <= duration + 1e-9; dt += step) {
+    const gvins::GpsTime te = t + dt;
+    std::vector<std::pair<gvins::SatId, gvins::OrbitDifference>> rows;
+    double sum[gvins::kNumSystems] = {};
+    int cnt[gvins::kNumSystems] = {};
+    for (const gvins::SatId sat : store.satellites()) {
+      const auto b = store.satelliteState(sat, te, policy);
+      const auto p = preciseStore.preciseState(sat, te);
+      if (!b || !p) continue;
+      const gvins::OrbitDifference d = gvins::orbitDifference(*b, *p);
+      rows.emplace_back(sat, d);
+      sum[gvins::systemIndex(sat.system)] += d.clock;
+      ++cnt[gvins::systemIndex(sat.system)];
+    }
+    for (const auto& [sat, d] : rows) {
+      if (acc.empty()) std::printf("gpst,sat,radial_m,along_m,cross_m,clock_m,sisre_m\n");  // with the first row
+      const int si = gvins::systemIndex(sat.system);
+      const double mean = sum[si] / cnt[si];
+      const double e = gvins::sisre(sat, d, mean);
+      std::printf("%s,%s,%.4f,%.4f,%.4f,%.4f,%.4f\n", te.toString(3).c_str(), sat.str().c_str(), d.radial, d.along,
+                  d.cross, d.clock, e);
+      Acc& a = acc[si];
+      a.r2 += d.radial * d.radial;
+      a.a2 += d.along * d.along;
+      a.c2 += d.cross * d.cross;
+      a.k2 += (d.clock - mean) * (d.clock - mean);
+      a.s2 += e * e;
+      ++a.n;
+    }
+    ++epochs;
+  }
+  std::fflush(stdout);
+  std::fprintf(stderr, "gvins-orbit: broadcast minus precise, %d epoch(s) from %s GPST, RMS [m]\n", epochs,
+               t.toString(3).c_str());
+  std::fprintf(stderr, "  system     rows   radial    along    cross  clock-mean    SISRE\n");
+  for (const auto& [si, a] : acc) {
+    const auto rms = [&](double x) { return std::sqrt(x / a.n); };
+    std::fprintf(stderr, "  %-8s %6d %8.3f %8.3f %8.3f %11.3f %8.3f\n",
+                 std::string(gvins::systemName(static_cast<gvins::System>(si))).c_str(), a.n, rms(a.r2), rms(a.a2),
+                 rms(a.c2), rms(a.k2), rms(a.s2));
+  }
+  if (acc.empty()) {
+    std::fprintf(stderr,
+                 "gvins-orbit: --compare: no satellite has both a broadcast ephemeris and a precise state at %s GPST%s "
+                 "(the navigation files and the products do not overlap there)\n",
+                 t.toString(3).c_str(), duration > 0.0 ? " or later in --duration" : "");
+    return 1;
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::vector<std::string> files;
   gvins::PreciseProductFiles products;
-  const char* timeText = nullptr;
+  std::string timeText;
   bool utc = false, unhealthy = false, realtime = false, compare = false;
   double duration = 0.0, step = 300.0;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "-h" || a == "--help") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    } else if (a == "--time") {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "gvins-orbit: --time needs a value\n");
-        return 2;
-      }
-      timeText = argv[++i];
-    } else if (a == "--gpst") {
-      utc = false;
-    } else if (a == "--utc") {
-      utc = true;
-    } else if (a == "--unhealthy") {
-      unhealthy = true;
-    } else if (a == "--realtime") {
-      realtime = true;
-    } else if (a == "--compare") {
-      compare = true;
-    } else if (a == "--duration" || a == "--step") {
-      char* end = nullptr;
-      const double v = i + 1 < argc ? std::strtod(argv[i + 1], &end) : NAN;
-      if (i + 1 >= argc || end == argv[i + 1] || *end != '\0' || !(v >= 0.0 && v <= 30.0 * 86400.0) ||
-          (a == "--step" && !(v >= 1.0))) {
-        std::fprintf(stderr, "gvins-orbit: %s needs a number of seconds (%s)\n", a.c_str(),
-                     a == "--step" ? "1 s to 30 days" : "0 to 30 days");
-        return 2;
-      }
-      ++i;
-      (a == "--duration" ? duration : step) = v;
-    } else if (a.size() > 1 && a[0] == '-') {
-      std::fprintf(stderr, "gvins-orbit: unknown option '%s' (see --help)\n", a.c_str());
-      return 2;
-    } else {
-      if (!products.add(a)) files.push_back(a);
-    }
+  gvins::CommandLine cl("gvins-orbit", kUsage, argc, argv);
+  while (cl.next()) {
+    if (cl.is("--time")) timeText = cl.value();
+    else if (cl.is("--gpst")) utc = false;
+    else if (cl.is("--utc")) utc = true;
+    else if (cl.is("--unhealthy")) unhealthy = true;
+    else if (cl.is("--realtime")) realtime = true;
+    else if (cl.is("--compare")) compare = true;
+    else if (cl.is("--duration")) duration = cl.number(0.0, 30.0 * 86400.0, "s (0 to 30 days)");
+    else if (cl.is("--step")) step = cl.number(1.0, 30.0 * 86400.0, "s (1 s to 30 days)");
+    else if (const std::string& f = cl.operand(); !products.add(f)) files.push_back(f);
   }
   for (const std::string& b : products.biases)
     std::fprintf(stderr, "gvins-orbit: note: %s: code biases do not change satellite states; not used\n", b.c_str());
@@ -120,14 +160,14 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "gvins-orbit: --compare needs a precise orbit file (*.sp3)\n");
     return 2;
   }
-  if (files.empty() || !timeText) {
+  if (files.empty() || timeText.empty()) {
     std::fprintf(stderr, "gvins-orbit: %s\n%s", files.empty() ? "no navigation file given" : "--time is required",
                  kUsage);
     return 2;
   }
   gvins::CalendarTime cal;
-  if (!parseTime(timeText, cal)) {
-    std::fprintf(stderr, "gvins-orbit: bad --time '%s' (expected \"YYYY-MM-DD HH:MM:SS[.ffffff]\")\n", timeText);
+  if (!parseTime(timeText.c_str(), cal)) {
+    std::fprintf(stderr, "gvins-orbit: bad --time '%s' (expected \"YYYY-MM-DD HH:MM:SS[.ffffff]\")\n", timeText.c_str());
     return 2;
   }
   const gvins::GpsTime t = utc ? gvins::utcToGpst(cal) : gvins::GpsTime::fromCalendar(cal);
@@ -170,68 +210,7 @@ int main(int argc, char** argv) {
   gvins::EphemerisSelection policy;
   policy.allowUnhealthy = unhealthy;
   if (realtime) policy.futureTolerance = -1.0;
-  if (compare) {
-    // Broadcast minus precise, epoch after epoch; the clock differences of each system are
-    // referred to their mean at the epoch for the SISRE.
-    struct Acc {
-      double r2 = 0, a2 = 0, c2 = 0, k2 = 0, s2 = 0;
-      int n = 0;
-    };
-    std::map<int, Acc> acc;
-    gvins::EphemerisStore preciseStore;  // the products with the antenna offsets, if any
-    preciseStore.setPrecise(precise);
-    if (antennas) preciseStore.setSatelliteAntennas(antennas);
-    int epochs = 0;
-    for (double dt = 0.0; dt <= duration + 1e-9; dt += step) {
-      const gvins::GpsTime te = t + dt;
-      std::vector<std::pair<gvins::SatId, gvins::OrbitDifference>> rows;
-      double sum[gvins::kNumSystems] = {};
-      int cnt[gvins::kNumSystems] = {};
-      for (const gvins::SatId sat : store.satellites()) {
-        const auto b = store.satelliteState(sat, te, policy);
-        const auto p = preciseStore.preciseState(sat, te);
-        if (!b || !p) continue;
-        const gvins::OrbitDifference d = gvins::orbitDifference(*b, *p);
-        rows.emplace_back(sat, d);
-        sum[gvins::systemIndex(sat.system)] += d.clock;
-        ++cnt[gvins::systemIndex(sat.system)];
-      }
-      for (const auto& [sat, d] : rows) {
-        if (acc.empty()) std::printf("gpst,sat,radial_m,along_m,cross_m,clock_m,sisre_m\n");  // with the first row
-        const int si = gvins::systemIndex(sat.system);
-        const double mean = sum[si] / cnt[si];
-        const double e = gvins::sisre(sat, d, mean);
-        std::printf("%s,%s,%.4f,%.4f,%.4f,%.4f,%.4f\n", te.toString(3).c_str(), sat.str().c_str(), d.radial, d.along,
-                    d.cross, d.clock, e);
-        Acc& a = acc[si];
-        a.r2 += d.radial * d.radial;
-        a.a2 += d.along * d.along;
-        a.c2 += d.cross * d.cross;
-        a.k2 += (d.clock - mean) * (d.clock - mean);
-        a.s2 += e * e;
-        ++a.n;
-      }
-      ++epochs;
-    }
-    std::fflush(stdout);
-    std::fprintf(stderr, "gvins-orbit: broadcast minus precise, %d epoch(s) from %s GPST, RMS [m]\n", epochs,
-                 t.toString(3).c_str());
-    std::fprintf(stderr, "  system     rows   radial    along    cross  clock-mean    SISRE\n");
-    for (const auto& [si, a] : acc) {
-      const auto rms = [&](double x) { return std::sqrt(x / a.n); };
-      std::fprintf(stderr, "  %-8s %6d %8.3f %8.3f %8.3f %11.3f %8.3f\n",
-                   std::string(gvins::systemName(static_cast<gvins::System>(si))).c_str(), a.n, rms(a.r2), rms(a.a2),
-                   rms(a.c2), rms(a.k2), rms(a.s2));
-    }
-    if (acc.empty()) {
-      std::fprintf(stderr,
-                   "gvins-orbit: --compare: no satellite has both a broadcast ephemeris and a precise state at %s GPST%s "
-                   "(the navigation files and the products do not overlap there)\n",
-                   t.toString(3).c_str(), duration > 0.0 ? " or later in --duration" : "");
-      return 1;
-    }
-    return 0;
-  }
+  if (compare) return compareOrbits(store, precise, antennas, policy, t, duration, step);
   if (precise) store.setPrecise(precise);
   if (antennas) store.setSatelliteAntennas(antennas);
   int perSystem[gvins::kNumSystems] = {};

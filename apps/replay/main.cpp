@@ -7,13 +7,14 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <sstream>
 #include <vector>
 #include <string>
 
-#include "gvins/base/option_values.hpp"
+#include "gvins/base/command_line.hpp"
 #include "gvins/base/parse_error.hpp"
 #include "gvins/fusion/gnss_fusion_config.hpp"
 #include "gvins/fusion/replay_config.hpp"
@@ -100,32 +101,156 @@ const char* kUsage =
     "\n"
     "Exit status: 0 success, 1 dataset/processing error, 2 usage error.\n";
 
-[[noreturn]] void usageError(const std::string& msg) {
-  std::fprintf(stderr, "gvins-replay: %s (see --help)\n", msg.c_str());
-  std::exit(2);
-}
-
 /// Largest lever-arm component accepted from --lever-arm, m.
 constexpr double kMaxLeverArm = 10.0;
 
-/// The value of a checked option (base/option_values.hpp), or a usage error naming it.
-template <class F>
-auto optionValue(F&& parse) {
-  try {
-    return parse();
-  } catch (const OptionError& e) {
-    usageError(e.what());
+/// The command line: only what was given (the configuration file and the dataset fill the rest).
+struct Args {
+  std::string dataset, outDir, nmeaPath, configPath, mode = "vio";
+  std::optional<bool> leverCalib, timeCalib;
+  std::optional<double> timeOffset, carrierSmoothing;
+  std::string saveTracks;
+  bool useFloat = false, quiet = false, images = false, noEval = false, skipBad = false, skipMissing = false;
+  std::optional<double> start, duration, maxGap;
+  std::optional<ImuGapPolicy> gapPolicy;
+  std::optional<std::string> rover, base, nav;
+  std::vector<std::string> sp3Files, clockFiles, antennaFiles, biasFiles;
+  bool broadcastOnly = false;
+  std::vector<std::string> ssrFiles;
+  std::optional<Eigen::Vector3d> basePos, leverArm;
+  std::int64_t sensorToGpst = 0;
+  std::string truthPos;
+  int truthQuality = 1;
+  std::optional<double> cameraLessRate;
+  std::vector<std::pair<double, double>> outages;  // --gnss-outage, s after the first frame
+};
+
+Args parseArgs(int argc, char** argv) {
+  Args a;
+  CommandLine cl("gvins-replay", kUsage, argc, argv);
+  while (cl.next()) {
+    if (cl.is("-o")) a.outDir = cl.value();
+    else if (cl.is("--nmea")) a.nmeaPath = cl.value();
+    else if (cl.is("--config")) a.configPath = cl.value();
+    else if (cl.is("--mode")) a.mode = cl.value();
+    else if (cl.is("--float")) a.useFloat = true;
+    else if (cl.is("--lever-arm-calib")) a.leverCalib = cl.onOff();
+    else if (cl.is("--time-offset-calib")) a.timeCalib = cl.onOff();
+    else if (cl.is("--time-offset")) a.timeOffset = cl.number(-1.0, 1.0, "s");
+    else if (cl.is("--rover")) a.rover = cl.value();
+    else if (cl.is("--base")) a.base = cl.value();
+    else if (cl.is("--nav")) a.nav = cl.value();
+    else if (cl.is("--sp3")) a.sp3Files.push_back(cl.value());
+    else if (cl.is("--clk")) a.clockFiles.push_back(cl.value());
+    else if (cl.is("--atx")) a.antennaFiles.push_back(cl.value());
+    else if (cl.is("--bia")) a.biasFiles.push_back(cl.value());
+    else if (cl.is("--broadcast")) a.broadcastOnly = true;
+    else if (cl.is("--ssr")) a.ssrFiles.push_back(cl.value());
+    else if (cl.is("--carrier-smoothing")) a.carrierSmoothing = cl.number(0.0, 3600.0, "s");
+    else if (cl.is("--base-position")) a.basePos = cl.stationEcef();
+    // A GNSS antenna a few metres from the IMU at most on the vehicles this estimator is for;
+    // a larger value is a unit or sign mistake that would only show as a km-level error.
+    else if (cl.is("--lever-arm")) a.leverArm = cl.vector3(-kMaxLeverArm, kMaxLeverArm, "m");
+    else if (cl.is("--sensor-to-gpst")) a.sensorToGpst = cl.integer(std::numeric_limits<std::int64_t>::min(), std::numeric_limits<std::int64_t>::max());
+    else if (cl.is("--start")) a.start = cl.number(0.0, 1e7, "s");
+    else if (cl.is("--duration")) a.duration = cl.number(0.0, 1e7, "s (0: to the end)");
+    else if (cl.is("--max-imu-gap")) a.maxGap = cl.number(1e-4, 3600.0, "s");
+    else if (cl.is("--imu-gaps")) a.gapPolicy = cl.choice(kImuGapPolicyNames);
+    else if (cl.is("--skip-bad-images")) a.skipBad = true;
+    else if (cl.is("--skip-missing-images")) a.skipMissing = true;
+    else if (cl.is("--images")) a.images = true;
+    else if (cl.is("--save-tracks")) a.saveTracks = cl.value();
+    else if (cl.is("--no-eval")) a.noEval = true;
+    else if (cl.is("--truth-pos")) a.truthPos = cl.value();
+    else if (cl.is("--truth-quality")) a.truthQuality = static_cast<int>(cl.integer(1, 6));
+    else if (cl.is("--camera-less-rate")) a.cameraLessRate = cl.number(0.5, 100.0, "Hz");
+    else if (cl.is("--gnss-outage")) {
+      const std::vector<double> w = cl.numberList(0.0, 1e7, "s");
+      if (w.size() != 2) cl.error("--gnss-outage takes START,LENGTH (s)");
+      a.outages.emplace_back(w[0], w[0] + w[1]);
+    }
+    else if (cl.is("-q", "--quiet")) a.quiet = true;
+    else if (a.dataset.empty()) a.dataset = cl.operand();
+    else cl.error(cl.isOption() ? "unknown option '" + cl.arg() + "'" : "more than one dataset given");
   }
+  if (a.dataset.empty()) cl.error("no dataset folder given");
+  return a;
 }
 
-double toNumber(const std::string& s, const std::string& opt) {
-  try {
-    std::size_t p = 0;
-    const double v = std::stod(s, &p);
-    if (p == s.size()) return v;
-  } catch (const std::exception&) {
+/// The replay options: the configuration file's, changed by the command line.
+ReplayOptions replayOptions(const ReplayConfig& rc, const Args& a) {
+  ReplayOptions opt = rc.options;
+  opt.outDir = a.outDir;
+  opt.nmeaPath = a.nmeaPath;
+  opt.modeName = a.mode;
+  opt.progress = !a.quiet;
+  if (a.start) opt.start_s = *a.start;
+  if (a.duration) opt.duration_s = *a.duration;
+  if (a.maxGap) opt.maxImuGap_s = *a.maxGap;
+  if (a.gapPolicy) opt.imuGapPolicy = *a.gapPolicy;
+  if (a.skipBad) opt.skipBadImages = true;
+  if (a.skipMissing) opt.skipMissingImages = true;
+  if (a.images) opt.useFeatureTracks = false;
+  if (!a.saveTracks.empty()) opt.saveTracksDir = a.saveTracks;
+  if (a.noEval) opt.evaluate = false;
+  opt.truthPos = a.truthPos;
+  opt.truthPosMaxQuality = a.truthQuality;
+  if (a.cameraLessRate) opt.cameraLessRate_hz = *a.cameraLessRate;
+  opt.gnssOutages = a.outages;
+  if (a.rover) opt.roverObs = *a.rover;
+  if (a.base) opt.baseObs = *a.base;
+  if (a.nav) opt.navFile = *a.nav;
+  opt.sp3Files = a.sp3Files;
+  opt.clockFiles = a.clockFiles;
+  opt.antennaFiles = a.antennaFiles;
+  opt.biasFiles = a.biasFiles;
+  opt.broadcastOnly = a.broadcastOnly;
+  opt.ssrFiles = a.ssrFiles;
+  opt.basePosition = a.basePos;
+  opt.sensorToGpst_ns = a.sensorToGpst;
+  return opt;
+}
+
+/// Estimator configuration: the dataset's calibration (IMU noise, cameras, a simulation's
+/// gravity), changed by the estimator file of the config if there is one (a file without
+/// cameras, e.g. config/estimator_euroc.yaml, tunes the filter for any dataset), then by the
+/// command line.
+vio::SriSwfConfig estimatorConfig(const ReplayConfig& rc, const ReplayOptions& opt, const std::optional<SimDatasetInfo>& info,
+                                  const Args& a) {
+  fs::path mav0 = fs::path(a.dataset) / "mav0";
+  if (!fs::is_directory(mav0)) mav0 = a.dataset;
+  // A rig without a camera (no cam0 folder) runs camera-less: IMU and GNSS only.
+  const bool cameraLess = fs::exists(mav0 / "imu0") && !fs::exists(mav0 / "cam0");
+  const bool datasetCalibration =
+      fs::exists(mav0 / "imu0" / "sensor.yaml") && (cameraLess || fs::exists(mav0 / "cam0" / "sensor.yaml"));
+  vio::SriSwfConfig ec;
+  if (datasetCalibration || rc.estimatorConfig.empty()) {
+    ec.imu = vio::readImuSensorYaml((mav0 / "imu0" / "sensor.yaml").string()).noise;
+    if (!cameraLess) ec.cameras.push_back(vio::readCameraSensorYaml((mav0 / "cam0" / "sensor.yaml").string()));
+    if (opt.frontend.useStereo && fs::exists(mav0 / "cam1" / "sensor.yaml"))
+      ec.cameras.push_back(vio::readCameraSensorYaml((mav0 / "cam1" / "sensor.yaml").string()));
+    if (info && info->gravity) ec.gravity = *info->gravity;
+    if (info && info->gravityModel == "rotating")
+      std::fprintf(stderr, "gvins-replay: note: the dataset's IMU includes the Earth rotation, which the estimator does not model\n");
   }
-  usageError("bad number '" + s + "' for " + opt);
+  if (!rc.estimatorConfig.empty()) ec = vio::loadSriSwfConfig(rc.estimatorConfig, datasetCalibration ? &ec : nullptr);
+  if (a.useFloat) ec.use_float = true;
+  if (a.timeCalib) ec.calibrate_time_offset = *a.timeCalib;
+  if (a.timeOffset) ec.time_offset = *a.timeOffset;
+  return ec;
+}
+
+/// The GNSS fusion configuration of a GNSS mode: the config's gnss_fusion: section, the
+/// dataset's true lever arm as the start value, the command line.
+GnssFusionConfig gnssConfig(const ReplayConfig& rc, GnssFusionMode mode, const std::optional<Eigen::Vector3d>& trueLever,
+                            const Args& a) {
+  GnssFusionConfig gc = rc.hasGnssFusion ? parseGnssFusionConfig(rc.text, rc.file) : GnssFusionConfig{};
+  gc.mode = mode;
+  if (a.leverCalib) gc.calibrateLeverArm = *a.leverCalib;
+  if (!gc.leverArmGiven && trueLever) gc.leverArm = *trueLever;
+  if (a.leverArm) gc.leverArm = *a.leverArm;
+  if (a.carrierSmoothing) gc.carrierSmoothing = *a.carrierSmoothing;
+  return gc;
 }
 
 template <typename Scalar>
@@ -140,186 +265,37 @@ ReplaySummary run(const std::string& dataset, const vio::SriSwfConfig& ec, const
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string nmeaPath;
-  std::string dataset, outDir, configPath, mode = "vio", leverCalib, timeCalib;
-  std::optional<double> timeOffset, carrierSmoothing;
-  std::string saveTracks;
-  bool useFloat = false, quiet = false, images = false, noEval = false, skipBad = false, skipMissing = false;
-  std::optional<double> start, duration, maxGap;
-  std::optional<std::string> gapPolicy, rover, base, nav;
-  std::vector<std::string> sp3Files, clockFiles, antennaFiles, biasFiles;
-  bool broadcastOnly = false;
-  std::vector<std::string> ssrFiles;
-  std::optional<Eigen::Vector3d> basePos, leverArm;
-  std::int64_t sensorToGpst = 0;
-  std::string truthPos;
-  int truthQuality = 1;
-  std::optional<double> cameraLessRate;
-  std::vector<std::pair<double, double>> outages;  // --gnss-outage, s after the first frame
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc) usageError("option " + a + " needs a value");
-      return argv[++i];
-    };
-    if (a == "-h" || a == "--help") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    } else if (a == "-o") outDir = value();
-    else if (a == "--nmea") nmeaPath = value();
-    else if (a == "--config") configPath = value();
-    else if (a == "--mode") mode = value();
-    else if (a == "--float") useFloat = true;
-    else if (a == "--lever-arm-calib") {
-      leverCalib = value();
-      if (leverCalib != "on" && leverCalib != "off") usageError("--lever-arm-calib takes on or off");
-    } else if (a == "--time-offset-calib") {
-      timeCalib = value();
-      if (timeCalib != "on" && timeCalib != "off") usageError("--time-offset-calib takes on or off");
-    } else if (a == "--time-offset") {
-      timeOffset = toNumber(value(), a);
-      if (!(std::abs(*timeOffset) <= 1.0)) usageError("--time-offset must be within [-1, 1] s");
-    } else if (a == "--rover") rover = value();
-    else if (a == "--base") base = value();
-    else if (a == "--nav") nav = value();
-    else if (a == "--sp3") sp3Files.push_back(value());
-    else if (a == "--clk") clockFiles.push_back(value());
-    else if (a == "--atx") antennaFiles.push_back(value());
-    else if (a == "--bia") biasFiles.push_back(value());
-    else if (a == "--broadcast") broadcastOnly = true;
-    else if (a == "--ssr") ssrFiles.push_back(value());
-    else if (a == "--carrier-smoothing") {
-      carrierSmoothing = toNumber(value(), a);
-      if (!(*carrierSmoothing >= 0.0 && *carrierSmoothing <= 3600.0)) usageError("--carrier-smoothing must be within 0..3600 s");
-    }
-    else if (a == "--base-position") basePos = optionValue([&] { return optionStationEcef(a, value()); });
-    else if (a == "--lever-arm") {
-      // A GNSS antenna a few metres from the IMU at most on the vehicles this estimator is for;
-      // a larger value is a unit or sign mistake that would only show as a km-level error.
-      leverArm = optionValue([&] { return optionVector3(a, value(), -kMaxLeverArm, kMaxLeverArm, "m"); });
-    } else if (a == "--sensor-to-gpst") {
-      const std::string v = value();
-      try {
-        std::size_t p = 0;
-        sensorToGpst = std::stoll(v, &p);
-        if (p != v.size()) throw std::invalid_argument("trailing");
-      } catch (const std::exception&) {
-        usageError("bad integer '" + v + "' for --sensor-to-gpst");
-      }
-    } else if (a == "--start") start = optionValue([&] { return optionNumber(a, value(), 0.0, 1e7, "s"); });
-    else if (a == "--duration") duration = optionValue([&] { return optionNumber(a, value(), 0.0, 1e7, "s (0: to the end)"); });
-    else if (a == "--max-imu-gap") maxGap = optionValue([&] { return optionNumber(a, value(), 1e-4, 3600.0, "s"); });
-    else if (a == "--imu-gaps") {
-      gapPolicy = value();
-      if (*gapPolicy != "error" && *gapPolicy != "warn") usageError("--imu-gaps takes error or warn");
-    } else if (a == "--skip-bad-images") skipBad = true;
-    else if (a == "--skip-missing-images") skipMissing = true;
-    else if (a == "--images") images = true;
-    else if (a == "--save-tracks") saveTracks = value();
-    else if (a == "--no-eval") noEval = true;
-    else if (a == "--truth-pos") truthPos = value();
-    else if (a == "--truth-quality") truthQuality = static_cast<int>(optionValue([&] { return optionNumber(a, value(), 1, 6); }));
-    else if (a == "--camera-less-rate") cameraLessRate = optionValue([&] { return optionNumber(a, value(), 0.5, 100.0, "Hz"); });
-    else if (a == "--gnss-outage") {
-      const std::string v = value();
-      const auto comma = v.find(',');
-      if (comma == std::string::npos) usageError("--gnss-outage takes START,LENGTH (s), not '" + v + "'");
-      const double s0 = optionValue([&] { return optionNumber(a, v.substr(0, comma), 0.0, 1e7, "s"); });
-      const double len = optionValue([&] { return optionNumber(a, v.substr(comma + 1), 0.0, 1e7, "s"); });
-      outages.emplace_back(s0, s0 + len);
-    } else if (a == "-q" || a == "--quiet") quiet = true;
-    else if (!a.empty() && a[0] == '-') usageError("unknown option " + a);
-    else if (dataset.empty()) dataset = a;
-    else usageError("more than one dataset given");
-  }
-  if (dataset.empty()) usageError("no dataset folder given");
+  const Args a = parseArgs(argc, argv);
   {
     std::error_code ec;
-    if (!fs::is_directory(dataset, ec)) {
-      std::fprintf(stderr, "gvins-replay: dataset %s: %s\n", dataset.c_str(),
-                   fs::exists(dataset, ec) ? "not a folder (give the dataset folder, e.g. as gvins-sim writes it)"
-                                           : "no such folder");
+    if (!fs::is_directory(a.dataset, ec)) {
+      std::fprintf(stderr, "gvins-replay: dataset %s: %s\n", a.dataset.c_str(),
+                   fs::exists(a.dataset, ec) ? "not a folder (give the dataset folder, e.g. as gvins-sim writes it)"
+                                             : "no such folder");
       return 1;
     }
   }
-  if (outDir.empty()) usageError("no output folder given (-o)");
-  const auto gnssMode = gnssFusionModeFromString(mode);
-  if (!gnssMode) usageError("unknown mode '" + mode + "'");
+  if (a.outDir.empty()) usageError("gvins-replay", "no output folder given (-o)");
+  const auto gnssMode = gnssFusionModeFromString(a.mode);
+  if (!gnssMode) usageError("gvins-replay", "unknown mode '" + a.mode + "'");
   try {
     ReplayConfig rc;
-    if (!configPath.empty()) rc = loadReplayConfig(configPath);
-    ReplayOptions opt = rc.options;
-    opt.outDir = outDir;
-    opt.nmeaPath = nmeaPath;
-    opt.modeName = mode;
-    opt.progress = !quiet;
-    if (start) opt.start_s = *start;
-    if (duration) opt.duration_s = *duration;
-    if (maxGap) opt.maxImuGap_s = *maxGap;
-    if (gapPolicy) opt.imuGapPolicy = *gapPolicy == "warn" ? ImuGapPolicy::Warn : ImuGapPolicy::Error;
-    if (skipBad) opt.skipBadImages = true;
-    if (skipMissing) opt.skipMissingImages = true;
-    if (images) opt.useFeatureTracks = false;
-    if (!saveTracks.empty()) opt.saveTracksDir = saveTracks;
-    if (noEval) opt.evaluate = false;
-    opt.truthPos = truthPos;
-    opt.truthPosMaxQuality = truthQuality;
-    if (cameraLessRate) opt.cameraLessRate_hz = *cameraLessRate;
-    opt.gnssOutages = outages;
-    if (rover) opt.roverObs = *rover;
-    if (base) opt.baseObs = *base;
-    if (nav) opt.navFile = *nav;
-    opt.sp3Files = sp3Files;
-    opt.clockFiles = clockFiles;
-    opt.antennaFiles = antennaFiles;
-    opt.biasFiles = biasFiles;
-    opt.broadcastOnly = broadcastOnly;
-    opt.ssrFiles = ssrFiles;
-    opt.basePosition = basePos;
-    opt.sensorToGpst_ns = sensorToGpst;
-
+    if (!a.configPath.empty()) rc = loadReplayConfig(a.configPath);
+    ReplayOptions opt = replayOptions(rc, a);
     // A gvins-sim dataset: its lever arm and the gravity its IMU was simulated with.
-    const std::optional<SimDatasetInfo> info = readSimDatasetInfo(dataset);
-    // Estimator configuration: the dataset's calibration (IMU noise, cameras, a simulation's
-    // gravity), changed by the estimator file of the config if there is one (a file without
-    // cameras, e.g. config/estimator_euroc.yaml, tunes the filter for any dataset).
-    fs::path mav0 = fs::path(dataset) / "mav0";
-    if (!fs::is_directory(mav0)) mav0 = dataset;
-    // A rig without a camera (no cam0 folder) runs camera-less: IMU and GNSS only.
-    const bool cameraLess = fs::exists(mav0 / "imu0") && !fs::exists(mav0 / "cam0");
-    const bool datasetCalibration =
-        fs::exists(mav0 / "imu0" / "sensor.yaml") && (cameraLess || fs::exists(mav0 / "cam0" / "sensor.yaml"));
-    vio::SriSwfConfig ec;
-    if (datasetCalibration || rc.estimatorConfig.empty()) {
-      ec.imu = vio::readImuSensorYaml((mav0 / "imu0" / "sensor.yaml").string()).noise;
-      if (!cameraLess) ec.cameras.push_back(vio::readCameraSensorYaml((mav0 / "cam0" / "sensor.yaml").string()));
-      if (opt.frontend.useStereo && fs::exists(mav0 / "cam1" / "sensor.yaml"))
-        ec.cameras.push_back(vio::readCameraSensorYaml((mav0 / "cam1" / "sensor.yaml").string()));
-      if (info && info->gravity) ec.gravity = *info->gravity;
-      if (info && info->gravityModel == "rotating")
-        std::fprintf(stderr, "gvins-replay: note: the dataset's IMU includes the Earth rotation, which the estimator does not model\n");
-    }
-    if (!rc.estimatorConfig.empty()) ec = vio::loadSriSwfConfig(rc.estimatorConfig, datasetCalibration ? &ec : nullptr);
-    if (useFloat) ec.use_float = true;
-    if (!timeCalib.empty()) ec.calibrate_time_offset = timeCalib == "on";
-    if (timeOffset) ec.time_offset = *timeOffset;
+    const std::optional<SimDatasetInfo> info = readSimDatasetInfo(a.dataset);
+    vio::SriSwfConfig ec = estimatorConfig(rc, opt, info, a);
     if (info) opt.timeOffsetTruth = info->cameraTimeOffset;
-
     std::optional<GnssFusionConfig> gc;
-    const std::optional<Eigen::Vector3d> trueLever = info ? info->leverArm : std::nullopt;
     if (*gnssMode != GnssFusionMode::kVio) {
-      gc = rc.hasGnssFusion ? parseGnssFusionConfig(rc.text, rc.file) : GnssFusionConfig{};
-      gc->mode = *gnssMode;
-      if (!leverCalib.empty()) gc->calibrateLeverArm = leverCalib == "on";
-      if (!gc->leverArmGiven && trueLever) gc->leverArm = *trueLever;
-      if (leverArm) gc->leverArm = *leverArm;
-      if (carrierSmoothing) gc->carrierSmoothing = *carrierSmoothing;
+      const std::optional<Eigen::Vector3d> trueLever = info ? info->leverArm : std::nullopt;
+      gc = gnssConfig(rc, *gnssMode, trueLever, a);
       opt.leverArmTruth = trueLever;
       // The differential modes keep the broadcast orbits unless products are named (ReplayOptions::folderProducts).
       opt.folderProducts = !gc->usesDifferences();
     }
     ec = estimatorConfigFor(ec, *gnssMode);
-    const ReplaySummary s = ec.use_float ? run<float>(dataset, ec, gc, opt) : run<double>(dataset, ec, gc, opt);
+    const ReplaySummary s = ec.use_float ? run<float>(a.dataset, ec, gc, opt) : run<double>(a.dataset, ec, gc, opt);
     if (s.framesProcessed == 0) {
       // Output files of a run without a single frame would look like a result: removed.
       for (const auto& f : s.files) std::filesystem::remove(f);
@@ -327,7 +303,7 @@ int main(int argc, char** argv) {
                    "gvins-replay: %s: no frame was processed (%zu frames in the dataset): empty or unreadable "
                    "cam0 data (features.csv / data.csv), or a --start/--duration window without frames; "
                    "no output written\n",
-                   dataset.c_str(), s.frames);
+                   a.dataset.c_str(), s.frames);
       return 1;
     }
     s.print(std::cout);

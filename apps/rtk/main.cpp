@@ -18,9 +18,9 @@
 #include <vector>
 
 #include "gvins/base/atomic_output_file.hpp"
+#include "gvins/base/command_line.hpp"
 #include "gvins/base/constants.hpp"
 #include "gvins/base/geodetic.hpp"
-#include "gvins/base/option_values.hpp"
 #include "gvins/base/heap_pages.hpp"
 #include "gvins/base/parse_error.hpp"
 #include "gvins/base/rinex_obs_reader.hpp"
@@ -102,7 +102,11 @@ struct Args {
   double baseWait = 0.0, maxOutage = 0.0;
   std::vector<std::string> inputs;
   std::optional<Eigen::Vector3d> baseXyz, truth;
-  std::optional<std::string> mode, dynamics, armode, systems, arSystems, validation;
+  std::optional<gvins::RtkMode> mode;
+  std::optional<gvins::RtkDynamics> dynamics;
+  std::optional<gvins::AmbiguityMode> armode;
+  std::optional<gvins::AmbiguityValidation> validation;
+  std::optional<std::string> systems, arSystems;
   std::optional<double> ratio, elmask, maxAge, maxFailureRate;
   std::optional<int> freq;
   bool combined = false;
@@ -110,127 +114,57 @@ struct Args {
   int timeDecimals = 3;
 };
 
-[[noreturn]] void usageError(const std::string& msg) {
-  std::fprintf(stderr, "gvins-rtk: %s (see --help)\n", msg.c_str());
-  std::exit(2);
-}
-
-double parseNumber(const std::string& opt, const std::string& s) {
-  char* end = nullptr;
-  const double v = std::strtod(s.c_str(), &end);
-  if (end == s.c_str() || *end != '\0' || !std::isfinite(v)) usageError(opt + " needs a number, not '" + s + "'");
-  return v;
-}
-
-Eigen::Vector3d parsePosition(const std::string& opt, const std::string& s, bool llh) {
-  // A base station near the Earth's surface (base/option_values.hpp).
-  try {
-    return llh ? gvins::optionStationLlh(opt, s) : gvins::optionStationEcef(opt, s);
-  } catch (const gvins::OptionError& e) {
-    usageError(e.what());
-  }
-}
+[[noreturn]] void usageError(const std::string& msg) { gvins::usageError("gvins-rtk", msg); }
 
 Args parseArgs(int argc, char** argv) {
   Args a;
-  auto value = [&](int& i, const std::string& opt) -> std::string {
-    if (i + 1 >= argc) usageError(opt + " needs a value");
-    return argv[++i];
-  };
-  for (int i = 1; i < argc; ++i) {
-    const std::string o = argv[i];
-    if (o == "-h" || o == "--help") {
-      std::fputs(kUsage, stdout);
-      std::exit(0);
-    } else if (o == "-o") {
-      a.out = value(i, o);
-    } else if (o == "--rover-stream") {
-      a.roverStream = value(i, o);
-    } else if (o == "--base-stream") {
-      a.baseStream = value(i, o);
-    } else if (o == "--latency-log") {
-      a.latencyLog = value(i, o);
-    } else if (o == "--base-wait") {
-      a.baseWait = parseNumber(o, value(i, o));
-      if (a.baseWait < 0.0 || a.baseWait > 3600.0) usageError("--base-wait must be within 0..3600 s");
-    } else if (o == "--max-outage") {
-      a.maxOutage = parseNumber(o, value(i, o));
-      if (a.maxOutage < 0.0) usageError("--max-outage must not be negative");
-    } else if (o == "--nmea") {
-      a.nmea = value(i, o);
-    } else if (o == "--kml") {
-      a.kml = value(i, o);
-    } else if (o == "--config") {
-      a.config = value(i, o);
-    } else if (o == "--base-xyz") {
-      a.baseXyz = parsePosition(o, value(i, o), false);
-    } else if (o == "--base-llh") {
-      a.baseXyz = parsePosition(o, value(i, o), true);
-    } else if (o == "--mode") {
-      a.mode = value(i, o);
-    } else if (o == "--dynamics") {
-      a.dynamics = value(i, o);
-    } else if (o == "--armode") {
-      a.armode = value(i, o);
-    } else if (o == "--ratio") {
-      a.ratio = parseNumber(o, value(i, o));
-    } else if (o == "--max-failure-rate") {
-      a.maxFailureRate = parseNumber(o, value(i, o));
-      if (*a.ratio < 1.0) usageError("--ratio must be at least 1");
-    } else if (o == "--validation") {
-      a.validation = value(i, o);
-    } else if (o == "--combined" || o == "-c") {
-      a.combined = true;
-    } else if (o == "--no-partial") {
-      a.noPartial = true;
-    } else if (o == "--systems") {
-      a.systems = value(i, o);
-    } else if (o == "--ar-systems") {
-      a.arSystems = value(i, o);
-    } else if (o == "--freq") {
-      const double f = parseNumber(o, value(i, o));
-      if (f != 1.0 && f != 2.0 && f != 3.0) usageError("--freq must be 1, 2 or 3");
-      a.freq = static_cast<int>(f);
-    } else if (o == "--elmask") {
-      a.elmask = parseNumber(o, value(i, o));
-      if (*a.elmask < -10.0 || *a.elmask > 90.0) usageError("--elmask must be within -10..90 degrees");
-    } else if (o == "--max-age") {
-      a.maxAge = parseNumber(o, value(i, o));
-      if (*a.maxAge < 0.0) usageError("--max-age must not be negative");
-    } else if (o == "--no-interpolation") {
-      a.noInterpolation = true;
-    } else if (o == "--xyz") {
-      a.xyz = true;
-    } else if (o == "--no-velocity") {
-      a.noVelocity = true;
-    } else if (o == "--time-decimals") {
-      const double d = parseNumber(o, value(i, o));
-      if (d < 0 || d > 9 || d != std::floor(d)) usageError("--time-decimals must be 0..9");
-      a.timeDecimals = static_cast<int>(d);
-    } else if (o == "--truth") {
-      a.truth = parsePosition(o, value(i, o), false);
-    } else if (o == "--truth-llh") {
-      a.truth = parsePosition(o, value(i, o), true);
-    } else if (o == "--strict") {
-      a.strict = true;
-    } else if (o == "-q" || o == "--quiet") {
-      a.quiet = true;
-    } else if (o.size() > 1 && o[0] == '-') {
-      usageError("unknown option '" + o + "'");
-    } else {
-      a.inputs.push_back(o);
-    }
+  gvins::CommandLine cl("gvins-rtk", kUsage, argc, argv);
+  while (cl.next()) {
+    if (cl.is("-o")) a.out = cl.value();
+    else if (cl.is("--rover-stream")) a.roverStream = cl.value();
+    else if (cl.is("--base-stream")) a.baseStream = cl.value();
+    else if (cl.is("--latency-log")) a.latencyLog = cl.value();
+    else if (cl.is("--base-wait")) a.baseWait = cl.number(0.0, 3600.0, "s");
+    else if (cl.is("--max-outage")) a.maxOutage = cl.number(0.0, 1e9, "s");
+    else if (cl.is("--nmea")) a.nmea = cl.value();
+    else if (cl.is("--kml")) a.kml = cl.value();
+    else if (cl.is("--config")) a.config = cl.value();
+    // A base station near the Earth's surface (base/option_values.hpp).
+    else if (cl.is("--base-xyz")) a.baseXyz = cl.stationEcef();
+    else if (cl.is("--base-llh")) a.baseXyz = cl.stationLlh();
+    else if (cl.is("--mode")) a.mode = cl.choice(gvins::kRtkModeNames);
+    else if (cl.is("--dynamics")) a.dynamics = cl.choice(gvins::kRtkDynamicsNames);
+    else if (cl.is("--armode")) a.armode = cl.choice(gvins::kAmbiguityModeNames);
+    else if (cl.is("--ratio")) a.ratio = cl.number(1.0, 1000.0);
+    else if (cl.is("--max-failure-rate")) a.maxFailureRate = cl.number(1e-9, 0.5);
+    else if (cl.is("--validation")) a.validation = cl.choice(gvins::kAmbiguityValidationNames);
+    else if (cl.is("--combined", "-c")) a.combined = true;
+    else if (cl.is("--no-partial")) a.noPartial = true;
+    else if (cl.is("--systems")) a.systems = cl.value();
+    else if (cl.is("--ar-systems")) a.arSystems = cl.value();
+    else if (cl.is("--freq")) a.freq = static_cast<int>(cl.integer(1, 3));
+    else if (cl.is("--elmask")) a.elmask = cl.number(-10.0, 90.0, "deg");
+    else if (cl.is("--max-age")) a.maxAge = cl.number(0.0, 1e9, "s");
+    else if (cl.is("--no-interpolation")) a.noInterpolation = true;
+    else if (cl.is("--xyz")) a.xyz = true;
+    else if (cl.is("--no-velocity")) a.noVelocity = true;
+    else if (cl.is("--time-decimals")) a.timeDecimals = static_cast<int>(cl.integer(0, 9));
+    else if (cl.is("--truth")) a.truth = cl.stationEcef();
+    else if (cl.is("--truth-llh")) a.truth = cl.stationLlh();
+    else if (cl.is("--strict")) a.strict = true;
+    else if (cl.is("-q", "--quiet")) a.quiet = true;
+    else a.inputs.push_back(cl.operand());
   }
   if (!a.roverStream.empty() || !a.baseStream.empty()) {
-    if (a.roverStream.empty() || a.baseStream.empty()) usageError("live mode needs --rover-stream and --base-stream");
+    if (a.roverStream.empty() || a.baseStream.empty()) cl.error("live mode needs --rover-stream and --base-stream");
     if (a.out.empty()) a.out = "-";
     return a;  // the inputs are navigation files
   }
-  if (a.out.empty()) usageError("no output file (-o OUT.pos)");
+  if (a.out.empty()) cl.error("no output file (-o OUT.pos)");
   const bool ubxInput = a.inputs.size() == 2 && (gvins::BaseReader::detect(a.inputs[0]) == gvins::BaseFormat::Ubx ||
                                                  gvins::BaseReader::detect(a.inputs[1]) == gvins::BaseFormat::Ubx);
   if (a.inputs.size() < 3 && !ubxInput) {
-    usageError("need a rover observation file, base data and at least one navigation file (not needed with UBX)");
+    cl.error("need a rover observation file, base data and at least one navigation file (not needed with UBX)");
   }
   return a;
 }
@@ -270,19 +204,9 @@ int runLive(const Args& a, const gvins::RtkConfig& cfg, const gvins::SppConfig& 
 
 void printError(const gvins::ParseError& e) { std::fprintf(stderr, "gvins-rtk: error: %s\n", e.what()); }
 
-double pct(long a, long b) { return b > 0 ? 100.0 * static_cast<double>(a) / static_cast<double>(b) : 0.0; }
-
-}  // namespace
-
-int main(int argc, char** argv) {
+/// Configuration: defaults, YAML, command line; 0 or the exit status of a bad configuration file.
+int configuration(const Args& args, gvins::RtkConfig& cfg, gvins::SppConfig& sppCfg) {
   using namespace gvins;
-  keepHeapPages();
-  const Args args = parseArgs(argc, argv);
-  const auto wall0 = std::chrono::steady_clock::now();
-
-  // Configuration: defaults, YAML, command line.
-  RtkConfig cfg;
-  SppConfig sppCfg;
   try {
     if (!args.config.empty()) {
       cfg = loadRtkConfig(args.config, cfg);
@@ -292,32 +216,12 @@ int main(int argc, char** argv) {
     printError(e);
     return 2;
   }
-  if (args.mode) {
-    if (*args.mode == "static") cfg.mode = RtkMode::Static;
-    else if (*args.mode == "kinematic") cfg.mode = RtkMode::Kinematic;
-    else usageError("--mode must be static or kinematic");
-  }
-  if (args.dynamics) {
-    if (*args.dynamics == "random-walk") cfg.dynamics = RtkDynamics::RandomWalk;
-    else if (*args.dynamics == "constant-velocity") cfg.dynamics = RtkDynamics::ConstantVelocity;
-    else usageError("--dynamics must be random-walk or constant-velocity");
-  }
-  if (args.armode) {
-    if (*args.armode == "off") cfg.ambiguityMode = AmbiguityMode::Off;
-    else if (*args.armode == "continuous") cfg.ambiguityMode = AmbiguityMode::Continuous;
-    else if (*args.armode == "instantaneous") cfg.ambiguityMode = AmbiguityMode::Instantaneous;
-    else if (*args.armode == "fix-and-hold") cfg.ambiguityMode = AmbiguityMode::FixAndHold;
-    else usageError("--armode must be off, continuous, instantaneous or fix-and-hold");
-  }
-  if (args.validation) {
-    if (const auto v = parseAmbiguityValidation(*args.validation)) cfg.ar.validation = *v;
-    else usageError("--validation must be fixed-failure-rate, ratio, success-rate or ratio+success-rate");
-  }
+  if (args.mode) cfg.mode = *args.mode;
+  if (args.dynamics) cfg.dynamics = *args.dynamics;
+  if (args.armode) cfg.ambiguityMode = *args.armode;
+  if (args.validation) cfg.ar.validation = *args.validation;
   if (args.ratio) cfg.ar.ratioThreshold = *args.ratio;
-  if (args.maxFailureRate) {
-    if (!(*args.maxFailureRate > 0.0 && *args.maxFailureRate <= 0.5)) usageError("--max-failure-rate must be in (0, 0.5]");
-    cfg.ar.maxFailureRate = *args.maxFailureRate;
-  }
+  if (args.maxFailureRate) cfg.ar.maxFailureRate = *args.maxFailureRate;
   if (args.noPartial) cfg.ar.partial = false;
   try {
     if (args.systems) {
@@ -336,6 +240,162 @@ int main(int argc, char** argv) {
   }
   if (args.maxAge) cfg.maxAge = *args.maxAge;
   if (args.noInterpolation) cfg.interpolateBase = false;
+  return 0;
+}
+
+double pct(long a, long b) { return b > 0 ? 100.0 * static_cast<double>(a) / static_cast<double>(b) : 0.0; }
+
+/// Counts of a run for the summary.
+struct RunCounts {
+  long epochs = 0, fixed = 0, floats = 0, singles = 0, none = 0, partial = 0, held = 0;
+  std::map<gvins::RtkIssue, long> issues;
+  std::map<gvins::ArStatus, long> arStatus;
+  gvins::QuantileHistogram ratios;
+  double ratioMin = 1e300, ratioMax = 0.0, ratioSum = 0.0;
+  long ratioCount = 0;
+  double satSum = 0.0, ageMax = 0.0;
+  long wrongFixes = 0;  ///< fixed epochs farther than kWrongFix from --truth
+  long baseEpochs = 0;
+  gvins::CombinationCounts combination;
+  double passSeconds[2] = {0.0, 0.0};
+};
+
+/// A fixed epoch farther than this from --truth counts as a wrong fix (3-D, m).
+constexpr double kWrongFix = 0.10;
+
+/// The summary on stderr.
+void printSummary(const Args& args, const gvins::RtkConfig& cfg, gvins::RtkSolver& solver, gvins::BaseReader& rover,
+                  gvins::BaseReader& base, const RunCounts& counts, const std::optional<Eigen::Vector3d>& basePosUsed,
+                  const std::string& baseSource, double wall, const std::optional<gvins::AccuracyStatistics>& fixStats,
+                  const std::optional<gvins::AccuracyStatistics>& rtkStats) {
+  using namespace gvins;
+  const long epochs = counts.epochs, fixed = counts.fixed, floats = counts.floats, singles = counts.singles,
+             none = counts.none, partial = counts.partial, held = counts.held;
+  const auto& issues = counts.issues;
+  const auto& arStatus = counts.arStatus;
+  const QuantileHistogram& ratios = counts.ratios;
+  const double ratioMin = counts.ratioMin, ratioMax = counts.ratioMax, ratioSum = counts.ratioSum;
+  const long ratioCount = counts.ratioCount;
+  const double satSum = counts.satSum, ageMax = counts.ageMax;
+  const long wrongFixes = counts.wrongFixes, baseEpochs = counts.baseEpochs;
+  const CombinationCounts& combination = counts.combination;
+  const double* passSeconds = counts.passSeconds;
+  const long solved = fixed + floats + singles;
+  std::fprintf(stderr, "gvins-rtk summary (%s, base %s)\n", args.inputs[0].c_str(), base.describe().c_str());
+  std::fprintf(stderr, "  mode                   %s, %s, AR %s, ratio %.1f\n", toString(cfg.mode),
+               cfg.mode == RtkMode::Kinematic ? toString(cfg.dynamics) : "static position", toString(cfg.ambiguityMode),
+               cfg.ar.ratioThreshold);
+  if (basePosUsed) {
+    std::fprintf(stderr, "  base position          %.4f %.4f %.4f (%s)\n", (*basePosUsed)[0], (*basePosUsed)[1], (*basePosUsed)[2],
+                 baseSource.c_str());
+  } else {
+    std::fprintf(stderr, "  base position          unknown (no header position, 1005/1006 or --base-xyz)\n");
+  }
+  std::fprintf(stderr, "  rover epochs           %8ld\n", epochs);
+  std::fprintf(stderr, "  base epochs read       %8ld\n", baseEpochs);
+  std::fprintf(stderr, "  fixed   (Q=1)          %8ld  %6.2f %%%s\n", fixed, pct(fixed, epochs),
+               partial ? (" (" + std::to_string(partial) + " partial)").c_str() : "");
+  std::fprintf(stderr, "  float   (Q=2)          %8ld  %6.2f %%\n", floats, pct(floats, epochs));
+  std::fprintf(stderr, "  single  (Q=5)          %8ld  %6.2f %%\n", singles, pct(singles, epochs));
+  std::fprintf(stderr, "  no solution            %8ld  %6.2f %%\n", none, pct(none, epochs));
+  std::fprintf(stderr, "  fix rate               %8.2f %% of epochs, %.2f %% of RTK epochs\n", pct(fixed, epochs),
+               pct(fixed, fixed + floats));
+  if (ratioCount) {
+    std::fprintf(stderr, "  ratio                  min %.2f  median %.2f  mean %.2f  max %.1f  (%ld epochs)\n", ratioMin,
+                 ratios.quantile(0.5), ratioSum / ratioCount, ratioMax, ratioCount);
+  }
+  std::fprintf(stderr, "  mean satellites        %8.1f   max age %.1f s\n", solved ? satSum / solved : 0.0, ageMax);
+  if (held) std::fprintf(stderr, "  fix-and-hold updates   %8ld\n", held);
+  if (args.combined) {
+    const CombinationCounts& k = combination;
+    std::fprintf(stderr, "  combined               forward %lld fixed (%.1f s), backward %lld fixed (%.1f s)\n",
+                 static_cast<long long>(k.forwardFixed), passSeconds[0], static_cast<long long>(k.backwardFixed),
+                 passSeconds[1]);
+    std::fprintf(stderr, "  combined fixes         %8lld  (%lld both, %lld forward only, %lld backward only)\n",
+                 static_cast<long long>(k.combinedFixed), static_cast<long long>(k.bothFixed),
+                 static_cast<long long>(k.forwardOnlyFixed), static_cast<long long>(k.backwardOnlyFixed));
+    std::fprintf(stderr, "  combined to float      %8lld disagreements (both fixed), %lld fixes inconsistent with the other float\n",
+                 static_cast<long long>(k.disagreements), static_cast<long long>(k.fixRejected));
+  }
+  for (const auto& [i, n] : issues) std::fprintf(stderr, "  no RTK: %-30s %6ld\n", toString(i), n);
+  for (const auto& [s, n] : arStatus) {
+    if (s != ArStatus::Fixed && s != ArStatus::PartialFixed) std::fprintf(stderr, "  AR: %-34s %6ld\n", toString(s), n);
+  }
+  const RtkCounters& c = solver.counters();
+  std::fprintf(stderr, "  ambiguities            %lld added, %lld slip resets, %lld outlier resets, %lld removed\n",
+               static_cast<long long>(c.ambiguitiesAdded), static_cast<long long>(c.slipResets),
+               static_cast<long long>(c.phaseOutliers), static_cast<long long>(c.ambiguitiesRemoved));
+  if (c.impreciseFixes || c.inconsistentFixes || c.unconfirmedFixes) {
+    std::fprintf(stderr, "  fixes not used         %lld imprecise (sigma > %.2f m), %lld inconsistent with float, %lld awaiting confirmation\n",
+                 static_cast<long long>(c.impreciseFixes), cfg.maxFixedSigma, static_cast<long long>(c.inconsistentFixes),
+                 static_cast<long long>(c.unconfirmedFixes));
+  }
+  if (c.codeOutliers || c.filterResets || c.rejectedFixes) {
+    std::fprintf(stderr, "  rejected               %lld code DDs, %lld fixes by residual check, %lld filter resets\n",
+                 static_cast<long long>(c.codeOutliers), static_cast<long long>(c.rejectedFixes),
+                 static_cast<long long>(c.filterResets));
+  }
+  auto slipLine = [&](const char* who, const CycleSlipCounts& s) {
+    std::fprintf(stderr, "  %s slips             LLI %lld, geometry-free %lld, Doppler %lld, gap %lld, half-cycle %lld\n", who,
+                 static_cast<long long>(s.lli), static_cast<long long>(s.geometryFree), static_cast<long long>(s.doppler),
+                 static_cast<long long>(s.gaps), static_cast<long long>(s.halfCycle));
+  };
+  slipLine("rover", solver.roverSlipCounts());
+  slipLine("base ", solver.base().slipCounts());
+  for (const DopplerConsistency* d : {&solver.roverDoppler(), &solver.base().doppler()}) {
+    std::fprintf(stderr, "  %-5s Doppler           %s\n", d->label().c_str(), d->countsText().c_str());
+    for (const std::string& line : d->summary()) std::fprintf(stderr, "    %s\n", line.c_str());
+  }
+  const DdFormationStats& ds = solver.differenceStats();
+  if (ds.notAtBase || ds.signalMismatch || ds.noEphemeris || ds.systemDisabled) {
+    std::fprintf(stderr, "  satellite-epochs       %lld not at base, %lld signal mismatches, %lld no ephemeris, %lld below mask\n",
+                 static_cast<long long>(ds.notAtBase), static_cast<long long>(ds.signalMismatch),
+                 static_cast<long long>(ds.noEphemeris), static_cast<long long>(ds.belowMask));
+  }
+  if (ds.crossMode || ds.crossModeRefused) {
+    std::fprintf(stderr, "  signal pairs           %lld across tracking modes (%s matching), %lld refused (strict, or phase alignment unknown)\n",
+                 static_cast<long long>(ds.crossMode), toString(cfg.signalMatching),
+                 static_cast<long long>(ds.crossModeRefused));
+  }
+  const BaseStationStats& bs = solver.base().stats();
+  if (bs.outOfOrder || bs.positionChanges) {
+    std::fprintf(stderr, "  base input             %lld epochs out of order, %lld position changes\n",
+                 static_cast<long long>(bs.outOfOrder), static_cast<long long>(bs.positionChanges));
+  }
+  static const RinexObsReaderStats kNoStats;
+  const RinexObsReaderStats& rs = rover.rinexStats() ? *rover.rinexStats() : kNoStats;
+  if (rover.skipped() || base.skipped()) {
+    std::fprintf(stderr, "  input                  %lld malformed rover epochs/frames skipped, %lld base epochs/frames skipped\n",
+                 static_cast<long long>(rover.skipped()), static_cast<long long>(base.skipped()));
+    for (const auto& m : rs.messages) std::fprintf(stderr, "    %s\n", m.c_str());
+  }
+  std::fprintf(stderr, "  time                   %8.3f s (%.0f epochs/s)\n", wall, wall > 0 ? epochs / wall : 0.0);
+  if (fixStats) {
+    std::fprintf(stderr, "  wrong fixes            %8ld of %ld fixed epochs more than %.2f m from the truth\n", wrongFixes, fixed,
+                 kWrongFix);
+  }
+  if (fixStats && fixStats->position().count > 0) {
+    std::fputs("  fixed solutions vs truth:\n", stderr);
+    std::fputs(fixStats->table().c_str(), stderr);
+  }
+  if (rtkStats && rtkStats->position().count > 0) {
+    std::fputs("  fixed and float solutions vs truth:\n", stderr);
+    std::fputs(rtkStats->table().c_str(), stderr);
+  }
+}
+
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace gvins;
+  keepHeapPages();
+  const Args args = parseArgs(argc, argv);
+  const auto wall0 = std::chrono::steady_clock::now();
+
+  RtkConfig cfg;
+  SppConfig sppCfg;
+  if (const int rc = configuration(args, cfg, sppCfg)) return rc;
 
   // Navigation data.
   EphemerisStore nav;
@@ -420,22 +480,22 @@ int main(int argc, char** argv) {
   std::unique_ptr<PosWriter> writer;
 
   std::optional<AccuracyStatistics> fixStats, rtkStats;
-  // A fixed epoch farther than this from --truth counts as a wrong fix (3-D, m).
-  constexpr double kWrongFix = 0.10;
-  long wrongFixes = 0;
+  RunCounts counts;
+  long& wrongFixes = counts.wrongFixes;
   if (args.truth) {
     fixStats.emplace(*args.truth);
     rtkStats.emplace(*args.truth);
   }
 
   // Counters.
-  long epochs = 0, fixed = 0, floats = 0, singles = 0, none = 0, partial = 0, held = 0;
-  std::map<RtkIssue, long> issues;
-  std::map<ArStatus, long> arStatus;
-  QuantileHistogram ratios;
-  double ratioMin = 1e300, ratioMax = 0.0, ratioSum = 0.0;
-  long ratioCount = 0;
-  double satSum = 0.0, ageMax = 0.0;
+  long &epochs = counts.epochs, &fixed = counts.fixed, &floats = counts.floats, &singles = counts.singles,
+       &none = counts.none, &partial = counts.partial, &held = counts.held;
+  std::map<RtkIssue, long>& issues = counts.issues;
+  std::map<ArStatus, long>& arStatus = counts.arStatus;
+  QuantileHistogram& ratios = counts.ratios;
+  double &ratioMin = counts.ratioMin, &ratioMax = counts.ratioMax, &ratioSum = counts.ratioSum;
+  long& ratioCount = counts.ratioCount;
+  double &satSum = counts.satSum, &ageMax = counts.ageMax;
   int exitCode = 0;
   const bool tty = isatty(fileno(stderr));
   auto lastProgress = wall0;
@@ -452,7 +512,7 @@ int main(int argc, char** argv) {
   ObsEpoch baseEpoch;
   bool baseDone = false, basePending = false;
   std::optional<GpsTime> lastBaseTime;
-  long baseEpochs = 0;
+  long& baseEpochs = counts.baseEpochs;
   std::optional<Eigen::Vector3d> basePosUsed = args.baseXyz;
 
   // Counts and writes one solution (streamed, or the combined solution of an epoch).
@@ -500,8 +560,8 @@ int main(int argc, char** argv) {
   // Combined mode (post-processing): every rover and base epoch in memory, a forward and a
   // backward pass, and per epoch the combination of the two (rtk_combination.hpp).
   std::optional<RtkSolver> backward;
-  CombinationCounts combination;
-  double passSeconds[2] = {0.0, 0.0};
+  CombinationCounts& combination = counts.combination;
+  double (&passSeconds)[2] = counts.passSeconds;
   if (args.combined) {
     std::vector<ObsEpoch> rovers, bases;
     try {
@@ -646,109 +706,8 @@ int main(int argc, char** argv) {
   if (!args.quiet && tty) std::fprintf(stderr, "\r%90s\r", "");
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
-  // Summary.
+  printSummary(args, cfg, solver, *rover, *base, counts, basePosUsed, baseSource, wall, fixStats, rtkStats);
   const long solved = fixed + floats + singles;
-  std::fprintf(stderr, "gvins-rtk summary (%s, base %s)\n", args.inputs[0].c_str(), base->describe().c_str());
-  std::fprintf(stderr, "  mode                   %s, %s, AR %s, ratio %.1f\n", toString(cfg.mode),
-               cfg.mode == RtkMode::Kinematic ? toString(cfg.dynamics) : "static position", toString(cfg.ambiguityMode),
-               cfg.ar.ratioThreshold);
-  if (basePosUsed) {
-    std::fprintf(stderr, "  base position          %.4f %.4f %.4f (%s)\n", (*basePosUsed)[0], (*basePosUsed)[1], (*basePosUsed)[2],
-                 baseSource.c_str());
-  } else {
-    std::fprintf(stderr, "  base position          unknown (no header position, 1005/1006 or --base-xyz)\n");
-  }
-  std::fprintf(stderr, "  rover epochs           %8ld\n", epochs);
-  std::fprintf(stderr, "  base epochs read       %8ld\n", baseEpochs);
-  std::fprintf(stderr, "  fixed   (Q=1)          %8ld  %6.2f %%%s\n", fixed, pct(fixed, epochs),
-               partial ? (" (" + std::to_string(partial) + " partial)").c_str() : "");
-  std::fprintf(stderr, "  float   (Q=2)          %8ld  %6.2f %%\n", floats, pct(floats, epochs));
-  std::fprintf(stderr, "  single  (Q=5)          %8ld  %6.2f %%\n", singles, pct(singles, epochs));
-  std::fprintf(stderr, "  no solution            %8ld  %6.2f %%\n", none, pct(none, epochs));
-  std::fprintf(stderr, "  fix rate               %8.2f %% of epochs, %.2f %% of RTK epochs\n", pct(fixed, epochs),
-               pct(fixed, fixed + floats));
-  if (ratioCount) {
-    std::fprintf(stderr, "  ratio                  min %.2f  median %.2f  mean %.2f  max %.1f  (%ld epochs)\n", ratioMin,
-                 ratios.quantile(0.5), ratioSum / ratioCount, ratioMax, ratioCount);
-  }
-  std::fprintf(stderr, "  mean satellites        %8.1f   max age %.1f s\n", solved ? satSum / solved : 0.0, ageMax);
-  if (held) std::fprintf(stderr, "  fix-and-hold updates   %8ld\n", held);
-  if (args.combined) {
-    const CombinationCounts& k = combination;
-    std::fprintf(stderr, "  combined               forward %lld fixed (%.1f s), backward %lld fixed (%.1f s)\n",
-                 static_cast<long long>(k.forwardFixed), passSeconds[0], static_cast<long long>(k.backwardFixed),
-                 passSeconds[1]);
-    std::fprintf(stderr, "  combined fixes         %8lld  (%lld both, %lld forward only, %lld backward only)\n",
-                 static_cast<long long>(k.combinedFixed), static_cast<long long>(k.bothFixed),
-                 static_cast<long long>(k.forwardOnlyFixed), static_cast<long long>(k.backwardOnlyFixed));
-    std::fprintf(stderr, "  combined to float      %8lld disagreements (both fixed), %lld fixes inconsistent with the other float\n",
-                 static_cast<long long>(k.disagreements), static_cast<long long>(k.fixRejected));
-  }
-  for (const auto& [i, n] : issues) std::fprintf(stderr, "  no RTK: %-30s %6ld\n", toString(i), n);
-  for (const auto& [s, n] : arStatus) {
-    if (s != ArStatus::Fixed && s != ArStatus::PartialFixed) std::fprintf(stderr, "  AR: %-34s %6ld\n", toString(s), n);
-  }
-  const RtkCounters& c = solver.counters();
-  std::fprintf(stderr, "  ambiguities            %lld added, %lld slip resets, %lld outlier resets, %lld removed\n",
-               static_cast<long long>(c.ambiguitiesAdded), static_cast<long long>(c.slipResets),
-               static_cast<long long>(c.phaseOutliers), static_cast<long long>(c.ambiguitiesRemoved));
-  if (c.impreciseFixes || c.inconsistentFixes || c.unconfirmedFixes) {
-    std::fprintf(stderr, "  fixes not used         %lld imprecise (sigma > %.2f m), %lld inconsistent with float, %lld awaiting confirmation\n",
-                 static_cast<long long>(c.impreciseFixes), cfg.maxFixedSigma, static_cast<long long>(c.inconsistentFixes),
-                 static_cast<long long>(c.unconfirmedFixes));
-  }
-  if (c.codeOutliers || c.filterResets || c.rejectedFixes) {
-    std::fprintf(stderr, "  rejected               %lld code DDs, %lld fixes by residual check, %lld filter resets\n",
-                 static_cast<long long>(c.codeOutliers), static_cast<long long>(c.rejectedFixes),
-                 static_cast<long long>(c.filterResets));
-  }
-  auto slipLine = [&](const char* who, const CycleSlipCounts& s) {
-    std::fprintf(stderr, "  %s slips             LLI %lld, geometry-free %lld, Doppler %lld, gap %lld, half-cycle %lld\n", who,
-                 static_cast<long long>(s.lli), static_cast<long long>(s.geometryFree), static_cast<long long>(s.doppler),
-                 static_cast<long long>(s.gaps), static_cast<long long>(s.halfCycle));
-  };
-  slipLine("rover", solver.roverSlipCounts());
-  slipLine("base ", solver.base().slipCounts());
-  for (const DopplerConsistency* d : {&solver.roverDoppler(), &solver.base().doppler()}) {
-    std::fprintf(stderr, "  %-5s Doppler           %s\n", d->label().c_str(), d->countsText().c_str());
-    for (const std::string& line : d->summary()) std::fprintf(stderr, "    %s\n", line.c_str());
-  }
-  const DdFormationStats& ds = solver.differenceStats();
-  if (ds.notAtBase || ds.signalMismatch || ds.noEphemeris || ds.systemDisabled) {
-    std::fprintf(stderr, "  satellite-epochs       %lld not at base, %lld signal mismatches, %lld no ephemeris, %lld below mask\n",
-                 static_cast<long long>(ds.notAtBase), static_cast<long long>(ds.signalMismatch),
-                 static_cast<long long>(ds.noEphemeris), static_cast<long long>(ds.belowMask));
-  }
-  if (ds.crossMode || ds.crossModeRefused) {
-    std::fprintf(stderr, "  signal pairs           %lld across tracking modes (%s matching), %lld refused (strict, or phase alignment unknown)\n",
-                 static_cast<long long>(ds.crossMode), toString(cfg.signalMatching),
-                 static_cast<long long>(ds.crossModeRefused));
-  }
-  const BaseStationStats& bs = solver.base().stats();
-  if (bs.outOfOrder || bs.positionChanges) {
-    std::fprintf(stderr, "  base input             %lld epochs out of order, %lld position changes\n",
-                 static_cast<long long>(bs.outOfOrder), static_cast<long long>(bs.positionChanges));
-  }
-  static const RinexObsReaderStats kNoStats;
-  const RinexObsReaderStats& rs = rover->rinexStats() ? *rover->rinexStats() : kNoStats;
-  if (rover->skipped() || base->skipped()) {
-    std::fprintf(stderr, "  input                  %lld malformed rover epochs/frames skipped, %lld base epochs/frames skipped\n",
-                 static_cast<long long>(rover->skipped()), static_cast<long long>(base->skipped()));
-    for (const auto& m : rs.messages) std::fprintf(stderr, "    %s\n", m.c_str());
-  }
-  std::fprintf(stderr, "  time                   %8.3f s (%.0f epochs/s)\n", wall, wall > 0 ? epochs / wall : 0.0);
-  if (fixStats) {
-    std::fprintf(stderr, "  wrong fixes            %8ld of %ld fixed epochs more than %.2f m from the truth\n", wrongFixes, fixed,
-                 kWrongFix);
-  }
-  if (fixStats && fixStats->position().count > 0) {
-    std::fputs("  fixed solutions vs truth:\n", stderr);
-    std::fputs(fixStats->table().c_str(), stderr);
-  }
-  if (rtkStats && rtkStats->position().count > 0) {
-    std::fputs("  fixed and float solutions vs truth:\n", stderr);
-    std::fputs(rtkStats->table().c_str(), stderr);
-  }
   if (solved == 0 && exitCode == 0) exitCode = 3;
   return exitCode;
 }

@@ -10,38 +10,30 @@
 #include <exception>
 #include <filesystem>
 #include <iostream>
+#include <limits>
+#include <optional>
 #include <system_error>
 #include <unistd.h>
 #include <string>
 
+#include "gvins/base/command_line.hpp"
 #include "gvins/base/parse_error.hpp"
 #include "gvins/sim/dataset_generator.hpp"
 #include "gvins/sim/scenario.hpp"
 
 namespace {
 
-void usage(std::ostream& os) {
-  os << "usage: gvins-sim [--config SCENARIO.yaml] [--seed N] [--features-only] [--no-gnss] [--threads N] [--force] -o DIR\n"
-        "  --config FILE     scenario (default: the built-in two-minute stereo UAV flight, config/default.yaml)\n"
-        "  --seed N          random seed (default: the scenario's `seed`); same seed -> identical dataset\n"
-        "  --features-only   write noisy feature tracks of 3-D landmarks instead of rendering images\n"
-        "  --no-gnss         skip the GNSS part (rover/base observations, RTCM, navigation)\n"
-        "  --threads N       rendering threads (default: all cores)\n"
-        "  -o, --output DIR  dataset folder to write (created; written under a temporary name and renamed at\n"
-        "                    the end, so a failed run leaves no dataset behind)\n"
-        "  --force           replace DIR if it exists and is not empty (otherwise an error: files of an older\n"
-        "                    dataset would mix with the new one)\n";
-}
-
-bool parseUnsigned(const std::string& s, std::uint64_t& out) {
-  if (s.empty() || s.size() > 20 || s.find_first_not_of("0123456789") != std::string::npos) return false;
-  try {
-    out = std::stoull(s);
-  } catch (const std::exception&) {
-    return false;
-  }
-  return true;
-}
+const char* kUsage =
+    "usage: gvins-sim [--config SCENARIO.yaml] [--seed N] [--features-only] [--no-gnss] [--threads N] [--force] -o DIR\n"
+    "  --config FILE     scenario (default: the built-in two-minute stereo UAV flight, config/default.yaml)\n"
+    "  --seed N          random seed (default: the scenario's `seed`); same seed -> identical dataset\n"
+    "  --features-only   write noisy feature tracks of 3-D landmarks instead of rendering images\n"
+    "  --no-gnss         skip the GNSS part (rover/base observations, RTCM, navigation)\n"
+    "  --threads N       rendering threads (default: all cores)\n"
+    "  -o, --output DIR  dataset folder to write (created; written under a temporary name and renamed at\n"
+    "                    the end, so a failed run leaves no dataset behind)\n"
+    "  --force           replace DIR if it exists and is not empty (otherwise an error: files of an older\n"
+    "                    dataset would mix with the new one)\n";
 
 namespace fs = std::filesystem;
 
@@ -86,59 +78,24 @@ int generateInto(const gvins::sim::Scenario& sc, const fs::path& out, bool force
 
 int main(int argc, char** argv) {
   std::string config, out;
-  std::uint64_t seed = 0;
-  bool seedGiven = false, force = false;
+  std::optional<std::uint64_t> seed;
+  bool force = false;
   gvins::sim::GenerationOptions opt;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&](const char* name) -> std::string {
-      if (i + 1 >= argc) {
-        std::cerr << "gvins-sim: " << name << " needs a value\n";
-        usage(std::cerr);
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (a == "--config" || a == "-c") {
-      config = value("--config");
-    } else if (a == "--seed") {
-      if (!parseUnsigned(value("--seed"), seed)) {
-        std::cerr << "gvins-sim: --seed needs a non-negative integer\n";
-        return 2;
-      }
-      seedGiven = true;
-    } else if (a == "--features-only") {
-      opt.featuresOnly = true;
-    } else if (a == "--no-gnss") {
-      opt.gnss = false;
-    } else if (a == "--threads") {
-      std::uint64_t n = 0;
-      if (!parseUnsigned(value("--threads"), n) || n < 1 || n > 64) {
-        std::cerr << "gvins-sim: --threads needs a number in [1, 64]\n";
-        return 2;
-      }
-      opt.threads = static_cast<int>(n);
-    } else if (a == "-o" || a == "--output") {
-      out = value("-o");
-    } else if (a == "--force") {
-      force = true;
-    } else if (a == "-h" || a == "--help") {
-      usage(std::cout);
-      return 0;
-    } else {
-      std::cerr << "gvins-sim: unknown argument '" << a << "'\n";
-      usage(std::cerr);
-      return 2;
-    }
+  gvins::CommandLine cl("gvins-sim", kUsage, argc, argv);
+  while (cl.next()) {
+    if (cl.is("--config", "-c")) config = cl.value();
+    else if (cl.is("--seed")) seed = cl.unsignedInteger(0, std::numeric_limits<std::uint64_t>::max());
+    else if (cl.is("--features-only")) opt.featuresOnly = true;
+    else if (cl.is("--no-gnss")) opt.gnss = false;
+    else if (cl.is("--threads")) opt.threads = static_cast<int>(cl.integer(1, 64));
+    else if (cl.is("-o", "--output")) out = cl.value();
+    else if (cl.is("--force")) force = true;
+    else cl.error("unknown argument '" + cl.arg() + "'");
   }
-  if (out.empty()) {
-    std::cerr << "gvins-sim: no output folder (-o DIR)\n";
-    usage(std::cerr);
-    return 2;
-  }
+  if (out.empty()) cl.error("no output folder (-o DIR)");
   try {
     const gvins::sim::Scenario sc = config.empty() ? gvins::sim::defaultScenario() : gvins::sim::loadScenario(config);
-    opt.seed = seedGiven ? seed : sc.seed;
+    opt.seed = seed ? *seed : sc.seed;
     opt.progress = &std::cerr;
     return generateInto(sc, out, force, opt);
   } catch (const gvins::ParseError& e) {

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "gvins/base/atomic_output_file.hpp"
+#include "gvins/base/command_line.hpp"
 #include "gvins/base/constants.hpp"
 #include "gvins/base/geodetic.hpp"
 #include "gvins/base/heap_pages.hpp"
@@ -95,7 +96,8 @@ struct Args {
   std::optional<std::string> systems;
   std::optional<double> elmask, snrmask;
   std::optional<int> freq;
-  std::optional<std::string> iono, tropo;
+  std::optional<gvins::IonosphereOption> iono;
+  std::optional<gvins::TroposphereOption> tropo;
   std::optional<double> smooth;
   std::vector<std::string> ssr;
   bool noFde = false, noVelocity = false, xyz = false, strict = false, quiet = false, dropFailed = false;
@@ -103,115 +105,43 @@ struct Args {
   std::optional<Eigen::Vector3d> truth;
 };
 
-[[noreturn]] void usageError(const std::string& msg) {
-  std::fprintf(stderr, "gvins-spp: %s (see --help)\n", msg.c_str());
-  std::exit(2);
-}
-
-bool parseTriple(const std::string& s, double v[3]) {
-  char extra = 0;
-  return std::sscanf(s.c_str(), "%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &extra) == 3 && std::isfinite(v[0]) &&
-         std::isfinite(v[1]) && std::isfinite(v[2]);
-}
-
-double parseNumber(const std::string& opt, const std::string& s) {
-  char* end = nullptr;
-  const double v = std::strtod(s.c_str(), &end);
-  if (end == s.c_str() || *end != '\0' || !std::isfinite(v)) usageError(opt + " needs a number, not '" + s + "'");
-  return v;
-}
-
 Args parseArgs(int argc, char** argv) {
   Args a;
-  auto value = [&](int& i, const std::string& opt) -> std::string {
-    if (i + 1 >= argc) usageError(opt + " needs a value");
-    return argv[++i];
-  };
-  for (int i = 1; i < argc; ++i) {
-    const std::string o = argv[i];
-    if (o == "-h" || o == "--help") {
-      std::fputs(kUsage, stdout);
-      std::exit(0);
-    } else if (o == "-o") {
-      a.out = value(i, o);
-    } else if (o == "--nmea") {
-      a.nmea = value(i, o);
-    } else if (o == "--kml") {
-      a.kml = value(i, o);
-    } else if (o == "--config") {
-      a.config = value(i, o);
-    } else if (o == "--systems") {
-      a.systems = value(i, o);
-    } else if (o == "--elmask") {
-      a.elmask = parseNumber(o, value(i, o));
-      if (*a.elmask < -10.0 || *a.elmask > 90.0) usageError("--elmask must be within -10..90 degrees");
-    } else if (o == "--snrmask") {
-      a.snrmask = parseNumber(o, value(i, o));
-    } else if (o == "--freq") {
-      const double f = parseNumber(o, value(i, o));
-      if (f != 1.0 && f != 2.0 && f != 3.0) usageError("--freq must be 1, 2 or 3");
-      a.freq = static_cast<int>(f);
-    } else if (o == "--iono") {
-      a.iono = value(i, o);
-    } else if (o == "--tropo") {
-      a.tropo = value(i, o);
-    } else if (o == "--smooth") {
-      a.smooth = parseNumber(o, value(i, o));
-      if (*a.smooth < 0.0 || *a.smooth > 3600.0) usageError("--smooth must be within 0..3600 s");
-    } else if (o == "--ssr") {
-      a.ssr.push_back(value(i, o));
-    } else if (o == "--no-fde") {
-      a.noFde = true;
-    } else if (o == "--no-velocity") {
-      a.noVelocity = true;
-    } else if (o == "--drop-failed") {
-      a.dropFailed = true;
-    } else if (o == "--xyz") {
-      a.xyz = true;
-    } else if (o == "--time-decimals") {
-      const double d = parseNumber(o, value(i, o));
-      if (d < 0 || d > 9 || d != std::floor(d)) usageError("--time-decimals must be 0..9");
-      a.timeDecimals = static_cast<int>(d);
-    } else if (o == "--truth" || o == "--truth-llh") {
-      double v[3];
-      const std::string s = value(i, o);
-      if (!parseTriple(s, v)) usageError(o + " needs three comma-separated numbers, not '" + s + "'");
-      if (o == "--truth") {
-        a.truth = Eigen::Vector3d(v[0], v[1], v[2]);
-      } else {
-        if (std::abs(v[0]) > 90.0 || std::abs(v[1]) > 360.0) usageError("--truth-llh latitude/longitude out of range");
-        a.truth = gvins::geodeticToEcef(gvins::geodeticFromDegrees(v[0], v[1], v[2]));
-      }
-    } else if (o == "--score") {
-      a.score = value(i, o);
-    } else if (o == "--strict") {
-      a.strict = true;
-    } else if (o == "-q" || o == "--quiet") {
-      a.quiet = true;
-    } else if (o.size() > 1 && o[0] == '-') {
-      usageError("unknown option '" + o + "'");
-    } else {
-      a.inputs.push_back(o);
-    }
+  gvins::CommandLine cl("gvins-spp", kUsage, argc, argv);
+  while (cl.next()) {
+    if (cl.is("-o")) a.out = cl.value();
+    else if (cl.is("--nmea")) a.nmea = cl.value();
+    else if (cl.is("--kml")) a.kml = cl.value();
+    else if (cl.is("--config")) a.config = cl.value();
+    else if (cl.is("--systems")) a.systems = cl.value();
+    else if (cl.is("--elmask")) a.elmask = cl.number(-10.0, 90.0, "deg");
+    else if (cl.is("--snrmask")) a.snrmask = cl.number(0.0, 100.0, "dB-Hz");
+    else if (cl.is("--freq")) a.freq = static_cast<int>(cl.integer(1, 3));
+    else if (cl.is("--iono")) a.iono = cl.choice(gvins::kIonosphereOptionNames);
+    else if (cl.is("--tropo")) a.tropo = cl.choice(gvins::kTroposphereOptionNames);
+    else if (cl.is("--smooth")) a.smooth = cl.number(0.0, 3600.0, "s");
+    else if (cl.is("--ssr")) a.ssr.push_back(cl.value());
+    else if (cl.is("--no-fde")) a.noFde = true;
+    else if (cl.is("--no-velocity")) a.noVelocity = true;
+    else if (cl.is("--drop-failed")) a.dropFailed = true;
+    else if (cl.is("--xyz")) a.xyz = true;
+    else if (cl.is("--time-decimals")) a.timeDecimals = static_cast<int>(cl.integer(0, 9));
+    else if (cl.is("--truth")) a.truth = cl.vector3(-1e8, 1e8, "m");
+    else if (cl.is("--truth-llh")) a.truth = cl.stationLlh();
+    else if (cl.is("--score")) a.score = cl.value();
+    else if (cl.is("--strict")) a.strict = true;
+    else if (cl.is("-q", "--quiet")) a.quiet = true;
+    else a.inputs.push_back(cl.operand());
   }
   if (!a.score.empty()) {
-    if (!a.truth) usageError("--score needs --truth or --truth-llh");
+    if (!a.truth) cl.error("--score needs --truth or --truth-llh");
     return a;
   }
-  if (a.out.empty()) usageError("no output file (-o OUT.pos)");
+  if (a.out.empty()) cl.error("no output file (-o OUT.pos)");
   if (a.inputs.empty() || (a.inputs.size() == 1 && gvins::BaseReader::detect(a.inputs[0]) != gvins::BaseFormat::Ubx)) {
-    usageError("need an observation file and at least one navigation file (a UBX log may come alone: it carries its own)");
+    cl.error("need an observation file and at least one navigation file (a UBX log may come alone: it carries its own)");
   }
   return a;
-}
-
-std::string ionoName(gvins::IonosphereOption o) {
-  switch (o) {
-    case gvins::IonosphereOption::Off: return "off";
-    case gvins::IonosphereOption::Broadcast: return "broadcast";
-    case gvins::IonosphereOption::DualFrequency: return "dual-frequency";
-  }
-  return "?";
 }
 
 std::string systemsText(const gvins::SppConfig& c) {
@@ -224,62 +154,53 @@ std::string systemsText(const gvins::SppConfig& c) {
 
 void printError(const gvins::ParseError& e) { std::fprintf(stderr, "gvins-spp: error: %s\n", e.what()); }
 
-}  // namespace
+using namespace gvins;
 
-int main(int argc, char** argv) {
-  using namespace gvins;
-  keepHeapPages();
-  const Args args = parseArgs(argc, argv);
-  const auto wall0 = std::chrono::steady_clock::now();
-  if (!args.score.empty()) {
-    try {
-      const PosFile f = readPosFile(args.score);
-      AccuracyStatistics st(*args.truth);
-      for (const auto& s : f.solutions) {
-        st.addPosition(s.position);
-        if (s.velocity) st.addVelocity(*s.velocity);
-      }
-      std::fprintf(stderr, "gvins-spp score (%s, %zu solutions)\n", args.score.c_str(), f.solutions.size());
-      std::fputs(st.table().c_str(), stderr);
-      return f.solutions.empty() ? 3 : 0;
-    } catch (const ParseError& e) {
-      printError(e);
-      return 1;
+/// --score: the accuracy table of an existing .pos file.
+int score(const Args& args) {
+  try {
+    const PosFile f = readPosFile(args.score);
+    AccuracyStatistics st(*args.truth);
+    for (const auto& s : f.solutions) {
+      st.addPosition(s.position);
+      if (s.velocity) st.addVelocity(*s.velocity);
     }
+    std::fprintf(stderr, "gvins-spp score (%s, %zu solutions)\n", args.score.c_str(), f.solutions.size());
+    std::fputs(st.table().c_str(), stderr);
+    return f.solutions.empty() ? 3 : 0;
+  } catch (const ParseError& e) {
+    printError(e);
+    return 1;
   }
+}
 
-  // Configuration: defaults, YAML, command line.
+/// Configuration: defaults, YAML, command line; exit status 2 on a bad configuration file.
+SppConfig configuration(const Args& args) {
   SppConfig cfg;
   try {
     if (!args.config.empty()) cfg = loadSppConfig(args.config, cfg);
   } catch (const ParseError& e) {
     printError(e);
-    return 2;
+    std::exit(2);
   }
   try {
     if (args.systems) cfg.systems = parseSystemLetters(*args.systems);
   } catch (const std::invalid_argument& e) {
-    usageError(std::string("--systems: ") + e.what());
+    usageError("gvins-spp", std::string("--systems: ") + e.what());
   }
   if (args.elmask) cfg.elevationMask = *args.elmask * constants::kDegToRad;
   if (args.snrmask) cfg.snrMask = *args.snrmask;
   if (args.freq) cfg.frequencies = *args.freq;
-  if (args.iono) {
-    if (*args.iono == "off") cfg.ionosphere = IonosphereOption::Off;
-    else if (*args.iono == "broadcast") cfg.ionosphere = IonosphereOption::Broadcast;
-    else if (*args.iono == "dual-frequency") cfg.ionosphere = IonosphereOption::DualFrequency;
-    else usageError("--iono must be off, broadcast or dual-frequency");
-  }
-  if (args.tropo) {
-    if (*args.tropo == "off") cfg.troposphere = TroposphereOption::Off;
-    else if (*args.tropo == "saastamoinen") cfg.troposphere = TroposphereOption::Saastamoinen;
-    else usageError("--tropo must be off or saastamoinen");
-  }
+  if (args.iono) cfg.ionosphere = *args.iono;
+  if (args.tropo) cfg.troposphere = *args.tropo;
   if (args.noFde) cfg.faultExclusion.enabled = false;
   if (args.noVelocity) cfg.velocity = false;
+  if (args.smooth) cfg.carrierSmoothing = *args.smooth;
+  return cfg;
+}
 
-  // Navigation data.
-  EphemerisStore nav;
+/// Navigation files and precise products (told apart by name) into `nav`; 0 or an exit status.
+int readNavigation(const Args& args, EphemerisStore& nav) {
   try {
     PreciseProductFiles products;
     for (std::size_t i = 1; i < args.inputs.size(); ++i) {
@@ -300,6 +221,142 @@ int main(int argc, char** argv) {
     printError(e);
     return 1;
   }
+  return 0;
+}
+
+/// SSR corrections: their times of week resolve against the first observation epoch.
+int readSsr(const Args& args, EphemerisStore& nav) {
+  GpsTime first;
+  try {
+    auto peek = BaseReader::open(args.inputs[0], GpsTime{}, nullptr, !args.strict);
+    ObsEpoch e;
+    if (peek->next(e)) first = e.time;
+  } catch (const ParseError& e) {
+    printError(e);
+    return 1;
+  }
+  try {
+    std::size_t n = 0;
+    for (const std::string& f : args.ssr) {
+      const rtcm::SsrFile ssr = rtcm::readSsrFile(f, first);
+      for (const SsrMessage& m : ssr.messages) nav.addSsr(m);
+      n += ssr.messages.size();
+      if (ssr.stats.malformed > 0 && !args.quiet)
+        std::fprintf(stderr, "%s: %lld malformed RTCM frames skipped\n", f.c_str(),
+                     static_cast<long long>(ssr.stats.malformed));
+    }
+    if (!args.quiet) std::fprintf(stderr, "SSR corrections: %zu messages\n", n);
+  } catch (const ParseError& e) {
+    printError(e);
+    return 1;
+  }
+  return 0;
+}
+
+/// The .pos header and columns.
+PosWriterOptions posOptions(const Args& args, const SppConfig& cfg, const BaseReader& obs, const RinexObsHeader& hdr) {
+  PosWriterOptions popt;
+  popt.coordinates = args.xyz ? PosCoordinates::Xyz : PosCoordinates::Llh;
+  // Velocity columns when a velocity can exist: Doppler observations in the file and asked for.
+  bool hasDoppler = false;
+  for (int i = 0; i < kNumSystems; ++i) {
+    if (!cfg.systems[i]) continue;
+    for (const ObsDescriptor& d : hdr.obsTypes[i]) hasDoppler = hasDoppler || d.type == ObsType::Doppler;
+  }
+  hasDoppler = hasDoppler || (obs.format() == BaseFormat::Ubx && obs.mayHaveDoppler());
+  popt.velocity = cfg.velocity && hasDoppler;
+  if (!cfg.velocity) popt.notes.emplace_back("no velocity columns: velocity not estimated (--no-velocity)");
+  else if (!hasDoppler) popt.notes.emplace_back("no velocity columns: no Doppler observations in the input");
+  popt.testColumn = true;
+  popt.timeDecimals = args.timeDecimals;
+  popt.program = "SRI-GVINS gvins-spp";
+  for (const auto& f : args.inputs) popt.headerFields.emplace_back("inp file", f);
+  popt.headerFields.emplace_back("pos mode", "single");
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "%.1f deg", cfg.elevationMask * constants::kRadToDeg);
+  popt.headerFields.emplace_back("elev mask", buf);
+  popt.headerFields.emplace_back("ionos opt", enumName(kIonosphereOptionNames, cfg.ionosphere));
+  popt.headerFields.emplace_back("tropo opt", cfg.troposphere == TroposphereOption::Off ? "off" : "saastamoinen+niell");
+  popt.headerFields.emplace_back("navi sys", systemsText(cfg));
+  std::snprintf(buf, sizeof buf, "%d", cfg.frequencies);
+  popt.headerFields.emplace_back("freqs", buf);
+  if (args.dropFailed) popt.headerFields.emplace_back("failed", "epochs failing the residual test omitted");
+  if (cfg.carrierSmoothing > 0.0) {
+    std::snprintf(buf, sizeof buf, "%.0f s", cfg.carrierSmoothing);
+    popt.headerFields.emplace_back("carrier smoothing", buf);
+  }
+  return popt;
+}
+
+/// Counts of the processing loop for the summary.
+struct Counts {
+  std::map<SppStatus, long> status;
+  std::map<SatId, long> excluded;
+  std::array<long, 8> use{};
+  long epochs = 0, solutions = 0, velocities = 0, testFailed = 0, untestable = 0, written = 0;
+  double satSum = 0.0;
+};
+
+/// The summary on stderr.
+void printSummary(const Args& args, const BaseReader& obs, const RinexObsHeader& hdr, const Counts& c,
+                  const DopplerConsistency& doppler, double wall) {
+  static const RinexObsReaderStats kNoStats;
+  const RinexObsReaderStats& rs = obs.rinexStats() ? *obs.rinexStats() : kNoStats;
+  const long epochs = c.epochs, solutions = c.solutions;
+  std::fprintf(stderr, "gvins-spp summary (%s)\n", args.inputs[0].c_str());
+  std::fprintf(stderr, "  epochs read            %8ld\n", epochs);
+  std::fprintf(stderr, "  solutions              %8ld (%.1f %%)\n", solutions, epochs ? 100.0 * solutions / epochs : 0.0);
+  std::fprintf(stderr, "    residual test failed %8ld (%s)\n", c.testFailed,
+               args.dropFailed ? "omitted: --drop-failed" : "written with test = 1");
+  std::fprintf(stderr, "    not testable         %8ld (no redundancy; test = 2)\n", c.untestable);
+  std::fprintf(stderr, "  rows written           %8ld\n", c.written);
+  std::fprintf(stderr, "  velocity solutions     %8ld\n", c.velocities);
+  std::fprintf(stderr, "  mean satellites used   %8.1f\n", solutions ? c.satSum / solutions : 0.0);
+  std::fprintf(stderr, "  Doppler                %s\n", doppler.countsText().c_str());
+  for (const std::string& line : doppler.summary()) std::fprintf(stderr, "    %s\n", line.c_str());
+  for (const auto& [st, n] : c.status) {
+    if (st != SppStatus::Ok && st != SppStatus::TestFailed) std::fprintf(stderr, "  no solution: %-22s %6ld\n", toString(st), n);
+  }
+  static const char* kUse[] = {"used", "system disabled", "no signal", "low C/N0", "no ephemeris", "below mask", "excluded"};
+  std::fprintf(stderr, "  satellite-epochs:");
+  for (int i = 0; i < 7; ++i) {
+    if (c.use[i]) std::fprintf(stderr, " %s %ld;", kUse[i], c.use[i]);
+  }
+  std::fprintf(stderr, "\n");
+  if (!c.excluded.empty()) {
+    std::fprintf(stderr, "  excluded by FDE:");
+    for (const auto& [s, n] : c.excluded) std::fprintf(stderr, " %s x%ld", s.str().c_str(), n);
+    std::fprintf(stderr, "\n");
+  }
+  if (rs.skippedEpochs || rs.skippedSatellites || rs.specialRecords || rs.emptyEpochs) {
+    std::fprintf(stderr, "  input: %lld malformed epochs skipped, %lld satellite records skipped, %lld event records, %lld empty epochs\n",
+                 static_cast<long long>(rs.skippedEpochs), static_cast<long long>(rs.skippedSatellites),
+                 static_cast<long long>(rs.specialRecords), static_cast<long long>(rs.emptyEpochs));
+    for (const auto& m : rs.messages) std::fprintf(stderr, "    %s\n", m.c_str());
+  }
+  if (obs.format() == BaseFormat::Ubx) {
+    std::fprintf(stderr, "  input: %s; %lld malformed messages skipped\n", obs.describe().c_str(),
+                 static_cast<long long>(obs.skipped()));
+  }
+  if (!hdr.ignoredTypes.empty()) {
+    std::fprintf(stderr, "  observation columns not used (unknown or non-measurement codes):");
+    for (const auto& t : hdr.ignoredTypes) std::fprintf(stderr, " %s;", t.c_str());
+    std::fprintf(stderr, "\n");
+  }
+  std::fprintf(stderr, "  time                   %8.3f s (%.0f epochs/s)\n", wall, wall > 0 ? epochs / wall : 0.0);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace gvins;
+  keepHeapPages();
+  const Args args = parseArgs(argc, argv);
+  const auto wall0 = std::chrono::steady_clock::now();
+  if (!args.score.empty()) return score(args);
+  const SppConfig cfg = configuration(args);
+  EphemerisStore nav;
+  if (const int rc = readNavigation(args, nav)) return rc;
   // Observations: RINEX or UBX, told apart by content (BaseReader). A UBX log adds the
   // ephemerides of its RXM-SFRBX subframes to `nav` as they are read.
   std::unique_ptr<BaseReader> obs;
@@ -321,33 +378,8 @@ int main(int argc, char** argv) {
   }
   static const RinexObsHeader kNoHeader;
   const RinexObsHeader& hdr = obs->rinexHeader() ? *obs->rinexHeader() : kNoHeader;
-
-  // SSR corrections: their times of week resolve against the first observation epoch.
   if (!args.ssr.empty()) {
-    GpsTime first;
-    try {
-      auto peek = BaseReader::open(args.inputs[0], GpsTime{}, nullptr, !args.strict);
-      ObsEpoch e;
-      if (peek->next(e)) first = e.time;
-    } catch (const ParseError& e) {
-      printError(e);
-      return 1;
-    }
-    try {
-      std::size_t n = 0;
-      for (const std::string& f : args.ssr) {
-        const rtcm::SsrFile ssr = rtcm::readSsrFile(f, first);
-        for (const SsrMessage& m : ssr.messages) nav.addSsr(m);
-        n += ssr.messages.size();
-        if (ssr.stats.malformed > 0 && !args.quiet)
-          std::fprintf(stderr, "%s: %lld malformed RTCM frames skipped\n", f.c_str(),
-                       static_cast<long long>(ssr.stats.malformed));
-      }
-      if (!args.quiet) std::fprintf(stderr, "SSR corrections: %zu messages\n", n);
-    } catch (const ParseError& e) {
-      printError(e);
-      return 1;
-    }
+    if (const int rc = readSsr(args, nav)) return rc;
   }
 
   SppSolver solver(nav, cfg);
@@ -369,54 +401,18 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "gvins-spp: error: %s\n", e.what());
     return 1;
   }
-  std::ostream* out = &output->stream();
-  PosWriterOptions popt;
-  popt.coordinates = args.xyz ? PosCoordinates::Xyz : PosCoordinates::Llh;
-  // Velocity columns when a velocity can exist: Doppler observations in the file and asked for.
-  bool hasDoppler = false;
-  for (int i = 0; i < kNumSystems; ++i) {
-    if (!cfg.systems[i]) continue;
-    for (const ObsDescriptor& d : hdr.obsTypes[i]) hasDoppler = hasDoppler || d.type == ObsType::Doppler;
-  }
-  hasDoppler = hasDoppler || (streamInput && obs->mayHaveDoppler());
-  popt.velocity = cfg.velocity && hasDoppler;
-  if (!cfg.velocity) popt.notes.emplace_back("no velocity columns: velocity not estimated (--no-velocity)");
-  else if (!hasDoppler) popt.notes.emplace_back("no velocity columns: no Doppler observations in the input");
-  popt.testColumn = true;
-  popt.timeDecimals = args.timeDecimals;
-  popt.program = "SRI-GVINS gvins-spp";
-  for (const auto& f : args.inputs) popt.headerFields.emplace_back("inp file", f);
-  popt.headerFields.emplace_back("pos mode", "single");
-  char buf[160];
-  std::snprintf(buf, sizeof buf, "%.1f deg", cfg.elevationMask * constants::kRadToDeg);
-  popt.headerFields.emplace_back("elev mask", buf);
-  popt.headerFields.emplace_back("ionos opt", ionoName(cfg.ionosphere));
-  popt.headerFields.emplace_back("tropo opt", cfg.troposphere == TroposphereOption::Off ? "off" : "saastamoinen+niell");
-  popt.headerFields.emplace_back("navi sys", systemsText(cfg));
-  std::snprintf(buf, sizeof buf, "%d", cfg.frequencies);
-  popt.headerFields.emplace_back("freqs", buf);
-  if (args.dropFailed) popt.headerFields.emplace_back("failed", "epochs failing the residual test omitted");
   std::optional<CarrierSmoother> smoother;
-  if (args.smooth) cfg.carrierSmoothing = *args.smooth;
   if (cfg.carrierSmoothing > 0.0) {
     CarrierSmoothingOptions so;
     so.window = cfg.carrierSmoothing;
     smoother.emplace(so);
-    std::snprintf(buf, sizeof buf, "%.0f s", cfg.carrierSmoothing);
-    popt.headerFields.emplace_back("carrier smoothing", buf);
   }
-
-  PosWriter writer(*out, popt);
-
+  PosWriter writer(output->stream(), posOptions(args, cfg, *obs, hdr));
   std::optional<AccuracyStatistics> stats;
   if (args.truth) stats.emplace(*args.truth);
 
   // Processing loop.
-  std::map<SppStatus, long> statusCount;
-  std::map<SatId, long> excludedCount;
-  std::array<long, 8> useCount{};
-  long epochs = 0, solutions = 0, velocities = 0, testFailed = 0, untestable = 0, written = 0;
-  double satSum = 0.0;
+  Counts c;
   const bool tty = isatty(fileno(stderr));
   auto lastProgress = wall0;
   const double span = hdr.firstObs && hdr.lastObs ? *hdr.lastObs - *hdr.firstObs : 0.0;
@@ -425,10 +421,11 @@ int main(int argc, char** argv) {
   // Doppler that disagrees with the phase/code rate is dropped, each with one warning.
   DopplerConsistency doppler("rover");
   std::size_t dopplerWarned = 0;
-  std::size_t signalWarned = 0;
-  ClockJumpRepair clockJumps("rover");
-  std::size_t jumpWarned = 0;  // primary signals from a fallback band (signal_choice.hpp)
+  ClockJumpRepair clockJumps("rover");  // whole-ms receiver clock jumps (clock_jump_repair.hpp)
+  std::size_t jumpWarned = 0;
+  std::size_t signalWarned = 0;  // primary signals from a fallback band (signal_choice.hpp)
   ObsEpoch epoch;
+  char buf[160];
   for (;;) {
     try {
       if (!obs->next(epoch)) break;
@@ -437,13 +434,13 @@ int main(int argc, char** argv) {
       exitCode = 1;
       break;
     }
-    ++epochs;
+    ++c.epochs;
     if (streamInput) {  // UBX: GLONASS channels arrive with the observations (RAWX freqId)
       channels = obs->glonassChannels();
       channels.mergeMissing(nav.glonassChannels());
       solver.setGlonassChannels(obs->glonassChannels());
     }
-    clockJumps.apply(epoch, channels);  // whole-ms receiver clock jumps, before smoothing
+    clockJumps.apply(epoch, channels);  // before the Doppler check and smoothing
     for (; jumpWarned < clockJumps.warnings().size(); ++jumpWarned) {
       std::fprintf(stderr, "%sgvins-spp: warning: %s\n", tty ? "\r" : "", clockJumps.warnings()[jumpWarned].c_str());
     }
@@ -456,18 +453,18 @@ int main(int argc, char** argv) {
     for (; signalWarned < solver.signalNotices().size(); ++signalWarned) {
       std::fprintf(stderr, "%sgvins-spp: warning: %s\n", tty ? "\r" : "", solver.signalNotices()[signalWarned].c_str());
     }
-    ++statusCount[sol.status];
-    for (const auto& s : sol.satellites) ++useCount[static_cast<int>(s.use)];
-    for (const auto& s : sol.excluded) ++excludedCount[s];
+    ++c.status[sol.status];
+    for (const auto& s : sol.satellites) ++c.use[static_cast<int>(s.use)];
+    for (const auto& s : sol.excluded) ++c.excluded[s];
     if (sol.valid()) {
-      ++solutions;
+      ++c.solutions;
       const PositionSolution ps = sol.toPositionSolution();
-      if (ps.residualTest == ResidualTest::Failed) ++testFailed;
-      if (ps.residualTest == ResidualTest::Untestable) ++untestable;
-      satSum += sol.numSatellites;
-      if (sol.velocity.valid) ++velocities;
+      if (ps.residualTest == ResidualTest::Failed) ++c.testFailed;
+      if (ps.residualTest == ResidualTest::Untestable) ++c.untestable;
+      c.satSum += sol.numSatellites;
+      if (sol.velocity.valid) ++c.velocities;
       if (args.dropFailed && ps.residualTest == ResidualTest::Failed) continue;
-      ++written;
+      ++c.written;
       writer.write(ps);
       side->add(ps, NmeaExtras{sol.dop.valid ? std::optional<double>(sol.dop.hdop) : std::nullopt, std::nullopt});
       if (stats) {
@@ -485,7 +482,7 @@ int main(int argc, char** argv) {
           pct = buf;
         }
         std::fprintf(stderr, "%s%s epoch %ld %s solutions %ld%s", tty ? "\r" : "", epoch.time.toString(1).c_str(),
-                     epochs, pct.c_str(), solutions, tty ? "   " : "\n");
+                     c.epochs, pct.c_str(), c.solutions, tty ? "   " : "\n");
         std::fflush(stderr);
       }
     }
@@ -503,52 +500,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "gvins-spp: no output written to '%s' (the run failed)\n", args.out.c_str());
   if (!args.quiet && tty) std::fprintf(stderr, "\r%60s\r", "");
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-
-  // Summary.
-  static const RinexObsReaderStats kNoStats;
-  const RinexObsReaderStats& rs = obs->rinexStats() ? *obs->rinexStats() : kNoStats;
-  std::fprintf(stderr, "gvins-spp summary (%s)\n", args.inputs[0].c_str());
-  std::fprintf(stderr, "  epochs read            %8ld\n", epochs);
-  std::fprintf(stderr, "  solutions              %8ld (%.1f %%)\n", solutions, epochs ? 100.0 * solutions / epochs : 0.0);
-  std::fprintf(stderr, "    residual test failed %8ld (%s)\n", testFailed,
-               args.dropFailed ? "omitted: --drop-failed" : "written with test = 1");
-  std::fprintf(stderr, "    not testable         %8ld (no redundancy; test = 2)\n", untestable);
-  std::fprintf(stderr, "  rows written           %8ld\n", written);
-  std::fprintf(stderr, "  velocity solutions     %8ld\n", velocities);
-  std::fprintf(stderr, "  mean satellites used   %8.1f\n", solutions ? satSum / solutions : 0.0);
-  std::fprintf(stderr, "  Doppler                %s\n", doppler.countsText().c_str());
-  for (const std::string& line : doppler.summary()) std::fprintf(stderr, "    %s\n", line.c_str());
-  for (const auto& [st, n] : statusCount) {
-    if (st != SppStatus::Ok && st != SppStatus::TestFailed) std::fprintf(stderr, "  no solution: %-22s %6ld\n", toString(st), n);
-  }
-  static const char* kUse[] = {"used", "system disabled", "no signal", "low C/N0", "no ephemeris", "below mask", "excluded"};
-  std::fprintf(stderr, "  satellite-epochs:");
-  for (int i = 0; i < 7; ++i) {
-    if (useCount[i]) std::fprintf(stderr, " %s %ld;", kUse[i], useCount[i]);
-  }
-  std::fprintf(stderr, "\n");
-  if (!excludedCount.empty()) {
-    std::fprintf(stderr, "  excluded by FDE:");
-    for (const auto& [s, n] : excludedCount) std::fprintf(stderr, " %s x%ld", s.str().c_str(), n);
-    std::fprintf(stderr, "\n");
-  }
-  if (rs.skippedEpochs || rs.skippedSatellites || rs.specialRecords || rs.emptyEpochs) {
-    std::fprintf(stderr, "  input: %lld malformed epochs skipped, %lld satellite records skipped, %lld event records, %lld empty epochs\n",
-                 static_cast<long long>(rs.skippedEpochs), static_cast<long long>(rs.skippedSatellites),
-                 static_cast<long long>(rs.specialRecords), static_cast<long long>(rs.emptyEpochs));
-    for (const auto& m : rs.messages) std::fprintf(stderr, "    %s\n", m.c_str());
-  }
-  if (streamInput) {
-    std::fprintf(stderr, "  input: %s; %lld malformed messages skipped\n", obs->describe().c_str(),
-                 static_cast<long long>(obs->skipped()));
-  }
-  if (!hdr.ignoredTypes.empty()) {
-    std::fprintf(stderr, "  observation columns not used (unknown or non-measurement codes):");
-    for (const auto& t : hdr.ignoredTypes) std::fprintf(stderr, " %s;", t.c_str());
-    std::fprintf(stderr, "\n");
-  }
-  std::fprintf(stderr, "  time                   %8.3f s (%.0f epochs/s)\n", wall, wall > 0 ? epochs / wall : 0.0);
+  printSummary(args, *obs, hdr, c, doppler, wall);
   if (stats) std::fputs(stats->table().c_str(), stderr);
-  if (solutions == 0 && exitCode == 0) exitCode = 3;
+  if (c.solutions == 0 && exitCode == 0) exitCode = 3;
   return exitCode;
 }

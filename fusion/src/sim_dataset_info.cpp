@@ -12,12 +12,7 @@
 namespace gvins::fusion {
 
 SimDatasetInfo parseSimDatasetInfo(std::string_view yaml, const std::string& file) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(yaml));
-  } catch (const YAML::Exception& e) {
-    throw ParseError(file, e.mark.is_null() ? 0 : e.mark.line + 1, "YAML", e.msg);
-  }
+  YAML::Node root = YamlReader::loadText(std::string(yaml), file);
   const YamlReader r(file);
   SimDatasetInfo info;
   if (root.IsNull()) return info;
@@ -40,11 +35,7 @@ SimDatasetInfo parseSimDatasetInfo(std::string_view yaml, const std::string& fil
 std::optional<SimDatasetInfo> readSimDatasetInfo(const std::string& datasetFolder) {
   const std::filesystem::path p = std::filesystem::path(datasetFolder) / "dataset.yaml";
   if (!std::filesystem::exists(p)) return std::nullopt;
-  std::ifstream in(p);
-  if (!in) throw ParseError(p.string(), 0, "", "cannot open file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parseSimDatasetInfo(ss.str(), p.string());
+  return parseSimDatasetInfo(YamlReader::readFile(p.string()), p.string());
 }
 
 }  // namespace gvins::fusion

@@ -9,22 +9,10 @@
 
 namespace gvins {
 
-const char* toString(AmbiguityValidation v) {
-  switch (v) {
-    case AmbiguityValidation::Ratio: return "ratio";
-    case AmbiguityValidation::SuccessRate: return "success-rate";
-    case AmbiguityValidation::RatioAndSuccessRate: return "ratio+success-rate";
-    case AmbiguityValidation::FixedFailureRate: return "fixed-failure-rate";
-  }
-  return "?";
-}
+const char* toString(AmbiguityValidation v) { return enumName(kAmbiguityValidationNames, v); }
 
 std::optional<AmbiguityValidation> parseAmbiguityValidation(std::string_view text) {
-  for (AmbiguityValidation v : {AmbiguityValidation::Ratio, AmbiguityValidation::SuccessRate,
-                                AmbiguityValidation::RatioAndSuccessRate, AmbiguityValidation::FixedFailureRate}) {
-    if (text == toString(v)) return v;
-  }
-  return std::nullopt;
+  return enumFromName(kAmbiguityValidationNames, text);
 }
 
 bool passesValidation(double ratio, double successRate, const AmbiguityResolutionOptions& o, double criticalRatio) {

@@ -13,21 +13,10 @@
 
 namespace gvins {
 
-const char* toString(RtkMode m) { return m == RtkMode::Static ? "static" : "kinematic"; }
-
-const char* toString(AmbiguityMode m) {
-  switch (m) {
-    case AmbiguityMode::Off: return "off";
-    case AmbiguityMode::Continuous: return "continuous";
-    case AmbiguityMode::Instantaneous: return "instantaneous";
-    case AmbiguityMode::FixAndHold: return "fix-and-hold";
-  }
-  return "?";
-}
-
-const char* toString(RtkDynamics d) { return d == RtkDynamics::RandomWalk ? "random-walk" : "constant-velocity"; }
-
-const char* toString(SignalMatching m) { return m == SignalMatching::Strict ? "strict" : "band"; }
+const char* toString(RtkMode m) { return enumName(kRtkModeNames, m); }
+const char* toString(AmbiguityMode m) { return enumName(kAmbiguityModeNames, m); }
+const char* toString(RtkDynamics d) { return enumName(kRtkDynamicsNames, d); }
+const char* toString(SignalMatching m) { return enumName(kSignalMatchingNames, m); }
 
 namespace {
 
@@ -43,11 +32,8 @@ void applyAr(const Reader& r, const YAML::Node& v, const std::string& where, Rtk
     if (k == "systems") c.arSystems = r.systems(x, f);
     else if (k == "elevation_mask_deg") c.arElevationMask = r.number(x, f, 0.0, 90.0) * constants::kDegToRad;
     else if (k == "min_lock") c.arMinLock = r.integer(x, f, 0, 100000);
-    else if (k == "validation") {
-      const std::string t = r.text(x, f);
-      if (const auto rule = parseAmbiguityValidation(t)) c.ar.validation = *rule;
-      else r.fail(x, f, "'" + f + "' must be ratio, success-rate, ratio+success-rate or fixed-failure-rate, not '" + t + "'");
-    } else if (k == "ratio_threshold") c.ar.ratioThreshold = r.number(x, f, 1.0, 1000.0);
+    else if (k == "validation") c.ar.validation = r.choice(x, f, kAmbiguityValidationNames);
+    else if (k == "ratio_threshold") c.ar.ratioThreshold = r.number(x, f, 1.0, 1000.0);
     else if (k == "max_failure_rate") c.ar.maxFailureRate = r.number(x, f, 1e-9, 0.5);
     else if (k == "partial") c.ar.partial = r.boolean(x, f);
     else if (k == "partial_success_rate") c.ar.partialSuccessRate = r.number(x, f, 0.5, 1.0);
@@ -72,22 +58,11 @@ void apply(const Reader& r, const YAML::Node& rtk, RtkConfig& c) {
       "cycle_slip", "ambiguity_outage_s", "outliers", "filter"};
   r.map(rtk, "rtk", kKeys, [&](const std::string& k, const std::string& full, const YAML::Node& v) {
     if (k == "mode") {
-      const std::string t = r.text(v, full);
-      if (t == "static") c.mode = RtkMode::Static;
-      else if (t == "kinematic") c.mode = RtkMode::Kinematic;
-      else r.fail(v, full, "'" + full + "' must be static or kinematic, not '" + t + "'");
+      c.mode = r.choice(v, full, kRtkModeNames);
     } else if (k == "dynamics") {
-      const std::string t = r.text(v, full);
-      if (t == "random-walk") c.dynamics = RtkDynamics::RandomWalk;
-      else if (t == "constant-velocity") c.dynamics = RtkDynamics::ConstantVelocity;
-      else r.fail(v, full, "'" + full + "' must be random-walk or constant-velocity, not '" + t + "'");
+      c.dynamics = r.choice(v, full, kRtkDynamicsNames);
     } else if (k == "ambiguity_mode") {
-      const std::string t = r.text(v, full);
-      if (t == "off") c.ambiguityMode = AmbiguityMode::Off;
-      else if (t == "continuous") c.ambiguityMode = AmbiguityMode::Continuous;
-      else if (t == "instantaneous") c.ambiguityMode = AmbiguityMode::Instantaneous;
-      else if (t == "fix-and-hold") c.ambiguityMode = AmbiguityMode::FixAndHold;
-      else r.fail(v, full, "'" + full + "' must be off, continuous, instantaneous or fix-and-hold, not '" + t + "'");
+      c.ambiguityMode = r.choice(v, full, kAmbiguityModeNames);
     } else if (k == "systems") {
       c.systems = r.systems(v, full);
     } else if (k == "frequencies") {
@@ -105,10 +80,7 @@ void apply(const Reader& r, const YAML::Node& rtk, RtkConfig& c) {
         c.bands[systemIndex(s)] = bands;
       });
     } else if (k == "signal_matching") {
-      const std::string t = r.text(v, full);
-      if (t == "strict") c.signalMatching = SignalMatching::Strict;
-      else if (t == "band") c.signalMatching = SignalMatching::Band;
-      else r.fail(v, full, "'" + full + "' must be band or strict, not '" + t + "'");
+      c.signalMatching = r.choice(v, full, kSignalMatchingNames);
     } else if (k == "elevation_mask_deg") {
       c.elevationMask = r.number(v, full, -10.0, 90.0) * constants::kDegToRad;
     } else if (k == "snr_mask_dbhz") {
@@ -188,12 +160,7 @@ void apply(const Reader& r, const YAML::Node& rtk, RtkConfig& c) {
 RtkConfig parseRtkConfig(std::string_view yaml, std::string_view name, const RtkConfig& base) {
   RtkConfig c = base;
   const Reader r{std::string(name)};
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(yaml));
-  } catch (const YAML::Exception& e) {
-    throw ParseError(std::string(name), e.mark.line >= 0 ? e.mark.line + 1 : 0, "YAML", e.msg);
-  }
+  YAML::Node root = YamlReader::loadText(std::string(yaml), std::string(name));
   if (root.IsNull()) return c;
   if (!root.IsMap()) r.fail(root, "", "the configuration must be a map with an 'rtk' section");
   try {

@@ -18,6 +18,7 @@
 #include "gvins/gnss/signal_choice.hpp"
 #include "gvins/gnss/zero_difference.hpp"
 #include "normal_equations.hpp"
+#include "spp_reported_covariance.hpp"
 
 namespace gvins {
 
@@ -82,6 +83,7 @@ struct SppSolver::Measurement {
   // Model values of the last iteration.
   AzEl azel{0.0, 0.5 * constants::kPi};
   double iono = 0.0, tropo = 0.0, variance = 1.0;
+  double errorVariance = 1.0;  // of the reported covariance's error model (ReportedErrorModel)
   bool active = true;  // above the mask in the last iteration
   double inflation = 1.0;  // variance factor from robust re-weighting
   double ionoMap = 0.0;    // partial of the delay w.r.t. a zenith L1 ionosphere correction
@@ -216,7 +218,8 @@ class SppSolver::Fit {
         ionoPar(solver.nav_.ionosphere()),
         n(static_cast<int>(meas.size())),
         // Zenith ionosphere correction to the broadcast model as an extra unknown (with a prior).
-        estIono(cfg.ionosphereEstimation.enabled && cfg.ionosphere != IonosphereOption::Off && ionoPar.gps.has_value()) {}
+        estIono(cfg.ionosphereEstimation.enabled && cfg.ionosphere != IonosphereOption::Off && ionoPar.gps.has_value()),
+        owner(solver) {}
 
   /// Updates az/el, atmospheric delays, variances and the mask flag of every measurement at x.
   /// Model values change by < 1 mm when the position moves by less than a metre (elevations by
@@ -251,6 +254,7 @@ class SppSolver::Fit {
   const IonosphereParameters& ionoPar;
   const int n;
   const bool estIono;
+  const SppSolver& owner;  // for its reported-covariance model
   double ionoPriorVar = 1.0;
   std::optional<Eigen::Vector3d> modelPoint;
   std::array<int, kNumSystems> col{};
@@ -317,8 +321,9 @@ void SppSolver::Fit::updateModels(const Eigen::Vector3d& x) {
       m.azel = AzEl{0.0, 0.5 * constants::kPi};
       m.active = true;
     }
-    double var = cfg.weighting.codeVariance(m.sat.system, m.azel.elevation, m.snr) * m.noiseFactor * m.noiseFactor;
-    var += ionoVar + tropoVar;
+    const double noiseVar =
+        cfg.weighting.codeVariance(m.sat.system, m.azel.elevation, m.snr) * m.noiseFactor * m.noiseFactor;
+    double var = noiseVar + ionoVar + tropoVar;
     double eph = m.state.precise || m.state.ssr ? cfg.preciseEphemerisError[systemIndex(m.sat.system)]
                                  : cfg.ephemerisError[systemIndex(m.sat.system)];
     if (!m.state.precise && !m.state.ssr && m.state.accuracy > cfg.ephemerisAlarmAccuracy && cfg.ephemerisAlarmAccuracy > 0.0) {
@@ -326,6 +331,9 @@ void SppSolver::Fit::updateModels(const Eigen::Vector3d& x) {
     }
     var += eph * eph;
     m.variance = var * m.inflation;
+    const ReportedErrorModel& re = cfg.reportedError;
+    m.errorVariance = re.noiseScale * re.noiseScale * noiseVar + re.ionosphereScale * re.ionosphereScale * ionoVar +
+                      re.modelScale * re.modelScale * (tropoVar + eph * eph);
   }
 }
 
@@ -576,13 +584,14 @@ void SppSolver::Fit::reweight() {
       }
       std::nth_element(u.begin(), u.begin() + static_cast<long>(u.size() / 2), u.end());
       const double scale = std::max(1.4826 * u[u.size() / 2], rb.minScale);
+      const double k0 = sol.testPassed ? rb.k0 : rb.k0Failed, k1 = sol.testPassed ? rb.k1 : rb.k1Failed;
       bool changed = false;
       for (int i = 0; i < n; ++i) {
         if (!use[i]) continue;
         const double z = last.normResidual[i] * std::sqrt(meas[i].inflation) / scale;
         double w = 1.0;
-        if (z > rb.k1) w = 1e-4;
-        else if (z > rb.k0) w = std::max(1e-4, rb.k0 / z * std::pow((rb.k1 - z) / (rb.k1 - rb.k0), 2));
+        if (z > k1) w = 1e-4;
+        else if (z > k0) w = std::max(1e-4, k0 / z * std::pow((k1 - z) / (k1 - k0), 2));
         const double infl = 1.0 / w;
         if (std::abs(infl - meas[i].inflation) > 0.05 * meas[i].inflation) changed = true;
         meas[i].variance *= infl / meas[i].inflation;
@@ -645,6 +654,10 @@ bool SppSolver::Fit::writeSolution() {
     ++sol.numSatellites;
     losEnu.push_back(rEnu * (m.state.position - x).normalized());
     clockIdx.push_back(col[m.sys]);
+  }
+  if (cfg.reportedError.enabled) {
+    const std::optional<double> ionoPrior = estIono ? std::optional<double>(ionoPriorVar) : std::nullopt;
+    owner.reportCovariance(sol, meas, use, x, col, colSystems, last.cov, ionoPrior, ion);
   }
   sol.dop = computeDop(losEnu, clockIdx, static_cast<int>(colSystems.size()));
   if (!sol.dop.valid || sol.dop.gdop > cfg.maxGdop) {
@@ -723,6 +736,34 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
   // Doppler velocity.
   if (cfg.velocity) fit.solveVelocity();
   return sol;
+}
+
+void SppSolver::reportCovariance(SppSolution& sol, const std::vector<Measurement>& meas, const std::vector<char>& use,
+                                 const Eigen::Vector3d& x, const std::array<int, kNumSystems>& col,
+                                 const std::vector<int>& colSystems, const Eigen::MatrixXd& cov,
+                                 std::optional<double> ionoPriorVar, double ion) const {
+  const int nc = static_cast<int>(colSystems.size());
+  const int nu = static_cast<int>(cov.rows());
+  std::vector<detail::ReportedRow> rr;
+  for (std::size_t i = 0; i < meas.size(); ++i) {
+    if (!use[i]) continue;
+    const Measurement& m = meas[i];
+    detail::ReportedRow row{Eigen::VectorXd::Zero(nu), m.variance, m.errorVariance, sol.satellites[m.result].residual};
+    row.h.head<3>() = -(m.state.position - x).normalized();
+    row.h[3 + col[m.sys]] = 1.0;
+    if (ionoPriorVar) row.h[3 + nc] = m.ionoMap;
+    rr.push_back(std::move(row));
+  }
+  if (ionoPriorVar) {  // the prior of the zenith correction, an error budget like the others
+    const double f = config_.reportedError.ionosphereScale;
+    rr.push_back(detail::ReportedRow{Eigen::VectorXd::Unit(nu, 3 + nc), *ionoPriorVar, f * f * *ionoPriorVar, -ion});
+  }
+  const detail::ReportedCovariance rc = detail::reportedCovariance(cov, rr, sol.dof, config_.covarianceScaling);
+  sol.varianceFactor = rc.varianceFactor;
+  sol.positionCovariance = rc.covariance.topLeftCorner<3, 3>();
+  for (int c = 0; c < nc; ++c) sol.clockBiasVariance[colSystems[c]] = rc.covariance(3 + c, 3 + c);
+  const int gi = systemIndex(System::Gps), ji = systemIndex(System::Qzss);
+  if (config_.qzssUsesGpsClock && sol.clockBias[gi]) sol.clockBiasVariance[ji] = sol.clockBiasVariance[gi];
 }
 
 void SppSolver::updateIsb(const SppSolution& sol, const Eigen::MatrixXd& cov, const std::vector<int>& clockSystems) {

@@ -26,11 +26,21 @@ namespace {
 
 using Reader = YamlReader;
 
+void applyReportedError(const Reader& r, const YAML::Node& v, const std::string& full, ReportedErrorModel& m) {
+  static const std::set<std::string> kE = {"enabled", "noise_scale", "ionosphere_scale", "model_scale"};
+  r.map(v, full, kE, [&](const std::string& ek, const std::string& ef, const YAML::Node& ev) {
+    if (ek == "enabled") m.enabled = r.boolean(ev, ef);
+    else if (ek == "noise_scale") m.noiseScale = r.number(ev, ef, 0.0, 100.0);
+    else if (ek == "ionosphere_scale") m.ionosphereScale = r.number(ev, ef, 0.0, 100.0);
+    else m.modelScale = r.number(ev, ef, 0.0, 100.0);
+  });
+}
+
 void apply(const Reader& r, const YAML::Node& spp, SppConfig& c) {
   static const std::set<std::string> kKeys = {
       "systems", "elevation_mask_deg", "snr_mask_dbhz", "frequencies", "bands", "ionosphere", "troposphere",
       "relative_humidity", "meteo", "weighting", "ionosphere_model_error", "troposphere_zenith_error_m",
-      "ephemeris_error_m", "ephemeris_alarm_accuracy_m", "precise_ephemeris_error_m", "fault_exclusion", "robust", "ionosphere_estimation", "covariance_scaling", "max_gdop", "isb_prior_sigma_m", "isb_random_walk_m2ps", "qzss_gps_clock",
+      "ephemeris_error_m", "ephemeris_alarm_accuracy_m", "precise_ephemeris_error_m", "fault_exclusion", "robust", "ionosphere_estimation", "covariance_scaling", "reported_error", "max_gdop", "isb_prior_sigma_m", "isb_random_walk_m2ps", "qzss_gps_clock",
       "max_iterations", "velocity", "carrier_smoothing_s", "allow_unhealthy"};
   r.map(spp, "spp", kKeys, [&](const std::string& k, const std::string& full, const YAML::Node& v) {
     if (k == "systems") {
@@ -48,16 +58,9 @@ void apply(const Reader& r, const YAML::Node& spp, SppConfig& c) {
         c.bands[systemIndex(s)] = bands;
       });
     } else if (k == "ionosphere") {
-      const std::string t = r.text(v, full);
-      if (t == "off") c.ionosphere = IonosphereOption::Off;
-      else if (t == "broadcast") c.ionosphere = IonosphereOption::Broadcast;
-      else if (t == "dual-frequency") c.ionosphere = IonosphereOption::DualFrequency;
-      else r.fail(v, full, "'" + full + "' must be off, broadcast or dual-frequency, not '" + t + "'");
+      c.ionosphere = r.choice(v, full, kIonosphereOptionNames);
     } else if (k == "troposphere") {
-      const std::string t = r.text(v, full);
-      if (t == "off") c.troposphere = TroposphereOption::Off;
-      else if (t == "saastamoinen") c.troposphere = TroposphereOption::Saastamoinen;
-      else r.fail(v, full, "'" + full + "' must be off or saastamoinen, not '" + t + "'");
+      c.troposphere = r.choice(v, full, kTroposphereOptionNames);
     } else if (k == "meteo") {
       const std::string t = r.text(v, full);
       if (t == "climatology") c.climatologicalMeteo = true;
@@ -115,15 +118,19 @@ void apply(const Reader& r, const YAML::Node& spp, SppConfig& c) {
         else c.faultExclusion.minRedundancy = r.integer(fv, ff, 0, 100);
       });
     } else if (k == "robust") {
-      static const std::set<std::string> kR = {"enabled", "k0", "k1", "min_scale", "max_iterations"};
+      static const std::set<std::string> kR = {"enabled", "k0", "k1", "k0_failed", "k1_failed", "min_scale",
+                                               "max_iterations"};
       r.map(v, full, kR, [&](const std::string& rk, const std::string& rf, const YAML::Node& rv) {
         if (rk == "enabled") c.robust.enabled = r.boolean(rv, rf);
         else if (rk == "k0") c.robust.k0 = r.number(rv, rf, 0.1, 100.0);
         else if (rk == "k1") c.robust.k1 = r.number(rv, rf, 0.2, 1000.0);
+        else if (rk == "k0_failed") c.robust.k0Failed = r.number(rv, rf, 0.1, 100.0);
+        else if (rk == "k1_failed") c.robust.k1Failed = r.number(rv, rf, 0.2, 1000.0);
         else if (rk == "min_scale") c.robust.minScale = r.number(rv, rf, 0.0, 100.0);
         else c.robust.maxIterations = r.integer(rv, rf, 1, 100);
       });
       if (c.robust.k1 <= c.robust.k0) r.fail(v, full, "robust.k1 must be larger than robust.k0");
+      if (c.robust.k1Failed <= c.robust.k0Failed) r.fail(v, full, "robust.k1_failed must be larger than robust.k0_failed");
     } else if (k == "ionosphere_estimation") {
       static const std::set<std::string> kI = {"enabled", "prior_fraction", "min_prior_sigma_m"};
       r.map(v, full, kI, [&](const std::string& ik, const std::string& iff, const YAML::Node& iv) {
@@ -137,6 +144,8 @@ void apply(const Reader& r, const YAML::Node& spp, SppConfig& c) {
         if (ck == "enabled") c.covarianceScaling.enabled = r.boolean(cv, cf);
         else c.covarianceScaling.priorDof = r.number(cv, cf, 0.0, 1000.0);
       });
+    } else if (k == "reported_error") {
+      applyReportedError(r, v, full, c.reportedError);
     } else if (k == "max_gdop") {
       c.maxGdop = r.number(v, full, 1.0, 1e6);
     } else if (k == "isb_prior_sigma_m") {

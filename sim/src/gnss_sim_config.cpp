@@ -8,6 +8,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "gvins/base/parse_error.hpp"
+#include "gvins/base/yaml_reader.hpp"
 #include "gvins/ephemeris/ssr_message.hpp"
 #include "gvins/rtcm/msm_signals.hpp"
 
@@ -481,12 +482,7 @@ GnssSimConfig parseGnssSimConfig(const YAML::Node& gnssSection, const std::strin
 }
 
 GnssSimConfig parseGnssSimConfigText(const std::string& yaml, const std::string& file) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml);
-  } catch (const YAML::Exception& e) {
-    throw ParseError(file, e.mark.line >= 0 ? e.mark.line + 1 : 0, "YAML", e.msg);
-  }
+  YAML::Node root = YamlReader::loadText(yaml, file);
   if (root.IsNull()) return GnssSimConfig{};
   if (!root.IsMap()) {
     const auto m = root.Mark();

@@ -11,6 +11,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "gvins/base/parse_error.hpp"
+#include "gvins/base/yaml_reader.hpp"
 #include "gvins/base/text_fields.hpp"
 
 // Where the installed data (data/gnss/...) lies relative to the folder of the running executable:
@@ -607,7 +608,7 @@ Scenario parseScenario(const std::string& text, const std::string& file) {
   sc.text = text;
   const Reader r(file);
   try {
-    const YAML::Node root = YAML::Load(text);
+    const YAML::Node root = YamlReader::loadText(text, file);
     if (root.IsNull()) return sc;
     parseRoot(r, root, sc);
   } catch (const YAML::Exception& e) {
@@ -617,17 +618,7 @@ Scenario parseScenario(const std::string& text, const std::string& file) {
 }
 
 Scenario loadScenario(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw ParseError(path, 0, "", "is a directory, not a scenario file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ParseError(path, 0, "", "cannot open scenario file");
-  std::string text;
-  char buf[65536];
-  while (in.read(buf, sizeof buf) || in.gcount() > 0) {
-    text.append(buf, static_cast<std::size_t>(in.gcount()));
-    if (text.size() > kMaxScenarioBytes) throw ParseError(path, 0, "", "scenario larger than 1 MiB");
-  }
-  return parseScenario(text, path);
+  return parseScenario(YamlReader::readFile(path, kMaxScenarioBytes), path);
 }
 
 }  // namespace gvins::sim

@@ -27,7 +27,7 @@ TEST(SppConfig, ParsesEveryKey) {
       "  ephemeris_alarm_accuracy_m: 20\n"
       "  fault_exclusion: {enabled: false, false_alarm_probability: 0.01, max_exclusions: 3,\n"
       "                    max_candidates: 5, min_redundancy: 2}\n"
-      "  robust: {enabled: false, k0: 1.5, k1: 4, min_scale: 0.3, max_iterations: 3}\n"
+      "  robust: {enabled: false, k0: 1.5, k1: 4, k0_failed: 1.2, k1_failed: 2.5, min_scale: 0.3, max_iterations: 3}\n"
       "  ionosphere_estimation: {enabled: false, prior_fraction: 0.5, min_prior_sigma_m: 0.2}\n"
       "  max_gdop: 20\n"
       "  isb_prior_sigma_m: 5\n"
@@ -36,7 +36,8 @@ TEST(SppConfig, ParsesEveryKey) {
       "  max_iterations: 12\n"
       "  velocity: false\n"
       "  carrier_smoothing_s: 60\n"
-      "  allow_unhealthy: true\n";
+      "  allow_unhealthy: true\n"
+      "  reported_error: {enabled: true, noise_scale: 0.5, ionosphere_scale: 0.75, model_scale: 0.2}\n";
   const SppConfig c = parseSppConfig(y, "all.yaml");
   EXPECT_TRUE(c.useSystem(System::Gps) && c.useSystem(System::Galileo) && c.useSystem(System::BeiDou));
   EXPECT_FALSE(c.useSystem(System::Glonass) || c.useSystem(System::Qzss));
@@ -59,6 +60,12 @@ TEST(SppConfig, ParsesEveryKey) {
   EXPECT_EQ(c.faultExclusion.maxCandidates, 5);
   EXPECT_FALSE(c.robust.enabled);
   EXPECT_EQ(c.robust.k1, 4.0);
+  EXPECT_EQ(c.robust.k0Failed, 1.2);
+  EXPECT_EQ(c.robust.k1Failed, 2.5);
+  EXPECT_TRUE(c.reportedError.enabled);
+  EXPECT_EQ(c.reportedError.noiseScale, 0.5);
+  EXPECT_EQ(c.reportedError.ionosphereScale, 0.75);
+  EXPECT_EQ(c.reportedError.modelScale, 0.2);
   EXPECT_FALSE(c.ionosphereEstimation.enabled);
   EXPECT_EQ(c.maxGdop, 20.0);
   EXPECT_FALSE(c.qzssUsesGpsClock);
@@ -115,7 +122,10 @@ TEST(SppConfig, ErrorsNameFileLineAndKey) {
   expectError("spp:\n  bands: {G: \"19\"}\n", 2, "spp.bands.G", "band '9'");
   expectError("spp:\n  bands: {X: \"1\"}\n", 2, "spp.bands.X", "unknown system");
   expectError("spp:\n  robust: {k0: 3, k1: 2}\n", 2, "spp.robust", "larger");
+  expectError("spp:\n  robust: {k0_failed: 3, k1_failed: 2}\n", 2, "spp.robust", "k1_failed must be larger");
   expectError("spp:\n  velocity: maybe\n", 2, "spp.velocity", "wrong type");
+  expectError("spp:\n  reported_error: {noise_scale: -1}\n", 2, "spp.reported_error.noise_scale", "outside");
+  expectError("spp:\n  reported_error: {scale: 1}\n", 2, "spp.reported_error.scale", "unknown key");
   expectError("spp:\n  carrier_smoothing_s: -1\n", 2, "spp.carrier_smoothing_s", "");
   expectError("spp: [1, 2\n", 2, "YAML", "");
   expectError("- a\n- b\n", 1, "", "map");

@@ -30,6 +30,7 @@
 
 #include "gvins/base/constants.hpp"
 #include "gvins/base/rinex_obs_reader.hpp"
+#include "gvins/base/yaml_reader.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/ephemeris/precise_product_files.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
@@ -269,7 +270,7 @@ TEST(SimDataset, NoiseFreeImuLogIntegratesToTheWrittenTruth) {
   ASSERT_EQ(imu.size(), sum.imuSamples);
   ASSERT_EQ(gt.size(), imu.size());
   EXPECT_NEAR(static_cast<double>(imu.size()), sum.duration * 200.0 + 1.0, 1.0);
-  const YAML::Node ds = YAML::LoadFile((dir.path() / "dataset.yaml").string());
+  const YAML::Node ds = YamlReader::loadFile((dir.path() / "dataset.yaml").string());
   const double g = ds["gravity"]["magnitude_mps2"].as<double>();
   const vio::ImuCalibration ic = vio::readImuSensorYaml((dir.path() / "mav0" / "imu0" / "sensor.yaml").string());
   EXPECT_EQ(ic.noise.rate_hz, 200.0);
@@ -290,7 +291,7 @@ TEST(SimDataset, NoiseFreeImuLogIntegratesToTheWrittenTruth) {
 TEST(SimDataset, DatasetYamlStatesConventionsAndCalibration) {
   TempDir dir("yaml");
   const auto sum = generate(shortFlight("cameras: {output: features}\nlever_arm_m: [0.1, -0.02, 0.2]\n"), dir.path(), 4);
-  const YAML::Node ds = YAML::LoadFile((dir.path() / "dataset.yaml").string());
+  const YAML::Node ds = YamlReader::loadFile((dir.path() / "dataset.yaml").string());
   EXPECT_EQ(ds["format"].as<std::string>(), "gvins-sim-dataset");
   EXPECT_NE(ds["time"]["convention"].as<std::string>().find("GPST"), std::string::npos);
   // 2024-06-24 08:20:00 GPST = GPS week 2320, TOW 116400 s (Monday 08:20;

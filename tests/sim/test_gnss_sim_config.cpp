@@ -9,6 +9,7 @@
 
 #include "gvins/base/constants.hpp"
 #include "gvins/base/parse_error.hpp"
+#include "gvins/base/yaml_reader.hpp"
 #include "gvins/sim/gnss_random.hpp"
 #include "gvins/sim/gnss_sim_config.hpp"
 
@@ -161,7 +162,7 @@ TEST(GnssSimConfig, DefaultsAreRealisticReceivers) {
 }
 
 TEST(GnssSimConfig, TheSectionNodeOfALargerScenario) {
-  const YAML::Node root = YAML::Load("name: test\ngnss:\n  rover: {elevation_mask_deg: 15}\n");
+  const YAML::Node root = YamlReader::loadText("name: test\ngnss:\n  rover: {elevation_mask_deg: 15}\n", "test.yaml");
   const GnssSimConfig c = parseGnssSimConfig(root["gnss"], "scenario.yaml");
   EXPECT_DOUBLE_EQ(c.rover.elevationMaskDeg, 15.0);
   EXPECT_DOUBLE_EQ(parseGnssSimConfig(YAML::Node(), "scenario.yaml").rover.elevationMaskDeg, 5.0);

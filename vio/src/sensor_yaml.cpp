@@ -17,6 +17,7 @@
 #include <Eigen/Geometry>
 
 #include "gvins/base/parse_error.hpp"
+#include "gvins/base/yaml_reader.hpp"
 #include "gvins/base/text_fields.hpp"
 
 namespace gvins::vio {
@@ -49,7 +50,7 @@ YAML::Node loadYaml(std::string_view text, const Ctx& c) {
     s.replace(0, eol == std::string::npos ? s.size() : eol, "");
   }
   try {
-    YAML::Node root = YAML::Load(s);
+    YAML::Node root = YamlReader::loadText(s, c.file);
     if (!root.IsMap()) fail(c, lineOf(root), "", "expected a YAML mapping of keys at the top level");
     return root;
   } catch (const YAML::Exception& e) {
@@ -57,17 +58,7 @@ YAML::Node loadYaml(std::string_view text, const Ctx& c) {
   }
 }
 
-std::string readFileText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ParseError(path, 0, "", "cannot open file");
-  std::string text;
-  char buf[65536];
-  while (in.read(buf, sizeof buf) || in.gcount() > 0) {
-    text.append(buf, static_cast<std::size_t>(in.gcount()));
-    if (text.size() > kMaxYamlBytes) throw ParseError(path, 0, "", "file larger than 1 MiB: not a sensor calibration file");
-  }
-  return text;
-}
+std::string readFileText(const std::string& path) { return YamlReader::readFile(path, kMaxYamlBytes); }
 
 YAML::Node child(const YAML::Node& map, const char* key, const Ctx& c, bool required = true) {
   if (!map.IsMap()) fail(c, lineOf(map), key, "expected a mapping containing this key");

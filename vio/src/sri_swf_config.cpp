@@ -12,6 +12,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "gvins/base/parse_error.hpp"
+#include "gvins/base/yaml_reader.hpp"
 #include "gvins/base/text_fields.hpp"
 #include "gvins/vio/sri_swf_estimator.hpp"
 
@@ -248,7 +249,7 @@ SriSwfConfig parseSriSwfConfig(std::string_view text, const std::string& name, c
     if (ch == '\0') fail(c, 0, "", "binary data (NUL byte) in a YAML file");
   }
   try {
-    const YAML::Node root = YAML::Load(std::string(text));
+    const YAML::Node root = YamlReader::loadText(std::string(text), name);
     if (!root.IsMap()) fail(c, lineOf(root), "", "expected a YAML mapping at the top level");
     return parseRoot(root, c, defaults);
   } catch (const YAML::Exception& e) {
@@ -257,12 +258,9 @@ SriSwfConfig parseSriSwfConfig(std::string_view text, const std::string& name, c
 }
 
 SriSwfConfig loadSriSwfConfig(const std::string& path, const SriSwfConfig* defaults) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ParseError(path, 0, "", "cannot open file");
-  std::stringstream ss;
-  ss << in.rdbuf();
+  const std::string text = YamlReader::readFile(path);
   const std::string dir = std::filesystem::path(path).parent_path().string();
-  return parseSriSwfConfig(ss.str(), path, dir.empty() ? "." : dir, defaults);
+  return parseSriSwfConfig(text, path, dir.empty() ? "." : dir, defaults);
 }
 
 }  // namespace gvins::vio

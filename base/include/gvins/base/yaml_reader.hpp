@@ -18,6 +18,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "gvins/base/enum_names.hpp"
 #include "gvins/base/parse_error.hpp"
 #include "gvins/base/satellite.hpp"
 
@@ -50,6 +51,14 @@ class YamlReader {
   std::string text(const YAML::Node& n, const std::string& key) const;
   /// One of `choices`.
   std::string choice(const YAML::Node& n, const std::string& key, const std::set<std::string>& choices) const;
+  /// One of the named values of an enumeration (enum_names.hpp).
+  /// "'key' must be a, b or c, not 'x'" otherwise.
+  template <class E, std::size_t N>
+  E choice(const YAML::Node& n, const std::string& key, const EnumName<E> (&names)[N]) const {
+    const std::string v = text(n, key);
+    if (const auto e = enumFromName(names, v)) return *e;
+    fail(n, key, "'" + key + "' must be " + enumNameList(names) + ", not '" + v + "'");
+  }
   /// A sequence of exactly `size` numbers (size < 0: any length ≥ 1), each in [lo, hi].
   std::vector<double> numbers(const YAML::Node& n, const std::string& key, int size, double lo, double hi) const;
   /// A map key that must be a plain scalar.

@@ -35,6 +35,7 @@
 
 #include <Eigen/Core>
 
+#include "gvins/base/enum_names.hpp"
 #include "gvins/base/gnss_time.hpp"
 #include "gvins/base/observation.hpp"
 #include "gvins/gnss/pos_reader.hpp"
@@ -117,6 +118,8 @@ class ReplayGnss {
 };
 
 enum class ImuGapPolicy { Error, Warn };
+/// Names of the IMU gap policies (replay: imu_gaps, --imu-gaps).
+inline constexpr EnumName<ImuGapPolicy> kImuGapPolicyNames[] = {{ImuGapPolicy::Error, "error"}, {ImuGapPolicy::Warn, "warn"}};
 
 struct ReplayOptions {
   std::string outDir;

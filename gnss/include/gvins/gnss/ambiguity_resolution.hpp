@@ -39,6 +39,7 @@
 
 #include <Eigen/Core>
 
+#include "gvins/base/enum_names.hpp"
 #include "gvins/gnss/lambda.hpp"
 
 namespace gvins {
@@ -49,6 +50,11 @@ enum class AmbiguityValidation {
   RatioAndSuccessRate,  ///< both
   FixedFailureRate      ///< ratio ≥ the critical value that bounds the failure rate (simulated)
 };
+inline constexpr EnumName<AmbiguityValidation> kAmbiguityValidationNames[] = {
+    {AmbiguityValidation::FixedFailureRate, "fixed-failure-rate"},
+    {AmbiguityValidation::Ratio, "ratio"},
+    {AmbiguityValidation::SuccessRate, "success-rate"},
+    {AmbiguityValidation::RatioAndSuccessRate, "ratio+success-rate"}};
 
 /// "ratio", "success-rate", "ratio+success-rate", "fixed-failure-rate".
 const char* toString(AmbiguityValidation v);

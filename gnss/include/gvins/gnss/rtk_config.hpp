@@ -6,6 +6,7 @@
 #include <string_view>
 
 #include "gvins/base/constants.hpp"
+#include "gvins/base/enum_names.hpp"
 #include "gvins/base/satellite.hpp"
 #include "gvins/gnss/ambiguity_resolution.hpp"
 #include "gvins/gnss/cycle_slip_detector.hpp"
@@ -29,11 +30,21 @@ enum class AmbiguityMode {
   FixAndHold,     ///< as Continuous, and validated fixes constrain the float ambiguities
 };
 
+inline constexpr EnumName<RtkMode> kRtkModeNames[] = {{RtkMode::Static, "static"}, {RtkMode::Kinematic, "kinematic"}};
+inline constexpr EnumName<RtkDynamics> kRtkDynamicsNames[] = {{RtkDynamics::RandomWalk, "random-walk"},
+                                                              {RtkDynamics::ConstantVelocity, "constant-velocity"}};
+inline constexpr EnumName<AmbiguityMode> kAmbiguityModeNames[] = {{AmbiguityMode::Off, "off"},
+                                                                  {AmbiguityMode::Continuous, "continuous"},
+                                                                  {AmbiguityMode::Instantaneous, "instantaneous"},
+                                                                  {AmbiguityMode::FixAndHold, "fix-and-hold"}};
+
 /// Which rover and base signals of one band are differenced (see double_difference.hpp).
 enum class SignalMatching {
   Strict,  ///< the same RINEX code at both receivers only
   Band,    ///< the same code if both have one, else another tracking mode of the same band
 };
+inline constexpr EnumName<SignalMatching> kSignalMatchingNames[] = {{SignalMatching::Band, "band"},
+                                                                    {SignalMatching::Strict, "strict"}};
 
 struct RtkConfig {
   RtkMode mode = RtkMode::Kinematic;

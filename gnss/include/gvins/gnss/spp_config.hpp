@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "gvins/base/constants.hpp"
+#include "gvins/base/enum_names.hpp"
 #include "gvins/base/satellite.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/gnss/fault_exclusion.hpp"
@@ -21,13 +22,25 @@ enum class IonosphereOption {
   DualFrequency,  ///< ionosphere-free pseudoranges where two bands exist, Broadcast otherwise
 };
 
+inline constexpr EnumName<IonosphereOption> kIonosphereOptionNames[] = {
+    {IonosphereOption::Off, "off"}, {IonosphereOption::Broadcast, "broadcast"}, {IonosphereOption::DualFrequency, "dual-frequency"}};
+
 enum class TroposphereOption { Off, Saastamoinen };
+inline constexpr EnumName<TroposphereOption> kTroposphereOptionNames[] = {{TroposphereOption::Off, "off"},
+                                                                          {TroposphereOption::Saastamoinen, "saastamoinen"}};
 
 /// Robust re-weighting of pseudoranges after fault exclusion (IGG-III equivalent weights).
 struct RobustEstimation {
   bool enabled = true;
   double k0 = 2.0;          ///< standardised residual (in robust scales) that keeps full weight
   double k1 = 5.0;          ///< beyond it the weight is ~0
+  /// k0 and k1 of the epochs whose residual test still fails after fault exclusion (urban
+  /// multipath and NLOS: several biased pseudoranges that exclusion could not isolate), where
+  /// harder down-weighting pays. Chosen on the simulated urban drive (bench/spp/urban_spp.yaml)
+  /// and checked on the real recordings with injected faults (bench/spp/fault_injection.py,
+  /// docs/spp.md); epochs that pass the test keep k0 and k1.
+  double k0Failed = 1.5;
+  double k1Failed = 3.0;
   double minScale = 0.5;    ///< floor of the robust scale (units of the a-priori sigmas)
   int maxIterations = 3;
 };
@@ -45,6 +58,27 @@ struct RobustEstimation {
 struct CovarianceScaling {
   bool enabled = true;
   double priorDof = 2.0;
+};
+
+/// Error model of the reported covariance (position, clocks), separate from the weights: the
+/// weights (`weighting` and the error budgets of the ionosphere, troposphere and ephemerides
+/// above) decide the solution and the residual test and stay as they are; the reported
+/// covariance is the covariance of that weighted solution when the measurement errors have the
+/// variances
+///   r = noiseScale^2 sigma_noise^2 + ionosphereScale^2 sigma_iono^2 + modelScale^2 (sigma_trop^2 + sigma_eph^2)
+/// (the weights' own budget terms; the prior of the estimated zenith ionosphere correction scaled
+/// by ionosphereScale as well): (H^T W H)^-1 H^T W R W H (H^T W H)^-1, scaled by the variance
+/// factor of the residuals under R, k = max(1, (chi2_R + nu0) / (dof + nu0)) (CovarianceScaling).
+/// Off by default: fitted on real recordings with known positions and checked on a held-out site
+/// (bench/spp/sigma_fit.py, docs/spp.md) no choice of the three scales brings the reported sigma
+/// closer to the errors than the weights' own covariance, because the broadcast-ionosphere error
+/// is correlated between satellites, which a per-satellite budget cannot express. Disabled: the
+/// a-priori covariance (H^T W H)^-1 scaled by the variance factor of the weights.
+struct ReportedErrorModel {
+  bool enabled = false;
+  double noiseScale = 1.0;
+  double ionosphereScale = 1.0;
+  double modelScale = 1.0;
 };
 
 /// A common correction to the broadcast ionosphere model's zenith delay, estimated with the
@@ -96,6 +130,7 @@ struct SppConfig {
   RobustEstimation robust;
   IonosphereEstimation ionosphereEstimation;
   CovarianceScaling covarianceScaling;
+  ReportedErrorModel reportedError;
   double maxGdop = 30.0;
   /// Inter-system clock biases: a prior from earlier epochs keeps systems with one or two
   /// satellites useful; sigma of the prior (m) and random-walk noise (m^2/s). 0 disables.
@@ -139,9 +174,11 @@ struct SppConfig {
 ///     ephemeris_alarm_accuracy_m: 10
 ///     fault_exclusion: {enabled: true, false_alarm_probability: 0.001, max_exclusions: 6,
 ///                       max_candidates: 10, min_redundancy: 1}
-///     robust: {enabled: true, k0: 2.0, k1: 5.0, min_scale: 0.5, max_iterations: 3}
+///     robust: {enabled: true, k0: 2.0, k1: 5.0, k0_failed: 1.5, k1_failed: 3.0, min_scale: 0.5,
+///              max_iterations: 3}
 ///     ionosphere_estimation: {enabled: true, prior_fraction: 1.0, min_prior_sigma_m: 0.3}
 ///     covariance_scaling: {enabled: true, prior_dof: 2}
+///     reported_error: {enabled: false, noise_scale: 1, ionosphere_scale: 1, model_scale: 1}
 ///     max_gdop: 30
 ///     isb_prior_sigma_m: 2
 ///     isb_random_walk_m2ps: 0.01
