@@ -138,6 +138,7 @@ void GnssFusion<Scalar>::forgetState() {
   ambiguities_.clear();
   ambiguityTime_.reset();
   stage_ = GnssFusionStage::kWaitingVio;
+  if (insAlign_) insAlign_->clear();
 }
 
 template <typename Scalar>
@@ -636,6 +637,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
   }
   if (!est.initialized()) {
     stage_ = GnssFusionStage::kWaitingVio;
+    if (config_.insStart) startFromGnss(est, rover, rep);
     return finish();
   }
   if (stage_ == GnssFusionStage::kWaitingVio) stage_ = GnssFusionStage::kWaitingFix;

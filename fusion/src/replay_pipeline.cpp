@@ -320,7 +320,7 @@ class FrameLoop {
     const std::int64_t tState = init ? est_.newestImuState().t_ns : frame.t_ns;
     const GpsTime limit = gpsFromNs(tState + opt_.sensorToGpst_ns);
     while (g_.haveRover && g_.nextRover.time <= limit) {
-      if (!init) {
+      if (!init && !gnss_->startsEstimator()) {
         ++sum_.gnssEpochsSkipped;
       } else {
         g_.advanceBase();
@@ -351,12 +351,18 @@ class FrameLoop {
       empty.time = g_.nextRover.time;
       ++sum.gnssEpochsInOutage;
     }
+    const bool before = !est_.initialized();  // the GNSS/INS start may start it with this epoch
     const auto t0 = Clock::now();
     const ReplayGnssOutcome o = gnss_->processEpoch(outage ? empty : g_.nextRover,
                                                     g_.haveCurrentBase && !outage ? &g_.currentBase : nullptr, g_.nav);
     const double ms = msSince(t0);
     for (const std::string& w : o.warnings) std::fprintf(stderr, "\n[gvins-replay] warning: %s\n", w.c_str());
-    ++sum.gnssEpochs;
+    if (before && o.stage != "tight") {  // the GNSS/INS start has not started the estimator yet
+      ++sum.gnssEpochsSkipped;
+      if (!o.insStart.empty()) ++sum.gnssEpochsWaitingBy[o.insStart];
+    } else {
+      ++sum.gnssEpochs;
+    }
     if (o.updated) ++sum.gnssEpochsUpdated;
     sum.phaseRowsUsed += static_cast<std::size_t>(o.phaseUsed);
     sum.phaseRowsRejected += static_cast<std::size_t>(o.phaseRejected);

@@ -102,6 +102,11 @@ void ReplaySummary::print(std::ostream& os) const {
     std::snprintf(k, sizeof k, "%-30s ", "initialisation");
     os << k << w.substr(0, w.size() - 2) << '\n';
   }
+  if (!gnssEpochsWaitingBy.empty()) {
+    std::string w;
+    for (const auto& [why, count] : gnssEpochsWaitingBy) w += why + " " + std::to_string(count) + ", ";
+    row("GNSS/INS start waiting", w.substr(0, w.size() - 2) + " (epochs)");
+  }
   if (gnssEpochs + gnssEpochsSkipped > 0) {
     row("GNSS epochs", std::to_string(gnssEpochs) + " processed (" + std::to_string(gnssEpochsUpdated) + " updated, " +
                            std::to_string(gnssEpochsFixed) + " RTK fixed), " + std::to_string(gnssEpochsSkipped) +

@@ -47,7 +47,7 @@ struct SriSwfEstimator<Scalar>::Impl : detail::SwfState<Scalar> {
   bool tryInitialize(const FeatureFrame& frame) {
     const std::optional<InitialState> s = this->initializer.tryInitialize(frame, this->imuSpan(), this->ext_fixed);
     if (!s) return false;
-    this->createState(s->state, s->P_theta_world, s->sigma_v, s->sigma_bg);
+    this->createState(s->state, initialStateCovariance(*s, this->cfg));
     this->clearCaches();
     this->addObservations(frame);
     return true;
@@ -179,6 +179,20 @@ SriSwfEstimator<Scalar>::~SriSwfEstimator() = default;
 template <typename Scalar>
 void SriSwfEstimator<Scalar>::addImu(const ImuSample& sample) {
   impl_->addImu(sample);
+}
+
+template <typename Scalar>
+bool SriSwfEstimator<Scalar>::initializeFrom(const ExternalInitialState& s) {
+  if (impl_->initialized || !externalInitialStateError(s).empty() || !impl_->imuCovers(s.state.t_ns, s.state.t_ns)) return false;
+  impl_->createState(s.state, s.covariance);
+  impl_->initializer.clear();
+  impl_->clearCaches();
+  return true;
+}
+
+template <typename Scalar>
+std::span<const ImuSample> SriSwfEstimator<Scalar>::bufferedImu() const {
+  return impl_->imuSpan();
 }
 
 template <typename Scalar>

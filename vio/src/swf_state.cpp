@@ -190,11 +190,8 @@ void SwfState<Scalar>::trimImu() {
 
 // ------------------------------------------------------------------ state creation
 template <typename Scalar>
-void SwfState<Scalar>::createState(const ImuState& s, const Eigen::Matrix3d& Ptheta_world, double sigma_v,
-                                   double sigma_bg) {
-  Eigen::Matrix<double, 6, 6> P = Eigen::Matrix<double, 6, 6>::Zero();
-  P.topLeftCorner<3, 3>() = s.R_WI.transpose() * Ptheta_world * s.R_WI;  // body-frame δθ
-  P.bottomRightCorner<3, 3>() = Eigen::Matrix3d::Identity() * cfg.init_position_sigma * cfg.init_position_sigma;
+void SwfState<Scalar>::createState(const ImuState& s, const Matrix15d& Pimu) {
+  const Eigen::Matrix<double, 6, 6> P = Pimu.topLeftCorner<6, 6>();
   const BlockId pid = f.addBlock(BlockSpec::pose("imu_pose"), poseEstimate<Scalar>(s.R_WI, s.p_WI),
                                  sri::Prior<Scalar>::covariance(P.cast<Scalar>()));
   setExact(pid, poseEstimate<double>(s.R_WI, s.p_WI));
@@ -218,17 +215,16 @@ void SwfState<Scalar>::createState(const ImuState& s, const Eigen::Matrix3d& Pth
     setExact(td_id, BlockEstimate<double>::fromVector(Eigen::Matrix<double, 1, 1>(frame_td)));
   }
   const Eigen::Matrix<double, 6, 1> xb = biasVector(s);
-  Eigen::Matrix<double, 6, 1> sdb;
-  sdb << Eigen::Vector3d::Constant(sigma_bg), Eigen::Vector3d::Constant(cfg.init_accel_bias_sigma);
-  const Eigen::Vector3d sdv = Eigen::Vector3d::Constant(sigma_v);
+  const Eigen::Matrix<double, 6, 6> Pb = Pimu.bottomRightCorner<6, 6>();
+  const Eigen::Matrix3d Pv = Pimu.block<3, 3>(ImuErr::kVel, ImuErr::kVel);
   // Bias, then velocity: with the extra last that is their order at the back; first, the
   // velocity goes in front of the bias.
   const BlockId bid = f.addBlock(BlockSpec::vector("imu_bias", 6), BlockEstimate<Scalar>::fromVector(xb.cast<Scalar>()),
-                                 sri::Prior<Scalar>::stdDevs(sdb.cast<Scalar>()), extraPlacement());
+                                 sri::Prior<Scalar>::covariance(Pb.cast<Scalar>()), extraPlacement());
   setExact(bid, BlockEstimate<double>::fromVector(xb));
   const BlockId vid = f.addBlock(BlockSpec::vector("imu_velocity", 3),
                                  BlockEstimate<Scalar>::fromVector(s.v_WI.cast<Scalar>()),
-                                 sri::Prior<Scalar>::stdDevs(sdv.cast<Scalar>()), extraPlacement());
+                                 sri::Prior<Scalar>::covariance(Pv.cast<Scalar>()), extraPlacement());
   setExact(vid, BlockEstimate<double>::fromVector(s.v_WI));
   newest = {pid, vid, bid};
   t_bias = s.t_ns;

@@ -156,8 +156,9 @@ struct SwfState {
 
   // ------------------------------------------------------------------ state creation
   /// The first state: the newest pose (the window's first clone), calibration blocks, bias and
-  /// velocity, with their priors (P_theta_world: attitude covariance in the world frame).
-  void createState(const ImuState& s, const Eigen::Matrix3d& Ptheta_world, double sigma_v, double sigma_bg);
+  /// velocity, with their priors from Pimu (ImuErr order, external_initial_state.hpp; the
+  /// correlations between pose, velocity and bias are dropped).
+  void createState(const ImuState& s, const Matrix15d& Pimu);
   /// Before a reset: carries the calibrated extrinsics and time offset into `next` when they
   /// lie within 3 prior σ of the configuration (see SriSwfEstimator::reset).
   void carryCalibration(SwfState& next) const;

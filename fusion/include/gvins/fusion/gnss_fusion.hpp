@@ -37,6 +37,7 @@
 #include "gvins/fusion/gnss_clock_states.hpp"
 #include "gvins/fusion/gnss_fusion_config.hpp"
 #include "gvins/fusion/gnss_gate_recovery.hpp"
+#include "gvins/fusion/gnss_ins_alignment.hpp"
 #include "gvins/fusion/gnss_measurement_models.hpp"
 #include "gvins/gnss/broadcast_record_change.hpp"
 #include "gvins/gnss/carrier_smoothing.hpp"
@@ -84,6 +85,9 @@ struct GnssEpochReport {
   int dof = 0;
   double elapsedMicroseconds = 0.0;
   std::vector<std::string> warnings;  ///< new this epoch (Doppler check of the rover and the base)
+  /// Before the estimator is initialised (GnssFusionConfig::insStart): where the GNSS/INS
+  /// alignment stands (kAligned: this epoch started the estimator).
+  std::optional<GnssInsStatus> insStart;
 };
 
 struct GnssRowSet;  // the rows of an epoch and their noise (internal)
@@ -184,6 +188,9 @@ class GnssFusion {
   bool buildState(const vio::EstimatorBackend<Scalar>& est, std::int64_t t_ns, GnssStateValues& s) const;
   void ensureLever(vio::EstimatorBackend<Scalar>& est);
   bool startFrame(vio::EstimatorBackend<Scalar>& est, const SppSolution& spp, std::int64_t t_ns);
+  /// Not initialised: feeds the epoch to the GNSS/INS alignment and, once it has a state, starts
+  /// the estimator from it in ENU (gnss_fusion_ins_start.cpp); the tight stage follows at once.
+  void startFromGnss(vio::EstimatorBackend<Scalar>& est, const ObsEpoch& rover, GnssEpochReport& rep);
   /// Whether the converged frame may be folded into the state: its yaw σ < σ_θ and the σ of the
   /// IMU's ENU position p_N = p_NW + Rz(ψ) p_W below frameReanchorPositionSigma on every axis.
   bool frameKnownInEnu(const vio::EstimatorBackend<Scalar>& est) const;
@@ -230,6 +237,7 @@ class GnssFusion {
   std::optional<GpsTime> lastUpdate_;
   const EphemerisStore* nav_ = nullptr;
   std::unique_ptr<SppSolver> spp_;
+  std::unique_ptr<GnssInsAlignment> insAlign_;  // insStart: before the estimator is initialised
   std::unique_ptr<RtkSolver> rtk_;
   DopplerConsistency roverDoppler_{"rover"};
   // Primary signals taken from another band than the system's usual one (signal_choice.hpp),

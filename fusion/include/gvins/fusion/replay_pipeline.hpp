@@ -96,6 +96,8 @@ struct ReplayGnssOutcome {
   std::optional<Eigen::Vector3d> antennaEcef, antennaVelocityEcef;
   Eigen::Matrix3d antennaCovarianceEcef = Eigen::Matrix3d::Zero();  ///< zero if unknown
   std::vector<std::string> warnings;  ///< new this epoch (e.g. a Doppler sign flip), for stderr
+  /// Before the estimator is initialised: the GNSS/INS start's status (empty: not attempted).
+  std::string insStart;
 };
 
 /// What the pipeline needs from the GNSS fusion.
@@ -110,6 +112,9 @@ class ReplayGnss {
   /// local outputs (trajectory.tum, covariances, the local evaluation) undo it, so that they stay
   /// in the VIO world frame of the start.
   virtual std::optional<vio::WorldFrameChange> worldChange() const { return std::nullopt; }
+  /// Whether the client may start the estimator itself (GnssFusionConfig::insStart): then it gets
+  /// the epochs before the estimator is initialised too.
+  virtual bool startsEstimator() const { return false; }
 };
 
 enum class ImuGapPolicy { Error, Warn };
@@ -216,6 +221,9 @@ struct ReplaySummary {
   double estimatorMsBeforeInit = std::numeric_limits<double>::quiet_NaN();
   double estimatorMsAfterInit = std::numeric_limits<double>::quiet_NaN();
   std::map<vio::InitStatus, std::size_t> framesWaitingBy;
+  /// GNSS modes with the GNSS/INS start: GNSS epochs before the initialisation by what the
+  /// alignment still missed (GnssFusion's GnssInsStatus text).
+  std::map<std::string, std::size_t> gnssEpochsWaitingBy;
   double gnssMsPerFrame = 0.0;   ///< GNSS time summed over the run / processed frames
   double cpuSeconds = 0.0;       ///< process CPU time (user + system), all threads
   std::vector<std::string> files;

@@ -70,10 +70,12 @@ class GnssFusionReplayClient final : public ReplayGnss {
       if (const auto c = fusion_.antennaCovariance(est_, r.t_ns)) o.antennaCovarianceEcef = *c;
     }
     o.warnings = r.warnings;
+    if (r.insStart) o.insStart = std::string(gnssInsStatusText(*r.insStart));
     return o;
   }
   std::optional<Eigen::Vector3d> leverArm() const override { return fusion_.leverArm(est_); }
   std::optional<vio::WorldFrameChange> worldChange() const override { return fusion_.worldChange(est_); }
+  bool startsEstimator() const override { return fusion_.config().insStart && fusion_.config().mode != GnssFusionMode::kVio; }
   GnssFusion<Scalar>& fusion() { return fusion_; }
 
  private:

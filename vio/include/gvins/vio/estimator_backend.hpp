@@ -41,7 +41,9 @@
 #include "gvins/sri/propagation.hpp"
 #include "gvins/sri/sri_filter.hpp"
 #include "gvins/sri/state_layout.hpp"
+#include "gvins/vio/external_initial_state.hpp"
 #include "gvins/vio/imu_integration.hpp"
+#include "gvins/vio/imu_sample.hpp"
 #include "gvins/vio/imu_state.hpp"
 #include "gvins/vio/world_frame_change.hpp"
 
@@ -100,6 +102,19 @@ class EstimatorBackend {
   /// Bias-corrected angular rate of the IMU (rad/s, IMU frame) at t_ns, interpolated from the
   /// buffer; nullopt outside it.
   virtual std::optional<Eigen::Vector3d> angularRateAt(std::int64_t t_ns) const = 0;
+
+  /// Starts a state from `s` (external_initial_state.hpp) while not initialised: s.state.t_ns must
+  /// lie within the buffered IMU samples (bufferedImu) and not after the next frame; the next
+  /// frame is propagated from it. False (nothing changes) when initialised already, when `s` is
+  /// invalid or outside the buffer, or when the backend does not support it.
+  virtual bool initializeFrom(const ExternalInitialState& s) {
+    (void)s;
+    return false;
+  }
+  /// The IMU samples the estimator holds (oldest first; before initialisation at least the last
+  /// init_window + 2 s): for a client's own alignment before the state exists. Empty when the
+  /// backend does not expose them.
+  virtual std::span<const ImuSample> bufferedImu() const { return {}; }
 
   // ------------------------------------------------------------------ client blocks
   virtual sri::BlockId addBlock(const sri::BlockSpec& spec, const sri::BlockEstimate<Scalar>& estimate,

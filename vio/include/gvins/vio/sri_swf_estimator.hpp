@@ -342,6 +342,8 @@ class SriSwfEstimator final : public EstimatorBackend<Scalar> {
   ImuNoise imuNoise() const override;
   std::optional<ImuIntegration> integrateToNewest(std::int64_t t_ns) const override;
   std::optional<Eigen::Vector3d> angularRateAt(std::int64_t t_ns) const override;
+  bool initializeFrom(const ExternalInitialState& s) override;
+  std::span<const ImuSample> bufferedImu() const override;
 
   sri::BlockId addBlock(const sri::BlockSpec& spec, const sri::BlockEstimate<Scalar>& estimate,
                         const sri::Prior<Scalar>& prior,
