@@ -161,6 +161,38 @@ void DoubleDifferenceBuilder::reset() {
   haveLast_ = false;
 }
 
+namespace {
+
+/// The pseudorange that dates the transmission: the first picked signal's code, else any
+/// plausible code of the satellite (0 if none).
+template <typename PickT>
+double transmitPseudorange(const SatObs& so, const PickT* picks, int np) {
+  for (int i = 0; i < np; ++i) {
+    if (picks[i].rover->hasCode() && picks[i].rover->pseudorange > 1e6) return picks[i].rover->pseudorange;
+  }
+  for (const SignalObs& s : so.signals) {
+    if (s.hasCode() && s.pseudorange > 1e6 && s.pseudorange < 1e8) return s.pseudorange;
+  }
+  return 0.0;
+}
+
+/// One group per system and band; each single difference gets its group's index.
+void assignGroups(DdEpoch& out) {
+  for (SingleDifference& d : out.sd) {
+    int gi = -1;
+    for (std::size_t k = 0; k < out.groups.size(); ++k) {
+      if (out.groups[k].system == d.sat.system && out.groups[k].band == d.code.band) gi = static_cast<int>(k);
+    }
+    if (gi < 0) {
+      out.groups.push_back(DdGroup{d.sat.system, d.code.band, -1, -1});
+      gi = static_cast<int>(out.groups.size() - 1);
+    }
+    d.group = gi;
+  }
+}
+
+}  // namespace
+
 void DoubleDifferenceBuilder::form(const ObsEpoch& rover, const CycleSlipDetector& roverSlips, const BaseSnapshot& base,
                                    const Eigen::Vector3d& basePosition, const Eigen::Vector3d& x, DdEpoch& out,
                                    TransmitStates* states) {
@@ -211,19 +243,7 @@ void DoubleDifferenceBuilder::form(const ObsEpoch& rover, const CycleSlipDetecto
     }
     if (np == 0) continue;
     // Satellite state at the rover transmit time.
-    double pr = 0.0;
-    for (int i = 0; i < np && pr == 0.0; ++i) {
-      if (picks[i].rover->hasCode() && picks[i].rover->pseudorange > 1e6) pr = picks[i].rover->pseudorange;
-    }
-    if (pr == 0.0) {
-      for (const SignalObs& s : so.signals) {
-        if (s.hasCode() && s.pseudorange > 1e6 && s.pseudorange < 1e8) {
-          pr = s.pseudorange;
-          break;
-        }
-      }
-    }
-    const auto tx = transmitState(states, nav_, so.sat, rover.time, pr);
+    const auto tx = transmitState(states, nav_, so.sat, rover.time, transmitPseudorange(so, picks, np));
     if (!tx) {
       ++stats_.noEphemeris;
       continue;
@@ -297,19 +317,7 @@ void DoubleDifferenceBuilder::form(const ObsEpoch& rover, const CycleSlipDetecto
       else ++it;
     }
   }
-  // Groups.
-  for (std::size_t i = 0; i < out.sd.size(); ++i) {
-    SingleDifference& d = out.sd[i];
-    int gi = -1;
-    for (std::size_t k = 0; k < out.groups.size(); ++k) {
-      if (out.groups[k].system == d.sat.system && out.groups[k].band == d.code.band) gi = static_cast<int>(k);
-    }
-    if (gi < 0) {
-      out.groups.push_back(DdGroup{d.sat.system, d.code.band, -1, -1});
-      gi = static_cast<int>(out.groups.size() - 1);
-    }
-    d.group = gi;
-  }
+  assignGroups(out);
   formDoubleDifferences(out);
 }
 
