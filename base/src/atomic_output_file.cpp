@@ -1,5 +1,6 @@
 #include "gvins/base/atomic_output_file.hpp"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -11,10 +12,16 @@
 namespace gvins {
 
 AtomicOutputFile::AtomicOutputFile(std::string path)
-    : path_(std::move(path)), temp_(path_ + ".part-" + std::to_string(::getpid())) {}
+    : path_(std::move(path)), temp_(path_ + ".part-" + std::to_string(::getpid())) {
+  struct stat st {};
+  if (::stat(path_.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode)) {
+    temp_ = path_;
+    direct_ = true;
+  }
+}
 
 AtomicOutputFile::~AtomicOutputFile() {
-  if (committed_) return;
+  if (committed_ || direct_) return;
   if (out_.is_open()) out_.close();
   std::remove(temp_.c_str());
 }
@@ -36,7 +43,7 @@ void AtomicOutputFile::commit() {
     out_.close();
     if (!good || out_.fail()) throw std::runtime_error("cannot write '" + path_ + "' (disk full?)");
   }
-  if (std::rename(temp_.c_str(), path_.c_str()) != 0)
+  if (!direct_ && std::rename(temp_.c_str(), path_.c_str()) != 0)
     throw std::runtime_error("cannot write '" + path_ + "': " + std::strerror(errno));
   committed_ = true;
 }

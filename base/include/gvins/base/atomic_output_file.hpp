@@ -1,6 +1,8 @@
 // An output file written under a temporary name in its destination folder and renamed over the
 // destination only when complete (rename(2) is atomic within a file system): a run that fails or
 // is interrupted leaves no file that looks valid, and an older file of that name stays intact.
+// A destination that exists and is not a regular file (/dev/null, a FIFO, a terminal) is written
+// directly: renaming over it would replace the device or pipe with a regular file.
 #pragma once
 
 #include <fstream>
@@ -20,7 +22,8 @@ class AtomicOutputFile {
   AtomicOutputFile& operator=(const AtomicOutputFile&) = delete;
 
   const std::string& path() const { return path_; }
-  /// "<path>.part-<pid>" (same folder, so the final rename does not cross file systems).
+  /// "<path>.part-<pid>" (same folder, so the final rename does not cross file systems); path()
+  /// itself for a destination that is a device, FIFO or socket.
   const std::string& tempPath() const { return temp_; }
   /// The temporary file opened for writing (binary); throws std::runtime_error naming path()
   /// if it cannot be created.
@@ -33,6 +36,7 @@ class AtomicOutputFile {
   std::string path_, temp_;
   std::ofstream out_;
   bool opened_ = false, committed_ = false;
+  bool direct_ = false;  // the destination is not a regular file: written in place
 };
 
 /// A tool's main output: standard output for "-", else an AtomicOutputFile opened at once.
