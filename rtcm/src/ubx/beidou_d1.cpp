@@ -45,11 +45,6 @@ void BeidouD1Decoder::add(const SfrbxMessage& msg, SatId sat, NavDataUpdate& out
   b.week = static_cast<int>(s1.u(48, 13));
   b.tgd1 = s1.s(78, 10);
   b.tgd2 = s1.s(88, 10);
-  std::array<std::int64_t, 4> alpha{}, beta{};
-  for (int i = 0; i < 4; ++i) {
-    alpha[static_cast<std::size_t>(i)] = s1.s(98 + 8 * i, 8);
-    beta[static_cast<std::size_t>(i)] = s1.s(130 + 8 * i, 8);
-  }
   b.a2 = s1.s(162, 11);
   b.a0 = s1.s(173, 24);
   b.a1 = s1.s(197, 22);
@@ -72,16 +67,10 @@ void BeidouD1Decoder::add(const SfrbxMessage& msg, SatId sat, NavDataUpdate& out
   b.omega0 = s3.s(159, 32);
   b.omega = s3.s(191, 32);
   const std::optional<KeplerEphemeris> e = beidouEphemeris(b, sat, NavMessage::BeiDouD1);
+  const KlobucharParameters iono = beidouKlobuchar(s1, 98, 130);
   p.subframe = {};  // parts of an emitted (or rejected) set never count as incomplete
-  if (!e) {
-    ++counts.unknownMessages;
-    return;
-  }
-  p.lastAode = b.aode;
-  p.lastToc = b.toc;
-  ++counts.ephemerides;
-  out.kepler.push_back(*e);
-  out.ionosphere.beidou = beidouKlobuchar(alpha, beta);
+  if (!emitBeidouEphemeris(e, b, p.lastAode, p.lastToc, out, counts)) return;
+  out.ionosphere.beidou = iono;
   ++counts.ionosphere;
 }
 

@@ -93,21 +93,9 @@ void BeidouD2Decoder::emit(Partial& p, SatId sat, NavDataUpdate& out, Navigation
   const std::optional<KeplerEphemeris> e = beidouEphemeris(b, sat, NavMessage::BeiDouD2);
   const std::optional<NavBits> iono = p.page[1];
   p.page = {};  // parts of an emitted (or rejected) set never count as incomplete
-  if (!e) {
-    ++counts.unknownMessages;
-    return;
-  }
-  p.lastAode = b.aode;
-  p.lastToc = b.toc;
-  ++counts.ephemerides;
-  out.kepler.push_back(*e);
+  if (!emitBeidouEphemeris(e, b, p.lastAode, p.lastToc, out, counts)) return;
   if (iono) {  // page 2: alpha0-3, beta0-3, 8 bits each from bit 42
-    std::array<std::int64_t, 4> alpha{}, beta{};
-    for (int i = 0; i < 4; ++i) {
-      alpha[static_cast<std::size_t>(i)] = iono->s(42 + 8 * i, 8);
-      beta[static_cast<std::size_t>(i)] = iono->s(74 + 8 * i, 8);
-    }
-    out.ionosphere.beidou = beidouKlobuchar(alpha, beta);
+    out.ionosphere.beidou = beidouKlobuchar(*iono, 42, 74);
     ++counts.ionosphere;
   }
 }

@@ -95,14 +95,28 @@ std::optional<KeplerEphemeris> beidouEphemeris(const BeidouBroadcast& b, SatId s
   return e;
 }
 
-KlobucharParameters beidouKlobuchar(const std::array<std::int64_t, 4>& alpha, const std::array<std::int64_t, 4>& beta) {
+KlobucharParameters beidouKlobuchar(const NavBits& bits, int alphaBit, int betaBit) {
   KlobucharParameters k;
   const int alphaExp[4] = {-30, -27, -24, -24}, betaExp[4] = {11, 14, 16, 16};
   for (std::size_t i = 0; i < 4; ++i) {
-    k.alpha[i] = scaled(alpha[i], alphaExp[i]);
-    k.beta[i] = scaled(beta[i], betaExp[i]);
+    const int at = 8 * static_cast<int>(i);
+    k.alpha[i] = scaled(bits.s(alphaBit + at, 8), alphaExp[i]);
+    k.beta[i] = scaled(bits.s(betaBit + at, 8), betaExp[i]);
   }
   return k;
+}
+
+bool emitBeidouEphemeris(const std::optional<KeplerEphemeris>& e, const BeidouBroadcast& b, int& lastAode,
+                         std::uint32_t& lastToc, NavDataUpdate& out, NavigationCounts& counts) {
+  if (!e) {
+    ++counts.unknownMessages;
+    return false;
+  }
+  lastAode = b.aode;
+  lastToc = b.toc;
+  ++counts.ephemerides;
+  out.kepler.push_back(*e);
+  return true;
 }
 
 }  // namespace gvins::ubx::detail

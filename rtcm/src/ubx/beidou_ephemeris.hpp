@@ -37,8 +37,15 @@ struct BeidouBroadcast {
 /// a week.
 std::optional<KeplerEphemeris> beidouEphemeris(const BeidouBroadcast& b, SatId sat, NavMessage message);
 
-/// Klobuchar alpha/beta from their 8-bit broadcast values (table 5-9: alpha 2^-30, 2^-27, 2^-24,
-/// 2^-24; beta 2^11, 2^14, 2^16, 2^16).
-KlobucharParameters beidouKlobuchar(const std::array<std::int64_t, 4>& alpha, const std::array<std::int64_t, 4>& beta);
+/// Klobuchar alpha0-3 and beta0-3, eight signed bits each from bits `alphaBit` and `betaBit` of a
+/// subframe (D1 subframe 1: 98, 130; D2 page 2: 42, 74), scaled by table 5-9 (alpha 2^-30,
+/// 2^-27, 2^-24, 2^-24; beta 2^11, 2^14, 2^16, 2^16).
+KlobucharParameters beidouKlobuchar(const NavBits& bits, int alphaBit, int betaBit);
+
+/// Hands a decoded set on: a record that failed beidouEphemeris() counts as an unknown message;
+/// else the set's AODE and toc become `lastAode`/`lastToc` (so that its repetitions are not sent
+/// again) and the record goes to `out`. True when a record was sent.
+bool emitBeidouEphemeris(const std::optional<KeplerEphemeris>& e, const BeidouBroadcast& b, int& lastAode,
+                         std::uint32_t& lastToc, NavDataUpdate& out, NavigationCounts& counts);
 
 }  // namespace gvins::ubx::detail
