@@ -30,24 +30,13 @@ const Eigen::Vector3d kLever(0.08, 0.0, 0.18);
 const fs::path& dataset() {
   static const fs::path dir = [] {
     const fs::path d = scratch() / "dataset";
-    std::ostringstream y;
-    y << "name: gnss_start_test\n"
-         "origin: {latitude_deg: 35.134707705, longitude_deg: 136.977577939, height_m: 104.853}\n"
-         "start_gpst: \"2024-06-24 08:20:00\"\n"
-         "trajectory: {type: flight, pattern: lawnmower, height_m: 20, length_m: 250, speed_mps: 8,\n"
-         "             climb_rate_mps: 3, rows: 2, row_spacing_m: 40, heading_deg: 240, wobble_deg: 0.3}\n"
-         "imu: {rate_hz: 250}\n"
-         "cameras:\n"
-         "  rate_hz: 20\n"
-         "  output: features\n"
-         "  list:\n"
-         "    - {name: cam0, look: down, position_m: [0.06, 0.06, -0.04], mount_rpy_deg: [0.4, -0.3, 0.2]}\n"
-         "lever_arm_m: [0.08, 0.0, 0.18]\n"
-         "gnss:\n"
-         "  navigation: " << GVINS_TEST_DATA << "/gnss/nagoya_static_2024/base.nav.gz\n"
-         "  rover:\n"
-         "    rate_hz: 5\n";
-    test::generateScenario(d, y.str(), "gnss_start_test", 3);
+    std::ostringstream tail;
+    tail << "lever_arm_m: [0.08, 0.0, 0.18]\n"
+            "gnss:\n"
+            "  navigation: " << GVINS_TEST_DATA << "/gnss/nagoya_static_2024/base.nav.gz\n"
+            "  rover:\n"
+            "    rate_hz: 5\n";
+    test::generateScenario(d, test::monoTakeoffScenario("gnss_start_test", tail.str()), "gnss_start_test", 3);
     return d;
   }();
   return dir;

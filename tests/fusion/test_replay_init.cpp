@@ -29,19 +29,7 @@ const fs::path& scratch() { return test::processScratchFolder("gvins_replay_init
 const fs::path& dataset() {
   static const fs::path dir = [] {
     const fs::path d = scratch() / "dataset";
-    const std::string y =
-        "name: mono_takeoff_test\n"
-        "origin: {latitude_deg: 35.134707705, longitude_deg: 136.977577939, height_m: 104.853}\n"
-        "start_gpst: \"2024-06-24 08:20:00\"\n"
-        "trajectory: {type: flight, pattern: lawnmower, height_m: 20, length_m: 250, speed_mps: 8,\n"
-        "             climb_rate_mps: 3, rows: 2, row_spacing_m: 40, heading_deg: 240, wobble_deg: 0.3}\n"
-        "imu: {rate_hz: 250}\n"
-        "cameras:\n"
-        "  rate_hz: 20\n"
-        "  output: features\n"
-        "  list:\n"
-        "    - {name: cam0, look: down, position_m: [0.06, 0.06, -0.04], mount_rpy_deg: [0.4, -0.3, 0.2]}\n"
-        "gnss: none\n";
+    const std::string y = test::monoTakeoffScenario("mono_takeoff_test", "gnss: none\n");
     const sim::GenerationSummary s = test::generateScenario(d, y, "mono_takeoff_test", 3);
     std::fprintf(stderr, "dataset: %.1f s, %.0f m, %zu frames\n", s.duration, s.pathLength, s.framesPerCamera);
     return d;
