@@ -368,8 +368,11 @@ class LiveSession {
       }
     }
     for (const Output* o : {&posOut_, &nmeaOut_}) {
-      if (!o->sink || (o->sink->boundPort() == 0 && o->sink->counters().clients == 0)) continue;
+      if (!o->sink) continue;
       const auto& k = o->sink->counters();
+      // Network outputs only: a server, or a client that connected or lost rows (a file or
+      // standard output has neither).
+      if (o->sink->boundPort() == 0 && k.clients == 0 && k.discarded == 0) continue;
       std::fprintf(stderr, "  %-9s output       %s: %lld bytes, %lld clients, %lld dropped, %lld bytes nobody received\n", o->what,
                    o->sink->name().c_str(), static_cast<long long>(k.bytes), static_cast<long long>(k.clients),
                    static_cast<long long>(k.drops), static_cast<long long>(k.discarded));
