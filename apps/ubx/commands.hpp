@@ -1,12 +1,11 @@
-// The gvins-ubx subcommands.
+// The gvins-ubx subcommands; each reads its options and operands from `cl` (after the command).
 #pragma once
 
-#include <string>
-#include <vector>
+#include "gvins/base/command_line.hpp"
 
 namespace gvins::ubx_app {
 
-int runInfo(const std::vector<std::string>& args);
-int runToRinex(const std::vector<std::string>& args);
+int runInfo(CommandLine& cl);
+int runToRinex(CommandLine& cl);
 
 }  // namespace gvins::ubx_app

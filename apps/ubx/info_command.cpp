@@ -1,7 +1,6 @@
 // gvins-ubx info FILE|-
 #include <iostream>
 #include <variant>
-#include <vector>
 
 #include "commands.hpp"
 #include "stream_summary.hpp"
@@ -9,16 +8,14 @@
 
 namespace gvins::ubx_app {
 
-using rtcm_app::UsageError;
-
-int runInfo(const std::vector<std::string>& args) {
+int runInfo(CommandLine& cl) {
   std::string path;
-  for (const auto& a : args) {
-    if (a.size() > 1 && a[0] == '-') throw UsageError("info: unknown option '" + a + "'");
-    if (!path.empty()) throw UsageError("info: more than one input");
+  while (cl.next()) {
+    const std::string& a = cl.operand();
+    if (!path.empty()) cl.error("info: more than one input");
     path = a;
   }
-  if (path.empty()) throw UsageError("info: no input (FILE or -)");
+  if (path.empty()) cl.error("info: no input (FILE or -)");
   ubx::DecoderOptions opt;
   opt.streamName = path;
   ubx::Decoder dec(opt);

@@ -1,10 +1,10 @@
 // gvins-ubx: u-blox UBX logs (RXM-RAWX raw observations, mixed with NMEA and RTCM 3 or not).
+#include <cstdio>
 #include <iostream>
 #include <string>
-#include <vector>
 
 #include "commands.hpp"
-#include "stream_summary.hpp"
+#include "gvins/base/command_line.hpp"
 
 namespace {
 
@@ -24,22 +24,22 @@ constexpr const char* kUsage =
 }  // namespace
 
 int main(int argc, char** argv) {
-  using namespace gvins::rtcm_app;
-  if (argc < 2 || std::string(argv[1]) == "-h" || std::string(argv[1]) == "--help") {
+  if (argc < 2) {
     std::cerr << kUsage;
-    return argc < 2 ? 2 : 0;
+    return 2;
   }
   const std::string cmd = argv[1];
-  const std::vector<std::string> args(argv + 2, argv + argc);
+  if (cmd == "-h" || cmd == "--help") {
+    std::fputs(kUsage, stdout);
+    return 0;
+  }
+  gvins::CommandLine cl("gvins-ubx", kUsage, argc, argv, 2);
   try {
-    if (cmd == "info") return gvins::ubx_app::runInfo(args);
-    if (cmd == "to-rinex") return gvins::ubx_app::runToRinex(args);
-    throw UsageError("unknown command '" + cmd + "'");
-  } catch (const UsageError& e) {
-    std::cerr << "gvins-ubx: " << e.what() << "\n" << kUsage;
-    return 2;
+    if (cmd == "info") return gvins::ubx_app::runInfo(cl);
+    if (cmd == "to-rinex") return gvins::ubx_app::runToRinex(cl);
   } catch (const std::exception& e) {
     std::cerr << "gvins-ubx: " << e.what() << "\n";
     return 1;
   }
+  cl.error("unknown command '" + cmd + "'");
 }

@@ -23,32 +23,24 @@
 
 namespace gvins::ubx_app {
 
-using rtcm_app::UsageError;
-
-int runToRinex(const std::vector<std::string>& args) {
+int runToRinex(CommandLine& cl) {
   std::string path, prefix;
   ubx::DecoderOptions opt;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    rtcm_app::requireValue(args, i, {"-o", "--max-phase-sigma"});
-    if (args[i] == "-o") {
-      prefix = args[++i];
-    } else if (args[i] == "--max-phase-sigma") {
-      char* end = nullptr;
-      const double v = std::strtod(args[++i].c_str(), &end);
-      if (end == args[i].c_str() || *end != '\0' || !(v > 0.0) || v > 1.0) {
-        throw UsageError("--max-phase-sigma must be a number of cycles in (0, 1], got '" + args[i] + "'");
-      }
+  while (cl.next()) {
+    if (cl.is("-o")) {
+      prefix = cl.value();
+    } else if (cl.is("--max-phase-sigma")) {
+      const double v = cl.number(0.0, 1.0, "cycles");
+      if (!(v > 0.0)) cl.error("--max-phase-sigma must be a number of cycles in (0, 1]");
       opt.maxPhaseStdDev = v;
-    } else if (args[i].size() > 1 && args[i][0] == '-') {
-      throw UsageError("to-rinex: unknown option '" + args[i] + "'");
-    } else if (path.empty()) {
-      path = args[i];
     } else {
-      throw UsageError("to-rinex: more than one input");
+      const std::string& a = cl.operand();
+      if (!path.empty()) cl.error("to-rinex: more than one input");
+      path = a;
     }
   }
-  if (path.empty()) throw UsageError("to-rinex: no input (FILE or -)");
-  if (prefix.empty()) throw UsageError("to-rinex: no output prefix (-o PREFIX)");
+  if (path.empty()) cl.error("to-rinex: no input (FILE or -)");
+  if (prefix.empty()) cl.error("to-rinex: no output prefix (-o PREFIX)");
   const std::string name = path == "-" ? "<stdin>" : path;
   opt.streamName = name;
 
