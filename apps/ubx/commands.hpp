@@ -7,5 +7,6 @@ namespace gvins::ubx_app {
 
 int runInfo(CommandLine& cl);
 int runToRinex(CommandLine& cl);
+int runToPos(CommandLine& cl);
 
 }  // namespace gvins::ubx_app

@@ -19,6 +19,11 @@ constexpr const char* kUsage =
     "      writes PREFIX.obs (RINEX 3.04) with every RXM-RAWX signal and PREFIX.nav (RINEX 3.04)\n"
     "      with the ephemerides of RXM-SFRBX; --max-phase-sigma leaves out phases whose reported\n"
     "      standard deviation is larger (RTKLIB's convbin: 0.02)\n"
+    "  to-pos FILE|- -o OUT.pos\n"
+    "      the receiver's own solutions (NAV-PVT) as an RTKLIB .pos file: GPST, latitude,\n"
+    "      longitude, ellipsoidal height, Q (1 RTK fixed, 2 RTK float, 4 differential, 5 single),\n"
+    "      satellites, sigmas from hAcc/vAcc, velocity with sigmas from sAcc; epochs without a 3D\n"
+    "      fix are left out and counted (docs/ubx.md)\n"
     "exit status: 0 ok, 1 error (file, decoding), 2 usage\n";
 
 }  // namespace
@@ -37,6 +42,7 @@ int main(int argc, char** argv) {
   try {
     if (cmd == "info") return gvins::ubx_app::runInfo(cl);
     if (cmd == "to-rinex") return gvins::ubx_app::runToRinex(cl);
+    if (cmd == "to-pos") return gvins::ubx_app::runToPos(cl);
   } catch (const std::exception& e) {
     std::cerr << "gvins-ubx: " << e.what() << "\n";
     return 1;

@@ -1,7 +1,10 @@
 // libFuzzer target: the UBX framer and the UBX decoder (mixed-stream splitter, RAWX, NAV, ESF,
 // SFRBX hand-off) on arbitrary bytes fed in arbitrary chunks. Every frame the framer returns must
 // carry a valid checksum and lie inside the input; the counters must add up; the decoder must
-// neither crash nor hang and must account for every byte.
+// neither crash nor hang and must account for every byte. Every NAV-PVT delivered must have
+// its fields in range, a solution kind that agrees with its flags, and a GPST (the week rules of
+// gvins-ubx to-pos) within half a week of the time it was resolved against.
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <variant>
@@ -9,6 +12,27 @@
 
 #include "gvins/ubx/ubx_decoder.hpp"
 #include "gvins/ubx/ubx_framer.hpp"
+
+namespace {
+
+void checkNavPvt(const gvins::ubx::NavPvt& p, const std::optional<gvins::GpsTime>& rawx) {
+  using gvins::ubx::NavPvtSolution;
+  if (p.iTow >= 604800000u || std::abs(p.latDeg) > 90.0 || std::abs(p.lonDeg) > 180.0) std::abort();
+  const NavPvtSolution s = gvins::ubx::navPvtSolution(p);
+  if (s != NavPvtSolution::None && !p.fixOk()) std::abort();
+  if ((s == NavPvtSolution::RtkFixed) != (s != NavPvtSolution::None && s != NavPvtSolution::TwoD && p.carrierSolution() == 2))
+    std::abort();
+  if ((s == NavPvtSolution::TwoD) != (p.fixOk() && p.fixType == 2)) std::abort();
+  const auto utc = gvins::ubx::navPvtUtcAsGpst(p);
+  for (const auto& near : {rawx, utc}) {
+    if (!near) continue;
+    const gvins::GpsTime t = gvins::ubx::timeOfWeekNear(p.iTow * 1e-3, *near);
+    if (!(std::abs(t - *near) <= 302400.0 + 1e-3)) std::abort();
+    if (std::abs(t.tow() - p.iTow * 1e-3) > 1e-6) std::abort();
+  }
+}
+
+}  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return 0;
@@ -35,6 +59,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       if (const auto* e = std::get_if<gvins::ObsEpoch>(&*d)) {
         if (e->sats.empty()) std::abort();
         ++epochs;
+      } else if (const auto* p = std::get_if<gvins::ubx::NavPvt>(&*d)) {
+        checkNavPvt(*p, dec.lastEpochTime());
       }
     }
   };

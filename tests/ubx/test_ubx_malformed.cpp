@@ -243,12 +243,14 @@ TEST(UbxMalformed, NavPvtClockAndTimeGps) {
   pvt[10] = 22;
   pvt[11] = 0x07;
   pvt[20] = 3;
-  pvt[21] = 0x81;  // gnssFixOK, carrier solution float
+  pvt[21] = 0x81;  // gnssFixOK, carrier solution fixed
   pvt[23] = 27;
   putU(pvt, 24, static_cast<std::uint32_t>(-1051471666), 4);  // lon -105.1471666 deg
   putU(pvt, 28, 400966933, 4);                                // lat 40.0966933 deg
   putU(pvt, 32, 1579933, 4);                                  // 1579.933 m
+  putU(pvt, 36, 1601321, 4);                                  // hMSL 1601.321 m
   putU(pvt, 48, static_cast<std::uint32_t>(-250), 4);         // velN -0.25 m/s
+  putU(pvt, 68, 83, 4);                                       // sAcc 0.083 m/s
   Bytes clk(20, 0);
   putU(clk, 4, static_cast<std::uint32_t>(-123456), 4);  // -123.456 us
   putU(clk, 8, 789, 4);
@@ -267,7 +269,10 @@ TEST(UbxMalformed, NavPvtClockAndTimeGps) {
   EXPECT_DOUBLE_EQ(p.lonDeg, -105.1471666);
   EXPECT_DOUBLE_EQ(p.latDeg, 40.0966933);
   EXPECT_DOUBLE_EQ(p.height, 1579.933);
+  EXPECT_DOUBLE_EQ(p.hMsl, 1601.321);
   EXPECT_DOUBLE_EQ(p.velN, -0.25);
+  EXPECT_DOUBLE_EQ(p.sAcc, 0.083);
+  EXPECT_EQ(navPvtSolution(p), NavPvtSolution::RtkFixed);
   const auto& c = std::get<NavClock>(out[1]);
   EXPECT_DOUBLE_EQ(c.biasS, -123456e-9);
   EXPECT_DOUBLE_EQ(c.driftSps, 789e-9);
