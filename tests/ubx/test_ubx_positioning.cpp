@@ -1,7 +1,8 @@
 // UBX as a receiver input of the GNSS tools: BaseReader detects UBX by content (and still RTCM
 // and RINEX), reads its epochs and adds the SFRBX ephemerides to the store; gvins-spp runs on the
-// walk log alone (no navigation file) and is scored against the publisher's RTK track, next to
-// RTKLIB's SPP on convbin's conversion of the same log.
+// walk log alone (no navigation file) and is scored horizontally against the receiver's own RTK
+// track (gnss_1730_sf.pos: NAV-PVT, mean-sea-level heights), next to RTKLIB's SPP on convbin's
+// conversion of the same log.
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
@@ -74,8 +75,8 @@ struct Score {
   double hrms = 0.0;
 };
 
-/// Horizontal RMS against the reference track, matching epochs within 5 ms (the publisher's
-/// solution is tagged 1 ms after RAWX's rcvTow).
+/// Horizontal RMS against the reference track, matching epochs within 5 ms (the track is tagged
+/// 1 ms after RAWX's rcvTow).
 Score score(const PosFile& sol, const PosFile& ref) {
   Score s;
   double sum = 0.0;
@@ -91,8 +92,8 @@ Score score(const PosFile& sol, const PosFile& ref) {
   return s;
 }
 
-/// The publisher's track (RTKLIB .pos layout but Q/ns written as floats, which readPosFile rejects):
-/// GPST date, time, latitude, longitude, ellipsoidal height.
+/// The shipped track (RTKLIB .pos layout, Q/ns written as floats): GPST date, time, latitude,
+/// longitude, height (above mean sea level: only the horizontal is scored).
 PosFile readTrack(const std::filesystem::path& path) {
   PosFile f;
   std::ifstream in(path);
