@@ -1,14 +1,16 @@
 #!/usr/bin/env python3
 """The real u-blox + MEMS IMU walk (../shared/data/gnss_imu/rtklibexplorer_walk_0827, a copy in
 tests/data) with simulated vision: gvins-sim drives a stereo pair along the trajectory fitted to
-the publisher's RTK track and the real IMU (config/real_walk_0827_vision.yaml, trajectory type
-gnss_track), keeping the real IMU samples and the real UBX log; gvins-replay runs every GNSS mode
-that needs no base station on it and on the same dataset without its cameras (camera-less), and
-the antenna is compared with the RTK track on its fixed epochs.
+the receiver's own real-time RTK track and the real IMU (config/real_walk_0827_vision.yaml,
+trajectory type gnss_track), keeping the real IMU samples and the real UBX log; gvins-replay runs
+every GNSS mode that needs no base station on it and on the same dataset without its cameras
+(camera-less), and the antenna is compared with the RTK track on its fixed epochs. The track is
+UBX-NAV-PVT with ellipsoidal heights, written by gvins-ubx to-pos (walk_reference.py).
 
     bench/fusion/real_walk_vision.py [--build DIR] [-o OUT] [--markdown FILE]
 
-Steps: gvins-imu puts the raw IMU log on GPST (its RTKLIB time tags); gvins-sim writes
+Steps: gvins-ubx to-pos writes the track OUT/walk_reference.pos; gvins-imu puts the raw IMU log
+on GPST (its RTKLIB time tags); gvins-sim writes
 OUT/dataset (feature tracks, gnss/rover.ubx); OUT/camera_less is a copy without mav0/cam*; then
 gvins-replay per mode and dataset. Columns: epochs compared (reference Q = 1), horizontal and
 vertical RMS, 95 % of the horizontal error, velocity RMS against the .pos velocity, the
@@ -24,12 +26,8 @@ import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from real_walk import enu, llh_to_ecef  # noqa: E402  (one geodesy for both pages)
+from walk_reference import REFERENCE_TEXT, ROOT, WALK, make_reference, matched_errors, read_pos  # noqa: E402
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-DATA = os.path.join(ROOT, "tests", "data")
-WALK = os.path.join(DATA, "gnss_imu", "walk_0827")
-REF = os.path.join(WALK, "gnss_1730_sf.pos")
 CONFIG = os.path.join(ROOT, "config", "real_walk_0827_vision.yaml")
 MODES = [("vio", "vio", False), ("vio+gpsvel", "vio+gpsvel", False), ("vio+dopp", "vio+dopp", False),
          ("vio+dopp+psr, ionosphere-free", "vio+dopp+psr", False),
@@ -47,39 +45,14 @@ def run(cmd):
     return subprocess.run(cmd, check=True, capture_output=True, text=True)
 
 
-def read_pos(path):
-    """{(date, time key): (lat, lon, h, Q, (ve, vn, vu) or None)} of a lat/lon/h .pos file (GPST)."""
-    out = {}
-    for line in open(path):
-        if line.startswith("%") or not line.strip():
-            continue
-        t = line.split()
-        key = round((int(t[1][0:2]) * 3600 + int(t[1][3:5]) * 60 + float(t[1][6:])) * 20) / 20.0
-        vel = None
-        if len(t) >= 18:  # date time lat lon h Q ns 6 sigmas age ratio vn ve vu ...
-            try:
-                vel = (float(t[16]), float(t[15]), float(t[17]))
-            except ValueError:
-                vel = None
-        out[(t[0], key)] = (float(t[2]), float(t[3]), float(t[4]), int(float(t[5])), vel)
-    return out
-
-
 def compare(path, ref):
     """Errors of a solution at the reference's fixed epochs: n, H RMS, V RMS, H 95 %, velocity
     RMS, H RMS about the mean horizontal offset, mean offset (E, N)."""
     if not os.path.exists(path):
         return None
-    est = read_pos(path)
-    d, dv = [], []
-    for k, r in ref.items():
-        if r[3] != 1 or k not in est:
-            continue
-        e = est[k]
-        a, b = llh_to_ecef(*e[:3]), llh_to_ecef(*r[:3])
-        d.append(enu([a[i] - b[i] for i in range(3)], r[0], r[1]))
-        if e[4] and r[4] and all(not math.isnan(x) for x in e[4]):
-            dv.append(sum((e[4][i] - r[4][i]) ** 2 for i in range(3)))
+    m = matched_errors(read_pos(path), ref)
+    d = [x[1] for x in m]
+    dv = [x[2] for x in m if x[2] is not None]
     if not d:
         return None
     n = len(d)
@@ -122,7 +95,7 @@ def fit_report(dataset_yaml):
     return out
 
 
-def build_dataset(b, out):
+def build_dataset(b, out, ref_path):
     imu = os.path.join(out, "imu0.csv")
     run([os.path.join(b, "gvins-imu"), "convert", os.path.join(WALK, "imu_1730.csv"), "--tag",
          os.path.join(WALK, "imu_1730.csv.tag"), "--columns", "ax,ay,az,gx,gy,gz,t", "--time", "counter-ms",
@@ -134,7 +107,9 @@ def build_dataset(b, out):
         key = line.strip().split(":")[0]
         if key == "imu_csv":
             line = "  imu_csv: " + imu + "\n"
-        elif key in ("pos_file", "rover_log"):
+        elif key == "pos_file":
+            line = "  pos_file: " + ref_path + "\n"
+        elif key == "rover_log":
             rel = line.split(":", 1)[1].strip()
             line = "  %s: %s\n" % (key, os.path.normpath(os.path.join(cfg_dir, rel)))
         lines.append(line)
@@ -158,17 +133,18 @@ def main():
     b = os.path.join(os.path.abspath(a.build), "bin")
     out = os.path.abspath(a.out)
     os.makedirs(out, exist_ok=True)
-    ds, cl = build_dataset(b, out)
+    ref_path = make_reference(b, out, run)
+    ds, cl = build_dataset(b, out, ref_path)
     single = os.path.join(out, "single_frequency.yaml")
     with open(single, "w") as f:
         f.write("gnss_fusion:\n  ionosphere: broadcast\n")
-    ref = read_pos(REF)
+    ref = read_pos(ref_path)
     rows = []
     for label, mode, sf in MODES:
         for rig, folder in (("stereo", ds), ("camera-less", cl)):
             o = os.path.join(out, "%s_%s%s" % (os.path.basename(folder), mode, "_sf" if sf else ""))
             run([os.path.join(b, "gvins-replay"), folder, "--mode", mode, "--rover", os.path.join(folder, "gnss", "rover.ubx"),
-                 "--truth-pos", REF, "--imu-gaps", "warn", "-q", "-o", o] + (["--config", single] if sf else []))
+                 "--truth-pos", ref_path, "--imu-gaps", "warn", "-q", "-o", o] + (["--config", single] if sf else []))
             rows.append((label, rig, compare(os.path.join(o, "global.pos"), ref), metrics(os.path.join(o, "metrics.csv"))))
     table = ["| mode | rig | epochs (ref. fixed) | H RMS [m] | V RMS [m] | H 95 % [m] | vel. RMS [m/s] | H RMS about mean [m] "
              "| mean offset E, N [m] | local H RMSE [m] | local vel. RMSE [m/s] |",
@@ -197,19 +173,20 @@ def write_page(path, table, fit_text):
         f.write(PAGE_INTRO)
         f.write("\n## The trajectory fitted to the RTK track and the real IMU (dataset.yaml)\n\n| key | value |\n|---|---|\n")
         f.write(fit_text + "\n")
-        f.write("\n## Against the publisher's RTK track, its fixed epochs\n\n")
+        f.write("\n## Against the receiver's RTK track, its fixed epochs\n\n")
         f.write(table)
         f.write(PAGE_NOTES)
 
 
-PAGE_INTRO = """Data: `tests/data/gnss_imu/walk_0827` and `tests/data/ubx/gnss_1730.ubx` (u-blox X20P, 4 Hz UBX
+PAGE_INTRO = f"""Data: `tests/data/gnss_imu/walk_0827` and `tests/data/ubx/gnss_1730.ubx` (u-blox X20P, 4 Hz UBX
 with its own SFRBX navigation, MEMS IMU; 2025-08-28, 132 s of a hand-held backyard walk). Dataset:
 `config/real_walk_0827_vision.yaml` (gvins-sim trajectory type `gnss_track`,
 docs/dataset_format.md): the real IMU samples and the real UBX log are kept; only the stereo
 feature tracks (10 Hz, 10 cm baseline, tilted 30 deg down over ground landmarks with 0.5 m relief,
 0.5 px noise) are simulated along the trajectory fitted to the RTK track and the real IMU.
 "Camera-less" is the same folder without `mav0/cam*`. Every GNSS row uses the real rover
-observations; the reference is the publisher's RTKLIB RTK track (`gnss_1730_sf.pos`, Q = 1).
+observations; the reference is {REFERENCE_TEXT}, its fixed epochs (Q = 1), and the same track is
+the one the trajectory is fitted to.
 "Local" columns are `gvins-replay`'s 4-DoF aligned trajectory against the fitted trajectory the
 cameras followed (the simulation truth; it follows the RTK track to 1.4 cm RMS, see below).
 """
@@ -221,23 +198,17 @@ for 2025-08-28 is in the repository, so its row runs on the broadcast ephemeride
 (gvins-replay warns). `vio` has no global solution.
 
 Reading the table: every fused solution, with or without cameras, sits metres from the RTK track
-(as do both SPPs of [real_walk.md](real_walk.md), 8.2-8.4 m horizontal RMS), mostly as a nearly
-constant horizontal offset ("mean offset"); the spread about it ("H RMS about mean") is what the
+(as do both SPPs of [real_walk.md](real_walk.md)), mostly as a nearly constant horizontal offset
+("mean offset"). The RTK track is relative to a base station whose data and coordinates are not
+published, so it carries any error of those coordinates as one constant shift; whether the
+offset belongs to that or to the receiver's pseudoranges cannot be decided from these files. The
+H RMS and V RMS columns hold the offset; the spread about it ("H RMS about mean") is what the
 receiver's code errors and the estimator leave, and there the cameras help most (vio+gpsvel
-0.11 m against 0.54 m). Whether the offset belongs to the receiver's pseudoranges or to the
-reference (a base position the publisher did not give) cannot be decided from these files.
-The cameras lower the velocity error in every GNSS mode (0.19-0.22 m/s against 0.23-0.30 m/s
-camera-less, and 8.3 m/s in the diverged camera-less run below). One
-row is worse with them: in `vio+dopp` (no absolute position after the frame initialisation) the
-stereo run's vertical error grows from -12.5 m to -40.6 m over the compared epochs while the
-camera-less one stays between -12.5 m and -15.9 m, although the stereo run's local trajectory is
-right to 6 cm vertically (the drift is in its global anchoring, which Doppler rows observe only
-weakly); not investigated further. The `psr-nointegration` ablation (rows at the newest state, no
-IMU integration to the measurement time) gives the psr figures with stereo, but diverges
-camera-less (203 m horizontal RMS; not investigated).
-The camera-less runs are sensitive to where the IMU log starts: this dataset begins at
-17:30:41.5 GPST; started at 17:30:41.0 the camera-less estimator loses its attitude (45 of 526
-GNSS epochs used), with the stereo tracks it does not.
+stereo against camera-less). In the vertical, the single-frequency psr rows (BeiDou's broadcast
+ionosphere) sit a few metres above the track on average and the ionosphere-free psr and ppp rows
+about 10 m below it, with or without cameras; every run starts about 4.7 m below it, where its
+first GNSS fix anchors the frame, and the modes without absolute position (vio+gpsvel, vio+dopp)
+stay near that. The cameras lower the velocity error in every GNSS mode.
 """
 
 
