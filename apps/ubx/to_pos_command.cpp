@@ -74,10 +74,11 @@ class PvtRows {
     ++navPvt_;
     if (ref_) {
       emit(p, ubx::timeOfWeekNear(p.iTow * 1e-3, *ref_));
-    } else if (pending_.size() < kMaxPending) {
-      pending_.push_back(p);
     } else {
-      resolveByUtc(p);
+      // A long stretch without any week source: the waiting rows take their own UTC dates (in
+      // stream order) rather than growing the queue without bound.
+      if (pending_.size() >= kMaxPending) finish();
+      pending_.push_back(p);
     }
   }
 
