@@ -15,7 +15,8 @@
 
 namespace gvins::rtcm_app {
 
-/// Thrown for command-line mistakes; main prints it with the usage hint and exits with 2.
+/// Thrown for command-line mistakes by parseDate and requireValue; gvins-ubx's main prints it
+/// with the usage hint and exits with 2 (gvins-rtcm's commands report theirs through CommandLine).
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
