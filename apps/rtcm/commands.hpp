@@ -1,14 +1,17 @@
-// The gvins-rtcm subcommands.
+// The gvins-rtcm subcommands. Each parses its own options from argv[2..argc) (CommandLine):
+// usage errors print "gvins-rtcm COMMAND: MESSAGE (see --help)" and exit with 2.
 #pragma once
 
-#include <string>
-#include <vector>
+#include <string_view>
 
 namespace gvins::rtcm_app {
 
-int runInfo(const std::vector<std::string>& args);
-int runToRinex(const std::vector<std::string>& args);
-int runNtrip(const std::vector<std::string>& args);
-int runFromProducts(const std::vector<std::string>& args);
+/// The usage text of gvins-rtcm (all commands).
+extern const std::string_view kUsage;
+
+int runInfo(int argc, char** argv);
+int runToRinex(int argc, char** argv);
+int runNtrip(int argc, char** argv);
+int runFromProducts(int argc, char** argv);
 
 }  // namespace gvins::rtcm_app

@@ -5,6 +5,7 @@
 // ssr_from_products.hpp). For testing a real-time (SSR) processing chain against the products
 // it is made from, e.g. `gvins-replay D --broadcast --ssr FILE` against `gvins-replay D`.
 #include <algorithm>
+#include <cstdlib>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -13,6 +14,7 @@
 
 #include "commands.hpp"
 #include "gvins/base/atomic_output_file.hpp"
+#include "gvins/base/command_line.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/ephemeris/precise_product_files.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
@@ -22,34 +24,31 @@
 
 namespace gvins::rtcm_app {
 
-int runFromProducts(const std::vector<std::string>& args) {
+int runFromProducts(int argc, char** argv) {
   std::string out;
   double interval = 5.0;
   std::vector<std::string> inputs;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    requireValue(args, i, {"-o", "--date", "--interval"});
-    if (args[i] == "-o") {
-      out = args[++i];
-    } else if (args[i] == "--interval") {
-      const std::string v = args[++i];
+  CommandLine cl("gvins-rtcm from-products", kUsage, argc, argv, 2);
+  while (cl.next()) {
+    if (cl.is("-o")) {
+      out = cl.value();
+    } else if (cl.is("--interval")) {
+      const std::string v = cl.value();
       char* end = nullptr;
       interval = std::strtod(v.c_str(), &end);
       if (end == v.c_str() || *end != '\0' || !isSsrUpdateInterval(interval))
-        throw UsageError("--interval must be an RTCM SSR update interval (1, 2, 5, 10, 15, 30, 60, ... 10800 s), not '" +
-                         v + "'");
-    } else if (!args[i].empty() && args[i][0] == '-') {
-      throw UsageError("from-products: unknown option '" + args[i] + "'");
+        cl.error("--interval must be an RTCM SSR update interval (1, 2, 5, 10, 15, 30, 60, ... 10800 s), not '" + v + "'");
     } else {
-      inputs.push_back(args[i]);
+      inputs.push_back(cl.operand());
     }
   }
-  if (out.empty()) throw UsageError("from-products needs -o FILE");
+  if (out.empty()) cl.error("needs -o FILE");
   EphemerisStore nav;
   PreciseProductFiles products;
   for (const std::string& f : inputs)
     if (!products.add(f)) nav.add(readRinexNav(f));
-  if (nav.size() == 0) throw UsageError("from-products needs a navigation file (the broadcast records to correct)");
-  if (products.orbits.empty()) throw UsageError("from-products needs an SP3 orbit file");
+  if (nav.size() == 0) cl.error("needs a navigation file (the broadcast records to correct)");
+  if (products.orbits.empty()) cl.error("needs an SP3 orbit file");
   EphemerisStore productStore;
   auto precise = readPreciseProducts(products.orbits, products.clocks);
   const auto [first, last] = precise->span();

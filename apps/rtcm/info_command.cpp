@@ -1,23 +1,26 @@
 // gvins-rtcm info FILE|- [--date YYYY-MM-DD]
 #include <iostream>
-#include <vector>
+#include <string>
 
 #include "commands.hpp"
+#include "gvins/base/command_line.hpp"
 #include "stream_summary.hpp"
 
 namespace gvins::rtcm_app {
 
-int runInfo(const std::vector<std::string>& args) {
+int runInfo(int argc, char** argv) {
   std::string path;
   std::optional<GpsTime> date;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    requireValue(args, i, {"-o", "--date", "--interval"});
-    if (args[i] == "--date") date = parseDate(args[++i]);
-    else if (args[i].size() > 1 && args[i][0] == '-') throw UsageError("info: unknown option '" + args[i] + "'");
-    else if (path.empty()) path = args[i];
-    else throw UsageError("info: more than one input");
+  CommandLine cl("gvins-rtcm info", kUsage, argc, argv, 2);
+  while (cl.next()) {
+    if (cl.is("--date")) date = dateOption(cl);
+    else if (path.empty()) path = cl.operand();
+    else {
+      cl.operand();  // an unknown option is reported as such
+      cl.error("more than one input");
+    }
   }
-  if (path.empty()) throw UsageError("info: no input (FILE or -)");
+  if (path.empty()) cl.error("no input (FILE or -)");
   rtcm::DecoderOptions opt;
   opt.referenceTime = referenceFor(path, date);
   opt.streamName = path;

@@ -1,16 +1,17 @@
 // gvins-rtcm: RTCM 3 streams from files, pipes and NTRIP casters.
 #include <iostream>
 #include <string>
-#include <vector>
+#include <string_view>
 
 #include "commands.hpp"
+#include "gvins/base/command_line.hpp"
 #include "gvins/base/parse_error.hpp"
 #include "gvins/rtcm/ntrip_error.hpp"
 #include "stream_summary.hpp"
 
-namespace {
+namespace gvins::rtcm_app {
 
-constexpr const char* kUsage =
+const std::string_view kUsage =
     "usage: gvins-rtcm <command> ...\n"
     "  info FILE|- [--date YYYY-MM-DD]\n"
     "      one row per message type (type, count, description), then time span, station,\n"
@@ -29,7 +30,7 @@ constexpr const char* kUsage =
     "      products' span; for testing real-time (SSR) processing: gvins-replay/gvins-spp --ssr\n"
     "exit status: 0 ok, 1 error (file, decoding, NTRIP), 2 usage\n";
 
-}  // namespace
+}  // namespace gvins::rtcm_app
 
 int main(int argc, char** argv) {
   using namespace gvins::rtcm_app;
@@ -38,16 +39,12 @@ int main(int argc, char** argv) {
     return argc < 2 ? 2 : 0;
   }
   const std::string cmd = argv[1];
-  const std::vector<std::string> args(argv + 2, argv + argc);
   try {
-    if (cmd == "info") return runInfo(args);
-    if (cmd == "to-rinex") return runToRinex(args);
-    if (cmd == "ntrip") return runNtrip(args);
-    if (cmd == "from-products") return runFromProducts(args);
-    throw UsageError("unknown command '" + cmd + "'");
-  } catch (const UsageError& e) {
-    std::cerr << "gvins-rtcm: " << e.what() << "\n" << kUsage;
-    return 2;
+    if (cmd == "info") return runInfo(argc, argv);
+    if (cmd == "to-rinex") return runToRinex(argc, argv);
+    if (cmd == "ntrip") return runNtrip(argc, argv);
+    if (cmd == "from-products") return runFromProducts(argc, argv);
+    gvins::usageError("gvins-rtcm", "unknown command '" + cmd + "'");
   } catch (const gvins::rtcm::NtripError& e) {
     std::cerr << "\ngvins-rtcm: NTRIP: " << e.what() << "\n";
     return 1;

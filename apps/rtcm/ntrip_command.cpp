@@ -7,43 +7,35 @@
 #include <iostream>
 
 #include "commands.hpp"
-#include "gvins/base/option_values.hpp"
+#include "gvins/base/command_line.hpp"
 #include "gvins/rtcm/framer.hpp"
 #include "gvins/rtcm/ntrip_client.hpp"
 #include "stream_summary.hpp"
 
 namespace gvins::rtcm_app {
 
-int runNtrip(const std::vector<std::string>& args) {
+int runNtrip(int argc, char** argv) {
   std::string url, outPath;
   double duration = 0.0;
   long long maxFrames = 0;
   rtcm::NtripOptions nopt;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    auto value = [&]() -> const std::string& {
-      if (i + 1 >= args.size()) throw UsageError("ntrip: " + a + " needs a value");
-      return args[++i];
-    };
-    try {
-      if (a == "-o") outPath = value();
-      else if (a == "--duration") duration = optionNumber(a, value(), 0.0, 1e8, "s");
-      else if (a == "--frames") maxFrames = static_cast<long long>(optionNumber(a, value(), 0.0, 1e15));
-      else if (a == "--version") nopt.version = static_cast<int>(optionNumber(a, value(), 1.0, 2.0));
-      else if (a == "--timeout") nopt.readTimeout = nopt.connectTimeout = optionNumber(a, value(), 0.1, 3600.0, "s");
-      else if (a == "--gga") nopt.gga = value();
-      else if (a.size() > 1 && a[0] == '-') throw UsageError("ntrip: unknown option '" + a + "'");
-      else if (url.empty()) url = a;
-      else throw UsageError("ntrip: more than one URL");
-    } catch (const OptionError& e) {
-      throw UsageError(std::string("ntrip: ") + e.what());
-    } catch (const std::logic_error&) {
-      throw UsageError("ntrip: bad number for " + a);
+  CommandLine cl("gvins-rtcm ntrip", kUsage, argc, argv, 2);
+  while (cl.next()) {
+    if (cl.is("-o")) outPath = cl.value();
+    else if (cl.is("--duration")) duration = cl.number(0.0, 1e8, "s");
+    else if (cl.is("--frames")) maxFrames = static_cast<long long>(cl.number(0.0, 1e15));
+    else if (cl.is("--version")) nopt.version = static_cast<int>(cl.number(1.0, 2.0));
+    else if (cl.is("--timeout")) nopt.readTimeout = nopt.connectTimeout = cl.number(0.1, 3600.0, "s");
+    else if (cl.is("--gga")) nopt.gga = cl.value();
+    else if (url.empty()) url = cl.operand();
+    else {
+      cl.operand();  // an unknown option is reported as such
+      cl.error("more than one URL");
     }
   }
-  if (url.empty()) throw UsageError("ntrip: no URL (ntrip://user:pass@host:port/MOUNT)");
-  if (outPath.empty()) throw UsageError("ntrip: no output file (-o FILE)");
-  if (nopt.version != 1 && nopt.version != 2) throw UsageError("ntrip: --version must be 1 or 2");
+  if (url.empty()) cl.error("no URL (ntrip://user:pass@host:port/MOUNT)");
+  if (outPath.empty()) cl.error("no output file (-o FILE)");
+  if (nopt.version != 1 && nopt.version != 2) cl.error("--version must be 1 or 2");
 
   rtcm::NtripClient client(rtcm::NtripUrl::parse(url), nopt);
   std::cerr << "connecting to " << client.url().display() << " (NTRIP " << nopt.version << ".0)\n";

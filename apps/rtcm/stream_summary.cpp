@@ -38,6 +38,15 @@ GpsTime parseDate(const std::string& text) {
   return GpsTime::fromCalendar(c);
 }
 
+GpsTime dateOption(CommandLine& cl) {
+  const std::string text = cl.value();
+  try {
+    return parseDate(text);
+  } catch (const UsageError& e) {
+    cl.error(e.what());
+  }
+}
+
 std::FILE* openInput(const std::string& path) {
   if (path == "-") return stdin;
   std::error_code ec;

@@ -8,13 +8,15 @@
 #include <string>
 #include <vector>
 
+#include "gvins/base/command_line.hpp"
 #include "gvins/base/gnss_time.hpp"
 #include "gvins/base/rinex_obs_header.hpp"
 #include "gvins/rtcm/decoder.hpp"
 
 namespace gvins::rtcm_app {
 
-/// Thrown for command-line mistakes; main prints it with the usage hint and exits with 2.
+/// Thrown for command-line mistakes by parseDate and requireValue; gvins-ubx's main prints it
+/// with the usage hint and exits with 2 (gvins-rtcm's commands report theirs through CommandLine).
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
@@ -25,6 +27,8 @@ void requireValue(const std::vector<std::string>& args, std::size_t i, std::init
 
 /// "YYYY-MM-DD" to 12:00 GPST of that day; throws UsageError.
 GpsTime parseDate(const std::string& text);
+/// The value of a --date option (parseDate); a usage error of `cl` if it is not a date.
+GpsTime dateOption(CommandLine& cl);
 
 /// Opens FILE or "-" (stdin); throws std::runtime_error naming the file.
 std::FILE* openInput(const std::string& path);

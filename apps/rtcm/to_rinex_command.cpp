@@ -12,6 +12,7 @@
 
 #include "commands.hpp"
 #include "gvins/base/atomic_output_file.hpp"
+#include "gvins/base/command_line.hpp"
 #include "gvins/base/rinex_obs_writer.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "stream_summary.hpp"
@@ -31,20 +32,22 @@ void mergeEpoch(ObsEpoch& a, const ObsEpoch& b) {
 
 }  // namespace
 
-int runToRinex(const std::vector<std::string>& args) {
+int runToRinex(int argc, char** argv) {
   std::string path, prefix;
   std::optional<GpsTime> date;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    requireValue(args, i, {"-o", "--date", "--interval"});
-    if (args[i] == "--date") date = parseDate(args[++i]);
-    else if (args[i] == "-o") prefix = args[++i];
-    else if (args[i].size() > 1 && args[i][0] == '-') throw UsageError("to-rinex: unknown option '" + args[i] + "'");
-    else if (path.empty()) path = args[i];
-    else throw UsageError("to-rinex: more than one input");
+  CommandLine cl("gvins-rtcm to-rinex", kUsage, argc, argv, 2);
+  while (cl.next()) {
+    if (cl.is("--date")) date = dateOption(cl);
+    else if (cl.is("-o")) prefix = cl.value();
+    else if (path.empty()) path = cl.operand();
+    else {
+      cl.operand();  // an unknown option is reported as such
+      cl.error("more than one input");
+    }
   }
-  if (path.empty()) throw UsageError("to-rinex: no input (FILE or -)");
-  if (!date) throw UsageError("to-rinex: --date YYYY-MM-DD is required (RTCM times carry no date)");
-  if (prefix.empty()) throw UsageError("to-rinex: no output prefix (-o PREFIX)");
+  if (path.empty()) cl.error("no input (FILE or -)");
+  if (!date) cl.error("--date YYYY-MM-DD is required (RTCM times carry no date)");
+  if (prefix.empty()) cl.error("no output prefix (-o PREFIX)");
 
   std::FILE* in = reopenable(path);
   rtcm::DecoderOptions opt;

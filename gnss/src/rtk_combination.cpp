@@ -1,6 +1,8 @@
 #include "gvins/gnss/rtk_combination.hpp"
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include <Eigen/Cholesky>
 
@@ -150,6 +152,24 @@ RtkSolution combineSolutions(const RtkSolution& f, const RtkSolution& b, const C
   if (f.valid()) s.time = f.time;
   if (how) *how = h;
   return s;
+}
+
+std::vector<RtkSolution> combinePasses(const std::vector<RtkSolution>& forward, const std::vector<RtkSolution>& backward,
+                                       const CombinationOptions& options, std::vector<Combination>* how,
+                                       CombinationCounts* counts) {
+  if (forward.size() != backward.size()) {
+    throw std::invalid_argument("combinePasses: forward pass of " + std::to_string(forward.size()) +
+                                " epochs, backward pass of " + std::to_string(backward.size()));
+  }
+  std::vector<RtkSolution> out;
+  out.reserve(forward.size());
+  for (std::size_t i = 0; i < forward.size(); ++i) {
+    Combination h = Combination::None;
+    out.push_back(combineSolutions(forward[i], backward[i], options, &h));
+    if (how) how->push_back(h);
+    if (counts) counts->add(forward[i], backward[i], h);
+  }
+  return out;
 }
 
 }  // namespace gvins

@@ -5,12 +5,12 @@
 #include <chrono>
 #include <cstring>
 
-#include <fcntl.h>
-#include <netdb.h>
 #include <poll.h>
 #include <sys/socket.h>
 #include <sys/types.h>
 #include <unistd.h>
+
+#include "tcp_socket.hpp"
 
 namespace gvins::rtcm {
 namespace {
@@ -22,10 +22,7 @@ double secondsLeft(Clock::time_point deadline) {
   return std::chrono::duration<double>(deadline - Clock::now()).count();
 }
 
-int pollMs(double seconds) {
-  if (seconds <= 0.0) return 0;
-  return static_cast<int>(std::min(seconds * 1000.0 + 1.0, 2.0e9));
-}
+using detail::pollMs;
 
 }  // namespace
 
@@ -34,10 +31,7 @@ NtripClient::NtripClient(NtripUrl url, NtripOptions options)
 
 NtripClient::~NtripClient() { close(); }
 
-void NtripClient::close() {
-  if (fd_ >= 0) ::close(fd_);
-  fd_ = -1;
-}
+void NtripClient::close() { detail::closeFd(fd_); }
 
 std::string NtripClient::request() const {
   std::string r;
@@ -66,51 +60,21 @@ void NtripClient::connect() {
   pending_.clear();
   ended_ = false;
   const std::string where = url_.host + ":" + std::to_string(url_.port);
-  addrinfo hints{};
-  hints.ai_family = AF_UNSPEC;
-  hints.ai_socktype = SOCK_STREAM;
-  addrinfo* res = nullptr;
-  const std::string port = std::to_string(url_.port);
-  const int gai = ::getaddrinfo(url_.host.c_str(), port.c_str(), &hints, &res);
-  if (gai != 0) throw NtripError(Kind::Resolve, "cannot resolve caster host '" + url_.host + "': " + gai_strerror(gai));
-
+  // One deadline for the connection, the request and the response header.
   const Clock::time_point deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(opt_.connectTimeout));
-  int lastErr = 0;
-  bool timedOut = false;
-  for (addrinfo* a = res; a && fd_ < 0; a = a->ai_next) {
-    const int fd = ::socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC, a->ai_protocol);
-    if (fd < 0) {
-      lastErr = errno;
-      continue;
-    }
-    ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) | O_NONBLOCK);
-    int rc = ::connect(fd, a->ai_addr, a->ai_addrlen);
-    if (rc != 0 && errno == EINPROGRESS) {
-      pollfd p{fd, POLLOUT, 0};
-      rc = ::poll(&p, 1, pollMs(secondsLeft(deadline)));
-      if (rc == 0) {
-        timedOut = true;
-        ::close(fd);
-        continue;
-      }
-      int err = 0;
-      socklen_t len = sizeof err;
-      ::getsockopt(fd, SOL_SOCKET, SO_ERROR, &err, &len);
-      rc = err == 0 ? 0 : -1;
-      errno = err;
-    }
-    if (rc != 0) {
-      lastErr = errno;
-      ::close(fd);
-      continue;
-    }
-    fd_ = fd;
-  }
-  ::freeaddrinfo(res);
+  std::string err;
+  detail::TcpConnectError why;
+  fd_ = detail::connectTcp(url_.host, url_.port, opt_.connectTimeout, err, &why);
   if (fd_ < 0) {
-    if (lastErr == ECONNREFUSED) throw NtripError(Kind::ConnectionRefused, "connection to caster " + where + " refused (nothing listens there)");
-    if (timedOut) throw NtripError(Kind::Timeout, "no connection to caster " + where + " within " + std::to_string(opt_.connectTimeout) + " s");
-    throw NtripError(Kind::Connection, "cannot connect to caster " + where + ": " + std::strerror(lastErr));
+    switch (why.kind) {
+      case detail::TcpConnectFailure::Resolve:
+        throw NtripError(Kind::Resolve, "cannot resolve caster host '" + url_.host + "': " + why.reason);
+      case detail::TcpConnectFailure::Refused:
+        throw NtripError(Kind::ConnectionRefused, "connection to caster " + where + " refused (nothing listens there)");
+      case detail::TcpConnectFailure::Timeout:
+        throw NtripError(Kind::Timeout, "no connection to caster " + where + " within " + std::to_string(opt_.connectTimeout) + " s");
+      default: throw NtripError(Kind::Connection, "cannot connect to caster " + where + ": " + why.reason);
+    }
   }
 
   // Send the request.

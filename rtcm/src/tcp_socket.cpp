@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 
 #include <netdb.h>
@@ -67,45 +68,81 @@ int boundPort(int fd) {
                                         : reinterpret_cast<sockaddr_in*>(&ss)->sin_port);
 }
 
-int connectTcp(const std::string& host, int port, double timeout, std::string& err) {
+namespace {
+
+/// Connects `fd` (non-blocking) to `a` until `deadline`: 0, or the errno of the failure
+/// (ETIMEDOUT when the deadline passed).
+int connectBy(int fd, const addrinfo& a, std::chrono::steady_clock::time_point deadline) {
+  if (::connect(fd, a.ai_addr, a.ai_addrlen) == 0) return 0;
+  if (errno != EINPROGRESS) return errno;
+  pollfd p{fd, POLLOUT, 0};
+  for (;;) {
+    const double left = std::chrono::duration<double>(deadline - std::chrono::steady_clock::now()).count();
+    const int rc = ::poll(&p, 1, pollMs(left));
+    if (rc < 0 && errno == EINTR) continue;
+    if (rc <= 0) return ETIMEDOUT;
+    break;
+  }
+  int e = 0;
+  socklen_t len = sizeof e;
+  ::getsockopt(fd, SOL_SOCKET, SO_ERROR, &e, &len);
+  return e;
+}
+
+/// A connection to a local port nobody listens on can meet itself (TCP simultaneous open when
+/// the kernel picks the destination port as the source port).
+bool connectedToItself(int fd) {
+  sockaddr_storage self{}, peer{};
+  socklen_t ls = sizeof self, lp = sizeof peer;
+  return ::getsockname(fd, reinterpret_cast<sockaddr*>(&self), &ls) == 0 &&
+         ::getpeername(fd, reinterpret_cast<sockaddr*>(&peer), &lp) == 0 && ls == lp && std::memcmp(&self, &peer, ls) == 0;
+}
+
+}  // namespace
+
+int connectTcp(const std::string& host, int port, double timeout, std::string& err, TcpConnectError* why) {
+  TcpConnectError unused;
+  TcpConnectError& failed = why ? *why : unused;
+  failed = TcpConnectError{};
+  const std::string where = host + ":" + std::to_string(port);
   addrinfo hints{};
   hints.ai_family = AF_UNSPEC;
   hints.ai_socktype = SOCK_STREAM;
   addrinfo* res = nullptr;
   const int gai = ::getaddrinfo(host.c_str(), std::to_string(port).c_str(), &hints, &res);
   if (gai != 0) {
-    err = "cannot resolve '" + host + "': " + gai_strerror(gai);
+    failed = {TcpConnectFailure::Resolve, gai_strerror(gai)};
+    err = "cannot resolve '" + host + "': " + failed.reason;
     return -1;
   }
-  err = "cannot connect to " + host + ":" + std::to_string(port) + ": no address";
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(timeout));
+  failed.reason = "no address";
+  err = "cannot connect to " + where + ": " + failed.reason;
+  int lastError = 0;  // of the last address that failed other than by the timeout
+  bool timedOut = false;
   int connected = -1;
   for (addrinfo* a = res; a && connected < 0; a = a->ai_next) {
     const int fd = ::socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC | SOCK_NONBLOCK, a->ai_protocol);
-    if (fd < 0) continue;
-    int rc = ::connect(fd, a->ai_addr, a->ai_addrlen);
-    if (rc != 0 && errno == EINPROGRESS) {
-      pollfd p{fd, POLLOUT, 0};
-      rc = ::poll(&p, 1, pollMs(timeout)) > 0 ? 0 : -1;
-      int e = ETIMEDOUT;
-      if (rc == 0) {
-        socklen_t len = sizeof e;
-        ::getsockopt(fd, SOL_SOCKET, SO_ERROR, &e, &len);
-        rc = e == 0 ? 0 : -1;
-      }
-      errno = e;
+    if (fd < 0) {
+      lastError = errno;
+      failed.reason = std::strerror(lastError);
+      err = "cannot connect to " + where + ": " + failed.reason;
+      continue;
     }
-    std::string why;
-    if (rc != 0) why = std::strerror(errno);
-    // A connection to a local port nobody listens on can meet itself (TCP simultaneous open
-    // when the kernel picks the destination port as the source port): refuse it.
-    sockaddr_storage self{}, peer{};
-    socklen_t ls = sizeof self, lp = sizeof peer;
-    if (rc == 0 && ::getsockname(fd, reinterpret_cast<sockaddr*>(&self), &ls) == 0 &&
-        ::getpeername(fd, reinterpret_cast<sockaddr*>(&peer), &lp) == 0 && ls == lp && std::memcmp(&self, &peer, ls) == 0) {
-      why = "connected to itself (nothing listens there)";
+    const int e = connectBy(fd, *a, deadline);
+    std::string failure;
+    if (e != 0) {
+      failure = std::strerror(e);
+      if (e == ETIMEDOUT) timedOut = true;
+      else lastError = e;
+    } else if (connectedToItself(fd)) {
+      failure = "connected to itself (nothing listens there)";
+      lastError = ECONNREFUSED;
     }
-    if (!why.empty()) {
-      err = "cannot connect to " + host + ":" + std::to_string(port) + ": " + why;
+    if (!failure.empty()) {
+      failed.reason = failure;
+      err = "cannot connect to " + where + ": " + failure;
       ::close(fd);
       continue;
     }
@@ -114,6 +151,11 @@ int connectTcp(const std::string& host, int port, double timeout, std::string& e
     connected = fd;
   }
   ::freeaddrinfo(res);
+  if (connected < 0) {
+    failed.kind = lastError == ECONNREFUSED ? TcpConnectFailure::Refused
+                  : timedOut                 ? TcpConnectFailure::Timeout
+                                             : TcpConnectFailure::Other;
+  }
   return connected;
 }
 

@@ -16,8 +16,24 @@ void closeFd(int& fd);
 int listenTcp(const std::string& host, int port, int backlog, std::string& err);
 /// The local port a socket is bound to.
 int boundPort(int fd);
-/// A connected TCP socket (TCP_NODELAY, blocking mode as given) within `timeout` s; -1 and `err`
-/// set on failure (resolution, refusal, timeout, or a connection that met itself).
-int connectTcp(const std::string& host, int port, double timeout, std::string& err);
+/// Why connectTcp failed.
+enum class TcpConnectFailure {
+  None,
+  Resolve,  ///< the host name cannot be resolved
+  Refused,  ///< nothing listens there (connection refused, or a connection that met itself)
+  Timeout,  ///< no answer within the timeout
+  Other,    ///< any other socket error
+};
+struct TcpConnectError {
+  TcpConnectFailure kind = TcpConnectFailure::None;
+  std::string reason;  ///< the resolver's or the last address's error text
+};
+
+/// A connected, non-blocking TCP socket (TCP_NODELAY) to `host`:`port`, trying the host's
+/// addresses in turn within `timeout` s for all of them. On failure -1, `err` set to a message
+/// naming host:port and the last address's error, and `why` (if given) to the kind: Refused if
+/// the last address that failed other than by the timeout refused, else Timeout if one timed
+/// out, else Resolve or Other.
+int connectTcp(const std::string& host, int port, double timeout, std::string& err, TcpConnectError* why = nullptr);
 
 }  // namespace gvins::rtcm::detail

@@ -56,11 +56,7 @@ Passes runPasses(const RtkConfig& c, std::size_t first = 0, std::size_t last = 3
     (k == 0 ? p.forward : p.backward) =
         runRtkPass(s, rover, d.base, k == 0 ? TimeDirection::Forward : TimeDirection::Backward);
   }
-  for (std::size_t i = 0; i < rover.size(); ++i) {
-    Combination how;
-    p.combined.push_back(combineSolutions(p.forward[i], p.backward[i], CombinationOptions{}, &how));
-    p.how.push_back(how);
-  }
+  p.combined = combinePasses(p.forward, p.backward, CombinationOptions{}, &p.how);
   return p;
 }
 
@@ -180,6 +176,16 @@ TEST(RtkCombined, BackwardPassAgreesWithForward) {
   }
   EXPECT_GE(both, std::min(ff, bf) - 5);
   EXPECT_EQ(fixedCount(p.combined), static_cast<int>(p.combined.size()));
+  // The counts of combinePasses against the solutions themselves.
+  CombinationCounts counts;
+  const std::vector<RtkSolution> again = combinePasses(p.forward, p.backward, CombinationOptions{}, nullptr, &counts);
+  ASSERT_EQ(again.size(), p.combined.size());
+  EXPECT_EQ(counts.forwardFixed, ff);
+  EXPECT_EQ(counts.backwardFixed, bf);
+  EXPECT_EQ(counts.bothFixed + counts.disagreements, both);
+  EXPECT_EQ(counts.combinedFixed, fixedCount(again));
+  EXPECT_THROW(combinePasses(p.forward, std::vector<RtkSolution>(p.forward.size() - 1), CombinationOptions{}),
+               std::invalid_argument);
 }
 
 // The weak single-epoch case of the integrity table (Galileo E1 only, 25 deg mask, instantaneous

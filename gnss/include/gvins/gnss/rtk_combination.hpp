@@ -64,4 +64,12 @@ bool consistent(const Eigen::Vector3d& xa, const Eigen::Vector3d& xb, const Eige
 RtkSolution combineSolutions(const RtkSolution& forward, const RtkSolution& backward, const CombinationOptions& options,
                              Combination* how = nullptr);
 
+/// The combined solutions of a forward and a backward pass over the same rover epochs (one
+/// solution per epoch in both, in the same order: rtk_pass.hpp): combineSolutions per epoch.
+/// `how` (if given) receives each epoch's Combination, `counts` (if given) adds them up. Throws
+/// std::invalid_argument when the passes differ in length.
+std::vector<RtkSolution> combinePasses(const std::vector<RtkSolution>& forward, const std::vector<RtkSolution>& backward,
+                                       const CombinationOptions& options, std::vector<Combination>* how = nullptr,
+                                       CombinationCounts* counts = nullptr);
+
 }  // namespace gvins

@@ -96,7 +96,9 @@ class GnssReceiverSim {
     GnssRandom rng;
     std::vector<SignalTrack> signals;
   };
+  /// One epoch (its stages: GnssEpochProducer in gnss_receiver_sim.cpp).
   void produce(const GpsTime& tag, const GpsTime& t, GnssSimEpoch& out);
+  friend class GnssEpochProducer;
   static void lose(SatTrack& st, const char* cause);
   static void loseSignal(SignalTrack& sg, const char* cause);
 
