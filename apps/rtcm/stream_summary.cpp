@@ -17,12 +17,6 @@
 
 namespace gvins::rtcm_app {
 
-void requireValue(const std::vector<std::string>& args, std::size_t i, std::initializer_list<const char*> withValue) {
-  if (i + 1 < args.size()) return;
-  for (const char* o : withValue)
-    if (args[i] == o) throw UsageError(args[i] + " needs a value");
-}
-
 GpsTime parseDate(const std::string& text) {
   CalendarTime c;
   char extra = 0;

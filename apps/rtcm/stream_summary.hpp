@@ -4,7 +4,6 @@
 #include <cstdio>
 #include <optional>
 #include <ostream>
-#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -15,15 +14,11 @@
 
 namespace gvins::rtcm_app {
 
-/// Thrown for command-line mistakes by parseDate and requireValue; gvins-ubx's main prints it
-/// with the usage hint and exits with 2 (gvins-rtcm's commands report theirs through CommandLine).
+/// Thrown by parseDate for a malformed date; dateOption turns it into a usage error of its
+/// CommandLine (exit 2).
 struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
-
-/// Throws UsageError when args[i] is one of `withValue` and no value follows it (rather than
-/// reporting it as an unknown option).
-void requireValue(const std::vector<std::string>& args, std::size_t i, std::initializer_list<const char*> withValue);
 
 /// "YYYY-MM-DD" to 12:00 GPST of that day; throws UsageError.
 GpsTime parseDate(const std::string& text);
