@@ -24,16 +24,6 @@ std::int64_t toNs(const GpsTime& t) {
 
 }  // namespace
 
-const char* toString(GnssFusionStage s) {
-  switch (s) {
-    case GnssFusionStage::kWaitingVio: return "waiting-vio";
-    case GnssFusionStage::kWaitingFix: return "waiting-fix";
-    case GnssFusionStage::kFrameInit: return "frame-init";
-    case GnssFusionStage::kTight: return "tight";
-  }
-  return "?";
-}
-
 template <typename Scalar>
 GnssFusion<Scalar>::GnssFusion(GnssFusionConfig config) : config_(std::move(config)) {}
 

@@ -36,6 +36,7 @@
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/fusion/gnss_ambiguity_states.hpp"
 #include "gvins/fusion/gnss_clock_states.hpp"
+#include "gvins/fusion/gnss_epoch_report.hpp"
 #include "gvins/fusion/gnss_fusion_config.hpp"
 #include "gvins/fusion/gnss_gate_recovery.hpp"
 #include "gvins/fusion/gnss_ins_alignment.hpp"
@@ -54,43 +55,6 @@
 #include "gvins/vio/estimator_backend.hpp"
 
 namespace gvins::fusion {
-
-enum class GnssFusionStage : std::uint8_t {
-  kWaitingVio,    ///< estimator not initialised
-  kWaitingFix,    ///< no SPP fix with enough speed yet
-  kFrameInit,     ///< frame block being estimated from SPP
-  kTight,         ///< frame converged, raw measurements used
-};
-const char* toString(GnssFusionStage s);
-
-struct GnssTypeCount {
-  int used = 0;
-  int rejected = 0;  ///< gated out (row or epoch test)
-};
-
-struct GnssEpochReport {
-  GpsTime time;                 ///< rover time tag
-  std::int64_t t_ns = 0;        ///< measurement time used (tag − receiver clock)
-  GnssFusionStage stage = GnssFusionStage::kWaitingVio;
-  GnssTypeCount psr, dopp, dpsr, ddcp, vel, frame;
-  GnssTypeCount phase;          ///< undifferenced carrier phase (vio+dopp+ppp)
-  int ambiguities = 0;          ///< float ambiguity states after the epoch (vio+dopp+ppp)
-  int recordChanges = 0;        ///< broadcast record changes carried over to ambiguities (vio+dopp+ppp)
-  bool updated = false;         ///< at least one update applied
-  bool clocksInitialized = false;  ///< this epoch
-  bool reset = false;           ///< outage reset this epoch, or the estimator started a new state
-  bool rtkFixed = false;
-  std::optional<Eigen::Vector3d> antennaEcef;  ///< after the update (at t_ns)
-  std::optional<Eigen::Vector3d> antennaVelocityEcef;
-  Geodetic antennaGeodetic;
-  double chi2 = 0.0;
-  int dof = 0;
-  double elapsedMicroseconds = 0.0;
-  std::vector<std::string> warnings;  ///< new this epoch (Doppler check of the rover and the base)
-  /// Before the estimator is initialised (GnssFusionConfig::insStart): where the GNSS/INS
-  /// alignment stands (kAligned: this epoch started the estimator).
-  std::optional<GnssInsStatus> insStart;
-};
 
 struct GnssRowSet;  // the rows of an epoch and their noise (internal)
 
