@@ -1,6 +1,8 @@
 #include "gvins/fusion/gnss_ambiguity_states.hpp"
 
 #include <span>
+#include <stdexcept>
+#include <string>
 
 namespace gvins::fusion {
 
@@ -31,6 +33,9 @@ std::map<SatId, double> GnssAmbiguityStates<Scalar>::values(const vio::Estimator
 template <typename Scalar>
 GnssAmbiguityArc& GnssAmbiguityStates<Scalar>::add(vio::EstimatorBackend<Scalar>& est, SatId sat, double x,
                                                    double sigma, const GpsTime& arcStart) {
+  if (states_.count(sat)) {
+    throw std::logic_error("GnssAmbiguityStates::add: satellite " + sat.str() + " already has a state");
+  }
   Eigen::Matrix<Scalar, Eigen::Dynamic, 1> v(1);
   v[0] = static_cast<Scalar>(x);
   State s;

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <map>
+#include <stdexcept>
 #include <vector>
 
 #include "gvins/fusion/gnss_ambiguity_states.hpp"
@@ -151,6 +152,7 @@ TEST(GnssAmbiguityStates, PriorRandomWalkOfBroadcastSatellitesAndRemoval) {
   GnssAmbiguityArc& arcG = a.add(be, g5, 12.5, 3.0, kT0 - 40.0);
   EXPECT_DOUBLE_EQ(arcG.start - kT0, -40.0);
   a.add(be, e11, -4.0, 30.0, kT0);
+  EXPECT_THROW(a.add(be, e11, 0.0, 30.0, kT0), std::logic_error);  // one state per satellite
   ASSERT_EQ(a.size(), 2u);
   EXPECT_TRUE(a.contains(g5));
   EXPECT_FALSE(a.contains(c1));

@@ -48,7 +48,7 @@ class GnssAmbiguityStates {
   std::map<SatId, double> values(const vio::EstimatorBackend<Scalar>& est) const;
 
   /// Adds the state of `sat`'s arc that started at `arcStart`: estimate `x`, prior σ `sigma` (m),
-  /// in front of the state. `sat` must have none (drop() the old arc's first).
+  /// in front of the state. `sat` must have none (drop() the old arc's first; std::logic_error).
   GnssAmbiguityArc& add(vio::EstimatorBackend<Scalar>& est, SatId sat, double x, double sigma, const GpsTime& arcStart);
   /// One random-walk step to time t of the states of `sats` that exist (satellites on broadcast
   /// records): variance q²·Δt each, q `randomWalk` (m/√s), Δt since the last call (none at the
