@@ -22,27 +22,10 @@ std::int64_t toNs(const GpsTime& t) {
   return t.wholeSeconds() * 1000000000LL + std::llround(t.fraction() * 1e9);
 }
 
-/// Marginalizes a client block that is in the state and forgets its id.
-template <typename Scalar>
-void marginalizeBlock(vio::EstimatorBackend<Scalar>& est, sri::BlockId& id) {
-  if (id.valid() && est.contains(id)) est.marginalize(std::span<const sri::BlockId>(&id, 1));
-  id = {};
-}
-
 }  // namespace
 
-const char* toString(GnssFusionStage s) {
-  switch (s) {
-    case GnssFusionStage::kWaitingVio: return "waiting-vio";
-    case GnssFusionStage::kWaitingFix: return "waiting-fix";
-    case GnssFusionStage::kFrameInit: return "frame-init";
-    case GnssFusionStage::kTight: return "tight";
-  }
-  return "?";
-}
-
 template <typename Scalar>
-GnssFusion<Scalar>::GnssFusion(GnssFusionConfig config) : config_(std::move(config)), leverStart_(config_.leverArm) {}
+GnssFusion<Scalar>::GnssFusion(GnssFusionConfig config) : config_(std::move(config)) {}
 
 template <typename Scalar>
 GnssFusion<Scalar>::~GnssFusion() = default;
@@ -80,8 +63,7 @@ bool GnssFusion<Scalar>::buildState(const vio::EstimatorBackend<Scalar>& est, st
 
 template <typename Scalar>
 Eigen::Vector3d GnssFusion<Scalar>::leverArm(const vio::EstimatorBackend<Scalar>& est) const {
-  if (leverBlock_.valid() && current(est)) return est.estimate(leverBlock_).vector.template cast<double>();
-  return carriedLever();  // no block yet, or the state is gone (its last estimate, if plausible)
+  return lever_.value(current(est) ? &est : nullptr);
 }
 
 template <typename Scalar>
@@ -102,8 +84,8 @@ std::optional<Eigen::Matrix3d> GnssFusion<Scalar>::antennaCovariance(const vio::
     J.middleCols<4>(n) = k.J_frame.template topRows<3>();
     n += 4;
   }
-  if (leverBlock_.valid()) {
-    blocks.push_back(leverBlock_);
+  if (lever_.valid()) {
+    blocks.push_back(lever_.block());
     J.middleCols<3>(n) = k.J_lever.template topRows<3>();
     n += 3;
   }
@@ -117,26 +99,15 @@ std::optional<Eigen::Matrix3d> GnssFusion<Scalar>::antennaCovariance(const vio::
 }
 
 template <typename Scalar>
-Eigen::Vector3d GnssFusion<Scalar>::carriedLever() const {
-  if (leverLast_ && ((*leverLast_ - config_.leverArm).cwiseAbs().array() <= 3.0 * config_.leverArmSigma).all()) {
-    return *leverLast_;
-  }
-  return leverStart_;
-}
-
-template <typename Scalar>
 void GnssFusion<Scalar>::forgetState() {
-  leverStart_ = carriedLever();
-  leverLast_.reset();
+  lever_.forget();
   frameBlock_ = {};
   worldChange_.reset();
-  leverBlock_ = {};
   clocks_.forget();
-  zwdBlock_ = {};
+  zwd_.forget();
   lastUpdate_.reset();
   gateRecovery_.reset();
-  ambiguities_.clear();
-  ambiguityTime_.reset();
+  ambiguities_.forget();
   stage_ = GnssFusionStage::kWaitingVio;
   if (insAlign_) insAlign_->clear();
 }
@@ -162,14 +133,6 @@ std::optional<AntennaKinematics> GnssFusion<Scalar>::antennaAt(const vio::Estima
   GnssStateValues s;
   if (!buildState(est, t_ns, s)) return std::nullopt;
   return antennaKinematics(s);
-}
-
-template <typename Scalar>
-void GnssFusion<Scalar>::ensureLever(vio::EstimatorBackend<Scalar>& est) {
-  if (!config_.calibrateLeverArm || leverBlock_.valid()) return;
-  leverBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_lever_arm", 3),
-                             sri::BlockEstimate<Scalar>::fromVector(leverStart_.template cast<Scalar>()),
-                             sri::Prior<Scalar>::stdDev(3, static_cast<Scalar>(config_.leverArmSigma)));
 }
 
 template <typename Scalar>
@@ -212,60 +175,14 @@ bool GnssFusion<Scalar>::frameKnownInEnu(const vio::EstimatorBackend<Scalar>& es
 
 template <typename Scalar>
 std::map<SatId, double> GnssFusion<Scalar>::ambiguities(const vio::EstimatorBackend<Scalar>& est) const {
-  std::map<SatId, double> out;
-  if (!current(est)) return out;
-  for (const auto& [sat, a] : ambiguities_) out[sat] = static_cast<double>(est.estimate(a.id).vector[0]);
-  return out;
+  if (!current(est)) return {};
+  return ambiguities_.values(est);
 }
 
 template <typename Scalar>
 std::optional<double> GnssFusion<Scalar>::zenithWetDelay(const vio::EstimatorBackend<Scalar>& est) const {
-  if (!zwdBlock_.valid() || !current(est)) return std::nullopt;
-  return static_cast<double>(est.estimate(zwdBlock_).vector[0]);
-}
-
-template <typename Scalar>
-void GnssFusion<Scalar>::propagateZwd(vio::EstimatorBackend<Scalar>& est, const GpsTime& t) {
-  const double dt = t - zwdTime_;
-  if (!zwdBlock_.valid() || dt <= 0.0) return;
-  zwdBlock_ = randomWalkStep(est, zwdBlock_, "gnss_zwd", 1, config_.zwdRandomWalk * config_.zwdRandomWalk * dt);
-  zwdTime_ = t;
-}
-
-template <typename Scalar>
-void GnssFusion<Scalar>::propagateAmbiguities(vio::EstimatorBackend<Scalar>& est, const std::vector<SatId>& broadcast,
-                                              const GpsTime& t) {
-  const double dt = ambiguityTime_ ? t - *ambiguityTime_ : 0.0;
-  ambiguityTime_ = t;
-  const double q = config_.broadcastAmbiguityRandomWalk;
-  if (!(dt > 0.0) || !(q > 0.0)) return;
-  std::vector<SatId> sats;
-  for (const SatId& s : broadcast)
-    if (ambiguities_.count(s)) sats.push_back(s);
-  if (sats.empty()) return;
-  using Mat = typename sri::Propagation<Scalar>::Matrix;
-  const auto n = static_cast<Eigen::Index>(sats.size());
-  sri::Propagation<Scalar> step;
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const sri::BlockId old = ambiguities_.at(sats[static_cast<std::size_t>(i)]).id;
-    step.addNewBlock(sri::BlockSpec::vector("gnss_ambiguity", 1), est.estimate(old));
-    Mat phi = Mat::Zero(n, 1);
-    phi(i, 0) = Scalar(1);
-    step.setTransition(old, phi);
-    step.marginalizeAfter(old);
-  }
-  step.setNoiseCovariance(Mat::Identity(n, n) * static_cast<Scalar>(q * q * dt));
-  const std::vector<sri::BlockId> ids = est.propagate(step, vio::ClientBlockRegion::kFront);
-  for (Eigen::Index i = 0; i < n; ++i)
-    ambiguities_.at(sats[static_cast<std::size_t>(i)]).id = ids.at(static_cast<std::size_t>(i));
-}
-
-template <typename Scalar>
-void GnssFusion<Scalar>::dropAmbiguity(vio::EstimatorBackend<Scalar>& est, SatId sat) {
-  const auto it = ambiguities_.find(sat);
-  if (it == ambiguities_.end()) return;
-  marginalizeBlock(est, it->second.id);
-  ambiguities_.erase(it);
+  if (!zwd_.valid() || !current(est)) return std::nullopt;
+  return zwd_.value(est);
 }
 
 namespace {
@@ -361,11 +278,11 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
   lay.nImu = lay.blocks.size();
   lay.dim = 15;
   lay.frameAt = lay.add(frameBlock_, 4);
-  lay.leverAt = lay.add(leverBlock_, 3);
+  lay.leverAt = lay.add(lever_.block(), 3);
   lay.clockAt = lay.add(clocks_.clockBlock(), 2);
   // With the clock, one per system after the first.
   lay.isbAt = lay.add(clocks_.isbBlock(), static_cast<int>(clocks_.systems().size()) - 1);
-  lay.zwdAt = lay.add(zwdBlock_, 1);
+  lay.zwdAt = lay.add(zwd_.block(), 1);
   lay.ambiguityAt = lay.dim;
   for (const sri::BlockId& id : ambiguities) lay.add(id, 1);
   const int dim = lay.dim;
@@ -542,10 +459,9 @@ void GnssFusion<Scalar>::feedRtk(Epoch& e, const ObsEpoch* base) {
 template <typename Scalar>
 void GnssFusion<Scalar>::resetAfterOutage(vio::EstimatorBackend<Scalar>& est, GnssEpochReport& rep) {
   clocks_.marginalize(est);
-  marginalizeBlock(est, zwdBlock_);
+  zwd_.marginalize(est);
   if (rtk_) rtk_->reset();
-  while (!ambiguities_.empty()) dropAmbiguity(est, ambiguities_.begin()->first);
-  ambiguityTime_.reset();
+  ambiguities_.dropAll(est);
   rep.reset = true;
   lastUpdate_.reset();
 }
@@ -615,7 +531,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
   GnssEpochReport rep;
   rep.time = roverInput.time;
   auto finish = [&]() {
-    if (leverBlock_.valid() && current(est)) leverLast_ = est.estimate(leverBlock_).vector.template cast<double>();
+    if (current(est)) lever_.record(est);
     rep.stage = stage_;
     reportNotices(rep);
     rep.elapsedMicroseconds =
@@ -648,7 +564,7 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
   }
   if (!measurementTime(est, e)) return finish();
   rep.t_ns = e.t_ns;
-  ensureLever(est);
+  if (config_.calibrateLeverArm) lever_.create(est);
 
   if (stage_ == GnssFusionStage::kWaitingFix) {
     if (!startFrame(est, sppOf(e), e.t_ns)) return finish();

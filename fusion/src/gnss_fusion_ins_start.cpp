@@ -30,7 +30,7 @@ void GnssFusion<Scalar>::startFromGnss(vio::EstimatorBackend<Scalar>& est, const
   const GpsTime t = rover.time - dtr;
   const std::int64_t t_ns = t.wholeSeconds() * 1000000000LL + std::llround(t.fraction() * 1e9);
   if (t_ns < imu.front().t_ns) return;
-  const std::optional<vio::ExternalInitialState> s = insAlign_->add(t_ns, spp, imu, leverStart_);
+  const std::optional<vio::ExternalInitialState> s = insAlign_->add(t_ns, spp, imu, lever_.start());
   rep.insStart = insAlign_->status();
   rep.t_ns = t_ns;
   if (!s || !est.initializeFrom(*s)) return;

@@ -72,28 +72,23 @@ bool GnssFusion<Scalar>::prepareStates(vio::EstimatorBackend<Scalar>& est, Epoch
     for (SatelliteModel& m : models) m.clock = clockIndex(m.sat);
   }
   if (clocks_.valid() && config_.zwdState()) {
-    if (!zwdBlock_.valid()) {
-      Eigen::Matrix<Scalar, Eigen::Dynamic, 1> z = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>::Zero(1);
-      zwdBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_zwd", 1), sri::BlockEstimate<Scalar>::fromVector(z),
-                               sri::Prior<Scalar>::stdDev(1, static_cast<Scalar>(config_.zwdSigma)));
-      zwdTime_ = e.tMeas;
-    }
-    propagateZwd(est, e.tMeas);
-    const double zwd = static_cast<double>(est.estimate(zwdBlock_).vector[0]);
+    if (!zwd_.valid()) zwd_.create(est, e.tMeas, config_.zwdSigma);
+    zwd_.propagate(est, e.tMeas, config_.zwdRandomWalk);
+    const double zwd = zwd_.value(est);
     for (SatelliteModel& m : models) m.troposphere += m.mapWet * zwd;
   }
   return true;
 }
 
 template <typename Scalar>
-sri::BlockId GnssFusion<Scalar>::newAmbiguity(vio::EstimatorBackend<Scalar>& est, const SatelliteModel& m) {
+GnssAmbiguityArc& GnssFusion<Scalar>::newAmbiguity(vio::EstimatorBackend<Scalar>& est, const SatelliteModel& m,
+                                                   const GpsTime& arcStart) {
   // Centred on phase minus code (code model: + c·group delay), which differ by the ambiguity
   // plus the code error. The arc may be older than the state (epochs before the VIO or the clocks
   // were ready, a restart after rejections): its carrier-smoothed code carries those epochs'
   // codes, weighted as the code rows are (each epoch as one measurement: σ/sqrt(n)) except for
   // the orbit/clock error, a bias per satellite that no averaging reduces; a new arc starts from
   // the raw code with a loose prior.
-  Eigen::Matrix<Scalar, Eigen::Dynamic, 1> x(1);
   double code = m.pseudorange, sigma = config_.ambiguitySigma;
   const SatObs* so = arcSmoothed_.find(m.sat);
   const SignalObs* s1 = so ? so->find(m.code) : nullptr;
@@ -103,11 +98,7 @@ sri::BlockId GnssFusion<Scalar>::newAmbiguity(vio::EstimatorBackend<Scalar>& est
     const double nf = arcs_->noiseFactor(m.sat);
     sigma = std::sqrt((m.codeVariance - m.ephemerisVariance) * nf * nf + m.ephemerisVariance);
   }
-  x[0] = static_cast<Scalar>(m.carrierRange - (code - kC * m.groupDelay));
-  // In front of the state: visual rows never reach those columns, and a state that ends with its
-  // arc is cheap to marginalize there.
-  return est.addBlock(sri::BlockSpec::vector("gnss_ambiguity", 1), sri::BlockEstimate<Scalar>::fromVector(x),
-                      sri::Prior<Scalar>::stdDev(1, static_cast<Scalar>(sigma)), vio::ClientBlockRegion::kFront);
+  return ambiguities_.add(est, m.sat, m.carrierRange - (code - kC * m.groupDelay), sigma, arcStart);
 }
 
 template <typename Scalar>
@@ -119,12 +110,12 @@ void GnssFusion<Scalar>::addPhaseRows(vio::EstimatorBackend<Scalar>& est, Epoch&
   std::vector<SatId> broadcast;
   for (const SatelliteModel& m : models)
     if (!m.precise && !m.ssr) broadcast.push_back(m.sat);
-  propagateAmbiguities(est, broadcast, e.tMeas);
+  ambiguities_.propagate(est, broadcast, e.tMeas, config_.broadcastAmbiguityRandomWalk);
   // Satellites with a state first, then the others highest first (max_ambiguities).
   std::vector<const SatelliteModel*> order;
   for (const SatelliteModel& m : models) order.push_back(&m);
   std::stable_sort(order.begin(), order.end(), [&](const SatelliteModel* a, const SatelliteModel* b) {
-    const bool ha = ambiguities_.count(a->sat) > 0, hb = ambiguities_.count(b->sat) > 0;
+    const bool ha = ambiguities_.contains(a->sat), hb = ambiguities_.contains(b->sat);
     if (ha != hb) return ha;
     return a->azel.elevation > b->azel.elevation;
   });
@@ -132,35 +123,32 @@ void GnssFusion<Scalar>::addPhaseRows(vio::EstimatorBackend<Scalar>& est, Epoch&
     const SatelliteModel& m = *mp;
     if (!m.hasCarrier || m.clock < 0 || arcs_->samples(m.sat) == 0) continue;
     const GpsTime start = rover.time - arcs_->arcLength(m.sat);
-    auto it = ambiguities_.find(m.sat);
-    if (it != ambiguities_.end() && std::abs(it->second.arcStart - start) > 1e-3) {
-      dropAmbiguity(est, m.sat);  // new arc: cycle slip, gap or signal change
-      it = ambiguities_.end();
+    GnssAmbiguityArc* arc = ambiguities_.arc(m.sat);
+    if (arc && std::abs(arc->start - start) > 1e-3) {
+      ambiguities_.drop(est, m.sat);  // new arc: cycle slip, gap or signal change
+      arc = nullptr;
     }
-    if (it == ambiguities_.end()) {
+    if (!arc) {
       if (config_.maxAmbiguities > 0 && static_cast<int>(ambiguities_.size()) >= config_.maxAmbiguities) continue;
-      Ambiguity a;
-      a.id = newAmbiguity(est, m);
-      a.arcStart = start;
-      it = ambiguities_.emplace(m.sat, a).first;
+      arc = &newAmbiguity(est, m, start);
     }
-    it->second.lastRow = rover.time;
-    const double nAmb = static_cast<double>(est.estimate(it->second.id).vector[0]);
+    arc->lastRow = rover.time;
+    const double nAmb = ambiguities_.value(est, m.sat);
     SatelliteModel mc = m;
     if (config_.broadcastRecordChanges && !m.precise && !m.ssr) {
-      BroadcastRecordContinuity& r = it->second.records;
+      BroadcastRecordContinuity& r = arc->records;
       if (r.update(e.nav, m.sat, rover.time - m.pseudorange / kC, m.transmitTime, k.x_E).changed) ++e.rep.recordChanges;
       mc.carrierRange += r.shift();
     }
     if (config_.phaseWindup) {
-      const double w = continueWindup(m.windup, it->second.windup);
-      it->second.windup = w;
+      const double w = continueWindup(m.windup, arc->windup);
+      arc->windup = w;
       mc.carrierRange -= m.windupWavelength * w;
     }
     GnssRow r = carrierPhaseRow(mc, k, clk[m.clock], nAmb);
     r.H_lever.setZero();
     r.ambiguity = static_cast<int>(rows.ambiguityBlocks.size());
-    rows.ambiguityBlocks.push_back(it->second.id);
+    rows.ambiguityBlocks.push_back(ambiguities_.block(m.sat));
     rows.ambiguitySats.push_back(m.sat);
     rows.add(r, kPhase, r.variance);
   }
@@ -224,9 +212,9 @@ void GnssFusion<Scalar>::applyRows(vio::EstimatorBackend<Scalar>& est, GnssEpoch
     // A phase row gated out again and again: the ambiguity no longer fits (undetected slip,
     // broadcast orbit/clock change); it restarts from phase minus code.
     const SatId sat = rows.ambiguitySats[static_cast<std::size_t>(rows.rows[i].ambiguity)];
-    Ambiguity& a = ambiguities_.at(sat);
+    GnssAmbiguityArc& a = *ambiguities_.arc(sat);
     a.rejections = acc[i] ? 0 : a.rejections + 1;
-    if (a.rejections >= config_.ambiguityResetRejections) dropAmbiguity(est, sat);
+    if (a.rejections >= config_.ambiguityResetRejections) ambiguities_.drop(est, sat);
   }
 }
 
@@ -247,12 +235,7 @@ bool GnssFusion<Scalar>::tightUpdate(vio::EstimatorBackend<Scalar>& est, Epoch& 
   addDifferenceRows(e, k, clk, rows);
   if (!rows.empty()) applyRows(est, e.rep, k, rows);
   // Ambiguities of satellites without a phase row for a while (set, masked, lost).
-  for (auto it = ambiguities_.begin(); it != ambiguities_.end();) {
-    const SatId sat = it->first;
-    const bool stale = e.rover.time - it->second.lastRow > 10.0;
-    ++it;
-    if (stale) dropAmbiguity(est, sat);
-  }
+  ambiguities_.dropStale(est, e.rover.time, 10.0);
   e.rep.ambiguities = static_cast<int>(ambiguities_.size());
   return true;
 }
@@ -262,7 +245,8 @@ bool GnssFusion<Scalar>::tightUpdate(vio::EstimatorBackend<Scalar>& est, Epoch& 
 #define GVINS_INSTANTIATE(S)                                                                                        \
   template bool GnssFusion<S>::prepareStates(vio::EstimatorBackend<S>&, Epoch&, std::vector<SatelliteModel>&,       \
                                              const AntennaKinematics&);                                             \
-  template sri::BlockId GnssFusion<S>::newAmbiguity(vio::EstimatorBackend<S>&, const SatelliteModel&);              \
+  template GnssAmbiguityArc& GnssFusion<S>::newAmbiguity(vio::EstimatorBackend<S>&, const SatelliteModel&,          \
+                                                         const GpsTime&);                                           \
   template void GnssFusion<S>::addPhaseRows(vio::EstimatorBackend<S>&, Epoch&, const std::vector<SatelliteModel>&,  \
                                             const AntennaKinematics&, const Eigen::VectorXd&, GnssRowSet&);         \
   template void GnssFusion<S>::addDifferenceRows(Epoch&, const AntennaKinematics&, const Eigen::VectorXd&,          \

@@ -91,31 +91,32 @@ class ReplayOutputs {
   }
 
   /// gnss_epochs.csv: one row per processed epoch.
-  void writeEpoch(const GpsTime& t, const ReplayGnssOutcome& o, double ms) {
+  void writeEpoch(const GpsTime& t, const GnssEpochReport& r, double ms) {
     char b[400];
     std::snprintf(b, sizeof b, "%d,%.3f,%s,%d,%d,%d,%d,%d,%d,%d,%d,%d,%d,%d,%d,%d,%.3f,%d,%.3f,%d,%d,%d\n", t.week(), t.tow(),
-                  o.stage.c_str(), o.psrUsed, o.psrRejected, o.doppUsed, o.doppRejected, o.dpsrUsed, o.dpsrRejected,
-                  o.ddcpUsed, o.ddcpRejected, o.velUsed, o.velRejected, o.updated ? 1 : 0, o.rtkFixed ? 1 : 0,
-                  o.reset ? 1 : 0, o.chi2, o.dof, ms, o.phaseUsed, o.phaseRejected, o.ambiguities);
+                  toString(r.stage), r.psr.used, r.psr.rejected, r.dopp.used, r.dopp.rejected, r.dpsr.used,
+                  r.dpsr.rejected, r.ddcp.used, r.ddcp.rejected, r.vel.used, r.vel.rejected, r.updated ? 1 : 0,
+                  r.rtkFixed ? 1 : 0, r.reset ? 1 : 0, r.chi2, r.dof, ms, r.phase.used, r.phase.rejected, r.ambiguities);
     epochFile_->out() << b;
   }
 
   /// The antenna solution of an epoch to global.pos, NMEA, global_ecef.csv and the KML track.
   PositionSolution writeSolution(const GpsTime& t, const ReplayGnssOutcome& o) {
+    const GnssEpochReport& r = o.report;
     PositionSolution ps;
     ps.time = t;
-    ps.position = *o.antennaEcef;
+    ps.position = *r.antennaEcef;
     ps.positionCovariance = o.antennaCovarianceEcef;
-    ps.quality = o.rtkFixed ? SolutionQuality::Fix
-                            : ((o.dpsrUsed + o.ddcpUsed) > 0 ? SolutionQuality::Float : SolutionQuality::Single);
-    ps.numSatellites = std::max({o.psrUsed, o.doppUsed, o.dpsrUsed, o.ddcpUsed, o.phaseUsed});
-    ps.velocity = o.antennaVelocityEcef;
+    ps.quality = r.rtkFixed ? SolutionQuality::Fix
+                            : ((r.dpsr.used + r.ddcp.used) > 0 ? SolutionQuality::Float : SolutionQuality::Single);
+    ps.numSatellites = std::max({r.psr.used, r.dopp.used, r.dpsr.used, r.ddcp.used, r.phase.used});
+    ps.velocity = r.antennaVelocityEcef;
     posWriter_->write(ps);
     if (nmeaWriter_) nmeaWriter_->write(ps);
-    const Eigen::Vector3d v = o.antennaVelocityEcef ? *o.antennaVelocityEcef : Eigen::Vector3d::Zero();
+    const Eigen::Vector3d v = r.antennaVelocityEcef ? *r.antennaVelocityEcef : Eigen::Vector3d::Zero();
     char b[400];
     std::snprintf(b, sizeof b, "%d,%.3f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%d\n", t.week(), t.tow(), ps.position.x(),
-                  ps.position.y(), ps.position.z(), v.x(), v.y(), v.z(), o.rtkFixed ? 1 : 0);
+                  ps.position.y(), ps.position.z(), v.x(), v.y(), v.z(), r.rtkFixed ? 1 : 0);
     ecefFile_->out() << b;
     kml_.push_back(ecefToGeodetic(ps.position));
     return ps;
@@ -356,28 +357,30 @@ class FrameLoop {
     const ReplayGnssOutcome o = gnss_->processEpoch(outage ? empty : g_.nextRover,
                                                     g_.haveCurrentBase && !outage ? &g_.currentBase : nullptr, g_.nav);
     const double ms = msSince(t0);
-    for (const std::string& w : o.warnings) std::fprintf(stderr, "\n[gvins-replay] warning: %s\n", w.c_str());
-    if (before && o.stage != "tight") {  // the GNSS/INS start has not started the estimator yet
+    const GnssEpochReport& r = o.report;
+    for (const std::string& w : r.warnings) std::fprintf(stderr, "\n[gvins-replay] warning: %s\n", w.c_str());
+    const bool tight = r.stage == GnssFusionStage::kTight;
+    if (before && !tight) {  // the GNSS/INS start has not started the estimator yet
       ++sum.gnssEpochsSkipped;
-      if (!o.insStart.empty()) ++sum.gnssEpochsWaitingBy[o.insStart];
+      if (r.insStart) ++sum.gnssEpochsWaitingBy[std::string(gnssInsStatusText(*r.insStart))];
     } else {
       ++sum.gnssEpochs;
     }
-    if (o.updated) ++sum.gnssEpochsUpdated;
-    sum.phaseRowsUsed += static_cast<std::size_t>(o.phaseUsed);
-    sum.phaseRowsRejected += static_cast<std::size_t>(o.phaseRejected);
-    sum.ambiguityStatesMax = std::max(sum.ambiguityStatesMax, static_cast<std::size_t>(o.ambiguities));
-    sum.recordChanges += static_cast<std::size_t>(o.recordChanges);
-    if (o.rtkFixed) ++sum.gnssEpochsFixed;
+    if (r.updated) ++sum.gnssEpochsUpdated;
+    sum.phaseRowsUsed += static_cast<std::size_t>(r.phase.used);
+    sum.phaseRowsRejected += static_cast<std::size_t>(r.phase.rejected);
+    sum.ambiguityStatesMax = std::max(sum.ambiguityStatesMax, static_cast<std::size_t>(r.ambiguities));
+    sum.recordChanges += static_cast<std::size_t>(r.recordChanges);
+    if (r.rtkFixed) ++sum.gnssEpochsFixed;
     const GpsTime& t = g_.nextRover.time;
-    out_.writeEpoch(t, o, ms);
-    if (o.antennaEcef) {
+    out_.writeEpoch(t, r, ms);
+    if (r.antennaEcef) {
       const PositionSolution ps = out_.writeSolution(t, o);
-      const EcefTruthSample a{gnssStamp(t), ps.position, o.antennaVelocityEcef};
+      const EcefTruthSample a{gnssStamp(t), ps.position, r.antennaVelocityEcef};
       antennaTrack_.push_back(a);
-      if (o.stage == "tight") {
+      if (tight) {
         if (firstTight_ < 0) firstTight_ = a.t_ns;
-        if (o.updated && o.psrUsed + o.doppUsed + o.dpsrUsed + o.ddcpUsed + o.velUsed > 0) tightRowsApplied_ = true;
+        if (r.updated && r.psr.used + r.dopp.used + r.dpsr.used + r.ddcp.used + r.vel.used > 0) tightRowsApplied_ = true;
         if (tightRowsApplied_) antennaTight_.push_back(a);
       }
     }

@@ -141,11 +141,11 @@ class StubGnss : public ReplayGnss {
     rover.push_back(r.time);
     if (b) base.push_back(b->time);
     ReplayGnssOutcome o;
-    o.stage = "tight";
-    o.psrUsed = static_cast<int>(r.sats.size());
-    o.updated = true;
-    o.antennaEcef = antenna;
-    o.antennaVelocityEcef = Eigen::Vector3d(0.1, 0.2, 0.3);
+    o.report.stage = GnssFusionStage::kTight;
+    o.report.psr.used = static_cast<int>(r.sats.size());
+    o.report.updated = true;
+    o.report.antennaEcef = antenna;
+    o.report.antennaVelocityEcef = Eigen::Vector3d(0.1, 0.2, 0.3);
     return o;
   }
 };

@@ -34,12 +34,15 @@
 #include "gvins/base/geodetic.hpp"
 #include "gvins/base/observation.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
+#include "gvins/fusion/gnss_ambiguity_states.hpp"
 #include "gvins/fusion/gnss_clock_states.hpp"
+#include "gvins/fusion/gnss_epoch_report.hpp"
 #include "gvins/fusion/gnss_fusion_config.hpp"
 #include "gvins/fusion/gnss_gate_recovery.hpp"
 #include "gvins/fusion/gnss_ins_alignment.hpp"
+#include "gvins/fusion/gnss_lever_arm_state.hpp"
 #include "gvins/fusion/gnss_measurement_models.hpp"
-#include "gvins/gnss/broadcast_record_change.hpp"
+#include "gvins/fusion/gnss_zwd_state.hpp"
 #include "gvins/gnss/carrier_smoothing.hpp"
 #include "gvins/gnss/clock_jump_repair.hpp"
 #include "gvins/gnss/doppler_consistency.hpp"
@@ -52,43 +55,6 @@
 #include "gvins/vio/estimator_backend.hpp"
 
 namespace gvins::fusion {
-
-enum class GnssFusionStage : std::uint8_t {
-  kWaitingVio,    ///< estimator not initialised
-  kWaitingFix,    ///< no SPP fix with enough speed yet
-  kFrameInit,     ///< frame block being estimated from SPP
-  kTight,         ///< frame converged, raw measurements used
-};
-const char* toString(GnssFusionStage s);
-
-struct GnssTypeCount {
-  int used = 0;
-  int rejected = 0;  ///< gated out (row or epoch test)
-};
-
-struct GnssEpochReport {
-  GpsTime time;                 ///< rover time tag
-  std::int64_t t_ns = 0;        ///< measurement time used (tag − receiver clock)
-  GnssFusionStage stage = GnssFusionStage::kWaitingVio;
-  GnssTypeCount psr, dopp, dpsr, ddcp, vel, frame;
-  GnssTypeCount phase;          ///< undifferenced carrier phase (vio+dopp+ppp)
-  int ambiguities = 0;          ///< float ambiguity states after the epoch (vio+dopp+ppp)
-  int recordChanges = 0;        ///< broadcast record changes carried over to ambiguities (vio+dopp+ppp)
-  bool updated = false;         ///< at least one update applied
-  bool clocksInitialized = false;  ///< this epoch
-  bool reset = false;           ///< outage reset this epoch, or the estimator started a new state
-  bool rtkFixed = false;
-  std::optional<Eigen::Vector3d> antennaEcef;  ///< after the update (at t_ns)
-  std::optional<Eigen::Vector3d> antennaVelocityEcef;
-  Geodetic antennaGeodetic;
-  double chi2 = 0.0;
-  int dof = 0;
-  double elapsedMicroseconds = 0.0;
-  std::vector<std::string> warnings;  ///< new this epoch (Doppler check of the rover and the base)
-  /// Before the estimator is initialised (GnssFusionConfig::insStart): where the GNSS/INS
-  /// alignment stands (kAligned: this epoch started the estimator).
-  std::optional<GnssInsStatus> insStart;
-};
 
 struct GnssRowSet;  // the rows of an epoch and their noise (internal)
 
@@ -178,15 +144,14 @@ class GnssFusion {
   /// vio+dopp+ppp: ionosphere-free phase rows, one float ambiguity state per satellite arc.
   void addPhaseRows(vio::EstimatorBackend<Scalar>& est, Epoch& e, const std::vector<SatelliteModel>& models,
                     const AntennaKinematics& k, const Eigen::VectorXd& clk, GnssRowSet& rows);
-  /// A new ambiguity state for the carrier arc of m's satellite.
-  sri::BlockId newAmbiguity(vio::EstimatorBackend<Scalar>& est, const SatelliteModel& m);
+  /// A new ambiguity state for the carrier arc of m's satellite that started at `arcStart`.
+  GnssAmbiguityArc& newAmbiguity(vio::EstimatorBackend<Scalar>& est, const SatelliteModel& m, const GpsTime& arcStart);
   /// Dpsr and ddcp rows from the RTK module's differences.
   void addDifferenceRows(Epoch& e, const AntennaKinematics& k, const Eigen::VectorXd& clk, GnssRowSet& rows);
   /// Applies the tight stage's rows; counts them and restarts ambiguities rejected too often.
   void applyRows(vio::EstimatorBackend<Scalar>& est, GnssEpochReport& rep, const AntennaKinematics& k,
                  GnssRowSet& rows);
   bool buildState(const vio::EstimatorBackend<Scalar>& est, std::int64_t t_ns, GnssStateValues& s) const;
-  void ensureLever(vio::EstimatorBackend<Scalar>& est);
   bool startFrame(vio::EstimatorBackend<Scalar>& est, const SppSolution& spp, std::int64_t t_ns);
   /// Not initialised: feeds the epoch to the GNSS/INS alignment and, once it has a state, starts
   /// the estimator from it in ENU (gnss_fusion_ins_start.cpp); the tight stage follows at once.
@@ -203,37 +168,29 @@ class GnssFusion {
   /// Moves the notices of the signal choice, clock jumps, late clocks and gate recovery not yet
   /// reported into the epoch's warnings.
   void reportNotices(GnssEpochReport& rep);
-  /// Random walk of the zenith wet delay state to time t.
-  void propagateZwd(vio::EstimatorBackend<Scalar>& est, const GpsTime& t);
   /// Gates rows one by one, stacks the accepted ones and applies them; returns the update.
   /// `ambiguities`: the blocks that rows' `ambiguity` indices refer to.
   vio::BackendUpdate<Scalar> apply(vio::EstimatorBackend<Scalar>& est, std::vector<GnssRow>& rows,
                                    const Eigen::MatrixXd& noise, const Eigen::Matrix<double, 9, 9>& intCov,
                                    std::vector<bool>& accepted, bool gate,
                                    const std::vector<sri::BlockId>& ambiguities = {});
-  /// vio+dopp+ppp: marginalizes the ambiguity state of `sat` (arc ended, slipped or rejected).
-  void dropAmbiguity(vio::EstimatorBackend<Scalar>& est, SatId sat);
   /// Whether the ids held belong to the estimator's current state (EstimatorBackend::generation).
   bool current(const vio::EstimatorBackend<Scalar>& est) const { return est.generation() == generation_; }
   /// Forgets every id of the estimator's state and goes back to waiting for the VIO. A calibrated
   /// lever arm within 3 prior σ (per axis) of the configured one becomes the next state's start
-  /// value (leverStart_); one further out (a state that ran away) does not.
+  /// value (GnssLeverArmState::forget); one further out (a state that ran away) does not.
   void forgetState();
-  /// The lever arm a new state starts from: the last estimate if within 3 prior σ of the
-  /// configured value, else the current start value.
-  Eigen::Vector3d carriedLever() const;
 
   GnssFusionConfig config_;
   sri::ChiSquareQuantiles rowGateQuantile_;  // χ²(1) quantile of config_.rowGate
   GnssFusionStage stage_ = GnssFusionStage::kWaitingVio;
   std::uint64_t generation_ = 0;  // estimator generation the ids below belong to
   GnssAnchor anchor_;
-  sri::BlockId frameBlock_, leverBlock_, zwdBlock_;
+  sri::BlockId frameBlock_;
   GnssClockStates<Scalar> clocks_;  // the receiver clock and inter-system bias blocks
+  GnssLeverArmState<Scalar> lever_{config_.leverArm, config_.leverArmSigma};  // calibrateLeverArm
+  GnssZwdState<Scalar> zwd_;        // zwdState()
   std::optional<vio::WorldFrameChange> worldChange_;  // set when the estimator was re-anchored in ENU
-  Eigen::Vector3d leverStart_;                // lever arm before/at the lever block's creation
-  std::optional<Eigen::Vector3d> leverLast_;  // the lever block's estimate after the last epoch
-  GpsTime zwdTime_;
   std::optional<GpsTime> lastUpdate_;
   const EphemerisStore* nav_ = nullptr;
   std::unique_ptr<SppSolver> spp_;
@@ -257,22 +214,9 @@ class GnssFusion {
   ObsEpoch smoothed_;
   // vio+dopp+ppp: one float ambiguity state per satellite arc; the arcs (cycle slips, gaps, signal
   // changes, code-carrier jumps) are those of a CarrierSmoother run on a copy of the rover epochs.
-  struct Ambiguity {
-    sri::BlockId id;
-    GpsTime arcStart;   ///< start of the carrier arc the state belongs to
-    GpsTime lastRow;    ///< last epoch with a phase row
-    int rejections = 0; ///< consecutive gated-out phase rows
-    std::optional<double> windup;  ///< cycles, continued over the arc
-    /// Broadcast satellites: the record of the last phase row and the jumps of the record changes
-    /// since the state started (added to the phase).
-    BroadcastRecordContinuity records;
-  };
   std::unique_ptr<CarrierSmoother> arcs_;
   ObsEpoch arcSmoothed_;  // the rover epoch with the arcs' carrier-smoothed codes
-  std::map<SatId, Ambiguity> ambiguities_;
-  std::optional<GpsTime> ambiguityTime_;  // last random-walk step of the broadcast satellites' states
-  /// Random walk of the ambiguity states of the satellites in `broadcast` to time t (one step).
-  void propagateAmbiguities(vio::EstimatorBackend<Scalar>& est, const std::vector<SatId>& broadcast, const GpsTime& t);
+  GnssAmbiguityStates<Scalar> ambiguities_;
 };
 
 extern template class GnssFusion<float>;

@@ -38,6 +38,7 @@
 #include "gvins/base/enum_names.hpp"
 #include "gvins/base/gnss_time.hpp"
 #include "gvins/base/observation.hpp"
+#include "gvins/fusion/gnss_epoch_report.hpp"
 #include "gvins/gnss/pos_reader.hpp"
 #include "gvins/vio/feature_frame.hpp"
 #include "gvins/vio/frontend.hpp"
@@ -82,22 +83,10 @@ class ReplayEstimator {
   virtual std::optional<TimeOffset> timeOffset() const { return std::nullopt; }
 };
 
-/// Result of one GNSS epoch as the outputs need it.
+/// Result of one GNSS epoch as the outputs need it: the fusion's report and the antenna's covariance.
 struct ReplayGnssOutcome {
-  std::string stage;                     ///< fusion stage name
-  int psrUsed = 0, psrRejected = 0, doppUsed = 0, doppRejected = 0;
-  int dpsrUsed = 0, dpsrRejected = 0, ddcpUsed = 0, ddcpRejected = 0;
-  int velUsed = 0, velRejected = 0;
-  int phaseUsed = 0, phaseRejected = 0, ambiguities = 0;  ///< vio+dopp+ppp
-  int recordChanges = 0;  ///< vio+dopp+ppp: broadcast record changes carried over to ambiguities
-  bool updated = false, rtkFixed = false, reset = false;
-  double chi2 = 0.0;
-  int dof = 0;
-  std::optional<Eigen::Vector3d> antennaEcef, antennaVelocityEcef;
+  GnssEpochReport report;
   Eigen::Matrix3d antennaCovarianceEcef = Eigen::Matrix3d::Zero();  ///< zero if unknown
-  std::vector<std::string> warnings;  ///< new this epoch (e.g. a Doppler sign flip), for stderr
-  /// Before the estimator is initialised: the GNSS/INS start's status (empty: not attempted).
-  std::string insStart;
 };
 
 /// What the pipeline needs from the GNSS fusion.

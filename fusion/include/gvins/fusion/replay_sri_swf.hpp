@@ -52,25 +52,11 @@ class GnssFusionReplayClient final : public ReplayGnss {
       : fusion_(config), est_(est) {}
   void setBasePosition(const Eigen::Vector3d& ecef) override { fusion_.setBasePosition(ecef); }
   ReplayGnssOutcome processEpoch(const ObsEpoch& rover, const ObsEpoch* base, const EphemerisStore& nav) override {
-    const GnssEpochReport r = fusion_.processEpoch(est_, rover, base, nav);
     ReplayGnssOutcome o;
-    o.stage = toString(r.stage);
-    o.psrUsed = r.psr.used, o.psrRejected = r.psr.rejected;
-    o.doppUsed = r.dopp.used, o.doppRejected = r.dopp.rejected;
-    o.dpsrUsed = r.dpsr.used, o.dpsrRejected = r.dpsr.rejected;
-    o.ddcpUsed = r.ddcp.used, o.ddcpRejected = r.ddcp.rejected;
-    o.velUsed = r.vel.used, o.velRejected = r.vel.rejected;
-    o.phaseUsed = r.phase.used, o.phaseRejected = r.phase.rejected, o.ambiguities = r.ambiguities;
-    o.recordChanges = r.recordChanges;
-    o.updated = r.updated, o.rtkFixed = r.rtkFixed, o.reset = r.reset;
-    o.chi2 = r.chi2, o.dof = r.dof;
-    o.antennaEcef = r.antennaEcef;
-    o.antennaVelocityEcef = r.antennaVelocityEcef;
-    if (r.antennaEcef) {
-      if (const auto c = fusion_.antennaCovariance(est_, r.t_ns)) o.antennaCovarianceEcef = *c;
+    o.report = fusion_.processEpoch(est_, rover, base, nav);
+    if (o.report.antennaEcef) {
+      if (const auto c = fusion_.antennaCovariance(est_, o.report.t_ns)) o.antennaCovarianceEcef = *c;
     }
-    o.warnings = r.warnings;
-    if (r.insStart) o.insStart = std::string(gnssInsStatusText(*r.insStart));
     return o;
   }
   std::optional<Eigen::Vector3d> leverArm() const override { return fusion_.leverArm(est_); }
