@@ -193,21 +193,42 @@ bool GnssFusion<Scalar>::startFrame(vio::EstimatorBackend<Scalar>& est, const Sp
   return true;
 }
 
+namespace {
+
+/// Covariance of [heading, p_N] of the newest IMU state in local ENU while the frame block
+/// [ψ, p_NW] is a state: heading = ψ + the yaw of R_WI (δθ is the right perturbation of R_WI, so
+/// its world yaw is e_zᵀ R_WI δθ), p_N = p_NW + Rz(ψ) p_W. The frame's own ψ is not the quantity
+/// the rows depend on: after a long stretch without GNSS (a cold start whose ephemerides come
+/// late) the IMU's yaw in W has drifted with an uncertainty no GNSS row can reduce, and σ_ψ keeps
+/// it, while the IMU's heading in ENU is what the GNSS rows determine. nullopt while not informed.
+template <typename Scalar>
+std::optional<Eigen::Matrix4d> enuHeadingPositionCovariance(const vio::EstimatorBackend<Scalar>& est,
+                                                            sri::BlockId frame) {
+  const vio::ImuBlocks ib = est.newestImuBlocks();
+  const std::array<sri::BlockId, 2> ids{ib.pose, frame};
+  if (!est.informed(ids)) return std::nullopt;
+  const Eigen::MatrixXd P = est.covariance(ids).template cast<double>();
+  const vio::ImuState x = est.newestImuState();
+  const Eigen::Matrix3d Rz = yawRotation(static_cast<double>(est.estimate(frame).vector[0]));
+  Eigen::Matrix<double, 4, 10> J = Eigen::Matrix<double, 4, 10>::Zero();  // ∂[heading; p_N]/∂[δθ δp | ψ p_NW]
+  J.block<1, 3>(0, 0) = x.R_WI.row(2);
+  J(0, 6) = 1.0;
+  J.block<3, 3>(1, 3) = Rz;
+  J.block<3, 1>(1, 6) = Eigen::Vector3d::UnitZ().cross(Rz * x.p_WI);
+  J.block<3, 3>(1, 7).setIdentity();
+  return Eigen::Matrix4d(J * P * J.transpose());
+}
+
+}  // namespace
+
 template <typename Scalar>
 bool GnssFusion<Scalar>::frameKnownInEnu(const vio::EstimatorBackend<Scalar>& est) const {
-  const vio::ImuBlocks ib = est.newestImuBlocks();
-  const std::array<sri::BlockId, 2> ids{ib.pose, frameBlock_};
-  if (!est.informed(ids)) return false;  // not informed (yet)
-  const Eigen::MatrixXd P = est.covariance(ids).template cast<double>();
-  const Eigen::Matrix3d Rz = yawRotation(static_cast<double>(est.estimate(frameBlock_).vector[0]));
-  Eigen::Matrix<double, 3, 10> J = Eigen::Matrix<double, 3, 10>::Zero();  // ∂p_N/∂[δθ δp | ψ p_NW]
-  J.block<3, 3>(0, 3) = Rz;
-  J.col(6) = Eigen::Vector3d::UnitZ().cross(Rz * est.newestImuState().p_WI);
-  J.block<3, 3>(0, 7).setIdentity();
-  const Eigen::Matrix3d Pn = J * P * J.transpose();
+  const std::optional<Eigen::Matrix4d> C = enuHeadingPositionCovariance(est, frameBlock_);
+  if (!C) return false;  // not informed (yet)
+  const Eigen::Vector4d var = C->diagonal();
   const double sth = config_.frameYawSigmaDeg * constants::kDegToRad;
   const double sp = config_.frameReanchorPositionSigma;
-  return P(6, 6) < sth * sth && Pn.diagonal().maxCoeff() < sp * sp;
+  return var[0] < sth * sth && var.tail<3>().maxCoeff() < sp * sp;
 }
 
 template <typename Scalar>
@@ -592,11 +613,10 @@ bool GnssFusion<Scalar>::frameUpdate(vio::EstimatorBackend<Scalar>& est, Epoch& 
   rep.dof = u.dof;
   for (std::size_t i = 0; i < rows.size(); ++i) (acc[i] ? rep.frame.used : rep.frame.rejected)++;
   rep.updated = u.applied;
-  if (est.informed(frameIds)) {
-    const auto P = est.covariance(frameIds);
-    const double sth = config_.frameYawSigmaDeg * constants::kDegToRad;
-    if (static_cast<double>(P(0, 0)) < sth * sth) stage_ = GnssFusionStage::kTight;
-  }
+  // Converged when the IMU's heading in ENU is known to σ_θ (enuHeadingPositionCovariance).
+  const std::optional<Eigen::Matrix4d> C = enuHeadingPositionCovariance(est, frameBlock_);
+  const double sth = config_.frameYawSigmaDeg * constants::kDegToRad;
+  if (C && (*C)(0, 0) < sth * sth) stage_ = GnssFusionStage::kTight;
   return true;
 }
 
