@@ -366,6 +366,38 @@ bool whitenRows(Eigen::MatrixXd& A, const Eigen::MatrixXd& noise, const std::vec
   return true;
 }
 
+/// The rows as the re-acquisition tests see them (gnss_gate_recovery.hpp). G: the columns of the
+/// newest pose's δp and of the receiver clock (range rows), of the velocity and the clock drift
+/// (rate rows). The band variance: the measurement noise plus the states G leaves out (the
+/// inter-system biases, the wet delay, the ambiguities; attitude, biases, frame and lever arm act
+/// on an epoch's rows through the antenna position and velocity, which the correction takes).
+ReacquisitionRows reacquisitionRows(const RowLayout& lay, const Eigen::MatrixXd& HJ, const Eigen::MatrixXd& P,
+                                    const Eigen::Matrix<double, 9, 9>& intCov, const Eigen::MatrixXd& noise,
+                                    const std::vector<GnssRow>& rows, const std::vector<int>& groups) {
+  const Eigen::Index n = HJ.rows(), dim = lay.dim;
+  const auto H = HJ.leftCols(dim);
+  const auto J = HJ.rightCols<9>();
+  ReacquisitionRows out;
+  out.group = groups;
+  out.residual.resize(n);
+  out.G = Eigen::MatrixXd::Zero(n, 4);
+  out.S = H * P * H.transpose() + J * intCov * J.transpose() + noise;
+  // The layout's blocks after the clock: inter-system biases, wet delay, ambiguities.
+  const Eigen::Index other = lay.isbAt >= 0 ? lay.isbAt : lay.zwdAt >= 0 ? lay.zwdAt : lay.ambiguityAt;
+  Eigen::MatrixXd Ho = Eigen::MatrixXd::Zero(n, dim);
+  Ho.rightCols(dim - other) = H.rightCols(dim - other);
+  out.bandVariance = (Ho * P).cwiseProduct(Ho).rowwise().sum() + noise.diagonal();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const GnssRow& r = rows[static_cast<std::size_t>(i)];
+    out.residual[i] = r.residual;
+    out.sats.push_back(r.sat);
+    const bool rate = groups[static_cast<std::size_t>(i)] == kReacquireRate;
+    out.G.row(i).head<3>() = H.row(i).segment<3>(rate ? 6 : 3);  // δv or the pose's δp
+    if (lay.clockAt >= 0) out.G(i, 3) = H(i, lay.clockAt + (rate ? 1 : 0));
+  }
+  return out;
+}
+
 }  // namespace
 
 template <typename Scalar>
@@ -373,7 +405,8 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
                                                      const Eigen::MatrixXd& noise,
                                                      const Eigen::Matrix<double, 9, 9>& intCov,
                                                      std::vector<bool>& accepted, bool gate,
-                                                     const std::vector<sri::BlockId>& ambiguities) {
+                                                     const std::vector<sri::BlockId>& ambiguities,
+                                                     ReacquisitionEpoch* reacquisition) {
   const vio::ImuBlocks ib = est.newestImuBlocks();
   accepted.assign(rows.size(), false);
   RowLayout lay;
@@ -426,6 +459,24 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
     }
     keep.push_back(static_cast<int>(i));
   }
+  // Re-acquisition (gnss_gate_recovery.hpp): the widened gate and the consensus choose the rows
+  // of their groups; the other rows keep the row gate above.
+  bool readmitted = false;
+  if (reacquisition && haveP) {
+    ReacquisitionEpoch& re = *reacquisition;
+    re.rows = reacquisitionRows(lay, HJ, P, intCov, noise, rows, re.groups);
+    re.selection = selectReacquisitionRows(re.rows, re.tau, gateRecovery_.acceleration(), q1, config_.epochGate);
+    std::vector<int> chosen;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const bool normal = std::find(keep.begin(), keep.end(), static_cast<int>(i)) != keep.end();
+      const bool admitted = re.selection.admitted[i];
+      if (re.groups[i] == kReacquireNone ? normal : admitted) chosen.push_back(static_cast<int>(i));
+      if (admitted && !normal) re.normal = false;
+      readmitted = readmitted || admitted;
+    }
+    for (const ReacquisitionGroupResult& g : re.selection.groups) re.normal = re.normal && (g.offered == 0 || g.admitted);
+    keep = std::move(chosen);
+  }
   vio::BackendUpdate<Scalar> u;
   if (keep.empty()) return u;
 
@@ -465,6 +516,11 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
   m.setWhitened();
   if (nuisance) m.projectNuisance(nullptr, sri::Measurement<Scalar>::NuisanceProjection::kHouseholder);
   u = est.update(m, gate ? config_.epochGate : 1.0);
+  if (readmitted) {
+    // Rejected by the normal epoch gate: the widened joint χ² of the consensus stands for it.
+    reacquisition->normal = reacquisition->normal && u.applied;
+    if (!u.applied) u = est.update(m, 1.0);
+  }
   if (u.applied) {
     for (int i : keep) accepted[static_cast<std::size_t>(i)] = true;
   }

@@ -206,11 +206,13 @@ class GnssFusion {
   /// Random walk of the zenith wet delay state to time t.
   void propagateZwd(vio::EstimatorBackend<Scalar>& est, const GpsTime& t);
   /// Gates rows one by one, stacks the accepted ones and applies them; returns the update.
-  /// `ambiguities`: the blocks that rows' `ambiguity` indices refer to.
+  /// `ambiguities`: the blocks that rows' `ambiguity` indices refer to. `reacquisition`: the
+  /// epoch goes through the re-acquisition gate instead (gnss_gate_recovery.hpp).
   vio::BackendUpdate<Scalar> apply(vio::EstimatorBackend<Scalar>& est, std::vector<GnssRow>& rows,
                                    const Eigen::MatrixXd& noise, const Eigen::Matrix<double, 9, 9>& intCov,
                                    std::vector<bool>& accepted, bool gate,
-                                   const std::vector<sri::BlockId>& ambiguities = {});
+                                   const std::vector<sri::BlockId>& ambiguities = {},
+                                   ReacquisitionEpoch* reacquisition = nullptr);
   /// vio+dopp+ppp: marginalizes the ambiguity state of `sat` (arc ended, slipped or rejected).
   void dropAmbiguity(vio::EstimatorBackend<Scalar>& est, SatId sat);
   /// Whether the ids held belong to the estimator's current state (EstimatorBackend::generation).
@@ -248,7 +250,7 @@ class GnssFusion {
   std::size_t jumpWarned_ = 0;
   std::vector<std::string> clockNotices_;  // systems that joined the clocks late
   std::size_t clockWarned_ = 0;
-  GnssGateRecovery gateRecovery_{config_.reacquireAfter, config_.reacquireWindow};
+  GnssGateRecovery gateRecovery_{config_.reacquireAfter, config_.reacquireAcceleration};
   std::size_t gateWarned_ = 0;
   ObsEpoch checkedRover_;      // the rover epoch after the Doppler check
   std::size_t baseWarned_ = 0;  // warnings of rtk_'s base Doppler check already reported
