@@ -226,7 +226,9 @@ void GnssGateRecovery::outcome(const GpsTime& t, std::size_t rows, bool applied,
     rejectedSince_ = t;
   }
   if (!active_) return;
-  if (selection && input && applied) {
+  const bool admitted =
+      selection && std::find(selection->admitted.begin(), selection->admitted.end(), true) != selection->admitted.end();
+  if (admitted && input && applied) {
     ++admissions_;
     for (const auto& g : selection->groups) rowsExcluded_ += g.offered - (g.admitted ? g.agreeing : 0);
     char buf[80];
