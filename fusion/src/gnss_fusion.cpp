@@ -156,21 +156,42 @@ bool GnssFusion<Scalar>::startFrame(vio::EstimatorBackend<Scalar>& est, const Sp
   return true;
 }
 
+namespace {
+
+/// Covariance of [heading, p_N] of the newest IMU state in local ENU while the frame block
+/// [ψ, p_NW] is a state: heading = ψ + the yaw of R_WI (δθ is the right perturbation of R_WI, so
+/// its world yaw is e_zᵀ R_WI δθ), p_N = p_NW + Rz(ψ) p_W. The frame's own ψ is not the quantity
+/// the rows depend on: after a long stretch without GNSS (a cold start whose ephemerides come
+/// late) the IMU's yaw in W has drifted with an uncertainty no GNSS row can reduce, and σ_ψ keeps
+/// it, while the IMU's heading in ENU is what the GNSS rows determine. nullopt while not informed.
+template <typename Scalar>
+std::optional<Eigen::Matrix4d> enuHeadingPositionCovariance(const vio::EstimatorBackend<Scalar>& est,
+                                                            sri::BlockId frame) {
+  const vio::ImuBlocks ib = est.newestImuBlocks();
+  const std::array<sri::BlockId, 2> ids{ib.pose, frame};
+  if (!est.informed(ids)) return std::nullopt;
+  const Eigen::MatrixXd P = est.covariance(ids).template cast<double>();
+  const vio::ImuState x = est.newestImuState();
+  const Eigen::Matrix3d Rz = yawRotation(static_cast<double>(est.estimate(frame).vector[0]));
+  Eigen::Matrix<double, 4, 10> J = Eigen::Matrix<double, 4, 10>::Zero();  // ∂[heading; p_N]/∂[δθ δp | ψ p_NW]
+  J.block<1, 3>(0, 0) = x.R_WI.row(2);
+  J(0, 6) = 1.0;
+  J.block<3, 3>(1, 3) = Rz;
+  J.block<3, 1>(1, 6) = Eigen::Vector3d::UnitZ().cross(Rz * x.p_WI);
+  J.block<3, 3>(1, 7).setIdentity();
+  return Eigen::Matrix4d(J * P * J.transpose());
+}
+
+}  // namespace
+
 template <typename Scalar>
 bool GnssFusion<Scalar>::frameKnownInEnu(const vio::EstimatorBackend<Scalar>& est) const {
-  const vio::ImuBlocks ib = est.newestImuBlocks();
-  const std::array<sri::BlockId, 2> ids{ib.pose, frameBlock_};
-  if (!est.informed(ids)) return false;  // not informed (yet)
-  const Eigen::MatrixXd P = est.covariance(ids).template cast<double>();
-  const Eigen::Matrix3d Rz = yawRotation(static_cast<double>(est.estimate(frameBlock_).vector[0]));
-  Eigen::Matrix<double, 3, 10> J = Eigen::Matrix<double, 3, 10>::Zero();  // ∂p_N/∂[δθ δp | ψ p_NW]
-  J.block<3, 3>(0, 3) = Rz;
-  J.col(6) = Eigen::Vector3d::UnitZ().cross(Rz * est.newestImuState().p_WI);
-  J.block<3, 3>(0, 7).setIdentity();
-  const Eigen::Matrix3d Pn = J * P * J.transpose();
+  const std::optional<Eigen::Matrix4d> C = enuHeadingPositionCovariance(est, frameBlock_);
+  if (!C) return false;  // not informed (yet)
+  const Eigen::Vector4d var = C->diagonal();
   const double sth = config_.frameYawSigmaDeg * constants::kDegToRad;
   const double sp = config_.frameReanchorPositionSigma;
-  return P(6, 6) < sth * sth && Pn.diagonal().maxCoeff() < sp * sp;
+  return var[0] < sth * sth && var.tail<3>().maxCoeff() < sp * sp;
 }
 
 template <typename Scalar>
@@ -262,6 +283,38 @@ bool whitenRows(Eigen::MatrixXd& A, const Eigen::MatrixXd& noise, const std::vec
   return true;
 }
 
+/// The rows as the re-acquisition tests see them (gnss_gate_recovery.hpp). G: the columns of the
+/// newest pose's δp and of the receiver clock (range rows), of the velocity and the clock drift
+/// (rate rows). The band variance: the measurement noise plus the states G leaves out (the
+/// inter-system biases, the wet delay, the ambiguities; attitude, biases, frame and lever arm act
+/// on an epoch's rows through the antenna position and velocity, which the correction takes).
+ReacquisitionRows reacquisitionRows(const RowLayout& lay, const Eigen::MatrixXd& HJ, const Eigen::MatrixXd& P,
+                                    const Eigen::Matrix<double, 9, 9>& intCov, const Eigen::MatrixXd& noise,
+                                    const std::vector<GnssRow>& rows, const std::vector<int>& groups) {
+  const Eigen::Index n = HJ.rows(), dim = lay.dim;
+  const auto H = HJ.leftCols(dim);
+  const auto J = HJ.rightCols<9>();
+  ReacquisitionRows out;
+  out.group = groups;
+  out.residual.resize(n);
+  out.G = Eigen::MatrixXd::Zero(n, 4);
+  out.S = H * P * H.transpose() + J * intCov * J.transpose() + noise;
+  // The layout's blocks after the clock: inter-system biases, wet delay, ambiguities.
+  const Eigen::Index other = lay.isbAt >= 0 ? lay.isbAt : lay.zwdAt >= 0 ? lay.zwdAt : lay.ambiguityAt;
+  Eigen::MatrixXd Ho = Eigen::MatrixXd::Zero(n, dim);
+  Ho.rightCols(dim - other) = H.rightCols(dim - other);
+  out.bandVariance = (Ho * P).cwiseProduct(Ho).rowwise().sum() + noise.diagonal();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const GnssRow& r = rows[static_cast<std::size_t>(i)];
+    out.residual[i] = r.residual;
+    out.sats.push_back(r.sat);
+    const bool rate = groups[static_cast<std::size_t>(i)] == kReacquireRate;
+    out.G.row(i).head<3>() = H.row(i).segment<3>(rate ? 6 : 3);  // δv or the pose's δp
+    if (lay.clockAt >= 0) out.G(i, 3) = H(i, lay.clockAt + (rate ? 1 : 0));
+  }
+  return out;
+}
+
 }  // namespace
 
 template <typename Scalar>
@@ -269,7 +322,8 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
                                                      const Eigen::MatrixXd& noise,
                                                      const Eigen::Matrix<double, 9, 9>& intCov,
                                                      std::vector<bool>& accepted, bool gate,
-                                                     const std::vector<sri::BlockId>& ambiguities) {
+                                                     const std::vector<sri::BlockId>& ambiguities,
+                                                     ReacquisitionEpoch* reacquisition) {
   const vio::ImuBlocks ib = est.newestImuBlocks();
   accepted.assign(rows.size(), false);
   RowLayout lay;
@@ -322,6 +376,24 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
     }
     keep.push_back(static_cast<int>(i));
   }
+  // Re-acquisition (gnss_gate_recovery.hpp): the widened gate and the consensus choose the rows
+  // of their groups; the other rows keep the row gate above.
+  bool readmitted = false;
+  if (reacquisition && haveP) {
+    ReacquisitionEpoch& re = *reacquisition;
+    re.rows = reacquisitionRows(lay, HJ, P, intCov, noise, rows, re.groups);
+    re.selection = selectReacquisitionRows(re.rows, re.tau, gateRecovery_.acceleration(), q1, config_.epochGate);
+    std::vector<int> chosen;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const bool normal = std::find(keep.begin(), keep.end(), static_cast<int>(i)) != keep.end();
+      const bool admitted = re.selection.admitted[i];
+      if (re.groups[i] == kReacquireNone ? normal : admitted) chosen.push_back(static_cast<int>(i));
+      if (admitted && !normal) re.normal = false;
+      readmitted = readmitted || admitted;
+    }
+    for (const ReacquisitionGroupResult& g : re.selection.groups) re.normal = re.normal && (g.offered == 0 || g.admitted);
+    keep = std::move(chosen);
+  }
   vio::BackendUpdate<Scalar> u;
   if (keep.empty()) return u;
 
@@ -361,6 +433,11 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
   m.setWhitened();
   if (nuisance) m.projectNuisance(nullptr, sri::Measurement<Scalar>::NuisanceProjection::kHouseholder);
   u = est.update(m, gate ? config_.epochGate : 1.0);
+  if (readmitted) {
+    // Rejected by the normal epoch gate: the widened joint χ² of the consensus stands for it.
+    reacquisition->normal = reacquisition->normal && u.applied;
+    if (!u.applied) u = est.update(m, 1.0);
+  }
   if (u.applied) {
     for (int i : keep) accepted[static_cast<std::size_t>(i)] = true;
   }
@@ -508,11 +585,10 @@ bool GnssFusion<Scalar>::frameUpdate(vio::EstimatorBackend<Scalar>& est, Epoch& 
   rep.dof = u.dof;
   for (std::size_t i = 0; i < rows.size(); ++i) (acc[i] ? rep.frame.used : rep.frame.rejected)++;
   rep.updated = u.applied;
-  if (est.informed(frameIds)) {
-    const auto P = est.covariance(frameIds);
-    const double sth = config_.frameYawSigmaDeg * constants::kDegToRad;
-    if (static_cast<double>(P(0, 0)) < sth * sth) stage_ = GnssFusionStage::kTight;
-  }
+  // Converged when the IMU's heading in ENU is known to σ_θ (enuHeadingPositionCovariance).
+  const std::optional<Eigen::Matrix4d> C = enuHeadingPositionCovariance(est, frameBlock_);
+  const double sth = config_.frameYawSigmaDeg * constants::kDegToRad;
+  if (C && (*C)(0, 0) < sth * sth) stage_ = GnssFusionStage::kTight;
   return true;
 }
 

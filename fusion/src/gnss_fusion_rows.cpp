@@ -199,9 +199,21 @@ template <typename Scalar>
 void GnssFusion<Scalar>::applyRows(vio::EstimatorBackend<Scalar>& est, GnssEpochReport& rep,
                                    const AntennaKinematics& k, GnssRowSet& rows) {
   std::vector<bool> acc;
-  const auto u = apply(est, rows.rows, rows.noise(), k.integrationCovariance, acc, gateRecovery_.gated(rep.time),
-                       rows.ambiguityBlocks);
-  gateRecovery_.outcome(rep.time, u.applied, rows.size());  // re-acquisition (gnss_gate_recovery.hpp)
+  // Re-acquisition (gnss_gate_recovery.hpp): code, phase and differences agree on a position and
+  // clock shift, Dopplers on a velocity and drift shift; SPP velocity triples keep their gate.
+  ReacquisitionEpoch re;
+  const bool reacquiring = gateRecovery_.reacquiring(rep.time);
+  if (reacquiring) {
+    re.tau = gateRecovery_.sinceUpdate(rep.time);
+    for (const int type : rows.types) {
+      re.groups.push_back(type == kDopp ? kReacquireRate : type == kVel || type == kFrame ? kReacquireNone : kReacquireRange);
+    }
+  }
+  const auto u = apply(est, rows.rows, rows.noise(), k.integrationCovariance, acc, true, rows.ambiguityBlocks,
+                       reacquiring ? &re : nullptr);
+  const bool tested = !re.selection.admitted.empty();
+  gateRecovery_.outcome(rep.time, rows.size(), u.applied, re.normal, tested ? &re.selection : nullptr,
+                        tested ? &re.rows : nullptr);
   rep.chi2 = static_cast<double>(u.chi2);
   rep.dof = u.dof;
   rep.updated = u.applied;

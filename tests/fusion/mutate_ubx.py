@@ -3,16 +3,21 @@
 checks (tests/fusion/real_walk_quirks.sh).
 
     mutate_ubx.py IN OUT [--clock-jump MS@S ...] [--flip-doppler] [--late-ephemeris S]
+                         [--code-bias SATS:M@S0-S1 ...]
 
   --clock-jump MS@S   from S seconds after the first RXM-RAWX epoch on, every pseudorange moves by
                       MS·c·1 ms and every carrier phase by MS·1 ms·f cycles (a receiver clock jump
                       as a free-running u-blox clock makes it; repeatable, jumps add up)
   --flip-doppler      every RXM-RAWX Doppler negated (the opposite sign convention)
   --late-ephemeris S  RXM-SFRBX messages of the first S seconds removed (ephemerides arrive late)
+  --code-bias SATS:M@S0-S1
+                      every pseudorange of the satellites SATS (e.g. G10,E07) moves by M metres from
+                      S0 to S1 seconds after the first RXM-RAWX epoch, carrier phases untouched (a
+                      burst of NLOS or multipath code errors; repeatable)
 
 RXM-RAWX layout (u-blox interface description, UBX-RXM-RAWX): 16-byte header (rcvTow R8, week U2,
 ...), then 32 bytes per measurement: prMes R8 at 0, cpMes R8 at 8, doMes R4 at 16, gnssId U1 at
-20, sigId U1 at 22, freqId U1 at 23. Frames keep their length; checksums are recomputed.
+20, svId U1 at 21, sigId U1 at 22, freqId U1 at 23. Frames keep their length; checksums are recomputed.
 """
 import argparse
 import struct
@@ -30,6 +35,10 @@ BANDS = {
     5: {0: 1575.42, 1: 1575.42, 4: 1227.60, 5: 1227.60, 8: 1176.45, 9: 1176.45},
     7: {0: 1176.45},
 }
+
+
+# RINEX system letter per gnssId.
+LETTER = {0: "G", 1: "S", 2: "E", 3: "C", 5: "J", 6: "R"}
 
 
 def frequency(gnss, sig, freq_id):
@@ -74,7 +83,14 @@ def main():
     ap.add_argument("--clock-jump", action="append", default=[])
     ap.add_argument("--flip-doppler", action="store_true")
     ap.add_argument("--late-ephemeris", type=float, default=0.0)
+    ap.add_argument("--code-bias", action="append", default=[])
     a = ap.parse_args()
+    biases = []  # (satellites, metres, start, end)
+    for b in a.code_bias:
+        sats, rest = b.split(":")
+        m, span = rest.split("@")
+        s0, s1 = span.split("-")
+        biases.append((set(sats.split(",")), float(m), float(s0), float(s1)))
     jumps = []
     for j in a.clock_jump:
         ms, at = j.split("@")
@@ -82,7 +98,7 @@ def main():
     data = open(a.inp, "rb").read()
     out = bytearray()
     t0 = tow = None
-    counts = {"rawx": 0, "jumped": 0, "sfrbx_removed": 0}
+    counts = {"rawx": 0, "jumped": 0, "sfrbx_removed": 0, "biased": 0}
     for _, cls, mid, payload in frames(data):
         if cls is None:
             out += payload
@@ -107,6 +123,11 @@ def main():
                     if cp != 0.0 and f:
                         cp += ms * 1e-3 * f * 1e6
                     counts["jumped"] += 1
+                sat = "%s%02d" % (LETTER.get(p[o + 20], "?"), p[o + 21])
+                for sats, m, s0, s1 in biases:
+                    if sat in sats and s0 <= tow - t0 < s1 and pr != 0.0:
+                        pr += m
+                        counts["biased"] += 1
                 if a.flip_doppler:
                     dop = -dop
                 struct.pack_into("<ddf", p, o, pr, cp, dop)
@@ -116,8 +137,8 @@ def main():
         body = bytes((cls, mid)) + struct.pack("<H", len(p)) + bytes(p)
         out += SYNC + body + checksum(body)
     open(a.out, "wb").write(out)
-    print("mutate_ubx: %d RAWX epochs, %d measurements jumped, %d SFRBX removed" %
-          (counts["rawx"], counts["jumped"], counts["sfrbx_removed"]), file=sys.stderr)
+    print("mutate_ubx: %d RAWX epochs, %d measurements jumped, %d SFRBX removed, %d pseudoranges biased" %
+          (counts["rawx"], counts["jumped"], counts["sfrbx_removed"], counts["biased"]), file=sys.stderr)
 
 
 if __name__ == "__main__":

@@ -61,7 +61,7 @@ check "late ephemerides: H RMS m" "$(metric global_horizontal_rmse_m "$W/late/me
 
 replay outages "$UBX" --gnss-outage 20,15 --gnss-outage 50,15 --gnss-outage 80,15 --gnss-outage 110,15
 has "outage epochs counted" "$W/outages.out" "240 in simulated outages"
-has "re-acquisition reported" "$W/outages.out" "re-acquiring without the gates"
+has "re-acquisition reported" "$W/outages.out" "re-acquiring through the widened gate"
 check "outages: H RMS m" "$(metric global_horizontal_rmse_m "$W/outages/metrics.csv")" "<=" 10
 # The drift of single 15 s outages (bench/fusion/real_walk.py table 2: 6.34 and 9.57 m with
 # vio+dopp+psr, 8.16 m with vio+dopp+ppp at 100 s); bound 12 m.

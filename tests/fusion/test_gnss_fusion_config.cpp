@@ -114,12 +114,12 @@ TEST(GnssFusionConfig, ReacquisitionAndLateSystemKeys) {
   EXPECT_DOUBLE_EQ(d.reacquireAfter, 2.0);
   EXPECT_EQ(d.lateSystemMinSatellites, 2);
   const GnssFusionConfig c = parseGnssFusionConfig(
-      "gnss_fusion:\n  reacquire_after: 0\n  reacquire_window: 0.5\n  late_system_min_satellites: 4\n");
+      "gnss_fusion:\n  reacquire_after: 0\n  reacquire_acceleration: 0.5\n  late_system_min_satellites: 4\n");
   EXPECT_DOUBLE_EQ(c.reacquireAfter, 0.0);  // never
-  EXPECT_DOUBLE_EQ(c.reacquireWindow, 0.5);
+  EXPECT_DOUBLE_EQ(c.reacquireAcceleration, 0.5);
   EXPECT_EQ(c.lateSystemMinSatellites, 4);
   EXPECT_THROW(parseGnssFusionConfig("gnss_fusion:\n  reacquire_after: -1\n"), ParseError);
-  EXPECT_THROW(parseGnssFusionConfig("gnss_fusion:\n  reacquire_window: 0\n"), ParseError);
+  EXPECT_THROW(parseGnssFusionConfig("gnss_fusion:\n  reacquire_acceleration: 0\n"), ParseError);
   EXPECT_THROW(parseGnssFusionConfig("gnss_fusion:\n  late_system_min_satellites: 0\n"), ParseError);
 }
 

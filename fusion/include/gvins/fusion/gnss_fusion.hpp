@@ -5,7 +5,8 @@
 //      RTK solver (gnss/ RtkSolver, LAMBDA) on rover + base for the SD code and the fixed DD phase.
 //   2. Frame initialisation (stage kFrameInit): client block [ψ, p_NW] with an uninformative prior
 //      added at the first SPP fix with enough speed (yaw guess from the velocity headings), updated
-//      with the SPP position/velocity predicted through the IMU integration until σ_ψ < σ_θ. Then
+//      with the SPP position/velocity predicted through the IMU integration until the σ of the
+//      IMU's heading in ENU (ψ + its yaw in W) < σ_θ. Then
 //      (frameReanchor) the estimator re-expresses its state in ENU and the block is marginalized
 //      (EstimatorBackend::reanchorWorld, an exact change of variables): as in the paper the frame
 //      leaves the state, but its information moves into the poses, so the VIO's yaw and position
@@ -17,7 +18,8 @@
 //      block): the receiver has one oscillator, the ISBs are hardware delays.
 //   4. Rows of the configured mode (gnss_measurement_models.hpp), each gated by a chi-square test
 //      (robust to NLOS), the accepted rows stacked, whitened with Σ_m + J Σ_g Jᵀ and applied with an
-//      epoch gate. No minimum satellite count once initialised.
+//      epoch gate. No minimum satellite count once initialised. After `reacquireAfter` s without
+//      an applied update, the re-acquisition gate instead (gnss_gate_recovery.hpp).
 //   5. Outages: after `outageReset` s without an applied GNSS update the clocks are re-initialised
 //      and the RTK ambiguities reset.
 #pragma once
@@ -169,11 +171,13 @@ class GnssFusion {
   /// reported into the epoch's warnings.
   void reportNotices(GnssEpochReport& rep);
   /// Gates rows one by one, stacks the accepted ones and applies them; returns the update.
-  /// `ambiguities`: the blocks that rows' `ambiguity` indices refer to.
+  /// `ambiguities`: the blocks that rows' `ambiguity` indices refer to. `reacquisition`: the
+  /// epoch goes through the re-acquisition gate instead (gnss_gate_recovery.hpp).
   vio::BackendUpdate<Scalar> apply(vio::EstimatorBackend<Scalar>& est, std::vector<GnssRow>& rows,
                                    const Eigen::MatrixXd& noise, const Eigen::Matrix<double, 9, 9>& intCov,
                                    std::vector<bool>& accepted, bool gate,
-                                   const std::vector<sri::BlockId>& ambiguities = {});
+                                   const std::vector<sri::BlockId>& ambiguities = {},
+                                   ReacquisitionEpoch* reacquisition = nullptr);
   /// Whether the ids held belong to the estimator's current state (EstimatorBackend::generation).
   bool current(const vio::EstimatorBackend<Scalar>& est) const { return est.generation() == generation_; }
   /// Forgets every id of the estimator's state and goes back to waiting for the VIO. A calibrated
@@ -205,7 +209,7 @@ class GnssFusion {
   std::size_t jumpWarned_ = 0;
   std::vector<std::string> clockNotices_;  // systems that joined the clocks late
   std::size_t clockWarned_ = 0;
-  GnssGateRecovery gateRecovery_{config_.reacquireAfter, config_.reacquireWindow};
+  GnssGateRecovery gateRecovery_{config_.reacquireAfter, config_.reacquireAcceleration};
   std::size_t gateWarned_ = 0;
   ObsEpoch checkedRover_;      // the rover epoch after the Doppler check
   std::size_t baseWarned_ = 0;  // warnings of rtk_'s base Doppler check already reported

@@ -51,8 +51,8 @@
 //                                         # marginalize the frame block (false: keep it as a state)
 //     frame_reanchor_position_sigma: 0.5  # m, ... once the IMU's ENU position σ is below this
 //     outage_reset: 60                    # s without GNSS update: clocks/ambiguities reset
-//     reacquire_after: 2                  # s of epochs with every row gated out: rows ungated ...
-//     reacquire_window: 1                 # ... for this long (re-acquisition; 0: never)
+//     reacquire_after: 2                  # s with every row gated out, or without update: re-acquisition (0: never)
+//     reacquire_acceleration: 0.3         # m/s², unmodelled acceleration that widens its gate with time
 //     late_system_min_satellites: 2       # satellites of a system first seen after the clocks started
 //     clock_ransac_threshold: 5.0         # m (pseudorange) for the clock RANSAC
 //     base_position: [x, y, z]            # ECEF of the base antenna (dpsr/ddcp)
@@ -186,11 +186,13 @@ struct GnssFusionConfig {
   /// A system first seen after the clocks started (its ephemerides arrived later) joins the clock
   /// state once this many of its satellites have a model (GnssFusion::addLateClockSystems).
   int lateSystemMinSatellites = 2;
-  /// Tight stage: after every epoch's rows were gated out for reacquireAfter seconds (the state
-  /// drifted beyond its covariance, e.g. through an outage), the rows are applied without the
-  /// gates for reacquireWindow seconds (gnss_gate_recovery.hpp); reacquireAfter <= 0: never.
+  /// Tight stage: after every epoch's rows were gated out, or no update was applied, for
+  /// reacquireAfter seconds, the rows go through the re-acquisition gate (gnss_gate_recovery.hpp):
+  /// the predicted innovation covariance widened as by an unmodelled acceleration
+  /// reacquireAcceleration (m/s²) since the last update, and a consensus of the satellites.
+  /// reacquireAfter <= 0: never.
   double reacquireAfter = 2.0;
-  double reacquireWindow = 1.0;
+  double reacquireAcceleration = 0.3;
   double rowGate = 0.999;
   double epochGate = 0.99999;
   double frameYawSigmaDeg = 3.0;
