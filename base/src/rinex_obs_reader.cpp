@@ -169,9 +169,24 @@ struct RinexObsReader::Impl {
 
   void readHeader();
   void headerLine(std::string_view l, std::string_view lab, bool inFile);
+  // Multi-field header records (headerLine).
+  void obsTypesLine(std::string_view l, const TextLocation& w, const std::string& labStr);
+  void rinex2TypesLine(std::string_view l, const TextLocation& w, const std::string& labStr);
+  void scaleFactorLine(std::string_view l, const TextLocation& w, const std::string& labStr);
+  void phaseShiftLine(std::string_view l, const TextLocation& w, const std::string& labStr);
+  void glonassSlotLine(std::string_view l, const TextLocation& w, const std::string& labStr);
+  void glonassBiasLine(std::string_view l, const TextLocation& w, const std::string& labStr);
+  void observationTimeLine(std::string_view l, std::string_view lab, const TextLocation& w, const std::string& labStr);
   void buildLayouts();
   GpsTime epochTime(const CalendarTime& c) const;
   bool readEpoch(ObsEpoch& e);
+  // Steps of readEpoch.
+  GpsTime epochLineTime(std::string_view l) const;
+  void readSpecialRecords(long nsat);
+  std::size_t readRinex2Satellites(ObsEpoch& e, long nsat);
+  std::size_t readRinex3Satellites(ObsEpoch& e, long nsat);
+  SatObs& beginSat(ObsEpoch& e, std::size_t& used, SatId id, const SystemLayout& lay);
+  void skipSat(std::string_view id, const char* why);
   void readSatValues(std::string_view l, std::size_t start, std::size_t perLine, SatObs& so,
                      const SystemLayout& lay, std::size_t firstColumn, std::size_t count);
   void finishSat(SatObs& so, const SystemLayout& lay);
@@ -280,131 +295,19 @@ void RinexObsReader::Impl::headerLine(std::string_view l, std::string_view lab, 
       hdr.station.antennaDeltaHen[i] = v;
     }
   } else if (lab == "SYS / # / OBS TYPES") {
-    const std::string_view s = column(l, 0, 1);
-    if (!s.empty() && s[0] != ' ') {
-      const auto sys = systemFromLetter(s[0]);
-      if (!sys) fail(labStr, "unknown satellite system '" + std::string(s) + "'");
-      lastTypesSystem = systemIndex(*sys);
-      const long n = parseInt(column(l, 3, 3), w, labStr + " count");
-      if (n < 0 || n > 999) fail(labStr + " count", "invalid number of types " + std::to_string(n));
-      declaredTypes[lastTypesSystem] = static_cast<int>(n);
-      rawTypes[lastTypesSystem].clear();
-      typesChanged = true;
-    } else if (lastTypesSystem < 0) {
-      fail(labStr, "continuation line without a system");
-    }
-    auto& list = rawTypes[lastTypesSystem];
-    for (int k = 0; k < 13; ++k) {
-      const std::string_view t = trimmedColumn(l, 7 + 4 * k, 3);
-      if (t.empty()) continue;
-      if (static_cast<int>(list.size()) >= declaredTypes[lastTypesSystem]) {
-        fail(labStr, "more types than the " + std::to_string(declaredTypes[lastTypesSystem]) + " declared");
-      }
-      list.emplace_back(t);
-    }
+    obsTypesLine(l, w, labStr);
   } else if (lab == "# / TYPES OF OBSERV") {
-    const auto n = parseOptionalInt(column(l, 0, 6), w, labStr + " count");
-    if (n) {
-      if (*n < 0 || *n > 999) fail(labStr + " count", "invalid number of types " + std::to_string(*n));
-      declaredR2Types = static_cast<int>(*n);
-      hdr.rinex2Types.clear();
-      typesChanged = true;
-    } else if (declaredR2Types < 0) {
-      fail(labStr, "continuation line without a count");
-    }
-    for (int k = 0; k < 9; ++k) {
-      const std::string_view t = trimmedColumn(l, 10 + 6 * k, 2);
-      if (t.empty()) continue;
-      if (static_cast<int>(hdr.rinex2Types.size()) >= declaredR2Types) {
-        fail(labStr, "more types than the " + std::to_string(declaredR2Types) + " declared");
-      }
-      hdr.rinex2Types.emplace_back(t);
-    }
+    rinex2TypesLine(l, w, labStr);
   } else if (lab == "SYS / SCALE FACTOR") {
-    const std::string_view s = column(l, 0, 1);
-    if (!s.empty() && s[0] != ' ') {
-      const auto sys = systemFromLetter(s[0]);
-      if (!sys) fail(labStr, "unknown satellite system '" + std::string(s) + "'");
-      lastScaleSystem = systemIndex(*sys);
-      const long f = parseInt(column(l, 2, 4), w, labStr + " factor");
-      if (f != 1 && f != 10 && f != 100 && f != 1000) {
-        fail(labStr + " factor", "factor must be 1, 10, 100 or 1000, not " + std::to_string(f));
-      }
-      lastScaleFactor = static_cast<double>(f);
-      const auto n = parseOptionalInt(column(l, 8, 2), w, labStr + " count");
-      if (!n || *n == 0) scale[lastScaleSystem].emplace_back("", lastScaleFactor);
-      typesChanged = true;
-    } else if (lastScaleSystem < 0) {
-      fail(labStr, "continuation line without a system");
-    }
-    for (int k = 0; k < 12; ++k) {
-      const std::string_view t = trimmedColumn(l, 11 + 4 * k, 3);
-      if (!t.empty()) scale[lastScaleSystem].emplace_back(std::string(t), lastScaleFactor);
-    }
+    scaleFactorLine(l, w, labStr);
   } else if (lab == "SYS / PHASE SHIFT") {
-    const std::string_view s = column(l, 0, 1);
-    if (!s.empty() && s[0] != ' ') {
-      const auto sys = systemFromLetter(s[0]);
-      if (!sys) fail(labStr, "unknown satellite system '" + std::string(s) + "'");
-      PhaseShiftRecord r;
-      r.system = *sys;
-      r.obs = ObsDescriptor::parse(trimmedColumn(l, 2, 3));
-      r.cycles = parseOptionalDouble(column(l, 6, 8), w, labStr + " correction");
-      hdr.phaseShifts.push_back(r);
-      lastPhaseShift = &hdr.phaseShifts.back();
-    }
-    if (lastPhaseShift) {
-      for (int k = 0; k < 10; ++k) {
-        const std::string_view t = trimmedColumn(l, 19 + 4 * k, 3);
-        if (t.empty()) continue;
-        const auto sat = SatId::parse(t);
-        if (!sat) fail(labStr + " satellite", "invalid satellite '" + std::string(t) + "'");
-        lastPhaseShift->satellites.push_back(*sat);
-      }
-    }
+    phaseShiftLine(l, w, labStr);
   } else if (lab == "GLONASS SLOT / FRQ #") {
-    const auto n = parseOptionalInt(column(l, 0, 3), w, labStr + " count");
-    if (n) {
-      declaredSlots = static_cast<int>(*n);
-      slotCount = 0;
-    }
-    for (int k = 0; k < 8; ++k) {
-      const std::string_view t = trimmedColumn(l, 4 + 7 * k, 3);
-      if (t.empty()) continue;
-      const auto sat = SatId::parse(t);
-      if (!sat || sat->system != System::Glonass) {
-        fail(labStr + " slot", "invalid GLONASS slot '" + std::string(t) + "'");
-      }
-      const long ch = parseInt(column(l, 8 + 7 * k, 2), w, labStr + " channel");
-      if (ch < -7 || ch > 6) fail(labStr + " channel", "channel " + std::to_string(ch) + " outside -7..6");
-      hdr.glonassChannels.set(sat->prn, static_cast<int>(ch));
-      ++slotCount;
-    }
+    glonassSlotLine(l, w, labStr);
   } else if (lab == "GLONASS COD/PHS/BIS") {
-    for (int k = 0; k < 4; ++k) {
-      const std::string_view t = trimmedColumn(l, 1 + 13 * k, 3);
-      if (t.empty()) continue;
-      const auto d = ObsDescriptor::parse(t);
-      if (!d) fail(labStr, "invalid observation code '" + std::string(t) + "'");
-      hdr.glonassBiases.push_back({*d, parseOptionalDouble(column(l, 5 + 13 * k, 8), w, labStr + " bias")});
-    }
+    glonassBiasLine(l, w, labStr);
   } else if (lab == "TIME OF FIRST OBS" || lab == "TIME OF LAST OBS") {
-    CalendarTime c;
-    c.year = static_cast<int>(parseInt(column(l, 0, 6), w, labStr + " year"));
-    c.month = static_cast<int>(parseInt(column(l, 6, 6), w, labStr + " month"));
-    c.day = static_cast<int>(parseInt(column(l, 12, 6), w, labStr + " day"));
-    c.hour = static_cast<int>(parseInt(column(l, 18, 6), w, labStr + " hour"));
-    c.minute = static_cast<int>(parseInt(column(l, 24, 6), w, labStr + " minute"));
-    c.second = parseDouble(column(l, 30, 13), w, labStr + " second");
-    if (!isValidCalendar(c) || c.year < 1980 || c.year > 2200) fail(labStr, "invalid date/time");
-    const std::string ts(trimmedColumn(l, 48, 3));
-    if (lab == "TIME OF FIRST OBS" && !ts.empty()) {
-      if (ts != "GPS" && ts != "GLO" && ts != "GAL" && ts != "BDT" && ts != "QZS" && ts != "IRN") {
-        fail(labStr + " time system", "unknown time system '" + ts + "'");
-      }
-      hdr.timeSystem = ts;
-    }
-    (lab == "TIME OF FIRST OBS" ? hdr.firstObs : hdr.lastObs) = epochTime(c);
+    observationTimeLine(l, lab, w, labStr);
   } else if (lab == "INTERVAL") {
     const auto v = parseOptionalDouble(column(l, 0, 10), w, labStr);
     if (v && *v > 0.0 && *v < 1e6) hdr.interval = v;
@@ -422,6 +325,162 @@ void RinexObsReader::Impl::headerLine(std::string_view l, std::string_view lab, 
   // Everything else (# OF SATELLITES, PRN / # OF OBS, WAVELENGTH FACT L1/2, ANTENNA: DELTA X/Y/Z,
   // ANTENNA: PHASECENTER, SYS / DCBS APPLIED, SYS / PCVS APPLIED, DOI, LICENSE OF USE, ...)
   // carries nothing the library uses and is tolerated.
+}
+
+/// SYS / # / OBS TYPES (RINEX 3): a system's observation types, continued on lines without a
+/// system.
+void RinexObsReader::Impl::obsTypesLine(std::string_view l, const TextLocation& w,
+                                        const std::string& labStr) {
+  const std::string_view s = column(l, 0, 1);
+  if (!s.empty() && s[0] != ' ') {
+    const auto sys = systemFromLetter(s[0]);
+    if (!sys) fail(labStr, "unknown satellite system '" + std::string(s) + "'");
+    lastTypesSystem = systemIndex(*sys);
+    const long n = parseInt(column(l, 3, 3), w, labStr + " count");
+    if (n < 0 || n > 999) fail(labStr + " count", "invalid number of types " + std::to_string(n));
+    declaredTypes[lastTypesSystem] = static_cast<int>(n);
+    rawTypes[lastTypesSystem].clear();
+    typesChanged = true;
+  } else if (lastTypesSystem < 0) {
+    fail(labStr, "continuation line without a system");
+  }
+  auto& list = rawTypes[lastTypesSystem];
+  for (int k = 0; k < 13; ++k) {
+    const std::string_view t = trimmedColumn(l, 7 + 4 * k, 3);
+    if (t.empty()) continue;
+    if (static_cast<int>(list.size()) >= declaredTypes[lastTypesSystem]) {
+      fail(labStr, "more types than the " + std::to_string(declaredTypes[lastTypesSystem]) + " declared");
+    }
+    list.emplace_back(t);
+  }
+}
+
+/// # / TYPES OF OBSERV (RINEX 2): the observation types of all systems, continued on lines
+/// without a count.
+void RinexObsReader::Impl::rinex2TypesLine(std::string_view l, const TextLocation& w,
+                                           const std::string& labStr) {
+  const auto n = parseOptionalInt(column(l, 0, 6), w, labStr + " count");
+  if (n) {
+    if (*n < 0 || *n > 999) fail(labStr + " count", "invalid number of types " + std::to_string(*n));
+    declaredR2Types = static_cast<int>(*n);
+    hdr.rinex2Types.clear();
+    typesChanged = true;
+  } else if (declaredR2Types < 0) {
+    fail(labStr, "continuation line without a count");
+  }
+  for (int k = 0; k < 9; ++k) {
+    const std::string_view t = trimmedColumn(l, 10 + 6 * k, 2);
+    if (t.empty()) continue;
+    if (static_cast<int>(hdr.rinex2Types.size()) >= declaredR2Types) {
+      fail(labStr, "more types than the " + std::to_string(declaredR2Types) + " declared");
+    }
+    hdr.rinex2Types.emplace_back(t);
+  }
+}
+
+/// SYS / SCALE FACTOR: a factor for some of a system's types (all of them when none is listed).
+void RinexObsReader::Impl::scaleFactorLine(std::string_view l, const TextLocation& w,
+                                           const std::string& labStr) {
+  const std::string_view s = column(l, 0, 1);
+  if (!s.empty() && s[0] != ' ') {
+    const auto sys = systemFromLetter(s[0]);
+    if (!sys) fail(labStr, "unknown satellite system '" + std::string(s) + "'");
+    lastScaleSystem = systemIndex(*sys);
+    const long f = parseInt(column(l, 2, 4), w, labStr + " factor");
+    if (f != 1 && f != 10 && f != 100 && f != 1000) {
+      fail(labStr + " factor", "factor must be 1, 10, 100 or 1000, not " + std::to_string(f));
+    }
+    lastScaleFactor = static_cast<double>(f);
+    const auto n = parseOptionalInt(column(l, 8, 2), w, labStr + " count");
+    if (!n || *n == 0) scale[lastScaleSystem].emplace_back("", lastScaleFactor);
+    typesChanged = true;
+  } else if (lastScaleSystem < 0) {
+    fail(labStr, "continuation line without a system");
+  }
+  for (int k = 0; k < 12; ++k) {
+    const std::string_view t = trimmedColumn(l, 11 + 4 * k, 3);
+    if (!t.empty()) scale[lastScaleSystem].emplace_back(std::string(t), lastScaleFactor);
+  }
+}
+
+/// SYS / PHASE SHIFT: a phase correction of a system's signal and the satellites it applies to.
+void RinexObsReader::Impl::phaseShiftLine(std::string_view l, const TextLocation& w,
+                                          const std::string& labStr) {
+  const std::string_view s = column(l, 0, 1);
+  if (!s.empty() && s[0] != ' ') {
+    const auto sys = systemFromLetter(s[0]);
+    if (!sys) fail(labStr, "unknown satellite system '" + std::string(s) + "'");
+    PhaseShiftRecord r;
+    r.system = *sys;
+    r.obs = ObsDescriptor::parse(trimmedColumn(l, 2, 3));
+    r.cycles = parseOptionalDouble(column(l, 6, 8), w, labStr + " correction");
+    hdr.phaseShifts.push_back(r);
+    lastPhaseShift = &hdr.phaseShifts.back();
+  }
+  if (lastPhaseShift) {
+    for (int k = 0; k < 10; ++k) {
+      const std::string_view t = trimmedColumn(l, 19 + 4 * k, 3);
+      if (t.empty()) continue;
+      const auto sat = SatId::parse(t);
+      if (!sat) fail(labStr + " satellite", "invalid satellite '" + std::string(t) + "'");
+      lastPhaseShift->satellites.push_back(*sat);
+    }
+  }
+}
+
+/// GLONASS SLOT / FRQ #: FDMA channels of GLONASS slots.
+void RinexObsReader::Impl::glonassSlotLine(std::string_view l, const TextLocation& w,
+                                           const std::string& labStr) {
+  const auto n = parseOptionalInt(column(l, 0, 3), w, labStr + " count");
+  if (n) {
+    declaredSlots = static_cast<int>(*n);
+    slotCount = 0;
+  }
+  for (int k = 0; k < 8; ++k) {
+    const std::string_view t = trimmedColumn(l, 4 + 7 * k, 3);
+    if (t.empty()) continue;
+    const auto sat = SatId::parse(t);
+    if (!sat || sat->system != System::Glonass) {
+      fail(labStr + " slot", "invalid GLONASS slot '" + std::string(t) + "'");
+    }
+    const long ch = parseInt(column(l, 8 + 7 * k, 2), w, labStr + " channel");
+    if (ch < -7 || ch > 6) fail(labStr + " channel", "channel " + std::to_string(ch) + " outside -7..6");
+    hdr.glonassChannels.set(sat->prn, static_cast<int>(ch));
+    ++slotCount;
+  }
+}
+
+/// GLONASS COD/PHS/BIS: code-phase biases.
+void RinexObsReader::Impl::glonassBiasLine(std::string_view l, const TextLocation& w,
+                                           const std::string& labStr) {
+  for (int k = 0; k < 4; ++k) {
+    const std::string_view t = trimmedColumn(l, 1 + 13 * k, 3);
+    if (t.empty()) continue;
+    const auto d = ObsDescriptor::parse(t);
+    if (!d) fail(labStr, "invalid observation code '" + std::string(t) + "'");
+    hdr.glonassBiases.push_back({*d, parseOptionalDouble(column(l, 5 + 13 * k, 8), w, labStr + " bias")});
+  }
+}
+
+/// TIME OF FIRST OBS (with the time system) or TIME OF LAST OBS.
+void RinexObsReader::Impl::observationTimeLine(std::string_view l, std::string_view lab, const TextLocation& w,
+                                               const std::string& labStr) {
+  CalendarTime c;
+  c.year = static_cast<int>(parseInt(column(l, 0, 6), w, labStr + " year"));
+  c.month = static_cast<int>(parseInt(column(l, 6, 6), w, labStr + " month"));
+  c.day = static_cast<int>(parseInt(column(l, 12, 6), w, labStr + " day"));
+  c.hour = static_cast<int>(parseInt(column(l, 18, 6), w, labStr + " hour"));
+  c.minute = static_cast<int>(parseInt(column(l, 24, 6), w, labStr + " minute"));
+  c.second = parseDouble(column(l, 30, 13), w, labStr + " second");
+  if (!isValidCalendar(c) || c.year < 1980 || c.year > 2200) fail(labStr, "invalid date/time");
+  const std::string ts(trimmedColumn(l, 48, 3));
+  if (lab == "TIME OF FIRST OBS" && !ts.empty()) {
+    if (ts != "GPS" && ts != "GLO" && ts != "GAL" && ts != "BDT" && ts != "QZS" && ts != "IRN") {
+      fail(labStr + " time system", "unknown time system '" + ts + "'");
+    }
+    hdr.timeSystem = ts;
+  }
+  (lab == "TIME OF FIRST OBS" ? hdr.firstObs : hdr.lastObs) = epochTime(c);
 }
 
 void RinexObsReader::Impl::buildLayouts() {
@@ -608,8 +667,7 @@ bool RinexObsReader::Impl::readEpoch(ObsEpoch& e) {
   const bool r2 = rinex2();
   if (!r2 && l[0] != '>') fail("epoch record", "expected an epoch line starting with '>'");
   if (r2 && !looksLikeEpoch(l)) fail("epoch record", "malformed RINEX 2 epoch line");
-  const std::size_t yearPos = r2 ? 1 : 2, yearLen = r2 ? 2 : 4;
-  const std::size_t monthPos = r2 ? 4 : 7;
+  const std::size_t yearPos = r2 ? 1 : 2;
   const std::size_t flagPos = r2 ? 28 : 31;
   const std::size_t nsatPos = r2 ? 29 : 32;
   const auto flagV = parseOptionalInt(column(l, flagPos, 1), where(), "epoch flag");
@@ -621,40 +679,13 @@ bool RinexObsReader::Impl::readEpoch(ObsEpoch& e) {
 
   // Date: blank allowed for event flags 2-5 (the event is then not time-tagged).
   const bool blankDate = isBlank(column(l, yearPos, r2 ? 25 : 27));
-  GpsTime t;
-  if (blankDate && flag >= 2 && flag <= 5) {
-    t = haveTime ? lastTime : GpsTime();
-  } else {
-    CalendarTime c;
-    long y = parseInt(column(l, yearPos, yearLen), where(), "epoch year");
-    if (r2) y += y < 80 ? 2000 : 1900;
-    c.year = static_cast<int>(y);
-    c.month = static_cast<int>(parseInt(column(l, monthPos, 2), where(), "epoch month"));
-    c.day = static_cast<int>(parseInt(column(l, monthPos + 3, 2), where(), "epoch day"));
-    c.hour = static_cast<int>(parseInt(column(l, monthPos + 6, 2), where(), "epoch hour"));
-    c.minute = static_cast<int>(parseInt(column(l, monthPos + 9, 2), where(), "epoch minute"));
-    c.second = parseDouble(column(l, monthPos + 11, 11), where(), "epoch second");
-    if (!isValidCalendar(c) || c.year < 1980 || c.year > 2200) fail("epoch time", "invalid date/time");
-    t = epochTime(c);
-  }
+  const GpsTime t = blankDate && flag >= 2 && flag <= 5 ? (haveTime ? lastTime : GpsTime()) : epochLineTime(l);
   e.time = t;
   e.flag = static_cast<EpochFlag>(flag);
   e.receiverClockOffset.reset();
 
   if (flag >= 2 && flag <= 5) {
-    // Special records: header lines (new site, in-file header information, events).
-    events.clear();
-    for (long i = 0; i < nsat; ++i) {
-      if (!in.next(line)) fail("special records", "file ends inside the records of an event epoch");
-      if (!r2 && !line.empty() && line[0] == '>') {
-        in.unread();
-        fail("special records", "fewer special records than the " + std::to_string(nsat) + " announced");
-      }
-      events.emplace_back(line);
-    }
-    typesChanged = false;
-    for (const auto& h : events) headerLine(h, label(h), true);
-    if (typesChanged) buildLayouts();
+    readSpecialRecords(nsat);
     e.sats.clear();
     if (!blankDate) {
       lastTime = t;
@@ -668,92 +699,143 @@ bool RinexObsReader::Impl::readEpoch(ObsEpoch& e) {
     const std::string_view clk = r2 ? column(l, 68, 12) : column(l, 41, 15);
     e.receiverClockOffset = parseOptionalDouble(clk, where(), "receiver clock offset");
   }
-  std::size_t used = 0;
   if (e.sats.size() < static_cast<std::size_t>(std::min<long>(nsat, 200))) {
     e.sats.resize(static_cast<std::size_t>(std::min<long>(nsat, 200)));
   }
-  auto beginSat = [&](SatId id, const SystemLayout& lay) -> SatObs& {
-    if (used >= e.sats.size()) e.sats.emplace_back();
-    SatObs& so = e.sats[used++];
-    so.sat = id;
-    so.signals.resize(lay.codes.size());
-    for (std::size_t k = 0; k < lay.codes.size(); ++k) so.signals[k] = SignalObs{lay.codes[k]};
-    if (ssiScratch.size() < lay.codes.size()) ssiScratch.resize(lay.codes.size());
-    for (std::size_t k = 0; k < lay.codes.size(); ++k) ssiScratch[k] = {0, 0, 0, 0};
-    return so;
-  };
-  auto skipSat = [&](std::string_view id, const char* why) {
-    ++stats.skippedSatellites;
-    note("satellite '" + std::string(id) + "' skipped: " + why);
-  };
-
-  if (r2) {
-    // Satellite list: 12 per line in columns 33-68, continuation lines for more.
-    satLines.clear();
-    satLines.emplace_back(line);
-    for (long i = 12; i < nsat; i += 12) {
-      if (!in.next(line)) fail("satellite list", "file ends inside the satellite list");
-      satLines.emplace_back(line);
-    }
-    const std::size_t ntypes = hdr.rinex2Types.size();
-    const std::size_t linesPerSat = ntypes == 0 ? 1 : (ntypes + 4) / 5;
-    for (long i = 0; i < nsat; ++i) {
-      const std::string_view sl = satLines[static_cast<std::size_t>(i / 12)];
-      const std::string_view idText = column(sl, 32 + 3 * static_cast<std::size_t>(i % 12), 3);
-      const auto id = SatId::parse(idText);
-      const SystemLayout* lay = id ? &layout[systemIndex(id->system)] : nullptr;
-      SatObs* so = nullptr;
-      if (!id) {
-        if (isBlank(idText)) fail("satellite list", "fewer satellites listed than the " + std::to_string(nsat) + " announced");
-        skipSat(idText, "unknown system or satellite number");
-      } else if (lay->columns.empty()) {
-        skipSat(idText, "no observation types for its system");
-      } else {
-        so = &beginSat(*id, *lay);
-      }
-      for (std::size_t k = 0; k < linesPerSat; ++k) {
-        if (!in.next(line)) fail("observation record", "file ends inside an epoch");
-        if (so) readSatValues(line, 0, 5, *so, *lay, 5 * k, std::min<std::size_t>(5, ntypes - 5 * k));
-      }
-      if (so) finishSat(*so, *lay);
-    }
-  } else {
-    for (long i = 0; i < nsat; ++i) {
-      if (!in.next(line)) fail("observation record", "file ends inside an epoch (" + std::to_string(i) + " of " +
-                                                         std::to_string(nsat) + " satellites read)");
-      if (!line.empty() && line[0] == '>') {
-        in.unread();
-        fail("observation record", "epoch has " + std::to_string(i) + " satellite records, " +
-                                       std::to_string(nsat) + " announced");
-      }
-      const std::string_view idText = column(line, 0, 3);
-      std::optional<SatId> id;
-      if (idText.size() == 3 && idText[1] >= '0' && idText[1] <= '9' && idText[2] >= '0' && idText[2] <= '9') {
-        if (const auto sys = systemFromLetter(idText[0])) {
-          const SatId q(*sys, (idText[1] - '0') * 10 + (idText[2] - '0'));
-          if (q.valid()) id = q;
-        }
-      } else {
-        id = SatId::parse(idText);
-      }
-      if (!id || (!idText.empty() && idText[0] == ' ')) {
-        skipSat(idText, "unknown system or satellite number");
-        continue;
-      }
-      const SystemLayout& lay = layout[systemIndex(id->system)];
-      if (lay.columns.empty()) {
-        skipSat(idText, "no observation types for its system");
-        continue;
-      }
-      SatObs& so = beginSat(*id, lay);
-      readSatValues(line, 3, lay.columns.size(), so, lay, 0, lay.columns.size());
-      finishSat(so, lay);
-    }
-  }
+  const std::size_t used = r2 ? readRinex2Satellites(e, nsat) : readRinex3Satellites(e, nsat);
   e.sats.resize(used);
   lastTime = t;
   haveTime = true;
   return true;
+}
+
+/// The date and time of an epoch line (RINEX 2 two-digit years: 1980-2079).
+GpsTime RinexObsReader::Impl::epochLineTime(std::string_view l) const {
+  const bool r2 = rinex2();
+  const std::size_t yearPos = r2 ? 1 : 2, yearLen = r2 ? 2 : 4;
+  const std::size_t monthPos = r2 ? 4 : 7;
+  CalendarTime c;
+  long y = parseInt(column(l, yearPos, yearLen), where(), "epoch year");
+  if (r2) y += y < 80 ? 2000 : 1900;
+  c.year = static_cast<int>(y);
+  c.month = static_cast<int>(parseInt(column(l, monthPos, 2), where(), "epoch month"));
+  c.day = static_cast<int>(parseInt(column(l, monthPos + 3, 2), where(), "epoch day"));
+  c.hour = static_cast<int>(parseInt(column(l, monthPos + 6, 2), where(), "epoch hour"));
+  c.minute = static_cast<int>(parseInt(column(l, monthPos + 9, 2), where(), "epoch minute"));
+  c.second = parseDouble(column(l, monthPos + 11, 11), where(), "epoch second");
+  if (!isValidCalendar(c) || c.year < 1980 || c.year > 2200) fail("epoch time", "invalid date/time");
+  return epochTime(c);
+}
+
+/// The `nsat` special records of an event epoch (flags 2-5) into `events`; header records among
+/// them update the header (and the column layouts when types change).
+void RinexObsReader::Impl::readSpecialRecords(long nsat) {
+  // Special records: header lines (new site, in-file header information, events).
+  events.clear();
+  for (long i = 0; i < nsat; ++i) {
+    if (!in.next(line)) fail("special records", "file ends inside the records of an event epoch");
+    if (!rinex2() && !line.empty() && line[0] == '>') {
+      in.unread();
+      fail("special records", "fewer special records than the " + std::to_string(nsat) + " announced");
+    }
+    events.emplace_back(line);
+  }
+  typesChanged = false;
+  for (const auto& h : events) headerLine(h, label(h), true);
+  if (typesChanged) buildLayouts();
+}
+
+/// The next satellite record of `e` (`used` of them so far), its signals laid out for its system.
+SatObs& RinexObsReader::Impl::beginSat(ObsEpoch& e, std::size_t& used, SatId id, const SystemLayout& lay) {
+  if (used >= e.sats.size()) e.sats.emplace_back();
+  SatObs& so = e.sats[used++];
+  so.sat = id;
+  so.signals.resize(lay.codes.size());
+  for (std::size_t k = 0; k < lay.codes.size(); ++k) so.signals[k] = SignalObs{lay.codes[k]};
+  if (ssiScratch.size() < lay.codes.size()) ssiScratch.resize(lay.codes.size());
+  for (std::size_t k = 0; k < lay.codes.size(); ++k) ssiScratch[k] = {0, 0, 0, 0};
+  return so;
+}
+
+/// Counts and notes a satellite record that is skipped.
+void RinexObsReader::Impl::skipSat(std::string_view id, const char* why) {
+  ++stats.skippedSatellites;
+  note("satellite '" + std::string(id) + "' skipped: " + why);
+}
+
+/// The satellite records of a RINEX 2 epoch (satellite list on the epoch line and its
+/// continuation lines, then each satellite's values over lines of five); returns the number
+/// of records filled in `e`.
+std::size_t RinexObsReader::Impl::readRinex2Satellites(ObsEpoch& e, long nsat) {
+  std::size_t used = 0;
+  // Satellite list: 12 per line in columns 33-68, continuation lines for more.
+  satLines.clear();
+  satLines.emplace_back(line);
+  for (long i = 12; i < nsat; i += 12) {
+    if (!in.next(line)) fail("satellite list", "file ends inside the satellite list");
+    satLines.emplace_back(line);
+  }
+  const std::size_t ntypes = hdr.rinex2Types.size();
+  const std::size_t linesPerSat = ntypes == 0 ? 1 : (ntypes + 4) / 5;
+  for (long i = 0; i < nsat; ++i) {
+    const std::string_view sl = satLines[static_cast<std::size_t>(i / 12)];
+    const std::string_view idText = column(sl, 32 + 3 * static_cast<std::size_t>(i % 12), 3);
+    const auto id = SatId::parse(idText);
+    const SystemLayout* lay = id ? &layout[systemIndex(id->system)] : nullptr;
+    SatObs* so = nullptr;
+    if (!id) {
+      if (isBlank(idText)) fail("satellite list", "fewer satellites listed than the " + std::to_string(nsat) + " announced");
+      skipSat(idText, "unknown system or satellite number");
+    } else if (lay->columns.empty()) {
+      skipSat(idText, "no observation types for its system");
+    } else {
+      so = &beginSat(e, used, *id, *lay);
+    }
+    for (std::size_t k = 0; k < linesPerSat; ++k) {
+      if (!in.next(line)) fail("observation record", "file ends inside an epoch");
+      if (so) readSatValues(line, 0, 5, *so, *lay, 5 * k, std::min<std::size_t>(5, ntypes - 5 * k));
+    }
+    if (so) finishSat(*so, *lay);
+  }
+  return used;
+}
+
+/// The satellite records of a RINEX 3/4 epoch (one line each, led by the satellite); returns
+/// the number of records filled in `e`.
+std::size_t RinexObsReader::Impl::readRinex3Satellites(ObsEpoch& e, long nsat) {
+  std::size_t used = 0;
+  for (long i = 0; i < nsat; ++i) {
+    if (!in.next(line)) fail("observation record", "file ends inside an epoch (" + std::to_string(i) + " of " +
+                                                       std::to_string(nsat) + " satellites read)");
+    if (!line.empty() && line[0] == '>') {
+      in.unread();
+      fail("observation record", "epoch has " + std::to_string(i) + " satellite records, " +
+                                     std::to_string(nsat) + " announced");
+    }
+    const std::string_view idText = column(line, 0, 3);
+    std::optional<SatId> id;
+    if (idText.size() == 3 && idText[1] >= '0' && idText[1] <= '9' && idText[2] >= '0' && idText[2] <= '9') {
+      if (const auto sys = systemFromLetter(idText[0])) {
+        const SatId q(*sys, (idText[1] - '0') * 10 + (idText[2] - '0'));
+        if (q.valid()) id = q;
+      }
+    } else {
+      id = SatId::parse(idText);
+    }
+    if (!id || (!idText.empty() && idText[0] == ' ')) {
+      skipSat(idText, "unknown system or satellite number");
+      continue;
+    }
+    const SystemLayout& lay = layout[systemIndex(id->system)];
+    if (lay.columns.empty()) {
+      skipSat(idText, "no observation types for its system");
+      continue;
+    }
+    SatObs& so = beginSat(e, used, *id, lay);
+    readSatValues(line, 3, lay.columns.size(), so, lay, 0, lay.columns.size());
+    finishSat(so, lay);
+  }
+  return used;
 }
 
 // ---------------------------------------------------------------------------------------------

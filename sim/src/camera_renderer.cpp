@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 
 #include <opencv2/imgproc.hpp>
@@ -229,6 +230,156 @@ __attribute__((target("avx2"))) int accumulateRowAvx2(const RowKernel& k, const 
 }
 #endif
 
+/// The per-pixel ray tables of a camera (CameraRenderer's).
+struct PixelRays {
+  const float* x;      // undistorted normalised coordinates
+  const float* y;
+  const float* norm;   // |(x, y, 1)|
+  const float* angle;  // sqrt(solid angle), rad
+  int w, h;
+};
+
+/// Pixel spacing of the grid on which a frame's texture tiles are planned.
+constexpr int kPlanStep = 16;
+
+/// Ground extent read at one mip level (empty while x0 > x1).
+struct GroundBox {
+  double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
+};
+
+/// The ground extent each mip level of a frame is read over, from the pixels of a coarse grid
+/// (every kPlanStep pixels and the last row and column); `poseOf(v)` is the camera pose of row v
+/// (rotation R, position p in the local frame).
+template <class PoseOf>
+std::vector<GroundBox> groundExtents(const PoseOf& poseOf, const PixelRays& rays, double maxRange, double log2s0,
+                                     int maxLevel) {
+  std::vector<GroundBox> boxes(static_cast<std::size_t>(maxLevel + 1));
+  auto groundAt = [&](int u, int v, double& gx, double& gy, double& level) {
+    const auto& P = poseOf(v);
+    const std::size_t i = static_cast<std::size_t>(v) * rays.w + u;
+    const Eigen::Vector3d d = P.R * Eigen::Vector3d(rays.x[i], rays.y[i], 1.0);
+    if (d.z() >= -1e-6 || P.p.z() <= 0.0) return false;
+    const double lam = -P.p.z() / d.z();
+    const double dist = lam * rays.norm[i];
+    if (dist > maxRange) return false;
+    gx = P.p.x() + lam * d.x();
+    gy = P.p.y() + lam * d.y();
+    const double cosInc = -d.z() / rays.norm[i];
+    level = std::log2(dist * rays.angle[i] / std::sqrt(cosInc)) - log2s0;
+    return true;
+  };
+  for (int v = 0;; v = std::min(v + kPlanStep, rays.h - 1)) {
+    for (int u = 0;; u = std::min(u + kPlanStep, rays.w - 1)) {
+      double gx, gy, lv;
+      if (groundAt(u, v, gx, gy, lv)) {
+        // A pixel at level lv reads floor(lv) and floor(lv) + 1; neighbours within a grid cell
+        // differ by a fraction of a level.
+        const int la = std::clamp(static_cast<int>(std::floor(lv - 0.3)), 0, maxLevel);
+        const int lb = std::clamp(static_cast<int>(std::floor(lv + 0.3)) + 1, 0, maxLevel);
+        for (int l = la; l <= lb; ++l) {
+          GroundBox& b = boxes[static_cast<std::size_t>(l)];
+          b.x0 = std::min(b.x0, gx);
+          b.x1 = std::max(b.x1, gx);
+          b.y0 = std::min(b.y0, gy);
+          b.y1 = std::max(b.y1, gy);
+        }
+      }
+      if (u == rays.w - 1) break;
+    }
+    if (v == rays.h - 1) break;
+  }
+  return boxes;
+}
+
+/// The level views of a frame: per mip level the tiles over its ground extent and a margin,
+/// relative to the frame origin (ox, oy). A level with an empty or absurdly large extent (grazing
+/// view) gets no tiles: its pixels take the slow path.
+std::vector<LevelView> levelViews(const std::vector<GroundBox>& boxes, const GroundTexture& tex, double ox, double oy) {
+  std::vector<LevelView> views(boxes.size());
+  for (std::size_t l = 0; l < views.size(); ++l) {
+    LevelView& view = views[l];
+    view.level = static_cast<int>(l);
+    const double s = tex.texelSize(static_cast<int>(l));
+    view.inv = static_cast<float>(1.0 / s);
+    const GroundBox& b = boxes[l];
+    if (b.x0 > b.x1) continue;
+    // Margin: the ground spacing of the planning grid at this level (kPlanStep pixels of about a
+    // texel each, more at grazing angles) and a bit.
+    const double m = (2.0 * kPlanStep + 2.0) * s;
+    const std::int64_t tx0 = floorDivTile(static_cast<std::int64_t>(std::floor((b.x0 - m) / s)));
+    const std::int64_t ty0 = floorDivTile(static_cast<std::int64_t>(std::floor((b.y0 - m) / s)));
+    const std::int64_t tx1 = floorDivTile(static_cast<std::int64_t>(std::floor((b.x1 + m) / s)));
+    const std::int64_t ty1 = floorDivTile(static_cast<std::int64_t>(std::floor((b.y1 + m) / s)));
+    if ((tx1 - tx0 + 1) * (ty1 - ty0 + 1) > 4096) continue;  // absurd (grazing view): slow path
+    view.nx = static_cast<int>(tx1 - tx0 + 1);
+    view.ny = static_cast<int>(ty1 - ty0 + 1);
+    view.offX = static_cast<float>(ox / s - 0.5 - static_cast<double>(tx0 * kTile));
+    view.offY = static_cast<float>(oy / s - 0.5 - static_cast<double>(ty0 * kTile));
+    view.tiles.reserve(static_cast<std::size_t>(view.nx) * view.ny);
+    for (std::int64_t ty = ty0; ty <= ty1; ++ty)
+      for (std::int64_t tx = tx0; tx <= tx1; ++tx) {
+        view.tiles.push_back(tex.tile(static_cast<int>(l), tx, ty));
+        view.data.push_back(view.tiles.back()->texels.data());
+      }
+  }
+  return views;
+}
+
+#ifdef GVINS_SIM_HAVE_AVX2_KERNEL
+/// The AVX2 kernel's tables of a frame's level views. The kernel addresses the texels of all
+/// views by 32-bit offsets from one base texel pointer (views whose tiles lie further apart in
+/// memory are left to the scalar loop). The row fields of `kern` are the caller's.
+struct KernelViews {
+  RowKernel kern{};
+  std::vector<float> inv, offX, offY;
+  std::vector<int> nx, ny;
+  std::vector<std::vector<std::int32_t>> off;
+  std::vector<const std::int32_t*> offPtr;
+
+  KernelViews(const std::vector<LevelView>& views, float maxRange, float l2s0, float maxL, float weight, int maxLevel)
+      : inv(views.size()), offX(views.size()), offY(views.size()), nx(views.size()), ny(views.size()),
+        off(views.size()), offPtr(views.size(), nullptr) {
+    const float* base = nullptr;
+    for (const LevelView& view : views)
+      if (!view.data.empty()) {
+        base = view.data.front();
+        break;
+      }
+    for (std::size_t l = 0; l < views.size(); ++l) {
+      const LevelView& view = views[l];
+      inv[l] = view.inv;
+      offX[l] = view.offX;
+      offY[l] = view.offY;
+      nx[l] = view.nx;
+      ny[l] = view.ny;
+      if (view.data.empty() || !base) continue;
+      std::vector<std::int32_t>& o = off[l];
+      for (const float* d : view.data) {
+        const std::intptr_t bytes = reinterpret_cast<std::intptr_t>(d) - reinterpret_cast<std::intptr_t>(base);
+        constexpr std::intptr_t kLimit = (std::intptr_t{1} << 31) - 2 * static_cast<std::intptr_t>(kStride * kStride);
+        if (bytes % static_cast<std::intptr_t>(sizeof(float)) != 0 || bytes / 4 > kLimit || bytes / 4 < -kLimit) break;
+        o.push_back(static_cast<std::int32_t>(bytes / 4));
+      }
+      if (o.size() == view.data.size()) offPtr[l] = o.data();
+    }
+    kern.base = base;
+    kern.inv = inv.data();
+    kern.offX = offX.data();
+    kern.offY = offY.data();
+    kern.nx = nx.data();
+    kern.ny = ny.data();
+    kern.tileOff = offPtr.data();
+    kern.maxRange = maxRange;
+    kern.l2s0 = l2s0;
+    kern.maxL = maxL;
+    kern.weight = weight;
+    kern.maxLevel = maxLevel;
+  }
+  KernelViews(const KernelViews&) = delete;
+  KernelViews& operator=(const KernelViews&) = delete;
+};
+#endif
+
 }  // namespace
 
 void ImagingConfig::validate() const {
@@ -291,73 +442,9 @@ void CameraRenderer::accumulate(const std::vector<RowPose>& rows, float weight, 
   // ground offsets small).
   const double ox = std::round(rows[0].p.x()), oy = std::round(rows[0].p.y());
 
-  // Plan the tiles this frame needs: ground points and levels on a coarse pixel grid.
-  constexpr int kStep = 16;
-  struct Box {
-    double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
-  };
-  std::vector<Box> boxes(static_cast<std::size_t>(maxLevel + 1));
-  auto groundAt = [&](int u, int v, double& gx, double& gy, double& level) {
-    const RowPose& P = poseOf(v);
-    const std::size_t i = static_cast<std::size_t>(v) * w_ + u;
-    const Eigen::Vector3d d = P.R * Eigen::Vector3d(rayX_[i], rayY_[i], 1.0);
-    if (d.z() >= -1e-6 || P.p.z() <= 0.0) return false;
-    const double lam = -P.p.z() / d.z();
-    const double dist = lam * rayNorm_[i];
-    if (dist > img_.maxRange) return false;
-    gx = P.p.x() + lam * d.x();
-    gy = P.p.y() + lam * d.y();
-    const double cosInc = -d.z() / rayNorm_[i];
-    level = std::log2(dist * pixelAngle_[i] / std::sqrt(cosInc)) - log2s0;
-    return true;
-  };
-  for (int v = 0;; v = std::min(v + kStep, h_ - 1)) {
-    for (int u = 0;; u = std::min(u + kStep, w_ - 1)) {
-      double gx, gy, lv;
-      if (groundAt(u, v, gx, gy, lv)) {
-        // A pixel at level lv reads floor(lv) and floor(lv) + 1; neighbours within a grid cell
-        // differ by a fraction of a level.
-        const int la = std::clamp(static_cast<int>(std::floor(lv - 0.3)), 0, maxLevel);
-        const int lb = std::clamp(static_cast<int>(std::floor(lv + 0.3)) + 1, 0, maxLevel);
-        for (int l = la; l <= lb; ++l) {
-          Box& b = boxes[static_cast<std::size_t>(l)];
-          b.x0 = std::min(b.x0, gx);
-          b.x1 = std::max(b.x1, gx);
-          b.y0 = std::min(b.y0, gy);
-          b.y1 = std::max(b.y1, gy);
-        }
-      }
-      if (u == w_ - 1) break;
-    }
-    if (v == h_ - 1) break;
-  }
-  std::vector<LevelView> views(static_cast<std::size_t>(maxLevel + 1));
-  for (int l = 0; l <= maxLevel; ++l) {
-    LevelView& view = views[static_cast<std::size_t>(l)];
-    view.level = l;
-    const double s = tex_.texelSize(l);
-    view.inv = static_cast<float>(1.0 / s);
-    const Box& b = boxes[static_cast<std::size_t>(l)];
-    if (b.x0 > b.x1) continue;
-    // Margin: the ground spacing of the planning grid at this level (kStep pixels of about a
-    // texel each, more at grazing angles) and a bit.
-    const double m = (2.0 * kStep + 2.0) * s;
-    const std::int64_t tx0 = floorDivTile(static_cast<std::int64_t>(std::floor((b.x0 - m) / s)));
-    const std::int64_t ty0 = floorDivTile(static_cast<std::int64_t>(std::floor((b.y0 - m) / s)));
-    const std::int64_t tx1 = floorDivTile(static_cast<std::int64_t>(std::floor((b.x1 + m) / s)));
-    const std::int64_t ty1 = floorDivTile(static_cast<std::int64_t>(std::floor((b.y1 + m) / s)));
-    if ((tx1 - tx0 + 1) * (ty1 - ty0 + 1) > 4096) continue;  // absurd (grazing view): slow path
-    view.nx = static_cast<int>(tx1 - tx0 + 1);
-    view.ny = static_cast<int>(ty1 - ty0 + 1);
-    view.offX = static_cast<float>(ox / s - 0.5 - static_cast<double>(tx0 * kTile));
-    view.offY = static_cast<float>(oy / s - 0.5 - static_cast<double>(ty0 * kTile));
-    view.tiles.reserve(static_cast<std::size_t>(view.nx) * view.ny);
-    for (std::int64_t ty = ty0; ty <= ty1; ++ty)
-      for (std::int64_t tx = tx0; tx <= tx1; ++tx) {
-        view.tiles.push_back(tex_.tile(l, tx, ty));
-        view.data.push_back(view.tiles.back()->texels.data());
-      }
-  }
+  // The tiles this frame needs: ground points and levels on a coarse pixel grid.
+  const PixelRays rays{rayX_.data(), rayY_.data(), rayNorm_.data(), pixelAngle_.data(), w_, h_};
+  const std::vector<LevelView> views = levelViews(groundExtents(poseOf, rays, img_.maxRange, log2s0, maxLevel), tex_, ox, oy);
 
   const auto sky = static_cast<float>(img_.sky);
   const auto maxRange = static_cast<float>(img_.maxRange);
@@ -365,52 +452,9 @@ void CameraRenderer::accumulate(const std::vector<RowPose>& rows, float weight, 
   const auto maxL = static_cast<float>(maxLevel);
 
 #ifdef GVINS_SIM_HAVE_AVX2_KERNEL
-  // The AVX2 kernel addresses the texels of all views by 32-bit offsets from one base texel
-  // pointer (views whose tiles lie further apart in memory are left to the scalar loop).
-  const bool simd = vectorized_ && cpuHasAvx2();
-  RowKernel kern{};
-  std::vector<float> kInv(views.size()), kOffX(views.size()), kOffY(views.size());
-  std::vector<int> kNx(views.size()), kNy(views.size());
-  std::vector<std::vector<std::int32_t>> kOff(views.size());
-  std::vector<const std::int32_t*> kOffPtr(views.size(), nullptr);
+  std::optional<KernelViews> simd;
+  if (vectorized_ && cpuHasAvx2()) simd.emplace(views, maxRange, l2s0, maxL, weight, maxLevel);
   std::vector<int> failed(static_cast<std::size_t>(w_ / 8 + 1));
-  if (simd) {
-    const float* base = nullptr;
-    for (const LevelView& view : views)
-      if (!view.data.empty()) {
-        base = view.data.front();
-        break;
-      }
-    for (std::size_t l = 0; l < views.size(); ++l) {
-      const LevelView& view = views[l];
-      kInv[l] = view.inv;
-      kOffX[l] = view.offX;
-      kOffY[l] = view.offY;
-      kNx[l] = view.nx;
-      kNy[l] = view.ny;
-      if (view.data.empty() || !base) continue;
-      std::vector<std::int32_t>& off = kOff[l];
-      for (const float* d : view.data) {
-        const std::intptr_t bytes = reinterpret_cast<std::intptr_t>(d) - reinterpret_cast<std::intptr_t>(base);
-        constexpr std::intptr_t kLimit = (std::intptr_t{1} << 31) - 2 * static_cast<std::intptr_t>(kStride * kStride);
-        if (bytes % static_cast<std::intptr_t>(sizeof(float)) != 0 || bytes / 4 > kLimit || bytes / 4 < -kLimit) break;
-        off.push_back(static_cast<std::int32_t>(bytes / 4));
-      }
-      if (off.size() == view.data.size()) kOffPtr[l] = off.data();
-    }
-    kern.base = base;
-    kern.inv = kInv.data();
-    kern.offX = kOffX.data();
-    kern.offY = kOffY.data();
-    kern.nx = kNx.data();
-    kern.ny = kNy.data();
-    kern.tileOff = kOffPtr.data();
-    kern.maxRange = maxRange;
-    kern.l2s0 = l2s0;
-    kern.maxL = maxL;
-    kern.weight = weight;
-    kern.maxLevel = maxLevel;
-  }
 #endif
 
   for (int v = 0; v < h_; ++v) {
@@ -448,7 +492,8 @@ void CameraRenderer::accumulate(const std::vector<RowPose>& rows, float weight, 
     };
     int u0 = 0;
 #ifdef GVINS_SIM_HAVE_AVX2_KERNEL
-    if (simd && kern.base) {
+    if (simd && simd->kern.base) {
+      RowKernel& kern = simd->kern;
       kern.r00 = r00, kern.r01 = r01, kern.r02 = r02;
       kern.r10 = r10, kern.r11 = r11, kern.r12 = r12;
       kern.r20 = r20, kern.r21 = r21, kern.r22 = r22;

@@ -312,6 +312,133 @@ const std::set<std::string> kReceiverKeys = {"rate_hz", "elevation_mask_deg", "c
                                              "multipath", "nlos", "blockage", "cycle_slips", "outages",
                                              "marker", "receiver_type", "antenna_type"};
 
+/// gnss.signals: up to 4 signals per system, one per band.
+void applySignals(const Reader& r, const YAML::Node& v, const std::string& full, GnssSimConfig& c) {
+  r.perSystem(v, full, [&](System s, const std::string& sf, const YAML::Node& sv) {
+    std::vector<ObsCode> codes;
+    r.sequence(sv, sf, [&](const std::string& item, const YAML::Node& cv) {
+      const ObsCode oc = r.code(s, cv, item);
+      if (std::find(codes.begin(), codes.end(), oc) != codes.end()) r.fail(cv, item, "signal " + oc.str() + " listed twice");
+      for (const ObsCode& o : codes)
+        if (o.band == oc.band) r.fail(cv, item, "two signals on band " + std::string(1, oc.band) + " (one per band)");
+      codes.push_back(oc);
+    });
+    if (codes.size() > 4) r.fail(sv, sf, "at most 4 signals per system");
+    c.signals[systemIndex(s)] = codes;
+  });
+}
+
+/// gnss.satellite_errors: broadcast record blending and per-system SISRE.
+void applySatelliteErrors(const Reader& r, const YAML::Node& v, const std::string& full, GnssSimConfig& c) {
+  r.map(v, full, {"blend_records", "sisre_m"}, [&](const std::string& sk, const std::string& sf, const YAML::Node& sv) {
+    if (sk == "blend_records") {
+      c.satelliteErrors.blendRecords = r.boolean(sv, sf);
+    } else {
+      r.perSystem(sv, sf, [&](System s, const std::string& xf, const YAML::Node& xv) {
+        c.satelliteErrors.sisre[systemIndex(s)] = r.number(xv, xf, 0.0, 100.0);
+      });
+    }
+  });
+}
+
+/// gnss.precise_products: the precise orbit/clock files and the SSR stream.
+void applyPreciseProducts(const Reader& r, const YAML::Node& v, const std::string& full, GnssSimConfig& c) {
+  r.map(v, full, {"write", "orbit_interval_s", "clock_interval_s", "sisre_m", "centre_of_mass", "ssr_interval_s"},
+        [&](const std::string& pk, const std::string& pf, const YAML::Node& pv) {
+          auto& p = c.preciseProducts;
+          if (pk == "write") {
+            p.write = r.boolean(pv, pf);
+          } else if (pk == "centre_of_mass") {
+            p.centreOfMass = r.boolean(pv, pf);
+          } else if (pk == "orbit_interval_s") {
+            p.orbitInterval = r.number(pv, pf, 1.0, 3600.0);
+          } else if (pk == "clock_interval_s") {
+            p.clockInterval = r.number(pv, pf, 1.0, 3600.0);
+          } else if (pk == "ssr_interval_s") {
+            // DF391 update intervals (RTCM 10403.3), 0 = no SSR stream.
+            const double interval = r.number(pv, pf, 0.0, 10800.0);
+            if (interval != 0.0 && !isSsrUpdateInterval(interval))
+              r.fail(pv, pf,
+                     "'" + pf + "' must be 0 or an RTCM SSR update interval (1, 2, 5, 10, 15, 30, 60, 120, 240, "
+                     "300, 600, 900, 1800, 3600, 7200 or 10800 s)");
+            p.ssrInterval = interval;
+          } else {
+            r.perSystem(pv, pf, [&](System s, const std::string& xf, const YAML::Node& xv) {
+              p.sisre[systemIndex(s)] = r.number(xv, xf, 0.0, 100.0);
+            });
+          }
+        });
+}
+
+/// gnss.troposphere: the true troposphere's deviations from the model.
+void applyTroposphere(const Reader& r, const YAML::Node& v, const std::string& full, GnssSimConfig& c) {
+  r.map(v, full,
+        {"relative_humidity", "hydrostatic_scale_sigma", "wet_scale_sigma", "layer_height_m", "residual"},
+        [&](const std::string& tk, const std::string& tf, const YAML::Node& tv) {
+          auto& t = c.troposphere;
+          if (tk == "relative_humidity") t.relativeHumidity = r.number(tv, tf, 0.0, 1.0);
+          else if (tk == "hydrostatic_scale_sigma") t.hydrostaticScaleSigma = r.number(tv, tf, 0.0, 0.5);
+          else if (tk == "wet_scale_sigma") t.wetScaleSigma = r.number(tv, tf, 0.0, 2.0);
+          else if (tk == "layer_height_m") t.layerHeight = r.number(tv, tf, 1.0, 20000.0);
+          else t.residual = fields(r, tv, tf, "sigma_m", 2.0);
+        });
+}
+
+/// gnss.ionosphere: the true ionosphere's deviations from the model.
+void applyIonosphere(const Reader& r, const YAML::Node& v, const std::string& full, GnssSimConfig& c) {
+  r.map(v, full, {"model_scale_sigma", "shell_height_km", "residual"},
+        [&](const std::string& ik, const std::string& iff, const YAML::Node& iv) {
+          auto& i = c.ionosphere;
+          if (ik == "model_scale_sigma") i.modelScaleSigma = r.number(iv, iff, 0.0, 2.0);
+          else if (ik == "shell_height_km") i.shellHeight = r.number(iv, iff, 50.0, 2000.0) * 1e3;
+          else i.residual = fields(r, iv, iff, "sigma_tecu", 200.0);
+        });
+}
+
+/// gnss.base: the base station's place and receiver.
+void applyBase(const Reader& r, const YAML::Node& v, const std::string& full, GnssSimConfig& c) {
+  std::set<std::string> keys = kReceiverKeys;
+  keys.insert({"enabled", "distance_m", "azimuth_deg", "height_m", "position_llh"});
+  r.map(v, full, keys, [&](const std::string& bk, const std::string& bf, const YAML::Node& bv) {
+    auto& b = c.base;
+    if (bk == "enabled") {
+      b.enabled = r.boolean(bv, bf);
+    } else if (bk == "distance_m") {
+      b.distance = r.number(bv, bf, 0.0, 1e6);
+    } else if (bk == "azimuth_deg") {
+      b.azimuthDeg = r.number(bv, bf, -360.0, 360.0);
+    } else if (bk == "height_m") {
+      b.height = r.number(bv, bf, -1000.0, 10000.0);
+    } else if (bk == "position_llh") {
+      if (!bv.IsSequence() || bv.size() != 3) r.fail(bv, bf, "'" + bf + "' must be [lat_deg, lon_deg, height_m]");
+      b.positionLlh = Eigen::Vector3d(r.number(bv[0], bf, -90.0, 90.0), r.number(bv[1], bf, -180.0, 360.0),
+                                      r.number(bv[2], bf, -1000.0, 1e5));
+    } else {
+      applyReceiver(r, bk, bf, bv, b.receiver);
+    }
+  });
+}
+
+/// gnss.rtcm: the base station's RTCM 3 stream.
+void applyRtcm(const Reader& r, const YAML::Node& v, const std::string& full, GnssSimConfig& c) {
+  r.map(v, full, {"msm", "station_id", "station_interval_s", "antenna_height_m", "ephemeris_interval_s"},
+        [&](const std::string& rk, const std::string& rf, const YAML::Node& rv) {
+          auto& t = c.rtcm;
+          if (rk == "msm") {
+            t.msm = r.integer(rv, rf, 4, 7);
+            if (t.msm != 4 && t.msm != 7) r.fail(rv, rf, "'" + rf + "' must be 4 or 7");
+          } else if (rk == "station_id") {
+            t.stationId = r.integer(rv, rf, 0, 4095);
+          } else if (rk == "station_interval_s") {
+            t.stationInterval = r.number(rv, rf, 0.1, 3600.0);
+          } else if (rk == "antenna_height_m") {
+            t.antennaHeight = r.number(rv, rf, 0.0, 6.5535);
+          } else {
+            t.ephemerisInterval = r.number(rv, rf, 1.0, 7200.0);
+          }
+        });
+}
+
 void apply(const Reader& r, const YAML::Node& g, const std::string& file, GnssSimConfig& c) {
   static const std::set<std::string> kKeys = {
       "navigation", "systems",     "signals",     "signal_satellites", "cn0_offset_db", "code_noise_factor",
@@ -327,18 +454,7 @@ void apply(const Reader& r, const YAML::Node& g, const std::string& file, GnssSi
     } else if (k == "systems") {
       c.systems = r.systems(v, full);
     } else if (k == "signals") {
-      r.perSystem(v, full, [&](System s, const std::string& sf, const YAML::Node& sv) {
-        std::vector<ObsCode> codes;
-        r.sequence(sv, sf, [&](const std::string& item, const YAML::Node& cv) {
-          const ObsCode oc = r.code(s, cv, item);
-          if (std::find(codes.begin(), codes.end(), oc) != codes.end()) r.fail(cv, item, "signal " + oc.str() + " listed twice");
-          for (const ObsCode& o : codes)
-            if (o.band == oc.band) r.fail(cv, item, "two signals on band " + std::string(1, oc.band) + " (one per band)");
-          codes.push_back(oc);
-        });
-        if (codes.size() > 4) r.fail(sv, sf, "at most 4 signals per system");
-        c.signals[systemIndex(s)] = codes;
-      });
+      applySignals(r, v, full, c);
     } else if (k == "signal_satellites") {
       r.perSignal(v, full, [&](System s, ObsCode oc, const std::string& sf, const YAML::Node& sv) {
         GnssSignalSatellites rule{s, oc, {}};
@@ -361,60 +477,13 @@ void apply(const Reader& r, const YAML::Node& g, const std::string& file, GnssSi
     } else if (k == "include_unhealthy") {
       c.includeUnhealthy = r.boolean(v, full);
     } else if (k == "satellite_errors") {
-      r.map(v, full, {"blend_records", "sisre_m"}, [&](const std::string& sk, const std::string& sf, const YAML::Node& sv) {
-        if (sk == "blend_records") {
-          c.satelliteErrors.blendRecords = r.boolean(sv, sf);
-        } else {
-          r.perSystem(sv, sf, [&](System s, const std::string& xf, const YAML::Node& xv) {
-            c.satelliteErrors.sisre[systemIndex(s)] = r.number(xv, xf, 0.0, 100.0);
-          });
-        }
-      });
+      applySatelliteErrors(r, v, full, c);
     } else if (k == "precise_products") {
-      r.map(v, full, {"write", "orbit_interval_s", "clock_interval_s", "sisre_m", "centre_of_mass", "ssr_interval_s"},
-            [&](const std::string& pk, const std::string& pf, const YAML::Node& pv) {
-              auto& p = c.preciseProducts;
-              if (pk == "write") {
-                p.write = r.boolean(pv, pf);
-              } else if (pk == "centre_of_mass") {
-                p.centreOfMass = r.boolean(pv, pf);
-              } else if (pk == "orbit_interval_s") {
-                p.orbitInterval = r.number(pv, pf, 1.0, 3600.0);
-              } else if (pk == "clock_interval_s") {
-                p.clockInterval = r.number(pv, pf, 1.0, 3600.0);
-              } else if (pk == "ssr_interval_s") {
-                // DF391 update intervals (RTCM 10403.3), 0 = no SSR stream.
-                const double interval = r.number(pv, pf, 0.0, 10800.0);
-                if (interval != 0.0 && !isSsrUpdateInterval(interval))
-                  r.fail(pv, pf,
-                         "'" + pf + "' must be 0 or an RTCM SSR update interval (1, 2, 5, 10, 15, 30, 60, 120, 240, "
-                         "300, 600, 900, 1800, 3600, 7200 or 10800 s)");
-                p.ssrInterval = interval;
-              } else {
-                r.perSystem(pv, pf, [&](System s, const std::string& xf, const YAML::Node& xv) {
-                  p.sisre[systemIndex(s)] = r.number(xv, xf, 0.0, 100.0);
-                });
-              }
-            });
+      applyPreciseProducts(r, v, full, c);
     } else if (k == "troposphere") {
-      r.map(v, full,
-            {"relative_humidity", "hydrostatic_scale_sigma", "wet_scale_sigma", "layer_height_m", "residual"},
-            [&](const std::string& tk, const std::string& tf, const YAML::Node& tv) {
-              auto& t = c.troposphere;
-              if (tk == "relative_humidity") t.relativeHumidity = r.number(tv, tf, 0.0, 1.0);
-              else if (tk == "hydrostatic_scale_sigma") t.hydrostaticScaleSigma = r.number(tv, tf, 0.0, 0.5);
-              else if (tk == "wet_scale_sigma") t.wetScaleSigma = r.number(tv, tf, 0.0, 2.0);
-              else if (tk == "layer_height_m") t.layerHeight = r.number(tv, tf, 1.0, 20000.0);
-              else t.residual = fields(r, tv, tf, "sigma_m", 2.0);
-            });
+      applyTroposphere(r, v, full, c);
     } else if (k == "ionosphere") {
-      r.map(v, full, {"model_scale_sigma", "shell_height_km", "residual"},
-            [&](const std::string& ik, const std::string& iff, const YAML::Node& iv) {
-              auto& i = c.ionosphere;
-              if (ik == "model_scale_sigma") i.modelScaleSigma = r.number(iv, iff, 0.0, 2.0);
-              else if (ik == "shell_height_km") i.shellHeight = r.number(iv, iff, 50.0, 2000.0) * 1e3;
-              else i.residual = fields(r, iv, iff, "sigma_tecu", 200.0);
-            });
+      applyIonosphere(r, v, full, c);
     } else if (k == "shapiro") {
       c.shapiroDelay = r.boolean(v, full);
     } else if (k == "phase_windup") {
@@ -424,43 +493,9 @@ void apply(const Reader& r, const YAML::Node& g, const std::string& file, GnssSi
         applyReceiver(r, rk, rf, rv, c.rover);
       });
     } else if (k == "base") {
-      std::set<std::string> keys = kReceiverKeys;
-      keys.insert({"enabled", "distance_m", "azimuth_deg", "height_m", "position_llh"});
-      r.map(v, full, keys, [&](const std::string& bk, const std::string& bf, const YAML::Node& bv) {
-        auto& b = c.base;
-        if (bk == "enabled") {
-          b.enabled = r.boolean(bv, bf);
-        } else if (bk == "distance_m") {
-          b.distance = r.number(bv, bf, 0.0, 1e6);
-        } else if (bk == "azimuth_deg") {
-          b.azimuthDeg = r.number(bv, bf, -360.0, 360.0);
-        } else if (bk == "height_m") {
-          b.height = r.number(bv, bf, -1000.0, 10000.0);
-        } else if (bk == "position_llh") {
-          if (!bv.IsSequence() || bv.size() != 3) r.fail(bv, bf, "'" + bf + "' must be [lat_deg, lon_deg, height_m]");
-          b.positionLlh = Eigen::Vector3d(r.number(bv[0], bf, -90.0, 90.0), r.number(bv[1], bf, -180.0, 360.0),
-                                          r.number(bv[2], bf, -1000.0, 1e5));
-        } else {
-          applyReceiver(r, bk, bf, bv, b.receiver);
-        }
-      });
+      applyBase(r, v, full, c);
     } else if (k == "rtcm") {
-      r.map(v, full, {"msm", "station_id", "station_interval_s", "antenna_height_m", "ephemeris_interval_s"},
-            [&](const std::string& rk, const std::string& rf, const YAML::Node& rv) {
-              auto& t = c.rtcm;
-              if (rk == "msm") {
-                t.msm = r.integer(rv, rf, 4, 7);
-                if (t.msm != 4 && t.msm != 7) r.fail(rv, rf, "'" + rf + "' must be 4 or 7");
-              } else if (rk == "station_id") {
-                t.stationId = r.integer(rv, rf, 0, 4095);
-              } else if (rk == "station_interval_s") {
-                t.stationInterval = r.number(rv, rf, 0.1, 3600.0);
-              } else if (rk == "antenna_height_m") {
-                t.antennaHeight = r.number(rv, rf, 0.0, 6.5535);
-              } else {
-                t.ephemerisInterval = r.number(rv, rf, 1.0, 7200.0);
-              }
-            });
+      applyRtcm(r, v, full, c);
     } else if (k == "error_terms") {
       c.writeErrorTerms = r.boolean(v, full);
     }
