@@ -27,6 +27,10 @@ constexpr double kC = constants::kSpeedOfLight;
 constexpr int kMaxUnknowns = 4 + kNumSystems;  // position, clocks, zenith ionosphere
 using MatN = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxUnknowns, kMaxUnknowns>;
 using VecN = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxUnknowns, 1>;
+/// Sigma (m) of the vertical L1 ionospheric delay when no broadcast model is available (a receiver
+/// that has not yet decoded the parameters): about 30 TECU (1 TECU = 0.162 m on L1), a daytime
+/// value; the reported covariance's error model maps it to each line of sight.
+constexpr double kUnmodelledVerticalIonosphere = 5.0;
 
 /// Whether an ECEF position is near the Earth's surface (-1000 km .. +1000 km from the ellipsoid
 /// sphere approximation), i.e. converged enough for elevations and atmospheric models.
@@ -350,8 +354,14 @@ void SppSolver::Fit::updateModels(const Eigen::Vector3d& x) {
     m.ephemerisVariance = eph * eph;
     // The reported model's ionosphere error: a field of vertical errors of one sigma (the model
     // error times the zenith delay at the receiver) seen through each line's obliquity.
-    m.ionosphereSigma = m.ionoMap > 0.0 && zenithIono > 0.0 ? cfg.ionosphereModelError * zenithIono * m.ionoMap
-                                                             : std::sqrt(ionoVar);
+    // Without a broadcast model the whole delay is the error: kUnmodelledVerticalIonosphere.
+    if (m.ionoMap > 0.0 && zenithIono > 0.0 && m.iono != 0.0) {
+      m.ionosphereSigma = cfg.ionosphereModelError * zenithIono * m.ionoMap;
+    } else if (m.ionoMap > 0.0 && m.iono == 0.0) {
+      m.ionosphereSigma = kUnmodelledVerticalIonosphere * m.ionoMap;
+    } else {
+      m.ionosphereSigma = std::sqrt(ionoVar);
+    }
     if (surface) m.piercePoint = detail::ionosphericPiercePoint(x, m.state.position, 350e3);
   }
 }
