@@ -70,7 +70,8 @@ struct CovarianceScaling {
 ///     the RMS delay: IS-GPS-200N 20.3.3.5.2.5), seen through each line's obliquity, correlated
 ///     between two lines of sight as exp(-d^2 / (2 L^2)), d the distance of their pierce points on
 ///     a 350 km shell and L = `ionosphereCorrelationLength` (the one scale chosen on the real
-///     recordings, leave-one-site-out: bench/spp/sigma_fit.py);
+///     recordings, leave-one-site-out: bench/spp/sigma_fit.py); without broadcast parameters the
+///     whole delay, 5 m vertical;
 ///   - troposphere residual: `troposphereZenithError` at the zenith, one value for all lines of
 ///     sight (mapped);
 ///   - independent per satellite: code noise and multipath (`weighting`, times `noiseScale`) and
