@@ -21,7 +21,9 @@ others, and scored apart as well where there are some.
 Truths: Nagoya rover and base: the positions in tests/data/gnss/nagoya_static_2024/*_position.txt;
 Kamakura: the GSI F5 ECEF position in tests/data/README.md; GEONET 0759 and 3040: only the
 approximate position of their RINEX headers (RTKLIB's static RTK puts 0759 within 0.2 m of it,
-small against SPP errors of metres); the u-blox walk (tests/data/ubx/gnss_1730.ubx, 4 Hz, own
+small against SPP errors of metres); RTKLIB's testglo RTCM log (GPS + GLONASS, 3 minutes, as
+convbin's RINEX in tests/data/reference): the reference station position of its own 1005
+messages; the u-blox walk (tests/data/ubx/gnss_1730.ubx, 4 Hz, own
 SFRBX ephemerides): the publisher's RTK track (walk_reference), heights made ellipsoidal, with the
 mean horizontal error removed (its base position is not published). Simulated: a 10-minute urban
 drive (bench/spp/urban_spp.yaml: 1.5 m code multipath, NLOS reception of 5-80 m extra path on
@@ -183,7 +185,10 @@ def cases():
          "geonet_0759_spp.pos", "RINEX header only"),
         ("GEONET 3040", [g + "/30400920.05o.gz", g + "/30400920.05n.gz"], header_position(g + "/30400920.05o.gz"),
          None, "RINEX header only"),
-        ("u-blox walk", [UBX], walk_reference(), None, "publisher's RTK track, mean horizontal error removed"),
+        ("u-blox walk", [UBX], walk_reference(), "ubx_gnss_1730_spp.pos",
+         "publisher's RTK track, mean horizontal error removed"),
+        ("RTCM testglo", [REF + "/rtcm_testglo_convbin.obs", REF + "/rtcm_testglo_convbin.nav"],
+         [-3869297.5138, 3436571.3345, 3717369.3757], None, "station position of its 1005 message"),
     ]
 
 
