@@ -324,7 +324,9 @@ def commit_of_tree():
     def git(*a):
         return subprocess.run(["git", "-C", ROOT] + list(a), capture_output=True, text=True).stdout.strip()
     c = git("rev-parse", "--short", "HEAD")
-    return c + (" (with uncommitted changes)" if git("status", "--porcelain", "--untracked-files=no") else "")
+    # Results files being rewritten do not count as changes of the tree that made them.
+    dirty = git("status", "--porcelain", "--untracked-files=no", "--", ".", ":!docs/results")
+    return c + (" (with uncommitted changes)" if dirty else "")
 
 
 def main():
@@ -370,11 +372,12 @@ def main():
     print("\n".join(lines))
     shutil.rmtree(tmp)
     if "--write" in sys.argv:
+        commit = commit_of_tree()  # before the file is opened (and so modified)
         with open(RESULTS, "w") as f:
             f.write("# SPP standard deviation against the truth\n\n")
             f.write("Written by `bench/spp/sigma_calibration.py BUILD_DIR --write` at commit %s, %s. "
                     "What the columns mean and what the rows say: docs/spp.md, \"Standard deviation\".\n\n"
-                    % (commit_of_tree(), datetime.date.today().isoformat()))
+                    % (commit, datetime.date.today().isoformat()))
             f.write("\n".join(lines) + "\n")
     if "--check" in sys.argv:
         for msg in failures:

@@ -101,11 +101,12 @@ def main():
     print("\n".join(lines if markdown else lines[2:]))
     if "--write" in sys.argv:
         import datetime
+        commit = sc.commit_of_tree()  # before the file is opened (and so modified)
         with open(os.path.join(sc.ROOT, "docs", "results", "spp_sigma_fit.md"), "w") as f:
             f.write("# SPP correlated-error model: correlation length, leave-one-site-out\n\n")
             f.write("Written by `bench/spp/sigma_fit.py BUILD_DIR --write` at commit %s, %s. Shares of the "
                     "epochs within 1/2/3 reported sigma, pooled per site; what it says: docs/spp.md, "
-                    "\"Standard deviation\".\n\n" % (sc.commit_of_tree(), datetime.date.today().isoformat()))
+                    "\"Standard deviation\".\n\n" % (commit, datetime.date.today().isoformat()))
             f.write("\n".join(lines) + "\n")
     print("cross-validated loss %.1f; fitted on all sites %s, loss %.1f" % (
         loss(cv), allp, loss(pooled([site_pct[(s, allp)] for s in sites]))), file=sys.stderr)
