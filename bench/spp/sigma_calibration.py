@@ -1,28 +1,40 @@
 #!/usr/bin/env python3
 """SPP sigma calibration on the real recordings with a known antenna position.
 
-    bench/spp/sigma_calibration.py [BUILD_DIR] [--markdown]     (default build dir: build)
+    bench/spp/sigma_calibration.py [BUILD_DIR] [--markdown] [--write] [--check]
+                                                        (default build dir: build)
 
 Needs gvins-spp and, for the simulated case, gvins-sim in BUILD_DIR/bin.
 
-Runs gvins-spp three times on every recording: with the a-priori covariance of the weighted least
-squares (`covariance_scaling: {enabled: false}`), with the defaults, and with the defaults on
-dual-frequency ionosphere-free pseudoranges (`--freq 2 --iono dual-frequency`: what remains when
-the broadcast ionosphere model's error is removed), and scores RTKLIB 2.4.3's stored SPP solutions of the same files where there
-are some (tests/data/reference/rtklib-2.4.3). For each run and axis (east, north, up) it prints
-the share of epochs whose error lies within 1, 2 and 3 of the reported standard deviations; a
-Gaussian error with an honest sigma gives 68.3 / 95.4 / 99.7 %. Also the median of |error|/sigma
-(0.674 for an honest sigma) and the RMS error. Epochs whose residual test failed (test = 1) are
-counted like the others.
+Runs gvins-spp on every recording: with the a-priori covariance of the weighted least squares
+(`covariance_scaling` and `reported_error` off), with the correlated-error model off (all errors
+independent, scaled by the variance factor), with the defaults (errors correlated between
+satellites, docs/spp.md), and the last two on dual-frequency ionosphere-free pseudoranges
+(`--freq 2 --iono dual-frequency`), and scores
+RTKLIB 2.4.3's stored SPP solutions of the same files where there are some
+(tests/data/reference/rtklib-2.4.3). For each run and axis (east, north, up) it prints the share of
+epochs whose error lies within 1, 2 and 3 of the reported standard deviations; a Gaussian error
+with an honest sigma gives 68.3 / 95.4 / 99.7 %. Also the median of |error|/sigma (0.674 for an
+honest sigma) and the RMS error. Epochs whose residual test failed (test = 1) are counted like the
+others, and scored apart as well where there are some.
 
 Truths: Nagoya rover and base: the positions in tests/data/gnss/nagoya_static_2024/*_position.txt;
 Kamakura: the GSI F5 ECEF position in tests/data/README.md; GEONET 0759 and 3040: only the
 approximate position of their RINEX headers (RTKLIB's static RTK puts 0759 within 0.2 m of it,
-small against SPP errors of metres); the u-blox walk (tests/data/ubx/gnss_1730.ubx, 4 Hz, own
-SFRBX ephemerides): the publisher's RTK track with its mean offset removed (ReferenceTrack).
-Simulated: a 10-minute urban drive (bench/spp/urban_spp.yaml:
-1.5 m code multipath, NLOS reception of 5-80 m extra path on low satellites) with gvins-sim's
-antenna truth, standing in for the urban recordings we do not have.
+small against SPP errors of metres); RTKLIB's testglo RTCM log (GPS + GLONASS, 3 minutes, as
+convbin's RINEX in tests/data/reference): the reference station position of its own 1005
+messages; the u-blox walk (tests/data/ubx/gnss_1730.ubx, 4 Hz, own
+SFRBX ephemerides): the publisher's RTK track (walk_reference), heights made ellipsoidal, with the
+mean horizontal error removed (its base position is not published). Simulated: a 10-minute urban
+drive (bench/spp/urban_spp.yaml: 1.5 m code multipath, NLOS reception of 5-80 m extra path on
+low satellites) with gvins-sim's antenna truth, standing in for the urban recordings we do not
+have.
+
+--write writes the table to docs/results/spp_sigma.md with the commit and the command.
+--check exits non-zero unless the bands of check() hold (the ctest test spp_sigma_calibration):
+within 3 sigma >= 97 % on every axis of every real recording, with the defaults and with the
+correlated-error model off, and the defaults' median |error|/sigma >= 0.1 (the sigma not more
+than about 7x the typical error).
 """
 import datetime
 import gzip
@@ -38,6 +50,11 @@ DATA = os.path.join(ROOT, "tests", "data", "gnss")
 REF = os.path.join(ROOT, "tests", "data", "reference", "rtklib-2.4.3")
 UBX = os.path.join(ROOT, "tests", "data", "ubx", "gnss_1730.ubx")
 WALK_REF = os.path.join(ROOT, "tests", "data", "gnss_imu", "walk_0827", "gnss_1730_sf.pos")
+# The walk reference's heights are above mean sea level: its lat/lon/height equal the UBX log's
+# NAV-PVT lat/lon/hMSL in all 536 epochs, and NAV-PVT's ellipsoidal height there is
+# hMSL - 21.387 m (u-blox interface description, UBX-NAV-PVT: height above ellipsoid and hMSL;
+# -21.387/-21.388 m throughout the log).
+WALK_GEOID_SEPARATION = -21.387
 
 # WGS84 (NIMA TR8350.2)
 A = 6378137.0
@@ -168,22 +185,38 @@ def cases():
          "geonet_0759_spp.pos", "RINEX header only"),
         ("GEONET 3040", [g + "/30400920.05o.gz", g + "/30400920.05n.gz"], header_position(g + "/30400920.05o.gz"),
          None, "RINEX header only"),
-        ("u-blox walk", [UBX], ReferenceTrack(WALK_REF), None, "publisher's RTK track, mean error removed"),
+        ("u-blox walk", [UBX], walk_reference(), "ubx_gnss_1730_spp.pos",
+         "publisher's RTK track, mean horizontal error removed"),
+        ("RTCM testglo", [REF + "/rtcm_testglo_convbin.obs", REF + "/rtcm_testglo_convbin.nav"],
+         [-3869297.5138, 3436571.3345, 3717369.3757], None, "station position of its 1005 message"),
     ]
+
+
+def walk_reference():
+    """The u-blox walk's reference track with ellipsoidal heights: the publisher's RTK .pos, whose
+    heights are above mean sea level, moved by the constant geoid separation of the receiver's
+    NAV-PVT (WALK_GEOID_SEPARATION). One function, so that a track written with ellipsoidal
+    heights (NAV-PVT to .pos) can replace the file and the constant."""
+    return ReferenceTrack(WALK_REF, height_offset=WALK_GEOID_SEPARATION)
 
 
 class ReferenceTrack:
     """A reference .pos track (latitude/longitude/height, GPST): the position of the row nearest
-    in time, within 0.1 s (the solutions of a 4 Hz receiver carry its epoch times to the ms).
-    relative: the track's absolute position is not known (the u-blox walk's base station position
-    is not published; both our single- and dual-frequency SPP put it 6 m west and 13-18 m above
-    our solutions, about the geoid undulation there), so the mean error is removed before scoring:
-    what is scored is the time-varying part of the error only."""
+    in time, within 0.1 s (the solutions of a 4 Hz receiver carry its epoch times to the ms);
+    `height_offset` (m) is added to its heights. Its horizontal position is relative: the track
+    is an RTK solution relative to a base station whose position is not published (every SPP
+    solution, ours and RTKLIB's, sits 6-8 m off it horizontally), so the mean horizontal error is
+    removed before scoring (horizontal: the time-varying part only; up: absolute)."""
 
-    relative = True
+    relative_axes = (0, 1)
 
-    def __init__(self, path):
-        self.rows = sorted((t, x) for t, x, _, _ in read_pos(path))
+    def __init__(self, path, height_offset=0.0):
+        self.rows = []
+        for t, x, _, _ in read_pos(path):
+            lat, lon = ecef_to_latlon(x)
+            up = [math.cos(lat) * math.cos(lon), math.cos(lat) * math.sin(lon), math.sin(lat)]
+            self.rows.append((t, [x[i] + height_offset * up[i] for i in range(3)]))
+        self.rows.sort()
 
     def at(self, t):
         import bisect
@@ -228,7 +261,8 @@ def score(rows, truth):
         lat, lon = ecef_to_latlon(tx)
         errors.append((mat_vec(enu_rotation(lat, lon), [x[i] - tx[i] for i in range(3)]), c))
     n = len(errors)
-    mean = [sum(e[a] for e, _ in errors) / n if getattr(truth, "relative", False) else 0.0 for a in range(3)]
+    relative = getattr(truth, "relative_axes", ())
+    mean = [sum(e[a] for e, _ in errors) / n if a in relative else 0.0 for a in range(3)]
     for e, c in errors:
         e = [e[a] - mean[a] for a in range(3)]
         for a in range(3):
@@ -243,21 +277,68 @@ def score(rows, truth):
 
 
 EXTRA_RUNS = []  # (label, gvins-spp arguments): experiments
+RESULTS = os.path.join(ROOT, "docs", "results", "spp_sigma.md")
+MODEL_OFF = "correlated-error model off"  # label of the runs with spp.reported_error disabled
+
+
+def runs_of(spp, inputs, tmp):
+    """(label, rows) of every gvins-spp configuration on one recording."""
+    apriori = os.path.join(tmp, "apriori.yaml")
+    independent = os.path.join(tmp, "independent.yaml")
+    with open(apriori, "w") as f:
+        f.write("spp:\n  covariance_scaling: {enabled: false}\n  reported_error: {enabled: false}\n")
+    with open(independent, "w") as f:
+        f.write("spp:\n  reported_error: {enabled: false}\n")
+    dual = ["--freq", "2", "--iono", "dual-frequency"]
+    runs = []
+    for label, extra in [("a-priori", ["--config", apriori]), (MODEL_OFF, ["--config", independent]),
+                         ("default", []), ("default, dual-frequency", dual),
+                         (MODEL_OFF + ", dual-frequency", ["--config", independent] + dual)] + EXTRA_RUNS:
+        out = os.path.join(tmp, "out.pos")
+        cmd = [spp, "-q"] + extra + ["-o", out] + inputs
+        p = subprocess.run(cmd, stderr=subprocess.PIPE, text=True)
+        if p.returncode != 0:
+            sys.exit("failed: " + " ".join(cmd) + "\n" + p.stderr)
+        runs.append(("gvins-spp " + label, read_pos(out)))
+    return runs
+
+
+def check(name, label, pct, med):
+    """The bands of --check; a list of failures. Every real recording, with the defaults and with
+    the correlated-error model off: at least 97 % of the epochs within 3 sigma on every axis (not
+    optimistic); with the defaults the median |error|/sigma over the axes at least 0.1 (not
+    grossly pessimistic)."""
+    bad = []
+    if label not in ("gvins-spp default", "gvins-spp " + MODEL_OFF):
+        return bad
+    for a in range(3):
+        if pct[a][2] < 97.0:
+            bad.append("%s, %s: %s within 3 sigma %.1f %% < 97 %%" % (name, label, "ENU"[a], pct[a][2]))
+    m = sorted(med)[1]
+    if label == "gvins-spp default" and m < 0.1:
+        bad.append("%s, %s: median |error|/sigma %.2f < 0.1 (sigma grossly pessimistic)" % (name, label, m))
+    return bad
+
+
+def commit_of_tree():
+    def git(*a):
+        return subprocess.run(["git", "-C", ROOT] + list(a), capture_output=True, text=True).stdout.strip()
+    c = git("rev-parse", "--short", "HEAD")
+    # Results files being rewritten do not count as changes of the tree that made them.
+    dirty = git("status", "--porcelain", "--untracked-files=no", "--", ".", ":!docs/results")
+    return c + (" (with uncommitted changes)" if dirty else "")
 
 
 def main():
     args = [a for a in sys.argv[1:] if not a.startswith("--")]
-    markdown = "--markdown" in sys.argv
+    markdown = "--markdown" in sys.argv or "--write" in sys.argv
     build = args[0] if args else "build"
     build = build if os.path.isabs(build) else os.path.join(ROOT, build)
     spp = os.path.join(build, "bin", "gvins-spp")
     if not os.access(spp, os.X_OK):
         sys.exit("gvins-spp not built: " + spp)
     tmp = tempfile.mkdtemp()
-    before_cfg = os.path.join(tmp, "before.yaml")
-    with open(before_cfg, "w") as f:
-        f.write("spp:\n  covariance_scaling: {enabled: false}\n  reported_error: {enabled: false}\n")
-    lines = []
+    lines, failures = [], []
     if markdown:
         lines.append("| recording (truth) | solution | epochs | E 1/2/3 σ (%) | N 1/2/3 σ (%) | U 1/2/3 σ (%) "
                      "| median abs(err)/σ E/N/U | RMS E/N/U (m) |")
@@ -267,15 +348,7 @@ def main():
             "recording", "solution", "epochs", "E within 1/2/3 sd", "N within 1/2/3 sd", "U within 1/2/3 sd",
             "median |e|/sd ENU", "RMS E/N/U m"))
     for name, inputs, truth, ref, truth_note in cases() + simulated_case(build, tmp):
-        runs = []
-        for label, extra in [("a-priori", ["--config", before_cfg]), ("default", []),
-                             ("default, dual-frequency", ["--freq", "2", "--iono", "dual-frequency"])] + EXTRA_RUNS:
-            out = os.path.join(tmp, "out.pos")
-            cmd = [spp, "-q"] + extra + ["-o", out] + inputs
-            p = subprocess.run(cmd, stderr=subprocess.PIPE, text=True)
-            if p.returncode != 0:
-                sys.exit("failed: " + " ".join(cmd) + "\n" + p.stderr)
-            runs.append(("gvins-spp " + label, read_pos(out)))
+        runs = runs_of(spp, inputs, tmp)
         if ref:
             runs.append(("RTKLIB 2.4.3 (stored)", read_pos(os.path.join(REF, ref))))
         print("%s: %s" % (name, " ".join(os.path.basename(i) for i in inputs)), file=sys.stderr)
@@ -286,6 +359,8 @@ def main():
                 if not rows:
                     continue
                 n, pct, med, rms = score(rows, truth)
+                if not part and not name.startswith("Sim"):
+                    failures += check(name, label, pct, med)
                 if markdown:
                     lines.append("| %s (%s) | %s | %d | %s | %s | %s | %s | %s |" % (
                         name, truth_note, label + part, n, *["%.1f / %.1f / %.1f" % tuple(pct[a]) for a in range(3)],
@@ -296,6 +371,18 @@ def main():
                         " ".join("%5.2f" % m for m in med), " ".join("%5.2f" % r for r in rms)))
     print("\n".join(lines))
     shutil.rmtree(tmp)
+    if "--write" in sys.argv:
+        commit = commit_of_tree()  # before the file is opened (and so modified)
+        with open(RESULTS, "w") as f:
+            f.write("# SPP standard deviation against the truth\n\n")
+            f.write("Written by `bench/spp/sigma_calibration.py BUILD_DIR --write` at commit %s, %s. "
+                    "What the columns mean and what the rows say: docs/spp.md, \"Standard deviation\".\n\n"
+                    % (commit, datetime.date.today().isoformat()))
+            f.write("\n".join(lines) + "\n")
+    if "--check" in sys.argv:
+        for msg in failures:
+            print("FAIL " + msg, file=sys.stderr)
+        sys.exit(1 if failures else 0)
 
 
 if __name__ == "__main__":

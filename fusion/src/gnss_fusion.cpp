@@ -484,7 +484,11 @@ template <typename Scalar>
 void GnssFusion<Scalar>::useNavigation(const EphemerisStore& nav) {
   if (nav_ == &nav) return;
   nav_ = &nav;
-  spp_ = std::make_unique<SppSolver>(nav);
+  // The SPP covariance of the frame updates and the alignment as before the correlated-error
+  // model of the reported covariance (spp_config.hpp ReportedErrorModel), until it is tuned here.
+  SppConfig sppConfig;
+  sppConfig.reportedError.enabled = false;
+  spp_ = std::make_unique<SppSolver>(nav, sppConfig);
   if (config_.usesDifferences()) {
     rtk_ = std::make_unique<RtkSolver>(nav);
     rtk_->setRoverDopplerCheckedByCaller();  // checked at the input (prepareRover), once

@@ -27,6 +27,10 @@ constexpr double kC = constants::kSpeedOfLight;
 constexpr int kMaxUnknowns = 4 + kNumSystems;  // position, clocks, zenith ionosphere
 using MatN = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxUnknowns, kMaxUnknowns>;
 using VecN = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxUnknowns, 1>;
+/// Sigma (m) of the vertical L1 ionospheric delay when no broadcast model is available (a receiver
+/// that has not yet decoded the parameters): about 30 TECU (1 TECU = 0.162 m on L1), a daytime
+/// value; the reported covariance's error model maps it to each line of sight.
+constexpr double kUnmodelledVerticalIonosphere = 5.0;
 
 /// Whether an ECEF position is near the Earth's surface (-1000 km .. +1000 km from the ellipsoid
 /// sphere approximation), i.e. converged enough for elevations and atmospheric models.
@@ -83,7 +87,12 @@ struct SppSolver::Measurement {
   // Model values of the last iteration.
   AzEl azel{0.0, 0.5 * constants::kPi};
   double iono = 0.0, tropo = 0.0, variance = 1.0;
-  double errorVariance = 1.0;  // of the reported covariance's error model (ReportedErrorModel)
+  // Error budget of the reported covariance (ReportedErrorModel): variances of the noise and of
+  // the broadcast orbit/clock, the slant broadcast-ionosphere error sigma, its pierce point, the
+  // troposphere residual's mapping; the residual of the fit before robust re-weighting.
+  double noiseVariance = 0.0, ephemerisVariance = 0.0, ionosphereSigma = 0.0, troposphereMap = 0.0;
+  Eigen::Vector3d piercePoint = Eigen::Vector3d::UnitZ();
+  double priorResidual = 0.0;
   bool active = true;  // above the mask in the last iteration
   double inflation = 1.0;  // variance factor from robust re-weighting
   double ionoMap = 0.0;    // partial of the delay w.r.t. a zenith L1 ionosphere correction
@@ -218,8 +227,7 @@ class SppSolver::Fit {
         ionoPar(solver.nav_.ionosphere()),
         n(static_cast<int>(meas.size())),
         // Zenith ionosphere correction to the broadcast model as an extra unknown (with a prior).
-        estIono(cfg.ionosphereEstimation.enabled && cfg.ionosphere != IonosphereOption::Off && ionoPar.gps.has_value()),
-        owner(solver) {}
+        estIono(cfg.ionosphereEstimation.enabled && cfg.ionosphere != IonosphereOption::Off && ionoPar.gps.has_value()) {}
 
   /// Updates az/el, atmospheric delays, variances and the mask flag of every measurement at x.
   /// Model values change by < 1 mm when the position moves by less than a metre (elevations by
@@ -245,6 +253,11 @@ class SppSolver::Fit {
   bool writeSolution();
   /// Doppler velocity at the solution from the measurements used.
   void solveVelocity();
+  /// Keeps the residuals and the ionosphere correction of the fit before robust re-weighting
+  /// (the reported covariance's variance factor is taken from them).
+  void keepPriorResiduals();
+  /// The reported covariance under SppConfig::reportedError (spp_reported_covariance.hpp).
+  void reportCovariance();
 
   const SppConfig& cfg;
   const ObsEpoch& epoch;
@@ -254,8 +267,8 @@ class SppSolver::Fit {
   const IonosphereParameters& ionoPar;
   const int n;
   const bool estIono;
-  const SppSolver& owner;  // for its reported-covariance model
   double ionoPriorVar = 1.0;
+  double ionBeforeRobust = 0.0;
   std::optional<Eigen::Vector3d> modelPoint;
   std::array<int, kNumSystems> col{};
   std::vector<int> colSystems;
@@ -291,8 +304,12 @@ void SppSolver::Fit::updateModels(const Eigen::Vector3d& x) {
     mo.broadcastIonosphere = cfg.ionosphere != IonosphereOption::Off;
     model.emplace(x, epoch.time, mo, &ionoPar);
   }
+  double zenithIono = 0.0;  // broadcast model's zenith delay on L1 at the receiver, m
+  if (surface && ionoPar.gps) {
+    zenithIono = klobucharDelayL1(*ionoPar.gps, model->geodetic(), AzEl{0.0, 0.5 * constants::kPi}, epoch.time);
+  }
   if (surface && estIono && ionoPar.gps) {
-    const double iz = klobucharDelayL1(*ionoPar.gps, model->geodetic(), AzEl{0.0, 0.5 * constants::kPi}, epoch.time);
+    const double iz = zenithIono;
     ionoPriorVar = std::pow(std::max(cfg.ionosphereEstimation.priorFraction * iz, cfg.ionosphereEstimation.minPriorSigma), 2);
   }
   for (Measurement& m : meas) {
@@ -300,6 +317,7 @@ void SppSolver::Fit::updateModels(const Eigen::Vector3d& x) {
     m.tropo = 0.0;
     double ionoVar = 0.0, tropoVar = 0.0;
     m.ionoMap = 0.0;
+    m.troposphereMap = 0.0;
     if (surface) {
       // An ionosphere-free pseudorange (frequency 0) gets no ionosphere term.
       const SatelliteModelTerms t = model->terms(m.state.position, m.sat.system, m.ionosphereFree ? 0.0 : m.frequency);
@@ -307,7 +325,8 @@ void SppSolver::Fit::updateModels(const Eigen::Vector3d& x) {
       m.active = m.azel.elevation >= cfg.elevationMask;
       if (model->troposphere().valid()) {
         m.tropo = t.troposphere.slant;
-        const double e = cfg.troposphereZenithError * t.troposphere.mapHydrostatic;
+        m.troposphereMap = t.troposphere.mapHydrostatic;
+        const double e = cfg.troposphereZenithError * m.troposphereMap;
         tropoVar = e * e;
       }
       if (!m.ionosphereFree && cfg.ionosphere != IonosphereOption::Off) {
@@ -331,9 +350,19 @@ void SppSolver::Fit::updateModels(const Eigen::Vector3d& x) {
     }
     var += eph * eph;
     m.variance = var * m.inflation;
-    const ReportedErrorModel& re = cfg.reportedError;
-    m.errorVariance = re.noiseScale * re.noiseScale * noiseVar + re.ionosphereScale * re.ionosphereScale * ionoVar +
-                      re.modelScale * re.modelScale * (tropoVar + eph * eph);
+    m.noiseVariance = noiseVar;
+    m.ephemerisVariance = eph * eph;
+    // The reported model's ionosphere error: a field of vertical errors of one sigma (the model
+    // error times the zenith delay at the receiver) seen through each line's obliquity.
+    // Without a broadcast model the whole delay is the error: kUnmodelledVerticalIonosphere.
+    if (m.ionoMap > 0.0 && zenithIono > 0.0 && m.iono != 0.0) {
+      m.ionosphereSigma = cfg.ionosphereModelError * zenithIono * m.ionoMap;
+    } else if (m.ionoMap > 0.0 && m.iono == 0.0) {
+      m.ionosphereSigma = kUnmodelledVerticalIonosphere * m.ionoMap;
+    } else {
+      m.ionosphereSigma = std::sqrt(ionoVar);
+    }
+    if (surface) m.piercePoint = detail::ionosphericPiercePoint(x, m.state.position, 350e3);
   }
 }
 
@@ -655,10 +684,7 @@ bool SppSolver::Fit::writeSolution() {
     losEnu.push_back(rEnu * (m.state.position - x).normalized());
     clockIdx.push_back(col[m.sys]);
   }
-  if (cfg.reportedError.enabled) {
-    const std::optional<double> ionoPrior = estIono ? std::optional<double>(ionoPriorVar) : std::nullopt;
-    owner.reportCovariance(sol, meas, use, x, col, colSystems, last.cov, ionoPrior, ion);
-  }
+  if (cfg.reportedError.enabled) reportCovariance();
   sol.dop = computeDop(losEnu, clockIdx, static_cast<int>(colSystems.size()));
   if (!sol.dop.valid || sol.dop.gdop > cfg.maxGdop) {
     sol.status = SppStatus::GdopTooLarge;
@@ -722,6 +748,7 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
   sol.chi2 = fit.last.chi2;
   sol.dof = fit.last.nObs - fit.last.nUnknowns;
   sol.testPassed = sol.dof < 1 || sol.chi2 <= globalTestThreshold(sol.dof, cfg.faultExclusion.falseAlarmProbability);
+  fit.keepPriorResiduals();
   fit.reweight();
   if (!fit.writeSolution()) return sol;
 
@@ -738,32 +765,55 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
   return sol;
 }
 
-void SppSolver::reportCovariance(SppSolution& sol, const std::vector<Measurement>& meas, const std::vector<char>& use,
-                                 const Eigen::Vector3d& x, const std::array<int, kNumSystems>& col,
-                                 const std::vector<int>& colSystems, const Eigen::MatrixXd& cov,
-                                 std::optional<double> ionoPriorVar, double ion) const {
+void SppSolver::Fit::keepPriorResiduals() {
+  ionBeforeRobust = ion;
+  for (int i = 0; i < n; ++i) {
+    Measurement& m = meas[i];
+    if (!use[i]) continue;
+    const double pred = geometricRange(m.state.position, x) + clk[col[m.sys]] - kC * m.satClock + m.iono +
+                        m.ionoMap * ion + m.tropo;
+    m.priorResidual = m.pseudorange - pred;
+  }
+}
+
+void SppSolver::Fit::reportCovariance() {
   const int nc = static_cast<int>(colSystems.size());
-  const int nu = static_cast<int>(cov.rows());
-  std::vector<detail::ReportedRow> rr;
-  for (std::size_t i = 0; i < meas.size(); ++i) {
+  const int nu = static_cast<int>(last.cov.rows());
+  const ReportedErrorModel& re = cfg.reportedError;
+  detail::ReportedInputs in;
+  in.q = last.cov;
+  for (int i = 0; i < n; ++i) {
     if (!use[i]) continue;
     const Measurement& m = meas[i];
-    detail::ReportedRow row{Eigen::VectorXd::Zero(nu), m.variance, m.errorVariance, sol.satellites[m.result].residual};
+    detail::ReportedRow row;
+    row.h = Eigen::VectorXd::Zero(nu);
     row.h.head<3>() = -(m.state.position - x).normalized();
     row.h[3 + col[m.sys]] = 1.0;
-    if (ionoPriorVar) row.h[3 + nc] = m.ionoMap;
-    rr.push_back(std::move(row));
+    if (estIono) row.h[3 + nc] = m.ionoMap;
+    row.weight = 1.0 / m.variance;
+    row.priorWeight = 1.0 / (m.variance / m.inflation);
+    row.independentVariance = re.noiseScale * re.noiseScale * m.noiseVariance + m.ephemerisVariance;
+    row.ionosphereSigma = m.ionosphereSigma;
+    row.piercePoint = m.piercePoint;
+    row.troposphereMap = m.troposphereMap;
+    row.residual = m.priorResidual;
+    in.rows.push_back(std::move(row));
   }
-  if (ionoPriorVar) {  // the prior of the zenith correction, an error budget like the others
-    const double f = config_.reportedError.ionosphereScale;
-    rr.push_back(detail::ReportedRow{Eigen::VectorXd::Unit(nu, 3 + nc), *ionoPriorVar, f * f * *ionoPriorVar, -ion});
+  if (estIono) {
+    in.ionosphereColumn = 3 + nc;
+    in.ionosphereCorrection = ionBeforeRobust;
+    in.ionospherePriorWeight = 1.0 / ionoPriorVar;
   }
-  const detail::ReportedCovariance rc = detail::reportedCovariance(cov, rr, sol.dof, config_.covarianceScaling);
+  in.troposphereZenithSigma = cfg.troposphereZenithError;
+  in.ionosphereCorrelationLength = re.ionosphereCorrelationLength;
+  in.dof = sol.dof;
+  in.minVarianceFactor = re.minVarianceFactor;
+  const detail::ReportedCovariance rc = detail::reportedCovariance(in, cfg.covarianceScaling);
   sol.varianceFactor = rc.varianceFactor;
   sol.positionCovariance = rc.covariance.topLeftCorner<3, 3>();
   for (int c = 0; c < nc; ++c) sol.clockBiasVariance[colSystems[c]] = rc.covariance(3 + c, 3 + c);
   const int gi = systemIndex(System::Gps), ji = systemIndex(System::Qzss);
-  if (config_.qzssUsesGpsClock && sol.clockBias[gi]) sol.clockBiasVariance[ji] = sol.clockBiasVariance[gi];
+  if (cfg.qzssUsesGpsClock && sol.clockBias[gi]) sol.clockBiasVariance[ji] = sol.clockBiasVariance[gi];
 }
 
 void SppSolver::updateIsb(const SppSolution& sol, const Eigen::MatrixXd& cov, const std::vector<int>& clockSystems) {

@@ -27,12 +27,12 @@ namespace {
 using Reader = YamlReader;
 
 void applyReportedError(const Reader& r, const YAML::Node& v, const std::string& full, ReportedErrorModel& m) {
-  static const std::set<std::string> kE = {"enabled", "noise_scale", "ionosphere_scale", "model_scale"};
+  static const std::set<std::string> kE = {"enabled", "noise_scale", "ionosphere_correlation_km", "min_variance_factor"};
   r.map(v, full, kE, [&](const std::string& ek, const std::string& ef, const YAML::Node& ev) {
     if (ek == "enabled") m.enabled = r.boolean(ev, ef);
     else if (ek == "noise_scale") m.noiseScale = r.number(ev, ef, 0.0, 100.0);
-    else if (ek == "ionosphere_scale") m.ionosphereScale = r.number(ev, ef, 0.0, 100.0);
-    else m.modelScale = r.number(ev, ef, 0.0, 100.0);
+    else if (ek == "min_variance_factor") m.minVarianceFactor = r.number(ev, ef, 0.0, 1.0);
+    else m.ionosphereCorrelationLength = r.number(ev, ef, 1.0, 1e5) * 1e3;
   });
 }
 

@@ -1,28 +1,100 @@
 #include "spp_reported_covariance.hpp"
 
 #include <algorithm>
+#include <cmath>
+
+#include <Eigen/Cholesky>
 
 namespace gvins::detail {
 
-ReportedCovariance reportedCovariance(const Eigen::MatrixXd& q, const std::vector<ReportedRow>& rows, int dof,
-                                      const CovarianceScaling& scaling) {
-  // With N = H^T W H the sum over all rows of w h h^T, and the rows not listed honest (w^2 r = w):
-  //   H^T W R W H = N + sum_listed w (w r - 1) h h^T,  so  Q M Q = Q + Q D Q.
-  const auto m = q.rows();
-  Eigen::MatrixXd d = Eigen::MatrixXd::Zero(m, m);
-  double chi2 = 0.0;
-  for (const ReportedRow& row : rows) {
-    const double w = 1.0 / row.weightVariance;
-    d.noalias() += (w * (w * row.errorVariance - 1.0)) * row.h * row.h.transpose();
-    chi2 += row.residual * row.residual / row.errorVariance;
+namespace {
+constexpr double kEarthMeanRadius = 6371000.0;  // m (IUGG mean radius)
+
+Eigen::MatrixXd symmetricInverse(const Eigen::MatrixXd& n) {
+  return n.ldlt().solve(Eigen::MatrixXd::Identity(n.rows(), n.cols()));
+}
+}  // namespace
+
+Eigen::Vector3d ionosphericPiercePoint(const Eigen::Vector3d& receiver, const Eigen::Vector3d& satellite,
+                                       double shellHeight) {
+  // |r + s e| = R + h for the line of sight e, the positive root s.
+  const Eigen::Vector3d e = (satellite - receiver).normalized();
+  const double shell = kEarthMeanRadius + shellHeight;
+  const double b = receiver.dot(e);
+  const double c = receiver.squaredNorm() - shell * shell;
+  const double s = -b + std::sqrt(std::max(b * b - c, 0.0));
+  return (receiver + s * e).normalized();
+}
+
+Eigen::MatrixXd rowErrorCovariance(const std::vector<ReportedRow>& rows, double troposphereZenithSigma,
+                                   double ionosphereCorrelationLength) {
+  const auto n = static_cast<Eigen::Index>(rows.size());
+  Eigen::MatrixXd r(n, n);
+  const double shell = kEarthMeanRadius + 350e3;  // distances on the model's shell (no need for precision)
+  const double st2 = troposphereZenithSigma * troposphereZenithSigma;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const ReportedRow& a = rows[i];
+    for (Eigen::Index j = 0; j <= i; ++j) {
+      const ReportedRow& b = rows[j];
+      const double angle = std::acos(std::clamp(a.piercePoint.dot(b.piercePoint), -1.0, 1.0));
+      const double dl = shell * angle / ionosphereCorrelationLength;
+      const double rho = std::exp(-0.5 * dl * dl);
+      r(i, j) = r(j, i) = a.ionosphereSigma * b.ionosphereSigma * rho + st2 * a.troposphereMap * b.troposphereMap;
+    }
+    r(i, i) += a.independentVariance;
   }
+  return r;
+}
+
+ReportedCovariance reportedCovariance(const ReportedInputs& in, const CovarianceScaling& scaling) {
+  const auto n = static_cast<Eigen::Index>(in.rows.size());
+  const auto m = in.q.rows();
+  Eigen::MatrixXd h(n, m);
+  Eigen::VectorXd w(n), w0(n), v(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    h.row(i) = in.rows[i].h.transpose();
+    w[i] = in.rows[i].weight;
+    w0[i] = in.rows[i].priorWeight;
+    v[i] = in.rows[i].residual;
+  }
+  // The independent and the common (correlated) parts of R apart: residuals scale the former.
+  Eigen::MatrixXd rCommon = rowErrorCovariance(in.rows, in.troposphereZenithSigma, in.ionosphereCorrelationLength);
+  Eigen::VectorXd rIndependent(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    rIndependent[i] = in.rows[i].independentVariance;
+    rCommon(i, i) -= rIndependent[i];
+  }
+  // Information of the prior rows: the normal matrix minus the measurements' share; the
+  // inter-system bias priors are what remains after the ionosphere prior.
+  const Eigen::MatrixXd nFinal = symmetricInverse(in.q);
+  const Eigen::MatrixXd nPrior = nFinal - h.transpose() * w.asDiagonal() * h;
+  Eigen::MatrixXd nIsb = nPrior;
+  if (in.ionosphereColumn >= 0) nIsb(in.ionosphereColumn, in.ionosphereColumn) -= in.ionospherePriorWeight;
+  const Eigen::MatrixXd g = in.q * h.transpose() * w.asDiagonal();
+  // The expectation of the a-priori fit's weighted residuals under each part of R: v = (I - H G0) e
+  // for the measurements, and -(G0 e)_ion for the ionosphere prior.
+  const Eigen::MatrixXd q0 = symmetricInverse(nPrior + h.transpose() * w0.asDiagonal() * h);
+  const Eigen::MatrixXd g0 = q0 * h.transpose() * w0.asDiagonal();
+  const Eigen::MatrixXd a = Eigen::MatrixXd::Identity(n, n) - h * g0;
+  auto expected = [&](const Eigen::MatrixXd& r) {
+    double e = (w0.asDiagonal() * a * r * a.transpose()).trace();
+    if (in.ionosphereColumn >= 0) {
+      const auto c = in.ionosphereColumn;
+      e += in.ionospherePriorWeight * (g0.row(c) * r * g0.row(c).transpose())(0, 0);
+    }
+    return e;
+  };
   ReportedCovariance out;
-  out.covariance = q + q * d * q;
-  out.covariance = 0.5 * (out.covariance + out.covariance.transpose());
-  if (scaling.enabled && dof >= 1) {
-    out.varianceFactor = std::max(1.0, (chi2 + scaling.priorDof) / (dof + scaling.priorDof));
+  const Eigen::MatrixXd rInd = rIndependent.asDiagonal();
+  const double eInd = expected(rInd), eCommon = expected(rCommon);
+  out.expectedChi2 = eInd + eCommon;
+  out.chi2 = v.dot(w0.asDiagonal() * v);
+  if (in.ionosphereColumn >= 0) out.chi2 += in.ionospherePriorWeight * in.ionosphereCorrection * in.ionosphereCorrection;
+  if (scaling.enabled && in.dof >= 1) {
+    out.varianceFactor = std::max(in.minVarianceFactor, (out.chi2 - eCommon + scaling.priorDof) / (eInd + scaling.priorDof));
   }
-  out.covariance *= out.varianceFactor;
+  out.covariance = out.varianceFactor * g * rInd * g.transpose() + g * rCommon * g.transpose() + in.q * nIsb * in.q;
+  out.covariance = 0.5 * (out.covariance + out.covariance.transpose());
   return out;
 }
 

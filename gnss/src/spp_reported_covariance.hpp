@@ -1,5 +1,6 @@
-// The reported covariance of a weighted least-squares solution under an error model other than
-// its weights (SppConfig::reportedError, docs/spp.md "Standard deviation").
+// The reported covariance of SPP's weighted least-squares solution under an error model with
+// errors correlated between satellites (SppConfig::reportedError, docs/spp.md "Standard
+// deviation").
 #pragma once
 
 #include <vector>
@@ -10,25 +11,55 @@
 
 namespace gvins::detail {
 
-/// One row of the fit: design row h (size of the unknowns), the variance its weight came from
-/// (1/w), the error variance r of the reported model and the post-fit residual.
+/// One pseudorange of the fit and its error budget.
 struct ReportedRow {
-  Eigen::VectorXd h;
-  double weightVariance = 1.0;
-  double errorVariance = 1.0;
-  double residual = 0.0;
+  Eigen::VectorXd h;             ///< design row (size of the unknowns)
+  double weight = 1.0;           ///< weight of the final fit (after robust re-weighting)
+  double priorWeight = 1.0;      ///< a-priori weight (before robust re-weighting)
+  double independentVariance = 0.0;  ///< m^2: noise and multipath, broadcast orbit and clock
+  double ionosphereSigma = 0.0;  ///< m: slant broadcast-ionosphere error
+  Eigen::Vector3d piercePoint = Eigen::Vector3d::UnitZ();  ///< unit vector (ECEF) of the pierce point
+  double troposphereMap = 0.0;   ///< slant/zenith of the troposphere residual
+  double residual = 0.0;         ///< m, post-fit, a-priori fit (before robust re-weighting)
+};
+
+struct ReportedInputs {
+  Eigen::MatrixXd q;  ///< inverse normal matrix of the final fit, with its prior rows
+  std::vector<ReportedRow> rows;
+  int ionosphereColumn = -1;          ///< column of the zenith ionosphere correction, -1: none
+  double ionosphereCorrection = 0.0;  ///< its estimate (m)
+  double ionospherePriorWeight = 0.0;
+  double troposphereZenithSigma = 0.0;   ///< m
+  double ionosphereCorrelationLength = 1.0;  ///< m, between pierce points
+  int dof = 0;  ///< degrees of freedom of the fit (no variance factor without)
+  double minVarianceFactor = 1.0;  ///< floor of the independent part's variance factor
 };
 
 struct ReportedCovariance {
-  Eigen::MatrixXd covariance;  ///< k Q (H^T W R W H) Q, Q = (H^T W H)^-1
-  double varianceFactor = 1.0;  ///< k
+  Eigen::MatrixXd covariance;   ///< k G R G^T + the prior rows' own share
+  double varianceFactor = 1.0;  ///< k, of the independent part
+  double chi2 = 0.0;            ///< weighted a-priori residuals (measurements, ionosphere prior)
+  double expectedChi2 = 0.0;    ///< its expectation under R (before k)
 };
 
-/// `q`: the inverse of the normal matrix of the fit, which may hold further prior rows than
-/// `rows` (those are taken as honest: their error variance is their weight's). `dof`: degrees of
-/// freedom of the fit. The variance factor is max(1, (chi2_R + nu0) / (dof + nu0)), chi2_R the
-/// sum of residual^2 / r over `rows`, when `scaling` is enabled (else 1).
-ReportedCovariance reportedCovariance(const Eigen::MatrixXd& q, const std::vector<ReportedRow>& rows, int dof,
-                                      const CovarianceScaling& scaling);
+/// The pierce point (unit vector from the Earth's centre) of the line of sight from `receiver`
+/// to `satellite` (ECEF, m) through a thin shell `shellHeight` above a sphere of the Earth's mean
+/// radius.
+Eigen::Vector3d ionosphericPiercePoint(const Eigen::Vector3d& receiver, const Eigen::Vector3d& satellite,
+                                       double shellHeight);
+
+/// The error covariance R of the rows: independent variances on the diagonal, the broadcast
+/// ionosphere error correlated as exp(-d^2 / (2 L^2)) with d the distance of the pierce points on
+/// a 350 km shell, and the troposphere residual at the zenith common to all lines of sight.
+Eigen::MatrixXd rowErrorCovariance(const std::vector<ReportedRow>& rows, double troposphereZenithSigma,
+                                   double ionosphereCorrelationLength);
+
+/// The covariance of the weighted solution x = G y (G = Q H^T W) under R, k G R_ind G^T +
+/// G R_common G^T, plus the share of the prior rows other than the ionosphere's (the inter-system
+/// biases, taken as honest). The ionosphere prior carries no error of its own: the whole
+/// ionosphere error is in R. k = max(minVarianceFactor, (chi2 - E_common + nu0) / (E_ind + nu0))
+/// when `scaling` is enabled (else 1), chi2 the weighted residuals of the a-priori fit
+/// (measurements and the ionosphere prior) and E their expectations under the two parts of R.
+ReportedCovariance reportedCovariance(const ReportedInputs& in, const CovarianceScaling& scaling);
 
 }  // namespace gvins::detail

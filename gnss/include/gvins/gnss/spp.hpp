@@ -59,7 +59,8 @@ struct SppSolution {
   SppStatus status = SppStatus::NoObservations;
   Eigen::Vector3d position = Eigen::Vector3d::Zero();            ///< ECEF, m
   Eigen::Matrix3d positionCovariance = Eigen::Matrix3d::Zero();  ///< ECEF, m^2
-  /// Factor the least-squares covariance was scaled by (SppConfig::covarianceScaling; 1: none).
+  /// Factor the least-squares covariance was scaled by (SppConfig::covarianceScaling; 1: none);
+  /// with SppConfig::reportedError that of its independent part only.
   double varianceFactor = 1.0;
   /// Receiver clock bias per system (m), present for the systems estimated.
   std::array<std::optional<double>, kNumSystems> clockBias;
@@ -113,13 +114,6 @@ class SppSolver {
   };
   bool gatherMeasurements(const ObsEpoch& epoch, SppSolution& sol, std::vector<Measurement>& meas);
   void updateIsb(const SppSolution& sol, const Eigen::MatrixXd& cov, const std::vector<int>& clockSystems);
-  /// The reported covariance under SppConfig::reportedError of the fit with inverse normal matrix
-  /// `cov` at `x` (measurements `use`, clock column `col` per system, the zenith ionosphere
-  /// unknown after the clocks when its prior variance is given).
-  void reportCovariance(SppSolution& sol, const std::vector<Measurement>& meas, const std::vector<char>& use,
-                        const Eigen::Vector3d& x, const std::array<int, kNumSystems>& col,
-                        const std::vector<int>& colSystems, const Eigen::MatrixXd& cov,
-                        std::optional<double> ionoPriorVar, double ion) const;
 
   const EphemerisStore& nav_;
   SppConfig config_;

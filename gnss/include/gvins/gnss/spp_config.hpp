@@ -61,24 +61,37 @@ struct CovarianceScaling {
 };
 
 /// Error model of the reported covariance (position, clocks), separate from the weights: the
-/// weights (`weighting` and the error budgets of the ionosphere, troposphere and ephemerides
-/// above) decide the solution and the residual test and stay as they are; the reported
-/// covariance is the covariance of that weighted solution when the measurement errors have the
-/// variances
-///   r = noiseScale^2 sigma_noise^2 + ionosphereScale^2 sigma_iono^2 + modelScale^2 (sigma_trop^2 + sigma_eph^2)
-/// (the weights' own budget terms; the prior of the estimated zenith ionosphere correction scaled
-/// by ionosphereScale as well): (H^T W H)^-1 H^T W R W H (H^T W H)^-1, scaled by the variance
-/// factor of the residuals under R, k = max(1, (chi2_R + nu0) / (dof + nu0)) (CovarianceScaling).
-/// Off by default: fitted on real recordings with known positions and checked on a held-out site
-/// (bench/spp/sigma_fit.py, docs/spp.md) no choice of the three scales brings the reported sigma
-/// closer to the errors than the weights' own covariance, because the broadcast-ionosphere error
-/// is correlated between satellites, which a per-satellite budget cannot express. Disabled: the
-/// a-priori covariance (H^T W H)^-1 scaled by the variance factor of the weights.
+/// weights (`weighting` and the per-satellite error budgets below) decide the solution and the
+/// residual test and stay as they are; the reported covariance is that of the weighted solution
+/// x = G y (G = (H^T W H)^-1 H^T W, with the prior rows) under an error covariance R in which the
+/// errors common to many satellites are correlated, as they are:
+///   - broadcast ionosphere: a smooth field of vertical errors of sigma `ionosphereModelError`
+///     times the model's zenith delay at the receiver (the Klobuchar model removes about 50 % of
+///     the RMS delay: IS-GPS-200N 20.3.3.5.2.5), seen through each line's obliquity, correlated
+///     between two lines of sight as exp(-d^2 / (2 L^2)), d the distance of their pierce points on
+///     a 350 km shell and L = `ionosphereCorrelationLength` (the one scale chosen on the real
+///     recordings, leave-one-site-out: bench/spp/sigma_fit.py); without broadcast parameters the
+///     whole delay, 5 m vertical;
+///   - troposphere residual: `troposphereZenithError` at the zenith, one value for all lines of
+///     sight (mapped);
+///   - independent per satellite: code noise and multipath (`weighting`, times `noiseScale`) and
+///     the broadcast orbit/clock error (`ephemerisError`).
+/// The independent part is scaled by the variance factor of the residuals,
+///   k = max(minVarianceFactor, (chi2 - E_common + nu0) / (E_independent + nu0)),
+/// chi2 the weighted residuals of the fit before robust re-weighting (measurements and the
+/// ionosphere prior) and E their expectations under the two parts of R (nu0 =
+/// CovarianceScaling::priorDof; no scaling when CovarianceScaling is disabled): residuals larger
+/// than the model says (multipath, NLOS) widen the sigma, residuals smaller than the noise model
+/// narrow its share, at most to `minVarianceFactor`. The correlated part is never scaled down:
+/// residuals do not show it. Calibration: bench/spp/sigma_calibration.py,
+/// docs/results/spp_sigma.md. Disabled: the a-priori covariance (H^T W H)^-1 scaled by the
+/// variance factor of the weights (all errors independent), conservative by large factors on
+/// open sky.
 struct ReportedErrorModel {
-  bool enabled = false;
+  bool enabled = true;
   double noiseScale = 1.0;
-  double ionosphereScale = 1.0;
-  double modelScale = 1.0;
+  double ionosphereCorrelationLength = 2000e3;  ///< m
+  double minVarianceFactor = 0.25;
 };
 
 /// A common correction to the broadcast ionosphere model's zenith delay, estimated with the
@@ -178,7 +191,8 @@ struct SppConfig {
 ///              max_iterations: 3}
 ///     ionosphere_estimation: {enabled: true, prior_fraction: 1.0, min_prior_sigma_m: 0.3}
 ///     covariance_scaling: {enabled: true, prior_dof: 2}
-///     reported_error: {enabled: false, noise_scale: 1, ionosphere_scale: 1, model_scale: 1}
+///     reported_error: {enabled: true, noise_scale: 1, ionosphere_correlation_km: 2000,
+///                      min_variance_factor: 0.25}
 ///     max_gdop: 30
 ///     isb_prior_sigma_m: 2
 ///     isb_random_walk_m2ps: 0.01
