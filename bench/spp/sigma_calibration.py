@@ -24,8 +24,8 @@ approximate position of their RINEX headers (RTKLIB's static RTK puts 0759 withi
 small against SPP errors of metres); RTKLIB's testglo RTCM log (GPS + GLONASS, 3 minutes, as
 convbin's RINEX in tests/data/reference): the reference station position of its own 1005
 messages; the u-blox walk (tests/data/ubx/gnss_1730.ubx, 4 Hz, own
-SFRBX ephemerides): the publisher's RTK track (walk_reference), heights made ellipsoidal, with the
-mean horizontal error removed (its base position is not published). Simulated: a 10-minute urban
+SFRBX ephemerides): the receiver's own real-time RTK track (its NAV-PVT solutions, written with
+ellipsoidal heights by `gvins-ubx to-pos`; walk_reference), with the mean horizontal error removed (its base position is not published). Simulated: a 10-minute urban
 drive (bench/spp/urban_spp.yaml: 1.5 m code multipath, NLOS reception of 5-80 m extra path on
 low satellites) with gvins-sim's antenna truth, standing in for the urban recordings we do not
 have.
@@ -49,12 +49,9 @@ ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 DATA = os.path.join(ROOT, "tests", "data", "gnss")
 REF = os.path.join(ROOT, "tests", "data", "reference", "rtklib-2.4.3")
 UBX = os.path.join(ROOT, "tests", "data", "ubx", "gnss_1730.ubx")
-WALK_REF = os.path.join(ROOT, "tests", "data", "gnss_imu", "walk_0827", "gnss_1730_sf.pos")
-# The walk reference's heights are above mean sea level: its lat/lon/height equal the UBX log's
-# NAV-PVT lat/lon/hMSL in all 536 epochs, and NAV-PVT's ellipsoidal height there is
-# hMSL - 21.387 m (u-blox interface description, UBX-NAV-PVT: height above ellipsoid and hMSL;
-# -21.387/-21.388 m throughout the log).
-WALK_GEOID_SEPARATION = -21.387
+# The walk's reference: the receiver's own real-time RTK track, i.e. the log's NAV-PVT solutions,
+# written with ellipsoidal heights by `gvins-ubx to-pos` (the shipped gnss_1730_sf.pos holds the
+# same track with mean-sea-level heights; test_ubx_to_pos checks the two against each other).
 
 # WGS84 (NIMA TR8350.2)
 A = 6378137.0
@@ -170,7 +167,7 @@ def simulated_case(build, tmp):
              "simulation truth")]
 
 
-def cases():
+def cases(build, tmp):
     n = os.path.join(DATA, "nagoya_static_2024")
     k = os.path.join(DATA, "kamakura_static_2021")
     g = os.path.join(DATA, "geonet_0759_3040_2005")
@@ -185,25 +182,26 @@ def cases():
          "geonet_0759_spp.pos", "RINEX header only"),
         ("GEONET 3040", [g + "/30400920.05o.gz", g + "/30400920.05n.gz"], header_position(g + "/30400920.05o.gz"),
          None, "RINEX header only"),
-        ("u-blox walk", [UBX], walk_reference(), "ubx_gnss_1730_spp.pos",
+        ("u-blox walk", [UBX], walk_reference(build, tmp), "ubx_gnss_1730_spp.pos",
          "publisher's RTK track, mean horizontal error removed"),
         ("RTCM testglo", [REF + "/rtcm_testglo_convbin.obs", REF + "/rtcm_testglo_convbin.nav"],
          [-3869297.5138, 3436571.3345, 3717369.3757], None, "station position of its 1005 message"),
     ]
 
 
-def walk_reference():
-    """The u-blox walk's reference track with ellipsoidal heights: the publisher's RTK .pos, whose
-    heights are above mean sea level, moved by the constant geoid separation of the receiver's
-    NAV-PVT (WALK_GEOID_SEPARATION). One function, so that a track written with ellipsoidal
-    heights (NAV-PVT to .pos) can replace the file and the constant."""
-    return ReferenceTrack(WALK_REF, height_offset=WALK_GEOID_SEPARATION)
+def walk_reference(build, tmp):
+    """The u-blox walk's reference track with ellipsoidal heights: the receiver's NAV-PVT solutions
+    of the log, written by `gvins-ubx to-pos`."""
+    path = os.path.join(tmp, "walk_reference.pos")
+    subprocess.run([os.path.join(build, "bin", "gvins-ubx"), "to-pos", UBX, "-o", path], check=True,
+                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    return ReferenceTrack(path)
 
 
 class ReferenceTrack:
     """A reference .pos track (latitude/longitude/height, GPST): the position of the row nearest
     in time, within 0.1 s (the solutions of a 4 Hz receiver carry its epoch times to the ms);
-    `height_offset` (m) is added to its heights. Its horizontal position is relative: the track
+    `height_offset` (m) is added to its heights (0 for a track with ellipsoidal heights). Its horizontal position is relative: the track
     is an RTK solution relative to a base station whose position is not published (every SPP
     solution, ours and RTKLIB's, sits 6-8 m off it horizontally), so the mean horizontal error is
     removed before scoring (horizontal: the time-varying part only; up: absolute)."""
@@ -347,7 +345,7 @@ def main():
         lines.append("%-15s %-31s %6s  %-17s %-17s %-17s %-17s %s" % (
             "recording", "solution", "epochs", "E within 1/2/3 sd", "N within 1/2/3 sd", "U within 1/2/3 sd",
             "median |e|/sd ENU", "RMS E/N/U m"))
-    for name, inputs, truth, ref, truth_note in cases() + simulated_case(build, tmp):
+    for name, inputs, truth, ref, truth_note in cases(build, tmp) + simulated_case(build, tmp):
         runs = runs_of(spp, inputs, tmp)
         if ref:
             runs.append(("RTKLIB 2.4.3 (stored)", read_pos(os.path.join(REF, ref))))

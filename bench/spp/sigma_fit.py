@@ -60,7 +60,7 @@ def main():
     tmp = tempfile.mkdtemp()
     grid = list(LENGTHS_KM)
     shares = {}  # (site, pair) -> [3x3 per recording]
-    for name, inputs, truth, _, _ in sc.cases():
+    for name, inputs, truth, _, _ in sc.cases(build, tmp):
         if name not in SITES:
             continue
         for pair in grid + [None, "independent", "off"]:  # defaults, correlated-error model off, a-priori
