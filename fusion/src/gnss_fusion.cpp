@@ -132,6 +132,7 @@ void GnssFusion<Scalar>::forgetState() {
   worldChange_.reset();
   leverBlock_ = {};
   clocks_.forget();
+  baseClock_.reset();
   zwdBlock_ = {};
   lastUpdate_.reset();
   gateRecovery_.reset();
@@ -542,6 +543,7 @@ void GnssFusion<Scalar>::feedRtk(Epoch& e, const ObsEpoch* base) {
 template <typename Scalar>
 void GnssFusion<Scalar>::resetAfterOutage(vio::EstimatorBackend<Scalar>& est, GnssEpochReport& rep) {
   clocks_.marginalize(est);
+  baseClock_.reset();
   marginalizeBlock(est, zwdBlock_);
   if (rtk_) rtk_->reset();
   while (!ambiguities_.empty()) dropAmbiguity(est, ambiguities_.begin()->first);
