@@ -151,10 +151,10 @@ def page(results, command):
                   "floor \\|Up\\| mean / worst [m]"] + ["%s [m]" % t for t in attribution.TERMS]
     run_header = ["family", "seed", "flight", "filter RMSE [m]", "causal floor RMS [m]", "filter mean Up [m]",
                   "floor Up [m]"] + ["%s Up [m]" % t for t in attribution.TERMS]
-    text = ["# Pseudorange modes: filter error against the floor of the simulated errors\n",
+    text = ["# Pseudorange modes: filter error against the floor of the simulated errors\n\n",
             "Written by `%s` at commit %s on %s. Do not edit by hand: run the script again. Flights: the sweep's "
             "open-sky families and seeds (bench/sweep/sweep.py's variant drawing), simulated with "
-            "`gnss: error_terms: true`; floors: bench/fusion/psr_error_attribution.py.\n"
+            "`gnss: error_terms: true`; floors: bench/fusion/psr_error_attribution.py.\n\n"
             % (command, commit(), time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())),
             "Filter: RMSE of the antenna in ENU from the first tight epoch on (as the sweep) and its mean Up error. "
             "Floor: the same rows' simulated errors (carrier-smoothed as the replay smooths them, the fusion's "
