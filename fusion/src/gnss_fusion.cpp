@@ -104,6 +104,7 @@ void GnssFusion<Scalar>::forgetState() {
   frameBlock_ = {};
   worldChange_.reset();
   clocks_.forget();
+  baseClock_.reset();
   zwd_.forget();
   lastUpdate_.reset();
   gateRecovery_.reset();
@@ -540,6 +541,7 @@ void GnssFusion<Scalar>::feedRtk(Epoch& e, const ObsEpoch* base) {
 template <typename Scalar>
 void GnssFusion<Scalar>::resetAfterOutage(vio::EstimatorBackend<Scalar>& est, GnssEpochReport& rep) {
   clocks_.marginalize(est);
+  baseClock_.reset();
   zwd_.marginalize(est);
   if (rtk_) rtk_->reset();
   ambiguities_.dropAll(est);

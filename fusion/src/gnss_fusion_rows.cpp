@@ -167,19 +167,20 @@ void GnssFusion<Scalar>::addDifferenceRows(Epoch& e, const AntennaKinematics& k,
   if (!e.baseAge || !config_.usesDifferences() || *e.baseAge > config_.maxBaseAge) return;
   const DdEpoch& dd = rtk_->measurements();
   const int n = static_cast<int>(clocks_.systems().size());
-  // Base clock per system: mean base code OMC (clock + errors common to the base).
-  std::vector<double> sum(static_cast<std::size_t>(n), 0.0);
-  std::vector<int> cnt(static_cast<std::size_t>(n), 0);
+  // Base clock per system from the base code OMCs, continued over the signals common with the
+  // previous epoch, so that satellites joining or leaving do not move it (gnss_base_clock.hpp).
+  std::vector<GnssBaseClock::Residual> omc;
   for (const SingleDifference& sd : dd.sd) {
     const int c = clockIndex(sd.sat);
     if (c < 0 || !sd.hasCode) continue;
-    sum[static_cast<std::size_t>(c)] += sd.baseCodeOmc;
-    cnt[static_cast<std::size_t>(c)]++;
+    omc.push_back({c, static_cast<std::int64_t>(satIndex(sd.sat)) * 65536 + sd.code.band * 256 + sd.code.attr,
+                   sd.baseCodeOmc});
   }
+  const std::vector<double> baseClock = baseClock_.update(omc, n);
   for (const SingleDifference& sd : dd.sd) {
     const int c = clockIndex(sd.sat);
     if (c < 0 || !sd.hasCode || sd.elevation < config_.elevationMaskDeg * constants::kDegToRad) continue;
-    const double cb = sum[static_cast<std::size_t>(c)] / cnt[static_cast<std::size_t>(c)];
+    const double cb = baseClock[static_cast<std::size_t>(c)];
     GnssRow r = sdPseudorangeRow(sd, k, clk[c], cb);
     r.clockBias = c;
     rows.add(r, kDpsr, r.variance);

@@ -37,6 +37,7 @@
 #include "gvins/base/observation.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/fusion/gnss_ambiguity_states.hpp"
+#include "gvins/fusion/gnss_base_clock.hpp"
 #include "gvins/fusion/gnss_clock_states.hpp"
 #include "gvins/fusion/gnss_epoch_report.hpp"
 #include "gvins/fusion/gnss_fusion_config.hpp"
@@ -214,6 +215,7 @@ class GnssFusion {
   ObsEpoch checkedRover_;      // the rover epoch after the Doppler check
   std::size_t baseWarned_ = 0;  // warnings of rtk_'s base Doppler check already reported
   std::optional<GpsTime> lastBase_;
+  GnssBaseClock baseClock_;  // c·dt_b per clock system of the dpsr rows (gnss_base_clock.hpp)
   std::unique_ptr<CarrierSmoother> smoother_, baseSmoother_;  // carrierSmoothing > 0: psr, dpsr
   ObsEpoch smoothed_;
   // vio+dopp+ppp: one float ambiguity state per satellite arc; the arcs (cycle slips, gaps, signal
