@@ -121,8 +121,21 @@ TEST(InitObservability, InitializerReportsTheReason) {
   {
     VisualInertialInitializer init(cfg);
     const std::vector<ImuSample> turn = circleImu(0.32, 25.0, 3.0);
-    for (const FeatureFrame& f : frames(30, 2.0)) EXPECT_FALSE(init.tryInitialize(f, turn, ext));
+    const std::deque<FeatureFrame> fs = frames(30, 2.0);
+    for (const FeatureFrame& f : fs) EXPECT_FALSE(init.tryInitialize(f, turn, ext));
     EXPECT_EQ(init.status(), InitStatus::kTooLittleParallax);
+    // Bounded work before initialisation (issue 43), counted rather than timed: attempts at most
+    // every init.mono_attempt_interval (0.1 s = 2 frames) once the 20-frame window is full, and each
+    // integrates the window's IMU once (twice with a gyro bias): 0.95 s at 250 Hz plus a split at
+    // each frame. Integrating from the window's start to every frame separately costs 10x that.
+    const InitWork& w = init.work();
+    EXPECT_EQ(w.frames, static_cast<std::int64_t>(fs.size()));
+    const auto full = static_cast<std::int64_t>(fs.size()) - cfg.init_mono_motion_frames + 1;
+    EXPECT_GE(w.mono_attempts, 1);
+    EXPECT_LE(w.mono_attempts, (full + 1) / 2);
+    const double window_s = (cfg.init_mono_motion_frames - 1) * 0.05;
+    EXPECT_LE(static_cast<double>(w.mono_imu_intervals),
+              2.0 * (window_s * 250.0 + cfg.init_mono_motion_frames) * static_cast<double>(w.mono_attempts));
   }
   // Constant velocity (features move, the IMU is quiet): no standstill, and no mono alignment
   // (the excitation test stops it before the structure-from-motion).
@@ -130,6 +143,7 @@ TEST(InitObservability, InitializerReportsTheReason) {
     VisualInertialInitializer init(cfg);
     for (const FeatureFrame& f : frames(30, 2.0)) EXPECT_FALSE(init.tryInitialize(f, rest, ext));
     EXPECT_EQ(init.status(), InitStatus::kMovingNoAcceleration);
+    EXPECT_EQ(init.work().mono_attempts, 0);
   }
   // At rest without tracks: initialises from the IMU (init.static_without_tracks) ...
   {

@@ -244,7 +244,8 @@ std::optional<MotionAlignment> VisualInertialInitializer::tryMono(const FeatureF
     return std::nullopt;
   }
   last_attempt_ns_ = frame.t_ns;
-  std::optional<MotionAlignment> a = alignMonoInMotion(cfg, frames_, imu, e0, &status_);
+  ++work_.mono_attempts;
+  std::optional<MotionAlignment> a = alignMonoInMotion(cfg, frames_, imu, e0, &status_, &work_.mono_imu_intervals);
   last_attempt_status_ = status_;
   return a;
 }
@@ -288,6 +289,7 @@ std::optional<InitialState> VisualInertialInitializer::tryInitialize(const Featu
                                                                    const std::vector<CameraExtrinsic>& ext) {
   const SriSwfConfig& cfg = cfg_;
   const bool stereo = cfg.cameras.size() > 1;
+  ++work_.frames;
   frames_.push_back(frame);
   const std::int64_t horizon = static_cast<std::int64_t>(cfg.init_window * 1e9);
   const int keep = stereo ? cfg.init_motion_frames : cfg.init_mono_motion_frames;
