@@ -100,6 +100,16 @@ TEST(InitObservability, StandstillSaysWhatIsMissing) {
   EXPECT_NEAR(ma.z(), kG, 1e-12);
   EXPECT_EQ(outcome(rest, frames(3, 0.0)), Standstill::kImuOnly) << "fewer than 5 tracks";
   EXPECT_EQ(outcome(rest, frames(0, 0.0)), Standstill::kImuOnly) << "no features at all (on the ground)";
+  // Seen but not tracked through the window (a steady descent towards the ground loses its
+  // tracks by the image's expansion): 6 features per frame, new ones every 4 frames (0.2 s).
+  std::deque<FeatureFrame> fleeting = frames(6, 0.0);
+  for (std::size_t k = 0; k < fleeting.size(); ++k) {
+    for (FeatureObservation& o : fleeting[k].features) o.id += 1000 * (k / 4);
+  }
+  EXPECT_EQ(outcome(rest, fleeting), Standstill::kFeaturesMove) << "features seen, none tracked through the window";
+  std::deque<FeatureFrame> ending = frames(6, 0.0);
+  for (std::size_t k = ending.size() - 3; k < ending.size(); ++k) ending[k].features.resize(2);
+  EXPECT_EQ(outcome(rest, ending), Standstill::kFeaturesMove) << "5 or more features earlier in the window";
   // 2 px per frame, 40 px over the 20 frames of the window: a quiet IMU at constant velocity.
   EXPECT_EQ(outcome(rest, frames(30, 2.0)), Standstill::kFeaturesMove);
   // A steady turn has constant specific force and rate in the body: the spread test alone passes

@@ -67,6 +67,14 @@ Standstill standstill(const SriSwfConfig& cfg, std::span<const ImuSample> imu, c
     // and rate in the body): the IMU alone must also show gravity and a bias-sized rate.
     if (std::abs(ma.norm() - cfg.gravity) > 3.0 * cfg.static_max_accel_std || mg.norm() > cfg.init_mono_max_gyro_bias)
       return Standstill::kNo;
+    // Features seen in the window but not tracked through it: the scene changes, so the quiet IMU
+    // is a steady motion (a descent at constant rate towards the ground loses its tracks by the
+    // expansion of the image), not a standstill. Only a camera that sees (almost) nothing over
+    // the whole window leaves the IMU to decide alone.
+    for (const FeatureFrame& fr : frames) {
+      if (fr.t_ns >= t0 && fr.t_ns <= t1 && fr.features.size() >= 5) return Standstill::kFeaturesMove;
+    }
+    if (frame.features.size() >= 5) return Standstill::kFeaturesMove;
     return Standstill::kImuOnly;
   }
   return initMedian(par) <= cfg.static_max_parallax ? Standstill::kYes : Standstill::kFeaturesMove;

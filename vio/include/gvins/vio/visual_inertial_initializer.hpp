@@ -53,9 +53,10 @@ inline bool imuCovers(std::span<const ImuSample> imu, std::int64_t t0, std::int6
 enum class Standstill {
   kNo,            ///< the IMU moves (or the window is not covered yet)
   kImuOnly,       ///< the IMU is at rest (also: mean specific force within 3 static_max_accel_std of
-                  ///< gravity, mean rate within init_mono_max_gyro_bias), fewer than 5 features
-                  ///< tracked over the window to confirm it
-  kFeaturesMove,  ///< the IMU is at rest but the features move: constant velocity
+                  ///< gravity, mean rate within init_mono_max_gyro_bias) and no frame of the window
+                  ///< has 5 features or more to confirm it
+  kFeaturesMove,  ///< the IMU is at rest but the features move, or are seen and not tracked through
+                  ///< the window: constant velocity
   kYes,           ///< IMU at rest and median feature displacement within static_max_parallax
 };
 
