@@ -135,6 +135,7 @@ def main():
     a = ap.parse_args()
     a.argv = ["--heights", a.heights, "--seeds", a.seeds, "--rigs", a.rigs, "--starts", "'%s'" % a.starts,
               "--ground", "'%s'" % a.ground, "--ground-starts", a.ground_starts, "--modes", a.modes]
+    a.commit = commit()  # before the page is rewritten (it would count as a local change)
     a.work = a.work or tempfile.mkdtemp(prefix="init_sweep_")
     os.makedirs(a.work, exist_ok=True)
     split = lambda v: [x for x in v.split(",") if x]
@@ -187,7 +188,7 @@ def main():
                     "drift after initialisation (local: 4-DoF aligned; global: antenna in ENU, GNSS modes only). "
                     "Estimator ms per frame on a shared 2-core host; the initialised reference of a start in motion "
                     "is the same flight replayed from its start (take-off or rest) in the same mode.\n\n"
-                    % (" ".join(a.argv), commit()))
+                    % (" ".join(a.argv), a.commit))
             f.write("\n".join(lines) + "\n")
 
 

@@ -222,8 +222,9 @@ InitialState VisualInertialInitializer::fromMotion(const MotionAlignment& a, std
 }
 
 
-// Bounded cost (issue 43): the mono alignment costs 5-25 ms; it runs only when the cheap
-// excitation test passes and at most every init_mono_attempt_interval after a failure.
+// Bounded cost (issue 43): the mono alignment runs only when the cheap excitation test passes, at
+// most every init_mono_attempt_interval after a failure, and less often while it keeps failing for
+// the same reason.
 std::optional<MotionAlignment> VisualInertialInitializer::tryMono(const FeatureFrame& frame,
                                                                  std::span<const ImuSample> imu,
                                                                  const CameraExtrinsic& e0) {
@@ -247,13 +248,19 @@ std::optional<MotionAlignment> VisualInertialInitializer::tryMono(const FeatureF
       return std::nullopt;
     }
   }
-  if (last_attempt_ns_ && static_cast<double>(frame.t_ns - *last_attempt_ns_) * 1e-9 < cfg.init_mono_attempt_interval) {
+  // Back-off: the interval doubles (up to 8 init_mono_attempt_interval) while the attempts fail for
+  // the same reason, and returns to init_mono_attempt_interval when the reason changes.
+  if (last_attempt_ns_ && static_cast<double>(frame.t_ns - *last_attempt_ns_) * 1e-9 < attempt_interval_) {
     status_ = last_attempt_status_;  // the reason found by the last attempt still stands
     return std::nullopt;
   }
+  const bool again = last_attempt_ns_.has_value();
   last_attempt_ns_ = frame.t_ns;
   ++work_.mono_attempts;
   std::optional<MotionAlignment> a = alignMonoInMotion(cfg, frames_, imu, e0, &status_, &work_.mono_imu_intervals);
+  attempt_interval_ = again && status_ == last_attempt_status_
+                          ? std::min(2.0 * attempt_interval_, 8.0 * cfg.init_mono_attempt_interval)
+                          : cfg.init_mono_attempt_interval;
   last_attempt_status_ = status_;
   return a;
 }

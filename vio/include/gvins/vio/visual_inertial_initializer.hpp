@@ -115,6 +115,7 @@ class VisualInertialInitializer {
   void clear() {
     frames_.clear();
     last_attempt_ns_.reset();
+    attempt_interval_ = 0.0;
     status_ = InitStatus::kCollecting;
   }
   /// Why the last tryInitialize did not initialise (kInitialized after it did).
@@ -132,6 +133,7 @@ class VisualInertialInitializer {
   std::deque<FeatureFrame> frames_;
   std::optional<std::int64_t> last_attempt_ns_;  // the last mono alignment attempt ...
   InitStatus last_attempt_status_ = InitStatus::kCollecting;  // ... and what it found
+  double attempt_interval_ = 0.0;  // s until the next attempt (back-off; 0: none yet)
   InitStatus status_ = InitStatus::kCollecting;
   InitWork work_;
 };
