@@ -56,6 +56,40 @@ TEST(ImuIntegration, TermsReproduceThePropagator) {
   EXPECT_LT((e.p_WI - a.p_WI).norm(), 1e-10);
 }
 
+TEST(ImuIntegration, ExtendContinuesTheIntegration) {
+  // Integrating to three frame times in turn (one pass) against integrating to each from the start,
+  // and against the analytic motion; the extension splits the sample interval at each frame time.
+  const test::AnalyticMotion m;
+  const Vector3d bg(0.003, -0.002, 0.01), ba(0.05, 0.02, -0.08);
+  const auto samples = m.samples(2.0, 200.0, bg, ba);
+  const ImuState a = m.state(0.3217);
+  ImuIntegration chained(ImuNoise{}, bg, ba);
+  chained.integrate(samples, a.t_ns, a.t_ns);
+  EXPECT_EQ(chained.intervals(), 0);
+  std::int64_t splits = 0;
+  for (const std::int64_t t : {std::int64_t{812'345'678}, std::int64_t{1'100'000'000}, std::int64_t{1'523'456'789}}) {
+    chained.extend(samples, t);
+    ImuIntegration once(ImuNoise{}, bg, ba);
+    once.integrate(samples, a.t_ns, t);
+    EXPECT_EQ(chained.tTo(), t);
+    EXPECT_LT(rotErr(chained.gamma(), once.gamma()), 1e-14);
+    EXPECT_LT((chained.beta() - once.beta()).norm(), 1e-12);
+    EXPECT_LT((chained.alpha() - once.alpha()).norm(), 1e-12);
+    EXPECT_LT((chained.biasJacobian() - once.biasJacobian()).norm(), 1e-11);
+    EXPECT_LT((chained.covariance() - once.covariance()).norm(), 1e-7 * once.covariance().norm());
+    // Work: the intervals of the one-shot integration plus one per split inside a sample interval.
+    EXPECT_EQ(chained.intervals(), once.intervals() + splits);
+    splits += t % 5'000'000 != 0 ? 1 : 0;
+    // And the analytic truth (noise-free samples with constant biases).
+    const ImuState b = m.state(static_cast<double>(t) * 1e-9);
+    const double dt = chained.dt();
+    EXPECT_LT(rotErr(a.R_WI * chained.gamma(), b.R_WI), 3e-11);
+    EXPECT_LT((a.v_WI + kG * dt + a.R_WI * chained.beta() - b.v_WI).norm(), 5e-9);
+    EXPECT_LT((a.p_WI + a.v_WI * dt + 0.5 * kG * dt * dt + a.R_WI * chained.alpha() - b.p_WI).norm(), 5e-9);
+  }
+  EXPECT_THROW(chained.extend(samples, 1'000'000'000), std::invalid_argument) << "backwards";
+}
+
 TEST(ImuIntegration, BiasJacobiansMatchReintegration) {
   const test::AnalyticMotion m;
   const auto samples = m.samples(1.0, 200.0);

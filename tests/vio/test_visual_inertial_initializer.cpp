@@ -70,10 +70,10 @@ TEST(InitObservability, ConstantVelocityHasNoAccelerationChange) {
   EXPECT_FALSE(accelerationChange(imu, 0, 3'000'000'000)) << "not covered by the IMU";
 }
 
-// Frames every 50 ms over 1.2 s with `n` features moving `px_per_frame` pixels per frame.
-std::deque<FeatureFrame> frames(int n, double px_per_frame) {
+// Frames every 50 ms from 0.2 s (25: over 1.2 s) with `n` features moving `px_per_frame` pixels per frame.
+std::deque<FeatureFrame> frames(int n, double px_per_frame, int count = 25) {
   std::deque<FeatureFrame> out;
-  for (int k = 0; k <= 24; ++k) {
+  for (int k = 0; k < count; ++k) {
     FeatureFrame f;
     f.t_ns = 200'000'000 + k * 50'000'000LL;
     for (int i = 0; i < n; ++i) {
@@ -100,6 +100,16 @@ TEST(InitObservability, StandstillSaysWhatIsMissing) {
   EXPECT_NEAR(ma.z(), kG, 1e-12);
   EXPECT_EQ(outcome(rest, frames(3, 0.0)), Standstill::kImuOnly) << "fewer than 5 tracks";
   EXPECT_EQ(outcome(rest, frames(0, 0.0)), Standstill::kImuOnly) << "no features at all (on the ground)";
+  // Seen but not tracked through the window (a steady descent towards the ground loses its
+  // tracks by the image's expansion): 6 features per frame, new ones every 4 frames (0.2 s).
+  std::deque<FeatureFrame> fleeting = frames(6, 0.0);
+  for (std::size_t k = 0; k < fleeting.size(); ++k) {
+    for (FeatureObservation& o : fleeting[k].features) o.id += 1000 * (k / 4);
+  }
+  EXPECT_EQ(outcome(rest, fleeting), Standstill::kFeaturesMove) << "features seen, none tracked through the window";
+  std::deque<FeatureFrame> ending = frames(6, 0.0);
+  for (std::size_t k = ending.size() - 3; k < ending.size(); ++k) ending[k].features.resize(2);
+  EXPECT_EQ(outcome(rest, ending), Standstill::kFeaturesMove) << "5 or more features earlier in the window";
   // 2 px per frame, 40 px over the 20 frames of the window: a quiet IMU at constant velocity.
   EXPECT_EQ(outcome(rest, frames(30, 2.0)), Standstill::kFeaturesMove);
   // A steady turn has constant specific force and rate in the body: the spread test alone passes
@@ -120,9 +130,22 @@ TEST(InitObservability, InitializerReportsTheReason) {
   // features' rays (all on the optical axis) give no parallax.
   {
     VisualInertialInitializer init(cfg);
-    const std::vector<ImuSample> turn = circleImu(0.32, 25.0, 3.0);
-    for (const FeatureFrame& f : frames(30, 2.0)) EXPECT_FALSE(init.tryInitialize(f, turn, ext));
+    const std::vector<ImuSample> turn = circleImu(0.32, 25.0, 4.0);
+    const std::deque<FeatureFrame> fs = frames(30, 2.0, 60);
+    for (const FeatureFrame& f : fs) EXPECT_FALSE(init.tryInitialize(f, turn, ext));
     EXPECT_EQ(init.status(), InitStatus::kTooLittleParallax);
+    // Bounded work before initialisation (issue 43), counted rather than timed. Attempts once the
+    // 20-frame window is full (at 1.15 s), then while they fail for the same reason after 0.1, 0.2,
+    // 0.4, 0.8, 0.8 s (back-off from init.mono_attempt_interval): 1.15, 1.25, 1.45, 1.85, 2.65 s
+    // within the 3.15 s of frames (every 0.1 s: 21 attempts). Each integrates the window's IMU once
+    // (twice with a gyro bias): 0.95 s at 250 Hz plus a split at each frame; integrating from the
+    // window's start to every frame separately costs 10x that.
+    const InitWork& w = init.work();
+    EXPECT_EQ(w.frames, static_cast<std::int64_t>(fs.size()));
+    EXPECT_EQ(w.mono_attempts, 5);
+    const double window_s = (cfg.init_mono_motion_frames - 1) * 0.05;
+    EXPECT_LE(static_cast<double>(w.mono_imu_intervals),
+              2.0 * (window_s * 250.0 + cfg.init_mono_motion_frames) * static_cast<double>(w.mono_attempts));
   }
   // Constant velocity (features move, the IMU is quiet): no standstill, and no mono alignment
   // (the excitation test stops it before the structure-from-motion).
@@ -130,6 +153,7 @@ TEST(InitObservability, InitializerReportsTheReason) {
     VisualInertialInitializer init(cfg);
     for (const FeatureFrame& f : frames(30, 2.0)) EXPECT_FALSE(init.tryInitialize(f, rest, ext));
     EXPECT_EQ(init.status(), InitStatus::kMovingNoAcceleration);
+    EXPECT_EQ(init.work().mono_attempts, 0);
   }
   // At rest without tracks: initialises from the IMU (init.static_without_tracks) ...
   {

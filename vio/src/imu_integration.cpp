@@ -23,11 +23,17 @@ void ImuIntegration::integrate(std::span<const ImuSample> samples, std::int64_t 
   cov_.setZero();
   t0_ = t_from_ns;
   t1_ = t_from_ns;
+  intervals_ = 0;
+  extend(samples, t_to_ns);
+}
+
+void ImuIntegration::extend(std::span<const ImuSample> samples, std::int64_t t_to_ns) {
   const double sg2 = noise_.gyroscope_noise_density * noise_.gyroscope_noise_density;
   const double sa2 = noise_.accelerometer_noise_density * noise_.accelerometer_noise_density;
   const Vector3d zero = Vector3d::Zero();
   ImuStepJacobians J;
-  forEachImuInterval(samples, t_from_ns, t_to_ns, [&](const ImuInterval& m) {
+  forEachImuInterval(samples, t1_, t_to_ns, [&](const ImuInterval& m) {
+    ++intervals_;
     // gamma, alpha, beta play the roles of R, p, v of the propagator with zero gravity; the
     // propagator's [theta, p, v] Jacobians are therefore those of [gamma, alpha, beta].
     integrateImuInterval(m, bg_, ba_, zero, gamma_, alpha_, beta_, &J);

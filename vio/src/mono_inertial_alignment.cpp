@@ -54,18 +54,23 @@ class MonoWindow {
     for (const FeatureObservation& o : frames_[first_].features) f0_.emplace(o.id, e0_.R_IC * ray(o.normalized0));
   }
 
-  /// The IMU integrations from F_0 to every later frame with gyro bias bg.
+  /// The IMU integrations from F_0 to every later frame with gyro bias bg: one pass over the
+  /// window's samples, extended from frame to frame (issue 43: bounded work per attempt).
   void integrateAll(const Eigen::Vector3d& bg) {
+    ImuIntegration integ(cfg_.imu, bg, Eigen::Vector3d::Zero());
+    integ.integrate(imu_, t0_, t0_);
     for (int j = 0; j < M_; ++j) {
       const FeatureFrame& Fj = frame(j);
-      ImuIntegration& integ = integs_[static_cast<std::size_t>(j)];
-      integ = ImuIntegration(cfg_.imu, bg, Eigen::Vector3d::Zero());
-      integ.integrate(imu_, t0_, Fj.t_ns);
+      integ.extend(imu_, Fj.t_ns);
+      integs_[static_cast<std::size_t>(j)] = integ;
       R0_[static_cast<std::size_t>(j)] = integ.gamma();
       alpha_[static_cast<std::size_t>(j)] = integ.alpha();
       dts_[static_cast<std::size_t>(j)] = static_cast<double>(Fj.t_ns - t0_) * 1e-9;
     }
+    imu_intervals_ += integ.intervals();
   }
+  /// IMU sample intervals integrated so far (all passes).
+  std::int64_t imuIntervals() const { return imu_intervals_; }
 
   Eigen::Vector3d gyroBias();
   std::optional<InitStatus> structure();
@@ -94,6 +99,7 @@ class MonoWindow {
   int kbest_ = -1;
   std::unordered_map<std::uint64_t, Eigen::Vector3d> pts_;
   std::vector<Eigen::Vector3d> cbar_;
+  std::int64_t imu_intervals_ = 0;
 };
 
 // 0. Gyro bias from the epipolar constraints (cfg.init_mono_gyro_bias): the rays of F_0 and of
@@ -314,7 +320,7 @@ bool MonoWindow::align(Eigen::Matrix<double, 7, 1>& x, double& sSigma, const Eig
 
 std::optional<MotionAlignment> alignMonoInMotion(const SriSwfConfig& cfg, const std::deque<FeatureFrame>& init_frames,
                                                  std::span<const ImuSample> imu, const CameraExtrinsic& e0,
-                                                 InitStatus* why) {
+                                                 InitStatus* why, std::int64_t* imu_intervals) {
   auto fail = [why](InitStatus r) {
     if (why) *why = r;
     return std::nullopt;
@@ -331,6 +337,7 @@ std::optional<MotionAlignment> alignMonoInMotion(const SriSwfConfig& cfg, const 
     bg = w.gyroBias();
     if (!bg.isZero()) w.integrateAll(bg);
   }
+  if (imu_intervals) *imu_intervals += w.imuIntervals();
   if (const auto bad = w.structure()) return fail(*bad);
   if (const auto bad = w.cameraCentres()) return fail(*bad);
   Eigen::Matrix<double, 7, 1> x;

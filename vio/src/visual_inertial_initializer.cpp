@@ -67,6 +67,14 @@ Standstill standstill(const SriSwfConfig& cfg, std::span<const ImuSample> imu, c
     // and rate in the body): the IMU alone must also show gravity and a bias-sized rate.
     if (std::abs(ma.norm() - cfg.gravity) > 3.0 * cfg.static_max_accel_std || mg.norm() > cfg.init_mono_max_gyro_bias)
       return Standstill::kNo;
+    // Features seen in the window but not tracked through it: the scene changes, so the quiet IMU
+    // is a steady motion (a descent at constant rate towards the ground loses its tracks by the
+    // expansion of the image), not a standstill. Only a camera that sees (almost) nothing over
+    // the whole window leaves the IMU to decide alone.
+    for (const FeatureFrame& fr : frames) {
+      if (fr.t_ns >= t0 && fr.t_ns <= t1 && fr.features.size() >= 5) return Standstill::kFeaturesMove;
+    }
+    if (frame.features.size() >= 5) return Standstill::kFeaturesMove;
     return Standstill::kImuOnly;
   }
   return initMedian(par) <= cfg.static_max_parallax ? Standstill::kYes : Standstill::kFeaturesMove;
@@ -214,8 +222,9 @@ InitialState VisualInertialInitializer::fromMotion(const MotionAlignment& a, std
 }
 
 
-// Bounded cost (issue 43): the mono alignment costs 5-25 ms; it runs only when the cheap
-// excitation test passes and at most every init_mono_attempt_interval after a failure.
+// Bounded cost (issue 43): the mono alignment runs only when the cheap excitation test passes, at
+// most every init_mono_attempt_interval after a failure, and less often while it keeps failing for
+// the same reason.
 std::optional<MotionAlignment> VisualInertialInitializer::tryMono(const FeatureFrame& frame,
                                                                  std::span<const ImuSample> imu,
                                                                  const CameraExtrinsic& e0) {
@@ -239,12 +248,19 @@ std::optional<MotionAlignment> VisualInertialInitializer::tryMono(const FeatureF
       return std::nullopt;
     }
   }
-  if (last_attempt_ns_ && static_cast<double>(frame.t_ns - *last_attempt_ns_) * 1e-9 < cfg.init_mono_attempt_interval) {
+  // Back-off: the interval doubles (up to 8 init_mono_attempt_interval) while the attempts fail for
+  // the same reason, and returns to init_mono_attempt_interval when the reason changes.
+  if (last_attempt_ns_ && static_cast<double>(frame.t_ns - *last_attempt_ns_) * 1e-9 < attempt_interval_) {
     status_ = last_attempt_status_;  // the reason found by the last attempt still stands
     return std::nullopt;
   }
+  const bool again = last_attempt_ns_.has_value();
   last_attempt_ns_ = frame.t_ns;
-  std::optional<MotionAlignment> a = alignMonoInMotion(cfg, frames_, imu, e0, &status_);
+  ++work_.mono_attempts;
+  std::optional<MotionAlignment> a = alignMonoInMotion(cfg, frames_, imu, e0, &status_, &work_.mono_imu_intervals);
+  attempt_interval_ = again && status_ == last_attempt_status_
+                          ? std::min(2.0 * attempt_interval_, 8.0 * cfg.init_mono_attempt_interval)
+                          : cfg.init_mono_attempt_interval;
   last_attempt_status_ = status_;
   return a;
 }
@@ -288,6 +304,7 @@ std::optional<InitialState> VisualInertialInitializer::tryInitialize(const Featu
                                                                    const std::vector<CameraExtrinsic>& ext) {
   const SriSwfConfig& cfg = cfg_;
   const bool stereo = cfg.cameras.size() > 1;
+  ++work_.frames;
   frames_.push_back(frame);
   const std::int64_t horizon = static_cast<std::int64_t>(cfg.init_window * 1e9);
   const int keep = stereo ? cfg.init_motion_frames : cfg.init_mono_motion_frames;

@@ -47,6 +47,14 @@ class ImuIntegration {
   /// Integrates the samples over [t_from, t_to] (t_from <= t_to), replacing any previous result.
   /// Sample coverage and ordering as for ImuPropagator::propagate(); throws std::invalid_argument.
   void integrate(std::span<const ImuSample> samples, std::int64_t t_from_ns, std::int64_t t_to_ns);
+  /// Continues the integration from tTo() to t_to_ns (>= tTo()) with the same step scheme, so the
+  /// terms from one time to each of a window's frames cost one pass over its samples. The sample
+  /// interval holding the old tTo() is integrated in two parts, which differs from
+  /// integrate(samples, tFrom(), t_to_ns) by the scheme's truncation error over that interval.
+  /// Backwards in time or beyond the samples: std::invalid_argument, as integrate().
+  void extend(std::span<const ImuSample> samples, std::int64_t t_to_ns);
+  /// Sample intervals integrated since the last integrate() (a work count for the callers' tests).
+  std::int64_t intervals() const { return intervals_; }
 
   std::int64_t tFrom() const { return t0_; }
   std::int64_t tTo() const { return t1_; }
@@ -71,6 +79,7 @@ class ImuIntegration {
   ImuNoise noise_;
   Eigen::Vector3d bg_ = Eigen::Vector3d::Zero(), ba_ = Eigen::Vector3d::Zero();
   std::int64_t t0_ = 0, t1_ = 0;
+  std::int64_t intervals_ = 0;
   Eigen::Matrix3d gamma_ = Eigen::Matrix3d::Identity();
   Eigen::Vector3d beta_ = Eigen::Vector3d::Zero(), alpha_ = Eigen::Vector3d::Zero();
   Eigen::Matrix<double, 9, 6> jBias_ = Eigen::Matrix<double, 9, 6>::Zero();

@@ -53,9 +53,10 @@ inline bool imuCovers(std::span<const ImuSample> imu, std::int64_t t0, std::int6
 enum class Standstill {
   kNo,            ///< the IMU moves (or the window is not covered yet)
   kImuOnly,       ///< the IMU is at rest (also: mean specific force within 3 static_max_accel_std of
-                  ///< gravity, mean rate within init_mono_max_gyro_bias), fewer than 5 features
-                  ///< tracked over the window to confirm it
-  kFeaturesMove,  ///< the IMU is at rest but the features move: constant velocity
+                  ///< gravity, mean rate within init_mono_max_gyro_bias) and no frame of the window
+                  ///< has 5 features or more to confirm it
+  kFeaturesMove,  ///< the IMU is at rest but the features move, or are seen and not tracked through
+                  ///< the window: constant velocity
   kYes,           ///< IMU at rest and median feature displacement within static_max_parallax
 };
 
@@ -75,10 +76,11 @@ std::optional<MotionAlignment> alignStereoInMotion(const SriSwfConfig& cfg, cons
                                                    const CameraExtrinsic& e1, InitStatus* why = nullptr);
 
 /// Mono in-motion alignment over the last init_mono_motion_frames frames (mono_inertial_alignment.cpp).
-/// `why` (if given) receives the reason of a failure.
+/// `why` (if given) receives the reason of a failure; `imu_intervals` (if given) is increased by
+/// the IMU sample intervals integrated (one pass over the window, two with a gyro bias).
 std::optional<MotionAlignment> alignMonoInMotion(const SriSwfConfig& cfg, const std::deque<FeatureFrame>& init_frames,
                                                  std::span<const ImuSample> imu, const CameraExtrinsic& e0,
-                                                 InitStatus* why = nullptr);
+                                                 InitStatus* why = nullptr, std::int64_t* imu_intervals = nullptr);
 
 /// The excitation of the accelerometer over [t0, t1]: the largest distance (m/s²) of a 0.1 s mean
 /// of the specific force, rotated into the IMU frame at t0 by the gyro, from the mean of those
@@ -86,6 +88,15 @@ std::optional<MotionAlignment> alignMonoInMotion(const SriSwfConfig& cfg, const 
 /// needs it to change, since a constant one trades against gravity and velocity. nullopt: the
 /// IMU does not cover the interval or it is shorter than 0.2 s.
 std::optional<double> accelerationChange(std::span<const ImuSample> imu, std::int64_t t0, std::int64_t t1);
+
+/// Work done by an initialiser since its construction (issue 43: the cost before initialisation
+/// is bounded by counts, not times): frames tried, mono alignment attempts and the IMU sample
+/// intervals they integrated.
+struct InitWork {
+  std::int64_t frames = 0;
+  std::int64_t mono_attempts = 0;
+  std::int64_t mono_imu_intervals = 0;
+};
 
 /// Buffers the frames before initialisation and tries, per frame, the standstill and (when
 /// configured) the in-motion alignment of the rig (stereo when the configuration has two cameras).
@@ -104,10 +115,12 @@ class VisualInertialInitializer {
   void clear() {
     frames_.clear();
     last_attempt_ns_.reset();
+    attempt_interval_ = 0.0;
     status_ = InitStatus::kCollecting;
   }
   /// Why the last tryInitialize did not initialise (kInitialized after it did).
   InitStatus status() const { return status_; }
+  const InitWork& work() const { return work_; }
 
  private:
   std::optional<InitialState> fromStandstill(const FeatureFrame& frame, std::span<const ImuSample> imu);
@@ -120,7 +133,9 @@ class VisualInertialInitializer {
   std::deque<FeatureFrame> frames_;
   std::optional<std::int64_t> last_attempt_ns_;  // the last mono alignment attempt ...
   InitStatus last_attempt_status_ = InitStatus::kCollecting;  // ... and what it found
+  double attempt_interval_ = 0.0;  // s until the next attempt (back-off; 0: none yet)
   InitStatus status_ = InitStatus::kCollecting;
+  InitWork work_;
 };
 
 }  // namespace gvins::vio
