@@ -22,26 +22,9 @@ BIN=$1
 DATA=$2
 PY=$3
 HERE=$(cd "$(dirname "$0")" && pwd)
-W=$(mktemp -d "${TMPDIR:-/tmp}/gvins_reacq.XXXXXX")
-trap 'rm -rf "$W"' EXIT
-fail=0
-check() {  # name value op bound
-  if awk -v v="$2" -v b="$4" -v op="$3" 'BEGIN { exit !((op == "<=" && v <= b) || (op == ">=" && v >= b)) }'; then
-    echo "ok   $1 = $2 ($3 $4)"
-  else
-    echo "FAIL $1 = $2 (expected $3 $4)"
-    fail=1
-  fi
-}
-UBX=$DATA/ubx/gnss_1730.ubx
-REF=$DATA/gnss_imu/walk_0827/gnss_1730_sf.pos
+. "$HERE/real_walk_common.sh"
 CMP="$PY $HERE/walk_compare.py"
-mkdir -p "$W/ds/mav0/imu0"
-"$BIN/gvins-imu" convert "$DATA/gnss_imu/walk_0827/imu_1730.csv" --tag "$DATA/gnss_imu/walk_0827/imu_1730.csv.tag" \
-  --columns ax,ay,az,gx,gy,gz,t --time counter-ms --accel-unit g --gyro-unit deg/s -o "$W/ds/mav0/imu0/data.csv" 2>"$W/imu.err" ||
-  { cat "$W/imu.err"; exit 1; }
-cp "$DATA/gnss_imu/walk_0827/imu0_sensor.yaml" "$W/ds/mav0/imu0/sensor.yaml"
-printf 'gnss_fusion:\n  ionosphere: broadcast\n' >"$W/sf.yaml"
+walk_dataset "$W/ds"
 replay() {  # name rover [options...]
   local name=$1 rover=$2
   shift 2

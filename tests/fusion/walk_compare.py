@@ -11,7 +11,8 @@ are seconds after the run's first frame (timing.csv), positions those of global.
                                               reference's fixed and float epochs from T0 on (the
                                               epochs that OUT_B also has, if given)
 
-The reference track's heights are NAV-PVT hMSL; its ellipsoidal heights are 21.387 m lower.
+REF.pos: the walk's reference track with ellipsoidal heights (gvins-ubx to-pos of the log's
+NAV-PVT, $REF of real_walk_common.sh).
 """
 import math
 import sys
@@ -19,7 +20,6 @@ import sys
 WEEK = 604800.0
 A = 6378137.0
 F = 1.0 / 298.257223563
-MSL_TO_ELLIPSOID = -21.387
 
 
 def first_frame(out):
@@ -94,7 +94,7 @@ def main():
         print("%.2f" % (tight - spp))
     elif cmd == "rms":
         t0 = first_frame(args[0])
-        est, ref = read_pos(args[0] + "/global.pos"), read_pos(args[1], 2, MSL_TO_ELLIPSOID)
+        est, ref = read_pos(args[0] + "/global.pos"), read_pos(args[1], 2)
         other = read_pos(args[3] + "/global.pos") if len(args) > 3 else est
         common = [t for t in est if t in ref and t in other and t - t0 >= float(args[2])]
         if not common:
