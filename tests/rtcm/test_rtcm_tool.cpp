@@ -21,6 +21,7 @@
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "gvins/gnss/spp.hpp"
 #include "independent_frame_scan.hpp"
+#include "run_command.hpp"
 
 namespace gvins::rtcm {
 namespace {
@@ -44,15 +45,7 @@ struct Reaper {
 };
 
 /// Runs a shell command, returns stdout and the exit status.
-std::pair<std::string, int> run(const std::string& cmd) {
-  std::FILE* p = ::popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
-  const int status = ::pclose(p);
-  return {out, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
-}
+std::pair<std::string, int> run(const std::string& cmd) { return gvins::test::runCommand(cmd); }
 
 std::filesystem::path tempDir() {
   const auto d = std::filesystem::temp_directory_path() / ("gvins_rtcm_tool_" + std::to_string(::getpid()));

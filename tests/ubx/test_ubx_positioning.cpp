@@ -19,6 +19,7 @@
 #include "gvins/gnss/base_reader.hpp"
 #include "gvins/gnss/pos_reader.hpp"
 #include "independent_ubx_scan.hpp"
+#include "run_command.hpp"
 
 namespace gvins::ubx {
 namespace {
@@ -60,15 +61,7 @@ TEST(UbxInput, ReaderDeliversEpochsAndSfrbxEphemerides) {
   EXPECT_EQ(f9p->glonassChannels().get(2), -4);  // convbin's "GLONASS SLOT / FRQ #": R02 -4
 }
 
-std::pair<std::string, int> run(const std::string& cmd) {
-  std::FILE* p = ::popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
-  const int status = ::pclose(p);
-  return {out, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
-}
+std::pair<std::string, int> run(const std::string& cmd) { return gvins::test::runCommand(cmd); }
 
 struct Score {
   std::size_t n = 0;

@@ -18,6 +18,7 @@
 #include "gvins/gnss/pos_reader.hpp"
 #include "gvins/ubx/ubx_decoder.hpp"
 #include "independent_ubx_scan.hpp"
+#include "run_command.hpp"
 
 namespace gvins::ubx {
 namespace {
@@ -28,15 +29,7 @@ using Bytes = std::vector<std::uint8_t>;
 
 const std::string kTool = std::string(GVINS_BIN_DIR) + "/gvins-ubx";
 
-std::pair<std::string, int> run(const std::string& cmd) {
-  std::FILE* p = ::popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
-  const int status = ::pclose(p);
-  return {out, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
-}
+std::pair<std::string, int> run(const std::string& cmd) { return gvins::test::runCommand(cmd); }
 
 struct TempDir {
   std::filesystem::path path;

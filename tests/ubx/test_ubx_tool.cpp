@@ -16,6 +16,7 @@
 #include "gvins/base/rinex_obs_reader.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "independent_ubx_scan.hpp"
+#include "run_command.hpp"
 
 namespace gvins::ubx {
 namespace {
@@ -25,15 +26,7 @@ using testing::readBytes;
 
 const std::string kTool = std::string(GVINS_BIN_DIR) + "/gvins-ubx";
 
-std::pair<std::string, int> run(const std::string& cmd) {
-  std::FILE* p = ::popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  std::size_t n;
-  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
-  const int status = ::pclose(p);
-  return {out, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
-}
+std::pair<std::string, int> run(const std::string& cmd) { return gvins::test::runCommand(cmd); }
 
 /// NMEA sentences counted as text: "$" + printable characters + "*hh" + CR LF, checksum right.
 std::int64_t countNmea(const std::vector<std::uint8_t>& d) {
