@@ -6,6 +6,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <Eigen/SVD>
 
 #include "gvins/sri/chi_square.hpp"
@@ -57,9 +58,17 @@ void GnssInsAlignment::dropOldest() {
     e.Jb_g = Rj.transpose() * (e.Jb_g - Jgj) + vio::so3::skew(Rj.transpose() * db) * Jtj;
     e.Jb_a = Rj.transpose() * (e.Jb_a - Jaj);
     e.Jth_g = e.Jth_g - e.R_0k.transpose() * Rj * Jtj;
-    e.R_0k = Rj.transpose() * e.R_0k;
+    // Kept a rotation: a product of products from every earlier slide compounds its rounding
+    // (the orthogonality error grew about 1.4× per slide: NaN after some 60 slides of 10 Hz).
+    e.R_0k = Eigen::Quaterniond(Rj.transpose() * e.R_0k).normalized().toRotationMatrix();
     e.beta_0k = Rj.transpose() * db;
   }
+  Epoch& f = epochs_.front();  // exactly the window's origin
+  f.R_0k.setIdentity();
+  f.beta_0k.setZero();
+  f.Jth_g.setZero();
+  f.Jb_g.setZero();
+  f.Jb_a.setZero();
 }
 
 std::optional<vio::ExternalInitialState> GnssInsAlignment::add(std::int64_t t_ns, const SppSolution& spp,

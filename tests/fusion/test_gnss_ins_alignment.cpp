@@ -1,6 +1,7 @@
 // GnssInsAlignment (gnss_ins_alignment.hpp) against simulation truth: an exact IMU and exact
 // GNSS velocities/positions of a circle flown with the body yawed 30° off the velocity and a gyro
-// bias, and of a straight line at constant velocity (yaw unobservable).
+// bias, and of a straight line at constant velocity (yaw unobservable), also over many window
+// slides.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -104,6 +105,23 @@ TEST(GnssInsAlignment, ConstantVelocityLeavesTheYawOpen) {
   }
   EXPECT_EQ(al.status(), GnssInsStatus::kNoAcceleration);
   EXPECT_LT(al.tiltSigmaDeg(), 1.0);  // the tilt is known from gravity
+}
+
+// A window that slides for a long time (10 Hz epochs, 30 s of a straight line: 250 re-basings)
+// must keep its fit: before the re-basing kept R_0k a rotation, the products compounded their
+// rounding and the fit went to NaN after about 60 slides (seen on a simulated walk).
+TEST(GnssInsAlignment, LongSlidingWindowStaysFinite) {
+  const auto imu = imuOf(0.0, 0.0, 31.0);
+  GnssInsAlignment al({}, vio::ImuNoise{}, kG);
+  for (int k = 0; k <= 300; ++k) {
+    const double t = 0.1 * k;
+    ASSERT_FALSE(al.add(static_cast<std::int64_t>(k) * 100'000'000, sppAt(truthAt(t, 0.0, 0.0)), imu,
+                        Eigen::Vector3d::Zero()));
+    if (k < 10) continue;  // the tilt needs a second of epochs
+    ASSERT_EQ(al.status(), GnssInsStatus::kNoAcceleration) << "t " << t;
+    ASSERT_TRUE(std::isfinite(al.yawSigmaDeg())) << "t " << t;
+    ASSERT_LT(al.tiltSigmaDeg(), 1.0) << "t " << t;
+  }
 }
 
 }  // namespace
