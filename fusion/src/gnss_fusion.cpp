@@ -491,7 +491,10 @@ void GnssFusion<Scalar>::useNavigation(const EphemerisStore& nav) {
   sppConfig.reportedError.enabled = false;
   spp_ = std::make_unique<SppSolver>(nav, sppConfig);
   if (config_.usesDifferences()) {
-    rtk_ = std::make_unique<RtkSolver>(nav);
+    // The SD code variances with the fusion's code weighting (double_difference.cpp).
+    RtkConfig rtkConfig;
+    if (config_.codeWeighting == GnssCodeWeighting::kElevationCn0) rtkConfig.codeWeighting = WeightingScheme::ElevationSnr;
+    rtk_ = std::make_unique<RtkSolver>(nav, rtkConfig);
     rtk_->setRoverDopplerCheckedByCaller();  // checked at the input (prepareRover), once
     baseWarned_ = 0;
     if (config_.basePosition) rtk_->setBasePosition(*config_.basePosition);

@@ -130,6 +130,11 @@ bool measurementKey(GnssFusionConfig& c, const Fields& F, const std::string& key
     });
   } else if (key == "code_sigma") {
     c.codeSigma = positive(v, f);
+  } else if (key == "code_weighting") {
+    c.codeWeighting = rd.choice(v, f, {"elevation", "elevation-cn0"}) == "elevation" ? GnssCodeWeighting::kElevation
+                                                                                     : GnssCodeWeighting::kElevationCn0;
+  } else if (key == "cn0_mask_dbhz") {
+    c.cn0MaskDbHz = rd.number(v, f, 0.0, 100.0);
   } else if (key == "carrier_smoothing") {
     c.carrierSmoothing = rd.number(v, f, 0.0, 3600.0);
   } else if (key == "smoothed_code_factor") {
@@ -234,6 +239,7 @@ GnssFusionConfig parseGnssFusionConfig(std::string_view yaml, const std::string&
   static const std::set<std::string> kKeys = {
       "mode", "lever_arm", "calibrate_lever_arm", "lever_arm_sigma", "min_rotation_rate", "systems",
       "elevation_mask_deg", "ionosphere", "bands", "ephemeris_error_m", "precise_ephemeris_error_m", "code_sigma",
+      "code_weighting", "cn0_mask_dbhz",
       "carrier_smoothing", "smoothed_code_factor", "phase_sigma", "ambiguity_sigma", "ambiguity_reset_rejections", "max_ambiguities", "phase_windup", "rtk_hold_fix", "rtk_revalidate_interval", "broadcast_ambiguity_random_walk", "broadcast_record_changes", "estimate_zwd", "zwd_sigma", "zwd_random_walk",
       "doppler_sigma",
       "clock_bias_random_walk", "clock_drift_random_walk", "isb_random_walk", "isb_renewal_interval", "row_gate", "epoch_gate", "frame_yaw_sigma_deg",

@@ -84,9 +84,10 @@ void addVelocityRows(const GnssAnchor& anchor, const VelocitySolution& velocity,
 /// columns only when the rotation excites the lever arm.
 void addDopplerRows(const std::vector<SatelliteModel>& models, const AntennaKinematics& k, const Eigen::VectorXd& clk,
                     bool excited, GnssRowSet& rows);
-/// Pseudorange rows of the satellites with an estimated clock (variance: the code model).
+/// Pseudorange rows of the satellites with an estimated clock (variance: the code model); those
+/// with a known C/N0 below `cn0Mask` (dB-Hz, 0: off) are dropped and counted in `masked`.
 void addPseudorangeRows(const std::vector<SatelliteModel>& models, const AntennaKinematics& k,
-                        const Eigen::VectorXd& clk, GnssRowSet& rows);
+                        const Eigen::VectorXd& clk, double cn0Mask, GnssRowSet& rows, int& masked);
 
 /// One rover epoch in GnssFusion::processEpoch.
 template <typename Scalar>

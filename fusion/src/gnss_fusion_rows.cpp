@@ -48,9 +48,13 @@ void addDopplerRows(const std::vector<SatelliteModel>& models, const AntennaKine
 }
 
 void addPseudorangeRows(const std::vector<SatelliteModel>& models, const AntennaKinematics& k,
-                        const Eigen::VectorXd& clk, GnssRowSet& rows) {
+                        const Eigen::VectorXd& clk, double cn0Mask, GnssRowSet& rows, int& masked) {
   for (const SatelliteModel& m : models) {
     if (m.clock < 0) continue;
+    if (m.cn0 > 0.0 && m.cn0 < cn0Mask) {
+      ++masked;
+      continue;
+    }
     GnssRow r = pseudorangeRow(m, k, clk[m.clock]);
     r.H_lever.setZero();
     rows.add(r, kPsr, r.variance);
@@ -180,6 +184,11 @@ void GnssFusion<Scalar>::addDifferenceRows(Epoch& e, const AntennaKinematics& k,
   for (const SingleDifference& sd : dd.sd) {
     const int c = clockIndex(sd.sat);
     if (c < 0 || !sd.hasCode || sd.elevation < config_.elevationMaskDeg * constants::kDegToRad) continue;
+    // cn0_mask_dbhz: either receiver's C/N0 (where known) below the mask.
+    if ((sd.snr > 0.0 && sd.snr < config_.cn0MaskDbHz) || (sd.baseSnr > 0.0 && sd.baseSnr < config_.cn0MaskDbHz)) {
+      ++e.rep.dpsr.masked;
+      continue;
+    }
     const double cb = baseClock[static_cast<std::size_t>(c)];
     GnssRow r = sdPseudorangeRow(sd, k, clk[c], cb);
     r.clockBias = c;
@@ -242,7 +251,7 @@ bool GnssFusion<Scalar>::tightUpdate(vio::EstimatorBackend<Scalar>& est, Epoch& 
   const bool excited = config_.calibrateLeverArm && (s.omegaMeasured - s.newest.bg).norm() >= config_.minRotationRate;
   GnssRowSet rows;
   if (config_.usesDoppler()) addDopplerRows(models, k, clk, excited, rows);
-  if (config_.usesPseudorange()) addPseudorangeRows(models, k, clk, rows);
+  if (config_.usesPseudorange()) addPseudorangeRows(models, k, clk, config_.cn0MaskDbHz, rows, e.rep.psr.masked);
   if (sppVel && sppVel->velocity.valid) addVelocityRows(anchor_, sppVel->velocity, k, kVel, false, rows);
   if (config_.mode == GnssFusionMode::kDoppPpp && clocks_.valid()) addPhaseRows(est, e, models, k, clk, rows);
   addDifferenceRows(e, k, clk, rows);

@@ -9,6 +9,7 @@
 #include "gvins/fusion/gnss_clock_init.hpp"
 #include "gvins/fusion/gnss_fusion.hpp"
 #include "gvins/gnss/ionosphere_free.hpp"
+#include "gvins/gnss/measurement_weighting.hpp"
 #include "gvins/gnss/satellite_observation_model.hpp"
 #include "gvins/gnss/signal_choice.hpp"
 #include "gvins/gnss/zero_difference.hpp"
@@ -17,6 +18,25 @@ namespace gvins::fusion {
 namespace {
 
 constexpr double kC = constants::kSpeedOfLight;
+
+/// White noise and multipath of a code of zenith sigma `sigma` (m²): `elevation` weighting,
+/// sigma² (0.5 + 0.5 / sin² el); `elevation-cn0`, the elevation + C/N0 model of
+/// measurement_weighting.hpp (a = b = sigma / √2, no system factor: the ephemeris error carries
+/// the system's part here), which falls back to the elevation model without a C/N0.
+double codeNoiseVariance(const GnssFusionConfig& c, double sigma, System sys, double elevation, double cn0) {
+  if (c.codeWeighting == GnssCodeWeighting::kElevationCn0) {
+    MeasurementWeighting w;
+    w.scheme = WeightingScheme::ElevationSnr;
+    w.a = w.b = sigma * std::sqrt(0.5);
+    w.systemFactor.fill(1.0);
+    return w.codeVariance(sys, elevation, cn0);
+  }
+  const double sinEl = std::max(std::sin(elevation), 0.1);
+  return sigma * sigma * (0.5 + 0.5 / (sinEl * sinEl));
+}
+
+/// C/N0 of a signal, dB-Hz (0 unknown).
+double cn0Of(const SignalObs& s) { return s.hasSnr() ? s.snr : 0.0; }
 
 }  // namespace
 
@@ -74,6 +94,7 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     m.mapWet = terms.troposphere.mapWet;
     m.shapiro = terms.shapiro;
     m.pseudorange = s->pseudorange;
+    m.cn0 = cn0Of(*s);
     const double sinEl = std::max(std::sin(m.azel.elevation), 0.1);
     // Code variance (below: single frequency after the pair search, the pair inside it): white
     // noise and multipath growing with 1/sin(el), and the ephemeris error.
@@ -108,8 +129,12 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
         m.code2 = s2->code;
         m.ifA1 = c.a1;
         m.ifA2 = c.a2;
-        m.codeVariance = std::pow(config_.codeSigma * c.noiseFactor() * smoothingFactor, 2) *
-                             (0.5 + 0.5 / (sinEl * sinEl)) + ephemerisVariance;
+        // The lower C/N0 of the two bands where both are known.
+        const double cn02 = cn0Of(*s2);
+        if (cn02 > 0.0 && (m.cn0 <= 0.0 || cn02 < m.cn0)) m.cn0 = cn02;
+        m.codeVariance = codeNoiseVariance(config_, config_.codeSigma * c.noiseFactor() * smoothingFactor, so.sat.system,
+                                           m.azel.elevation, m.cn0) +
+                         ephemerisVariance;
         // vio+dopp+ppp: the ionosphere-free phase of the same bands (the phase of another
         // tracking mode on a band only shifts the float ambiguity).
         if (config_.mode == GnssFusionMode::kDoppPpp) {
@@ -130,8 +155,9 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
       // evaluated only here (an ionosphere-free pair needs none), and 30 % of it in the code
       // variance (Klobuchar corrects about half of the delay; IS-GPS-200N 20.3.3.5.2.5).
       m.ionosphere = singleFrequency ? terms.ionosphere.slant : model.ionosphere(so.sat.system, m.azel, *f).slant;
-      m.codeVariance = std::pow(config_.codeSigma * smoothingFactor, 2) * (0.5 + 0.5 / (sinEl * sinEl)) +
-                       std::pow(0.3 * m.ionosphere, 2) + ephemerisVariance;
+      m.codeVariance =
+          codeNoiseVariance(config_, config_.codeSigma * smoothingFactor, so.sat.system, m.azel.elevation, m.cn0) +
+          std::pow(0.3 * m.ionosphere, 2) + ephemerisVariance;
     }
     m.dopplerVariance = std::pow(config_.dopplerSigma, 2) * (0.5 + 0.5 / (sinEl * sinEl));
     const SignalObs* d = s->hasDoppler() ? s : nullptr;

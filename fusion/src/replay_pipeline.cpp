@@ -369,6 +369,7 @@ class FrameLoop {
     if (r.updated) ++sum.gnssEpochsUpdated;
     sum.phaseRowsUsed += static_cast<std::size_t>(r.phase.used);
     sum.phaseRowsRejected += static_cast<std::size_t>(r.phase.rejected);
+    sum.codeRowsMasked += static_cast<std::size_t>(r.psr.masked + r.dpsr.masked);
     sum.ambiguityStatesMax = std::max(sum.ambiguityStatesMax, static_cast<std::size_t>(r.ambiguities));
     sum.recordChanges += static_cast<std::size_t>(r.recordChanges);
     if (r.rtkFixed) ++sum.gnssEpochsFixed;

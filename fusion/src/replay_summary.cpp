@@ -39,6 +39,7 @@ void ReplaySummary::writeMetrics(std::ostream& os) const {
   kv("phase_rows_used", static_cast<double>(phaseRowsUsed));
   kv("phase_rows_rejected", static_cast<double>(phaseRowsRejected));
   kv("ambiguity_states_max", static_cast<double>(ambiguityStatesMax));
+  kv("code_rows_masked", static_cast<double>(codeRowsMasked));
   kv("broadcast_record_changes", static_cast<double>(recordChanges));
   kv("frame_init_s", frameInitSeconds);
   kv("enu_move_s", enuMoveSeconds);
@@ -129,6 +130,7 @@ void ReplaySummary::print(std::ostream& os) const {
       row("carrier phase (PPP)", std::to_string(phaseRowsUsed) + " rows used, " + std::to_string(phaseRowsRejected) +
                                      " gated out; up to " + std::to_string(ambiguityStatesMax) + " ambiguity states" +
                                      (recordChanges > 0 ? "; " + std::to_string(recordChanges) + " broadcast record changes carried over" : ""));
+    if (codeRowsMasked > 0) row("C/N0 mask", std::to_string(codeRowsMasked) + " code rows dropped");
     if (std::isfinite(frameInitSeconds)) row("frame initialised", f("%.1f s after the first frame", frameInitSeconds));
     if (std::isfinite(enuMoveSeconds)) row("estimator in ENU", f("%.1f s after the first frame", enuMoveSeconds));
   }

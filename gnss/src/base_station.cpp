@@ -113,6 +113,7 @@ void BaseStation::addEpoch(const ObsEpoch& epoch) {
       b.code = s.code;
       b.hasPhase = s.hasPhase() && s.carrierPhase != 0.0 && std::isfinite(s.carrierPhase);
       b.hasCode = s.hasCode() && s.pseudorange > 1e6 && s.pseudorange < 1e8;
+      b.snr = s.hasSnr() ? s.snr : 0.0;
       if (!b.hasPhase && !b.hasCode) continue;
       if (b.hasPhase) {
         b.slipFlags = slips_.flags(so.sat, s.code);

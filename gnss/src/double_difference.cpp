@@ -9,6 +9,7 @@
 
 #include "gvins/base/geodetic.hpp"
 #include "gvins/base/local_frame.hpp"
+#include "gvins/gnss/measurement_weighting.hpp"
 #include "gvins/gnss/satellite_observation_model.hpp"
 #include "gvins/gnss/zero_difference.hpp"
 
@@ -215,6 +216,11 @@ void DoubleDifferenceBuilder::form(const ObsEpoch& rover, const CycleSlipDetecto
   ch.mergeMissing(nav_.glonassChannels());
   const double a2 = config_.phaseSigmaA * config_.phaseSigmaA;
   const double b2 = config_.phaseSigmaB * config_.phaseSigmaB;
+  MeasurementWeighting codeWeights;  // one receiver's code (RtkConfig::codeWeighting)
+  codeWeights.scheme = config_.codeWeighting;
+  codeWeights.a = config_.codePhaseRatio * config_.phaseSigmaA;
+  codeWeights.b = config_.codePhaseRatio * config_.phaseSigmaB;
+  codeWeights.systemFactor = config_.codeSystemFactor;
 
   for (const SatObs& so : rover.sats) {
     if (!so.sat.valid()) continue;
@@ -261,7 +267,6 @@ void DoubleDifferenceBuilder::form(const ObsEpoch& rover, const CycleSlipDetecto
     const double tropo = model.terms(tx->state.position, azel, sys, 0.0).troposphere.slant;
     const double sinEl = std::max(std::sin(azel.elevation), 0.05);
     const double varPhase = 2.0 * (a2 + b2 / (sinEl * sinEl));
-    const double f = config_.codePhaseRatio * config_.codeSystemFactor[static_cast<std::size_t>(systemIndex(sys))];
     bool any = false;
     for (int i = 0; i < np; ++i) {
       const SignalObs& rs = *picks[i].rover;
@@ -273,6 +278,7 @@ void DoubleDifferenceBuilder::form(const ObsEpoch& rover, const CycleSlipDetecto
       d.elevation = azel.elevation;
       d.azimuth = azel.azimuth;
       d.snr = rs.hasSnr() ? rs.snr : 0.0;
+      d.baseSnr = bs.snr;
       d.satPosition = tx->state.position;
       d.satClock = constants::kSpeedOfLight * tx->state.clockBias;
       d.troposphere = tropo;
@@ -302,7 +308,8 @@ void DoubleDifferenceBuilder::form(const ObsEpoch& rover, const CycleSlipDetecto
         d.baseCodeOmc = bs.codeOmc;
       }
       d.phaseVariance = varPhase;
-      d.codeVariance = f * f * varPhase;
+      d.codeVariance = codeWeights.codeVariance(sys, azel.elevation, d.snr) +
+                       codeWeights.codeVariance(sys, azel.elevation, d.baseSnr);
       out.sd.push_back(d);
       any = true;
     }

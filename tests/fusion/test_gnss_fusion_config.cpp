@@ -16,6 +16,8 @@ TEST(GnssFusionConfig, ParsesAllKeys) {
       "  calibrate_lever_arm: true\n"
       "  systems: GE\n"
       "  code_sigma: 0.8\n"
+      "  code_weighting: elevation-cn0\n"
+      "  cn0_mask_dbhz: 35\n"
       "  carrier_smoothing: 60\n"
       "  smoothed_code_factor: 0.5\n"
       "  ionosphere: broadcast\n"
@@ -43,6 +45,10 @@ TEST(GnssFusionConfig, ParsesAllKeys) {
   EXPECT_TRUE(c.useSystem(System::Galileo));
   EXPECT_FALSE(c.useSystem(System::BeiDou));
   EXPECT_DOUBLE_EQ(c.codeSigma, 0.8);
+  EXPECT_EQ(c.codeWeighting, GnssCodeWeighting::kElevationCn0);
+  EXPECT_DOUBLE_EQ(c.cn0MaskDbHz, 35.0);
+  EXPECT_EQ(d.codeWeighting, GnssCodeWeighting::kElevation);
+  EXPECT_DOUBLE_EQ(d.cn0MaskDbHz, 0.0);
   EXPECT_DOUBLE_EQ(c.carrierSmoothing, 60.0);
   EXPECT_DOUBLE_EQ(c.smoothedCodeFactor, 0.5);
   EXPECT_DOUBLE_EQ(c.rowGate, 0.99);
@@ -177,7 +183,8 @@ TEST(GnssFusionConfig, ErrorsNameFileLineAndField) {
                           "  phase_windup: 2\n", "  max_ambiguities: -1\n",
                           "  broadcast_ambiguity_random_walk: -1\n", "  broadcast_record_changes: 3\n",
                           "  rtk_hold_fix: sometimes\n", "  frame_reanchor: 1.5\n",
-                          "  frame_reanchor_position_sigma: 0\n"}) {
+                          "  frame_reanchor_position_sigma: 0\n", "  code_weighting: cn0\n",
+                          "  cn0_mask_dbhz: -3\n"}) {
     try {
       parseGnssFusionConfig(std::string("gnss_fusion:\n  mode: vio+dopp+psr\n") + bad, "b.yaml");
       FAIL() << "no error for " << bad;

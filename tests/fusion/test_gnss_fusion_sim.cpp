@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -160,7 +161,8 @@ struct SatelliteCut {
 
 template <typename Scalar>
 RunResult run(GnssFusionConfig cfg, const SatelliteCut& cut = {}, const EphemerisStore* store = nullptr,
-              double restartAt = -1.0, const IsbDrift& drift = {}, bool flipDoppler = false) {
+              double restartAt = -1.0, const IsbDrift& drift = {}, bool flipDoppler = false,
+              const std::function<void(ObsEpoch&, double)>& edit = {}) {
   const Scenario& sc = scenario();
   const EphemerisStore& nav = store ? *store : sc.nav;
   Eigen::Matrix<double, 15, 1> sigma;
@@ -222,6 +224,7 @@ RunResult run(GnssFusionConfig cfg, const SatelliteCut& cut = {}, const Ephemeri
         for (SignalObs& sig : so.signals) sig.doppler = -sig.doppler;
       }
     }
+    if (edit) edit(obs, tf);  // rover observations changed at flight time tf
     if (tf > cut.after) {
       std::erase_if(obs.sats, [&](const SatObs& so) {
         return std::find(cut.keep.begin(), cut.keep.end(), so.sat) == cut.keep.end();
@@ -259,6 +262,7 @@ RunResult run(GnssFusionConfig cfg, const SatelliteCut& cut = {}, const Ephemeri
     auto add = [](GnssTypeCount& a, const GnssTypeCount& b) {
       a.used += b.used;
       a.rejected += b.rejected;
+      a.masked += b.masked;
     };
     add(out.psr, r.psr);
     add(out.dopp, r.dopp);
@@ -735,6 +739,47 @@ TEST(GnssFusionSim, ModesTable) {
   EXPECT_LT(r[GnssFusionMode::kDoppDdcp].posRms, 0.25 * r[GnssFusionMode::kDoppDpsr].posRms);
   EXPECT_LT(f.horRms, 1.5);
   EXPECT_NEAR(f.horRms, psr.horRms, 0.2);
+}
+
+// Non-line-of-sight reception as in a street canyon (the diagnosis of the city drive: NLOS
+// codes arrive late by metres to tens of metres at a C/N0 about 10 dB lower than the direct
+// signals): from 25 s of flight on, every rover satellite whose primary-band C/N0 is below
+// 42 dB-Hz (the lower half, mostly the low satellites) is received via a reflection: all its
+// codes 15 m late, its C/N0 10 dB lower. Elevation-only weights let these rows pull the position
+// (part of them pass the row gate, the clock absorbing the common part); the elevation + C/N0
+// model (measurement_weighting.hpp) raises the elevation-independent half of their variance by
+// 10^(10/10) more than that of the direct signals; the 35 dB-Hz mask drops most of them.
+TEST(GnssFusionSim, Cn0WeightingAgainstNlosCodes) {
+  auto nlos = [](ObsEpoch& obs, double tf) {
+    if (tf < 25.0) return;
+    for (SatObs& so : obs.sats) {
+      if (so.signals.empty() || !so.signals.front().hasSnr() || so.signals.front().snr >= 42.0) continue;
+      for (SignalObs& sig : so.signals) {
+        if (sig.hasCode()) sig.pseudorange += 15.0;
+        if (sig.hasSnr()) sig.snr -= 10.0;
+      }
+    }
+  };
+  GnssFusionConfig elevation = mode(GnssFusionMode::kDoppPsr);
+  GnssFusionConfig cn0 = elevation;
+  cn0.codeWeighting = GnssCodeWeighting::kElevationCn0;
+  GnssFusionConfig masked = cn0;
+  masked.cn0MaskDbHz = 35.0;
+  const RunResult clean = run<double>(elevation);
+  const RunResult e = run<double>(elevation, {}, nullptr, -1.0, {}, false, nlos);
+  const RunResult c = run<double>(cn0, {}, nullptr, -1.0, {}, false, nlos);
+  const RunResult m = run<double>(masked, {}, nullptr, -1.0, {}, false, nlos);
+  std::fprintf(stderr, "NLOS codes: pos RMS clean %.3f m, elevation %.3f m, elevation-cn0 %.3f m, + mask 35 %.3f m "
+               "(%d psr rows masked)\n", clean.posRms, e.posRms, c.posRms, m.posRms, m.psr.masked);
+  // Measured (seed 2024): clean 0.58 m; NLOS with elevation weights 10.3 m, elevation-cn0 4.6 m,
+  // elevation-cn0 + mask 0.61 m (4436 rows masked of 13467 epochs' satellites).
+  EXPECT_LT(clean.posRms, 1.0);
+  EXPECT_GT(e.posRms, 5.0 * clean.posRms);  // the injected NLOS codes do hurt elevation-only weights
+  EXPECT_LT(c.posRms, 0.6 * e.posRms);
+  EXPECT_LT(m.posRms, 0.2 * e.posRms);
+  EXPECT_LT(m.posRms, 2.0 * clean.posRms);
+  EXPECT_EQ(e.psr.masked, 0);
+  EXPECT_GT(m.psr.masked, 1000);
 }
 
 // The tightly-coupled advantage: after 30 s (frame and clocks initialised) only three GPS

@@ -33,6 +33,7 @@ inline const char* toString(GnssFusionStage s) { return enumName(kGnssFusionStag
 struct GnssTypeCount {
   int used = 0;
   int rejected = 0;  ///< gated out (row or epoch test)
+  int masked = 0;    ///< code rows dropped below GnssFusionConfig::cn0MaskDbHz (psr, dpsr)
 };
 
 struct GnssEpochReport {

@@ -93,6 +93,14 @@ enum class GnssIonosphere : std::uint8_t {
   kDualFrequency,  ///< ionosphere-free pair where a second band exists, else kBroadcast
 };
 
+/// Weighting of the code rows (psr, dpsr).
+enum class GnssCodeWeighting : std::uint8_t {
+  kElevation,     ///< sigma^2 = code_sigma^2 (0.5 + 0.5 / sin^2 el)
+  /// The elevation + C/N0 model of gvins/gnss/measurement_weighting.hpp (ElevationSnr): the
+  /// elevation-independent half scaled by 10^((45 - C/N0) / 10); without C/N0, kElevation.
+  kElevationCn0,
+};
+
 struct GnssFusionConfig {
   GnssFusionMode mode = GnssFusionMode::kDoppPsr;
   Eigen::Vector3d leverArm = Eigen::Vector3d::Zero();
@@ -123,6 +131,13 @@ struct GnssFusionConfig {
     return b;
   }
   double codeSigma = 0.6;
+  /// `code_weighting`: elevation or elevation-cn0 (GnssCodeWeighting). An ionosphere-free pair
+  /// takes the lower C/N0 of its two bands; a single difference adds the rover's and the base's
+  /// variances, each with its own C/N0.
+  GnssCodeWeighting codeWeighting = GnssCodeWeighting::kElevation;
+  /// `cn0_mask_dbhz`: code rows (psr, dpsr) of signals with a C/N0 below this are dropped
+  /// (counted as GnssTypeCount::masked); 0 = off. An ionosphere-free pair: its lower C/N0.
+  double cn0MaskDbHz = 0.0;
   /// Carrier smoothing of the pseudoranges (psr modes; dpsr: rover and base): Hatch window in s,
   /// 0 = raw codes (CarrierSmoother); ddcp keeps raw codes. 100 s as in RTCA DO-229E; the
   /// ionosphere-free pair of smoothed codes has no ionospheric divergence, a single-frequency one

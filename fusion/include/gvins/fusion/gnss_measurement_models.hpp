@@ -111,6 +111,7 @@ struct SatelliteModel {
   bool ssr = false;         ///< orbit and clock corrected by SSR
   AzEl azel;
   double pseudorange = 0.0; ///< m
+  double cn0 = 0.0;         ///< C/N0 of the code, dB-Hz (an ionosphere-free pair: the lower one; 0 unknown)
   bool hasDoppler = false;
   double rangeRate = 0.0;   ///< m/s, −λ·D
   /// Ionosphere-free carrier phase a1·λ1·φ1 + a2·λ2·φ2 (m) of the pair's bands, when both phases

@@ -202,6 +202,7 @@ struct ReplaySummary {
   /// vio+dopp+ppp: carrier-phase rows used / gated out over the run, most ambiguity states at once.
   std::size_t phaseRowsUsed = 0, phaseRowsRejected = 0, ambiguityStatesMax = 0;
   std::size_t recordChanges = 0;  ///< broadcast record changes carried over to ambiguities
+  std::size_t codeRowsMasked = 0;  ///< psr/dpsr rows dropped below cn0_mask_dbhz
   double realTimeFactor() const { return wallSeconds > 0.0 ? datasetSeconds / wallSeconds : 0.0; }
   double estimatorMsMedian = 0.0;
   /// First processed frame to the first initialised one (s; NaN: never), the estimator's mean time

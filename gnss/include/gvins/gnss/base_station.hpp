@@ -61,6 +61,7 @@ struct BaseSignal {
   GpsTime arcStart;       ///< start of the phase arc (base cycle-slip detector)
   std::uint8_t slipFlags = 0;
   double elevation = 0.0;  ///< rad, at the base
+  double snr = 0.0;        ///< C/N0, dB-Hz (0 unknown)
 };
 
 /// Base values aligned to one rover epoch.

@@ -64,6 +64,7 @@ struct SingleDifference {
   double elevation = 0.0;   ///< rad, at the rover
   double azimuth = 0.0;     ///< rad, at the rover
   double snr = 0.0;         ///< rover C/N0, dB-Hz (0 unknown)
+  double baseSnr = 0.0;     ///< base C/N0, dB-Hz (0 unknown)
   Eigen::Vector3d satPosition = Eigen::Vector3d::Zero();  ///< at the rover transmit time (ECEF of that time)
   double satClock = 0.0;     ///< c·dt_s at that time, m
   double troposphere = 0.0;  ///< modelled rover slant delay, m
@@ -74,7 +75,7 @@ struct SingleDifference {
   double basePhaseOmc = 0.0;  ///< base phase minus its model, m
   double baseCodeOmc = 0.0;   ///< base code minus its model, m
   double phaseVariance = 0.0;  ///< of the SD phase, m²
-  double codeVariance = 0.0;   ///< of the SD code, m²
+  double codeVariance = 0.0;   ///< of the SD code, m² (rover plus base, RtkConfig::codeWeighting)
   GpsTime roverArc;  ///< start of the rover phase arc
   GpsTime baseArc;   ///< start of the base phase arc
   std::uint8_t roverSlip = 0;  ///< rover slip flags of this epoch (CycleSlipDetector)

@@ -10,6 +10,7 @@
 #include "gvins/base/satellite.hpp"
 #include "gvins/gnss/ambiguity_resolution.hpp"
 #include "gvins/gnss/cycle_slip_detector.hpp"
+#include "gvins/gnss/measurement_weighting.hpp"
 
 namespace gvins {
 
@@ -98,6 +99,10 @@ struct RtkConfig {
   /// Code σ = codePhaseRatio × phase σ (RTKLIB's "eratio"), per system factor on top.
   double codePhaseRatio = 100.0;
   std::array<double, kNumSystems> codeSystemFactor{1.0, 1.5, 1.0, 1.0, 1.0, 3.0, 1.5};
+  /// Code variance per receiver (measurement_weighting.hpp, a = codePhaseRatio·phaseSigmaA,
+  /// b = codePhaseRatio·phaseSigmaB, codeSystemFactor), each receiver with its own C/N0 and both
+  /// at the rover's elevation; Elevation: the phase model times the ratio squared.
+  WeightingScheme codeWeighting = WeightingScheme::Elevation;
   bool troposphere = true;  ///< Saastamoinen/Niell slant delays at both receivers
 
   // --- Base station.
