@@ -14,7 +14,7 @@
 #                 the drift ("re-acquiring" warning) and H RMS 7.18 m (bound 10; without the
 #                 re-acquisition every epoch after the second outage was gated out and the error
 #                 grew past 150 m); single outages at 40 and 100 s drift 6.3 and 9.6 m
-#                 (vio+dopp+ppp at 100 s: 8.2 m), bound 12 m (outage_drift.py)
+#                 (vio+dopp+ppp at 100 s: 8.2 m), bound 12 m (walk_compare.py drift)
 #   tests/fusion/real_walk_quirks.sh BIN_DIR TEST_DATA_DIR PYTHON3
 set -u
 BIN=$1
@@ -67,9 +67,9 @@ check "outages: H RMS m" "$(metric global_horizontal_rmse_m "$W/outages/metrics.
 # vio+dopp+psr, 8.16 m with vio+dopp+ppp at 100 s); bound 12 m.
 for at in 40 100; do
   replay "outage$at" "$UBX" --gnss-outage "$at,15"
-  check "outage at $at s: horizontal drift m" "$("$PY" "$HERE/outage_drift.py" "$W/outage$at" "$REF" "$at" 15)" "<=" 12
+  check "outage at $at s: horizontal drift m" "$("$PY" "$HERE/walk_compare.py" drift "$W/outage$at" "$REF" "$at" 15)" "<=" 12
 done
 "$BIN/gvins-replay" "$W/ds" --mode vio+dopp+ppp --rover "$UBX" --truth-pos "$REF" --imu-gaps warn -q -o "$W/ppp100" \
   --gnss-outage 100,15 >"$W/ppp100.out" 2>&1 || { cat "$W/ppp100.out"; exit 1; }
-check "vio+dopp+ppp outage at 100 s: horizontal drift m" "$("$PY" "$HERE/outage_drift.py" "$W/ppp100" "$REF" 100 15)" "<=" 12
+check "vio+dopp+ppp outage at 100 s: horizontal drift m" "$("$PY" "$HERE/walk_compare.py" drift "$W/ppp100" "$REF" 100 15)" "<=" 12
 exit $fail

@@ -1,12 +1,17 @@
 #!/usr/bin/env python3
-"""Figures of gvins-replay runs of the real walk for tests/fusion/real_walk_reacquisition.sh. Times
-are seconds after the run's first frame (timing.csv), positions those of global.pos.
+"""Figures of gvins-replay runs of the real walk for tests/fusion/real_walk_reacquisition.sh and
+real_walk_quirks.sh. Times are seconds after the run's first frame (timing.csv), positions those
+of global.pos.
 
     walk_compare.py first-update OUT T        s from T to the first epoch with an applied update
     walk_compare.py max-diff OUT_A OUT_B T0 T1  largest horizontal and vertical distance (m) between
                                               the two runs' common epochs in [T0, T1)
     walk_compare.py max-used OUT T0 T1        largest number of pseudorange rows used in [T0, T1)
     walk_compare.py frame-delay OUT SPP.pos   s from the first SPP fix to the first tight epoch
+    walk_compare.py drift OUT REF.pos T LEN   horizontal drift (m) of an outage [T, T+LEN): the change
+                                              of the horizontal error against the reference's fixed
+                                              and float epochs between the last epoch before the
+                                              window and the window's last epoch
     walk_compare.py rms OUT REF.pos T0 [OUT_B]  horizontal and vertical RMS (m) against the
                                               reference's fixed and float epochs from T0 on (the
                                               epochs that OUT_B also has, if given)
@@ -92,6 +97,16 @@ def main():
         spp = min(read_pos(args[1]))
         tight = next(float(e[1]) for e in epochs(args[0]) if e[2] == "tight")
         print("%.2f" % (tight - spp))
+    elif cmd == "drift":
+        t0, start, length = first_frame(args[0]), float(args[2]), float(args[3])
+        est, ref = read_pos(args[0] + "/global.pos"), read_pos(args[1], 2)
+        common = sorted(t for t in est if t in ref)
+        before = [t for t in common if t - t0 < start]
+        inside = [t for t in common if start <= t - t0 < start + length]
+        if not before or not inside:
+            sys.exit("walk_compare: no reference epoch before or inside the window")
+        e0, e1 = enu(est[before[-1]], ref[before[-1]]), enu(est[inside[-1]], ref[inside[-1]])
+        print("%.2f" % math.hypot(e1[0] - e0[0], e1[1] - e0[1]))
     elif cmd == "rms":
         t0 = first_frame(args[0])
         est, ref = read_pos(args[0] + "/global.pos"), read_pos(args[1], 2)
