@@ -218,7 +218,8 @@ def page(results, info):
          "run the script again. Families, modes and targets: bench/sweep/families.py; each seed draws its own "
          "variant (height, speed, length, pattern, heading, start time, base distance and direction) and "
          "simulator noise; datasets are feature tracks." % (
-             info["command"], commit(), datetime.datetime.utcnow().strftime("%Y-%m-%d %H:%M UTC"),
+             info["command"], info.get("binaries_commit") or commit(),
+             datetime.datetime.utcnow().strftime("%Y-%m-%d %H:%M UTC"),
              info["cores"], origin), "",
          "Seeds %s (the seeds column says how many each family has); %d runs, %d ok, %d failed." % (
              ", ".join(str(s) for s in seeds), len(results), ok, len(results) - ok), "",

@@ -6,7 +6,7 @@ the hand-held walk), feature-track datasets of gvins-sim. Writes the results pag
 per family and mode, targets met or missed, NEES, float against double, run time) and a CSV of
 every run.
 
-  bench/sweep/sweep.py [--bin build/bin] [--seeds 20] [--jobs 1] [--work out/sweep]
+  bench/sweep/sweep.py [--bin build/bin [--binaries-commit C]] [--seeds 20] [--jobs 1] [--work out/sweep]
                        [--families a,b] [--modes vio,ddcp,...] [--markdown docs/results/sweep.md]
                        [--csv docs/results/sweep.csv] [--retry-failed] [--keep-data]
 
@@ -235,6 +235,8 @@ def simulate(a, text, data):
 def parse_args():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--bin", default=os.path.join(ROOT, "build", "bin"))
+    ap.add_argument("--binaries-commit", default=None,
+                    help="commit the binaries of --bin were built from, for the page (default: this checkout's HEAD)")
     ap.add_argument("--seeds", type=int, default=20, help="seeds 1..N of every family (default 20)")
     ap.add_argument("--first-seed", type=int, default=1)
     ap.add_argument("--jobs", type=int, default=1, help="seeds simulated and replayed in parallel")
@@ -284,7 +286,8 @@ def main():
     info = {"command": "bench/sweep/sweep.py " + " ".join(
                 os.path.relpath(x, ROOT) if x.startswith(ROOT + os.sep) else x for x in sys.argv[1:]),
             "seeds": sorted({r["seed"] for r in results}), "jobs": a.jobs, "cores": os.cpu_count(), "wall_s": wall,
-            "computed": progress.computed, "report_only": a.report_only, "families": a.family_list, "modes": a.mode_list}
+            "computed": progress.computed, "report_only": a.report_only, "binaries_commit": a.binaries_commit,
+            "families": a.family_list, "modes": a.mode_list}
     if a.csv:
         report.write_csv(a.csv, results)
     page = report.page(results, info)
