@@ -14,6 +14,22 @@ namespace gvins::fusion::detail {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+/// Horizontal and vertical RMS of the aligned estimate against the reference (z is up).
+Eigen::Vector2d horizontalVerticalRmse(const vio::EvaluationResult& r) {
+  double h = 0.0, v = 0.0;
+  for (std::size_t i = 0; i < r.reference.size(); ++i) {
+    const Eigen::Vector3d e = r.estimateAligned[i] - r.reference[i];
+    h += e.head<2>().squaredNorm();
+    v += e.z() * e.z();
+  }
+  const double m = static_cast<double>(std::max<std::size_t>(r.reference.size(), 1));
+  return {std::sqrt(h / m), std::sqrt(v / m)};
+}
+
+}  // namespace
+
 ReplaySummary::Accuracy accuracyOf(const vio::EvaluationResult& r) {
   ReplaySummary::Accuracy a;
   a.poses = r.matched;
@@ -28,15 +44,9 @@ ReplaySummary::Accuracy accuracyOf(const vio::EvaluationResult& r) {
     a.positionNees = r.positionNees;
     a.orientationNees = r.orientationNees;
   }
-  double h = 0.0, v = 0.0;
-  for (std::size_t i = 0; i < r.reference.size(); ++i) {
-    const Eigen::Vector3d e = r.estimateAligned[i] - r.reference[i];
-    h += e.head<2>().squaredNorm();
-    v += e.z() * e.z();
-  }
-  const double m = static_cast<double>(std::max<std::size_t>(r.reference.size(), 1));
-  a.horizontalRmse = std::sqrt(h / m);
-  a.verticalRmse = std::sqrt(v / m);
+  const Eigen::Vector2d hv = horizontalVerticalRmse(r);
+  a.horizontalRmse = hv[0];
+  a.verticalRmse = hv[1];
   return a;
 }
 
@@ -115,20 +125,12 @@ void evaluateGlobal(const std::string& dataset, const ReplayOptions& opt, const 
     const auto r = vio::evaluateTrajectory(track, ref, {}, eo3);
     std::ostringstream os;
     vio::printEvaluation(os, r);
-    double h = 0.0, v = 0.0;
-    for (std::size_t i = 0; i < r.reference.size(); ++i) {
-      const Eigen::Vector3d e = r.estimateAligned[i] - r.reference[i];
-      h += e.head<2>().squaredNorm();
-      v += e.z() * e.z();
-    }
-    const double m = static_cast<double>(std::max<std::size_t>(r.reference.size(), 1));
+    const Eigen::Vector2d hv = horizontalVerticalRmse(r);
     char b[200];
-    std::snprintf(b, sizeof b, "horizontal RMS %.4f m, vertical RMS %.4f m over %zu epochs%s\n", std::sqrt(h / m),
-                  std::sqrt(v / m), r.reference.size(), fromTight ? " (from the first tightly coupled update)" : "");
+    std::snprintf(b, sizeof b, "horizontal RMS %.4f m, vertical RMS %.4f m over %zu epochs%s\n", hv[0], hv[1],
+                  r.reference.size(), fromTight ? " (from the first tightly coupled update)" : "");
     sum.globalEvaluationTable = os.str() + b;
-    sum.global = accuracyOf(r);
-    sum.global.horizontalRmse = std::sqrt(h / m);
-    sum.global.verticalRmse = std::sqrt(v / m);
+    sum.global = accuracyOf(r);  // its horizontal/vertical RMS are those printed above
     for (const auto& f : vio::writeEvaluationPlots(r, (out / "eval_global_").string())) sum.files.push_back(f);
   } catch (const std::invalid_argument& e) {
     sum.globalEvaluationTable = std::string("not evaluated: ") + e.what() + "\n";
