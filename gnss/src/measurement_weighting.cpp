@@ -27,6 +27,11 @@ double MeasurementWeighting::codeVariance(System sys, double elevation, double s
   return f * f * shape(*this, a * a, b * b, elevation, snr);
 }
 
+double MeasurementWeighting::combinationCodeVariance(System sys, double elevation, double a1, double snr1, double a2,
+                                                     double snr2) const {
+  return a1 * a1 * codeVariance(sys, elevation, snr1) + a2 * a2 * codeVariance(sys, elevation, snr2);
+}
+
 double MeasurementWeighting::dopplerVariance(System sys, double elevation, double snr) const {
   // Same shape as the code model, scaled so that sqrt(a^2 + b^2) corresponds to dopplerSigma.
   const double norm = a * a + b * b;

@@ -77,8 +77,10 @@ struct SppSolver::Measurement {
   double pseudorange = 0.0;
   double frequency = 0.0;  // of the primary signal (ionosphere scaling)
   bool ionosphereFree = false;
-  double noiseFactor = 1.0;
-  double snr = 0.0;
+  // The combination a1 P1 + a2 P2 of the pseudorange (ionosphere-free: both; else a1 = 1, a2 = 0)
+  // and the C/N0 of its signals (0: unknown), for its noise variance.
+  double a1 = 1.0, a2 = 0.0;
+  double snr = 0.0, snr2 = 0.0;
   SatelliteState state;
   double satClock = 0.0;  // s, clock bias minus group delay
   // Doppler
@@ -160,7 +162,9 @@ bool SppSolver::gatherMeasurements(const ObsEpoch& epoch, SppSolution& sol, std:
       ifc = ionosphereFreeCoefficients(f1, f2);
       m.pseudorange = ifc.a1 * s1->pseudorange + ifc.a2 * s2->pseudorange;
       m.ionosphereFree = true;
-      m.noiseFactor = ifc.noiseFactor();
+      m.a1 = ifc.a1;
+      m.a2 = ifc.a2;
+      m.snr2 = s2->hasSnr() ? s2->snr : 0.0;
     }
     // Transmit time, satellite state (broadcast, precise or SSR) and group delays: the one
     // satellite-source choice (zero_difference.hpp), with this solver's record cache.
@@ -256,6 +260,8 @@ class SppSolver::Fit {
   /// Keeps the residuals and the ionosphere correction of the fit before robust re-weighting
   /// (the reported covariance's variance factor is taken from them).
   void keepPriorResiduals();
+  /// Removed by fault exclusion (and of a system that keeps a clock column).
+  bool excludedByFde(int i) const;
   /// The reported covariance under SppConfig::reportedError (spp_reported_covariance.hpp).
   void reportCovariance();
 
@@ -340,8 +346,9 @@ void SppSolver::Fit::updateModels(const Eigen::Vector3d& x) {
       m.azel = AzEl{0.0, 0.5 * constants::kPi};
       m.active = true;
     }
+    // The noise of both signals of an ionosphere-free pseudorange, each by the weighting model.
     const double noiseVar =
-        cfg.weighting.codeVariance(m.sat.system, m.azel.elevation, m.snr) * m.noiseFactor * m.noiseFactor;
+        cfg.weighting.combinationCodeVariance(m.sat.system, m.azel.elevation, m.a1, m.snr, m.a2, m.snr2);
     double var = noiseVar + ionoVar + tropoVar;
     double eph = m.state.precise || m.state.ssr ? cfg.preciseEphemerisError[systemIndex(m.sat.system)]
                                  : cfg.ephemerisError[systemIndex(m.sat.system)];
@@ -765,11 +772,15 @@ SppSolution SppSolver::solve(const ObsEpoch& epoch) {
   return sol;
 }
 
+bool SppSolver::Fit::excludedByFde(int i) const {
+  return !use[i] && sol.satellites[meas[i].result].use == SatelliteUse::Excluded && col[meas[i].sys] >= 0;
+}
+
 void SppSolver::Fit::keepPriorResiduals() {
   ionBeforeRobust = ion;
   for (int i = 0; i < n; ++i) {
     Measurement& m = meas[i];
-    if (!use[i]) continue;
+    if (!use[i] && !excludedByFde(i)) continue;
     const double pred = geometricRange(m.state.position, x) + clk[col[m.sys]] - kC * m.satClock + m.iono +
                         m.ionoMap * ion + m.tropo;
     m.priorResidual = m.pseudorange - pred;
@@ -783,9 +794,10 @@ void SppSolver::Fit::reportCovariance() {
   detail::ReportedInputs in;
   in.q = last.cov;
   for (int i = 0; i < n; ++i) {
-    if (!use[i]) continue;
+    if (!use[i] && !excludedByFde(i)) continue;
     const Measurement& m = meas[i];
     detail::ReportedRow row;
+    row.excluded = !use[i];
     row.h = Eigen::VectorXd::Zero(nu);
     row.h.head<3>() = -(m.state.position - x).normalized();
     row.h[3 + col[m.sys]] = 1.0;

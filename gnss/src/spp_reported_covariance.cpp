@@ -46,23 +46,68 @@ Eigen::MatrixXd rowErrorCovariance(const std::vector<ReportedRow>& rows, double 
   return r;
 }
 
+namespace {
+/// The median estimate of the variance factor over all rows (see reportedCovariance): v = B e
+/// with B = [A 0; -H_x G0 I] for the kept rows f and the excluded rows x.
+double medianVarianceFactor(const ReportedInputs& in, const std::vector<Eigen::Index>& kept,
+                            const std::vector<Eigen::Index>& excluded, const Eigen::MatrixXd& a,
+                            const Eigen::MatrixXd& g0, const Eigen::MatrixXd& rIndAll, const Eigen::MatrixXd& rCommonAll) {
+  const auto nf = static_cast<Eigen::Index>(kept.size());
+  const auto nAll = nf + static_cast<Eigen::Index>(excluded.size());
+  std::vector<Eigen::Index> order = kept;
+  order.insert(order.end(), excluded.begin(), excluded.end());
+  Eigen::MatrixXd b = Eigen::MatrixXd::Zero(nAll, nAll);
+  b.topLeftCorner(nf, nf) = a;
+  for (Eigen::Index r = nf; r < nAll; ++r) {
+    b.block(r, 0, 1, nf) = -in.rows[order[r]].h.transpose() * g0;
+    b(r, r) = 1.0;
+  }
+  Eigen::MatrixXd ri(nAll, nAll), rc(nAll, nAll);
+  for (Eigen::Index i = 0; i < nAll; ++i) {
+    for (Eigen::Index j = 0; j < nAll; ++j) {
+      ri(i, j) = rIndAll(order[i], order[j]);
+      rc(i, j) = rCommonAll(order[i], order[j]);
+    }
+  }
+  const Eigen::VectorXd dInd = (b * ri * b.transpose()).diagonal(), dCommon = (b * rc * b.transpose()).diagonal();
+  std::vector<double> q;
+  for (Eigen::Index i = 0; i < nAll; ++i) {
+    const double v = in.rows[order[i]].residual;
+    if (dInd[i] > 0.0) q.push_back((v * v - dCommon[i]) / dInd[i]);
+  }
+  if (q.empty()) return 0.0;
+  std::nth_element(q.begin(), q.begin() + static_cast<long>(q.size() / 2), q.end());
+  constexpr double kChi2Median1 = 0.454936;  // median of chi-square with one degree of freedom
+  return q[q.size() / 2] / kChi2Median1;
+}
+}  // namespace
+
 ReportedCovariance reportedCovariance(const ReportedInputs& in, const CovarianceScaling& scaling) {
-  const auto n = static_cast<Eigen::Index>(in.rows.size());
+  std::vector<Eigen::Index> kept, excluded;
+  for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(in.rows.size()); ++i) {
+    (in.rows[i].excluded ? excluded : kept).push_back(i);
+  }
+  const auto n = static_cast<Eigen::Index>(kept.size());
   const auto m = in.q.rows();
   Eigen::MatrixXd h(n, m);
   Eigen::VectorXd w(n), w0(n), v(n);
   for (Eigen::Index i = 0; i < n; ++i) {
-    h.row(i) = in.rows[i].h.transpose();
-    w[i] = in.rows[i].weight;
-    w0[i] = in.rows[i].priorWeight;
-    v[i] = in.rows[i].residual;
+    const ReportedRow& row = in.rows[kept[i]];
+    h.row(i) = row.h.transpose();
+    w[i] = row.weight;
+    w0[i] = row.priorWeight;
+    v[i] = row.residual;
   }
   // The independent and the common (correlated) parts of R apart: residuals scale the former.
-  Eigen::MatrixXd rCommon = rowErrorCovariance(in.rows, in.troposphereZenithSigma, in.ionosphereCorrelationLength);
+  const Eigen::MatrixXd rAll = rowErrorCovariance(in.rows, in.troposphereZenithSigma, in.ionosphereCorrelationLength);
+  Eigen::MatrixXd rIndAll = Eigen::MatrixXd::Zero(rAll.rows(), rAll.cols());
+  for (Eigen::Index i = 0; i < rAll.rows(); ++i) rIndAll(i, i) = in.rows[i].independentVariance;
+  const Eigen::MatrixXd rCommonAll = rAll - rIndAll;
+  Eigen::MatrixXd rCommon(n, n);
   Eigen::VectorXd rIndependent(n);
   for (Eigen::Index i = 0; i < n; ++i) {
-    rIndependent[i] = in.rows[i].independentVariance;
-    rCommon(i, i) -= rIndependent[i];
+    rIndependent[i] = rIndAll(kept[i], kept[i]);
+    for (Eigen::Index j = 0; j < n; ++j) rCommon(i, j) = rCommonAll(kept[i], kept[j]);
   }
   // Information of the prior rows: the normal matrix minus the measurements' share; the
   // inter-system bias priors are what remains after the ionosphere prior.
@@ -92,6 +137,10 @@ ReportedCovariance reportedCovariance(const ReportedInputs& in, const Covariance
   if (in.ionosphereColumn >= 0) out.chi2 += in.ionospherePriorWeight * in.ionosphereCorrection * in.ionosphereCorrection;
   if (scaling.enabled && in.dof >= 1) {
     out.varianceFactor = std::max(in.minVarianceFactor, (out.chi2 - eCommon + scaling.priorDof) / (eInd + scaling.priorDof));
+    if (!excluded.empty()) {
+      out.varianceFactor =
+          std::max(out.varianceFactor, medianVarianceFactor(in, kept, excluded, a, g0, rIndAll, rCommonAll));
+    }
   }
   out.covariance = out.varianceFactor * g * rInd * g.transpose() + g * rCommon * g.transpose() + in.q * nIsb * in.q;
   out.covariance = 0.5 * (out.covariance + out.covariance.transpose());

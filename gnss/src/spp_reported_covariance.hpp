@@ -21,6 +21,10 @@ struct ReportedRow {
   Eigen::Vector3d piercePoint = Eigen::Vector3d::UnitZ();  ///< unit vector (ECEF) of the pierce point
   double troposphereMap = 0.0;   ///< slant/zenith of the troposphere residual
   double residual = 0.0;         ///< m, post-fit, a-priori fit (before robust re-weighting)
+  /// Removed by fault exclusion: not in the fit (its weights are ignored); its residual is the
+  /// prediction residual at the a-priori fit's solution and enters only the median estimate of
+  /// the variance factor.
+  bool excluded = false;
 };
 
 struct ReportedInputs {
@@ -60,6 +64,12 @@ Eigen::MatrixXd rowErrorCovariance(const std::vector<ReportedRow>& rows, double 
 /// ionosphere error is in R. k = max(minVarianceFactor, (chi2 - E_common + nu0) / (E_ind + nu0))
 /// when `scaling` is enabled (else 1), chi2 the weighted residuals of the a-priori fit
 /// (measurements and the ionosphere prior) and E their expectations under the two parts of R.
+/// With excluded rows, chi2 is that of the rows fault exclusion kept, the smallest residuals: a
+/// truncated sample that understates the noise when the exclusions took its tail rather than
+/// faults. k is then at least the median over all rows, excluded ones included, of
+/// (v_i^2 - E_common,i) / E_ind,i divided by the median of chi-square with one degree of freedom
+/// (0.4549): a scale estimate that a minority of faults cannot move and the truncation cannot
+/// bias (cf. the MAD scale of robust estimation, Huber 1981, Robust Statistics, ch. 5).
 ReportedCovariance reportedCovariance(const ReportedInputs& in, const CovarianceScaling& scaling);
 
 }  // namespace gvins::detail

@@ -150,6 +150,36 @@ TEST(Ionosphere, IonosphereFreeCombinationRemovesFirstOrderDelay) {
   EXPECT_NEAR(c.noiseFactor(), 2.978, 1e-3);
 }
 
+TEST(Statistics, IonosphereFreeCodeVarianceComesFromBothSignals) {
+  // The sample variance of the ionosphere-free combination of two independent simulated code
+  // errors, each with the sigma the weighting model gives its signal (L2 10 dB weaker in C/N0),
+  // against the model's variance of the combination. Equal C/N0: 2.978^2 = 8.87 times one code's.
+  const double f1 = *carrierFrequency(System::Gps, '1');
+  const double f2 = *carrierFrequency(System::Gps, '2');
+  const auto c = ionosphereFreeCoefficients(f1, f2);
+  MeasurementWeighting w;
+  const double el = 40.0 * kDegToRad;
+  const double one = w.codeVariance(System::Gps, el, 45.0);
+  EXPECT_NEAR(w.combinationCodeVariance(System::Gps, el, c.a1, 45.0, c.a2, 45.0) / one, 8.87, 0.01);
+  w.scheme = WeightingScheme::ElevationSnr;
+  const double s1 = std::sqrt(w.codeVariance(System::Gps, el, 45.0));
+  const double s2 = std::sqrt(w.codeVariance(System::Gps, el, 35.0));
+  std::mt19937 rng(3);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  const int n = 200000;
+  double sum = 0.0, sum2 = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double e = ionosphereFree(s1 * gauss(rng), s2 * gauss(rng), f1, f2);
+    sum += e;
+    sum2 += e * e;
+  }
+  const double sample = sum2 / n - (sum / n) * (sum / n);
+  const double model = w.combinationCodeVariance(System::Gps, el, c.a1, 45.0, c.a2, 35.0);
+  EXPECT_NEAR(sample / model, 1.0, 0.01);  // sampling sigma of the ratio: sqrt(2 / n) = 0.003
+  // Taking the first signal's variance for both would be 1.7x too small here.
+  EXPECT_GT(model / (s1 * s1 * c.noiseFactor() * c.noiseFactor()), 1.6);
+}
+
 TEST(Geometry, SagnacTermMatchesExactEarthRotationDuringTravel) {
   // Exact: rotate the satellite position (transmit-time frame) into the receive-time frame by the
   // travel time, iterating tau = |R r_s - r_r| / c.

@@ -316,6 +316,40 @@ TEST(Spp, VarianceFactorScalesTheCovarianceWhenTheWeightsAreOptimistic) {
   EXPECT_NEAR(nees, 3.0, 0.6);
 }
 
+TEST(Spp, VarianceFactorAfterFaultExclusionCountsTheExcludedSatellites) {
+  // The noise is 3x the weighting model's sigma and fault exclusion is on: the residual test fails
+  // and the exclusions (6 per epoch) remove the largest residuals, the tail of the noise, not
+  // faults. The chi2 of the kept satellites understates the noise: with the variance factor of
+  // the kept satellites alone NEES was 9.4 (a sigma 1.8x too small). The median estimate over all
+  // satellites, the excluded ones included, brings it to 5.6: the rest is the exclusion's own
+  // selection (the kept satellites are those that agree with the solution's error), which no
+  // variance of the kept errors describes.
+  SppConfig c = simulationNoiseConfig();
+  c.faultExclusion.enabled = true;
+  SimOptions o;
+  o.position = kNagoyaRover;
+  o.noise = 0.9;
+  std::mt19937 rng(5);
+  o.rng = &rng;
+  const int trials = 300;
+  double nees = 0.0;
+  int excluded = 0;
+  for (int i = 0; i < trials; ++i) {
+    const ObsEpoch e = simulate(nagoyaNav(), kNagoyaTime + i * 10.0, o);
+    SppSolver solver(nagoyaNav(), c);
+    solver.setInitialPosition(kNagoyaRover);
+    const SppSolution s = solver.solve(e);
+    ASSERT_TRUE(s.valid());
+    excluded += !s.excluded.empty();
+    const Eigen::Vector3d d = s.position - o.position;
+    nees += d.dot(s.positionCovariance.ldlt().solve(d));
+  }
+  nees /= trials;
+  EXPECT_GT(excluded, trials / 2);
+  EXPECT_GT(nees, 3.0);
+  EXPECT_LT(nees, 6.5);
+}
+
 TEST(Spp, ReportedErrorModelGivesTheCovarianceOfTheWeightedSolutionUnderOtherErrors) {
   // The weights assume 0.6 m, the simulated noise is 0.3 m: the a-priori covariance is 4x too
   // large (NEES ~0.75). The reported-error model with noise_scale 0.5 describes the true noise:

@@ -29,6 +29,11 @@ struct MeasurementWeighting {
 
   /// Pseudorange variance (m^2) for a system, elevation (rad) and C/N0 (dB-Hz, <= 0: unknown).
   double codeVariance(System sys, double elevation, double snr) const;
+  /// Variance (m^2) of the combination a1 P1 + a2 P2 of two pseudoranges of one satellite with
+  /// independent errors (e.g. the ionosphere-free one, ionosphere_free.hpp), each weighted by this
+  /// model with its own C/N0: a1^2 var(P1) + a2^2 var(P2). For L1/L2 that is (2.55^2 + 1.55^2) =
+  /// 8.9 times one code's variance when both are equal, more when the second is weaker.
+  double combinationCodeVariance(System sys, double elevation, double a1, double snr1, double a2, double snr2) const;
   /// Range-rate variance ((m/s)^2) from Doppler, same shape with dopplerSigma for sqrt(a^2+b^2).
   double dopplerVariance(System sys, double elevation, double snr) const;
 };

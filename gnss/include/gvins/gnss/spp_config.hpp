@@ -81,8 +81,13 @@ struct CovarianceScaling {
 /// chi2 the weighted residuals of the fit before robust re-weighting (measurements and the
 /// ionosphere prior) and E their expectations under the two parts of R (nu0 =
 /// CovarianceScaling::priorDof; no scaling when CovarianceScaling is disabled): residuals larger
-/// than the model says (multipath, NLOS) widen the sigma, residuals smaller than the noise model
-/// narrow its share, at most to `minVarianceFactor`. The correlated part is never scaled down:
+/// than the model says (multipath, NLOS) widen the sigma. After fault exclusion k is at least the
+/// median estimate over all satellites, the excluded ones included (the kept residuals are the
+/// smallest: their chi2 understates the noise when the exclusions took its tail). Residuals
+/// smaller than the noise model could narrow its share down to `minVarianceFactor`; the default
+/// 1 does not let them: one epoch's residuals have few degrees of freedom and errors correlated
+/// over many epochs, and below 1 the ionosphere-free sigma (nothing correlated left to carry it)
+/// was optimistic on the real walk (docs/spp.md). The correlated part is never scaled down:
 /// residuals do not show it. Calibration: bench/spp/sigma_calibration.py,
 /// docs/results/spp_sigma.md. Disabled: the a-priori covariance (H^T W H)^-1 scaled by the
 /// variance factor of the weights (all errors independent), conservative by large factors on
@@ -91,7 +96,7 @@ struct ReportedErrorModel {
   bool enabled = true;
   double noiseScale = 1.0;
   double ionosphereCorrelationLength = 2000e3;  ///< m
-  double minVarianceFactor = 0.25;
+  double minVarianceFactor = 1.0;
 };
 
 /// A common correction to the broadcast ionosphere model's zenith delay, estimated with the
@@ -192,7 +197,7 @@ struct SppConfig {
 ///     ionosphere_estimation: {enabled: true, prior_fraction: 1.0, min_prior_sigma_m: 0.3}
 ///     covariance_scaling: {enabled: true, prior_dof: 2}
 ///     reported_error: {enabled: true, noise_scale: 1, ionosphere_correlation_km: 2000,
-///                      min_variance_factor: 0.25}
+///                      min_variance_factor: 1}
 ///     max_gdop: 30
 ///     isb_prior_sigma_m: 2
 ///     isb_random_walk_m2ps: 0.01
