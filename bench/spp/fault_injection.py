@@ -2,7 +2,8 @@
 """SPP fault exclusion under injected multipath-like faults, on real recordings and the simulated
 urban drive.
 
-    bench/spp/fault_injection.py [BUILD_DIR] [--markdown] [--rtklib]     (default build dir: build)
+    bench/spp/fault_injection.py [BUILD_DIR] [--markdown] [--rtklib] [--write]
+                                                                    (default build dir: build)
 
 For every RINEX 3 recording with a known antenna position (Nagoya rover, Kamakura; the simulated
 urban drive of bench/spp/urban_spp.yaml, already full of NLOS and multipath) it writes copies of
@@ -17,7 +18,11 @@ epochs whose residual test still fails (test = 1), and the share of epochs whose
 pass the residual test on those that fail it (robust: {k0_failed: 2, k1_failed: 5}), the behaviour
 before the harder down-weighting of failed epochs. With --rtklib, RTKLIB 2.4.3's SPP (rnx2rtkp -p 0, RAIM-FDE on) of
 the same copies as a reference.
+
+--write writes the table to docs/results/spp_fault_injection.md with the commit and the command
+(docs/spp.md, "Injected faults", says what it shows).
 """
+import datetime
 import gzip
 import math
 import os
@@ -29,6 +34,7 @@ import tempfile
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import sigma_calibration as sc  # noqa: E402
 
+RESULTS = os.path.join(sc.ROOT, "docs", "results", "spp_fault_injection.md")
 SEGMENT_S = 10.0
 BIAS_M = (10.0, 100.0)
 MASK_DEG = 15.0
@@ -205,7 +211,7 @@ def rtklib_spp(obs, navs, tmp):
 
 def main():
     args = [a for a in sys.argv[1:] if not a.startswith("--")]
-    markdown, rtklib = "--markdown" in sys.argv, "--rtklib" in sys.argv
+    markdown, rtklib, write = "--markdown" in sys.argv, "--rtklib" in sys.argv, "--write" in sys.argv
     build = args[0] if args else "build"
     build = build if os.path.isabs(build) else os.path.join(sc.ROOT, build)
     spp = os.path.join(build, "bin", "gvins-spp")
@@ -238,7 +244,16 @@ def main():
                 else:
                     lines.append("| %s | %d | %s | %d | %.2f | %.2f | %.1f | %.1f | %.1f |" % ((name, nf, label) + st))
                 print(lines[-1], file=sys.stderr)
-    print("\n".join(lines) if markdown else "\n".join(lines[2:]))
+    print("\n".join(lines) if markdown or write else "\n".join(lines[2:]))
+    if write:
+        commit = sc.commit_of_tree()  # before the file is opened (and so modified)
+        command = "bench/spp/fault_injection.py BUILD_DIR --write" + (" --rtklib" if rtklib else "")
+        with open(RESULTS, "w") as f:
+            f.write("<!-- written by bench/spp/fault_injection.py; do not edit by hand -->\n")
+            f.write("# SPP under injected pseudorange faults\n\n")
+            f.write("Written by `%s` at commit %s, %s. What the rows are and what they say: docs/spp.md, "
+                    "\"Injected faults\".\n\n" % (command, commit, datetime.date.today().isoformat()))
+            f.write("\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":
