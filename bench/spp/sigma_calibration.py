@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """SPP sigma calibration on the real recordings with a known antenna position.
 
-    bench/spp/sigma_calibration.py [BUILD_DIR] [--markdown] [--write] [--check]
+    bench/spp/sigma_calibration.py [BUILD_DIR] [--markdown] [--write] [--check] [--seeds N]
                                                         (default build dir: build)
 
 Needs gvins-spp and, for the simulated case, gvins-sim in BUILD_DIR/bin.
@@ -29,6 +29,11 @@ ellipsoidal heights by `gvins-ubx to-pos`; walk_reference), with the mean horizo
 drive (bench/spp/urban_spp.yaml: 1.5 m code multipath, NLOS reception of 5-80 m extra path on
 low satellites) with gvins-sim's antenna truth, standing in for the urban recordings we do not
 have.
+
+--seeds N also simulates the urban drive with seeds 1..N (the yaml's `seed` replaced) and gives,
+for the defaults on single frequency and on ionosphere-free pseudoranges, the spread over the
+seeds of the share within 3 sigma and of the median |error|/sigma per axis (one seed is one draw
+of multipath and NLOS: no figure of the drive should rest on it).
 
 --write writes the table to docs/results/spp_sigma.md with the commit and the command.
 --check exits non-zero unless the bands of check() hold (the ctest test spp_sigma_calibration):
@@ -154,18 +159,56 @@ def position_file(path):
     return llh_to_ecef(lat, lon, h)
 
 
-def simulated_case(build, tmp):
-    """The harsh simulated drive of bench/spp/urban_spp.yaml (multipath, NLOS), made by gvins-sim."""
+def simulated_case(build, tmp, seed=None):
+    """The harsh simulated drive of bench/spp/urban_spp.yaml (multipath, NLOS), made by gvins-sim;
+    with `seed`, the same drive with that seed."""
     sim = os.path.join(build, "bin", "gvins-sim")
     if not os.access(sim, os.X_OK):
         print("gvins-sim not built: no simulated case", file=sys.stderr)
         return []
+    config = os.path.join(ROOT, "bench", "spp", "urban_spp.yaml")
     out = os.path.join(tmp, "urban_spp")
-    subprocess.run([sim, "--config", os.path.join(ROOT, "bench", "spp", "urban_spp.yaml"), "--features-only",
-                    "--threads", "1", "-o", out], check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    if seed is not None:
+        with open(config) as f:
+            text = f.read()
+        nav = os.path.join(ROOT, "tests", "data", "gnss", "nagoya_static_2024", "base.nav.gz")
+        text = "\n".join("seed: %d" % seed if l.startswith("seed:") else
+                         "  navigation: " + nav if l.strip().startswith("navigation:") else l
+                         for l in text.splitlines()) + "\n"
+        config = os.path.join(tmp, "urban_spp_seed.yaml")
+        with open(config, "w") as f:
+            f.write(text)
+        shutil.rmtree(out, ignore_errors=True)
+    subprocess.run([sim, "--config", config, "--features-only", "--threads", "1", "-o", out], check=True,
+                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     g = os.path.join(out, "gnss")
     return [("Sim urban drive", [g + "/rover.obs", g + "/nav.rnx"], AntennaTrack(g + "/truth/rover_antenna.csv"), None,
              "simulation truth")]
+
+
+def seed_spread(build, spp, tmp, seeds):
+    """Markdown lines: per solution (defaults, single frequency and ionosphere-free) and axis, the
+    spread over seeds 1..`seeds` of the simulated drive of the share within 3 sigma and of the
+    median |error|/sigma."""
+    runs = [("default", []), ("default, dual-frequency", ["--freq", "2", "--iono", "dual-frequency"])]
+    got = {label: [] for label, _ in runs}
+    for seed in range(1, seeds + 1):
+        _, inputs, truth, _, _ = simulated_case(build, tmp, seed)[0]
+        for label, extra in runs:
+            out = os.path.join(tmp, "seed.pos")
+            subprocess.run([spp, "-q"] + extra + ["-o", out] + inputs, check=True, stderr=subprocess.DEVNULL)
+            _, pct, med, _ = score(read_pos(out), truth)
+            got[label].append(([pct[a][2] for a in range(3)], med))
+        print("seed %d done" % seed, file=sys.stderr)
+    lines = ["| solution | axis | within 3 σ (%) min / median / max | median abs(err)/σ min / median / max |",
+             "|---|---|---|---|"]
+    for label, _ in runs:
+        for a in range(3):
+            w = sorted(x[0][a] for x in got[label])
+            m = sorted(x[1][a] for x in got[label])
+            lines.append("| gvins-spp %s | %s | %.1f / %.1f / %.1f | %.2f / %.2f / %.2f |" % (
+                label, "ENU"[a], w[0], w[len(w) // 2], w[-1], m[0], m[len(m) // 2], m[-1]))
+    return lines
 
 
 def cases(build, tmp):
@@ -332,7 +375,8 @@ def commit_of_tree():
 
 
 def main():
-    args = [a for a in sys.argv[1:] if not a.startswith("--")]
+    seeds = int(sys.argv[sys.argv.index("--seeds") + 1]) if "--seeds" in sys.argv else 0
+    args = [a for i, a in enumerate(sys.argv[1:], 1) if not a.startswith("--") and sys.argv[i - 1] != "--seeds"]
     markdown = "--markdown" in sys.argv or "--write" in sys.argv
     build = args[0] if args else "build"
     build = build if os.path.isabs(build) else os.path.join(ROOT, build)
@@ -372,15 +416,23 @@ def main():
                         name, label + part, n, *["%4.1f %4.1f %5.1f" % tuple(pct[a]) for a in range(3)],
                         " ".join("%5.2f" % m for m in med), " ".join("%5.2f" % r for r in rms)))
     print("\n".join(lines))
+    spread = seed_spread(build, spp, tmp, seeds) if seeds else []
+    if spread:
+        print("\n".join(spread))
     shutil.rmtree(tmp)
     if "--write" in sys.argv:
         commit = commit_of_tree()  # before the file is opened (and so modified)
         with open(RESULTS, "w") as f:
             f.write("# SPP standard deviation against the truth\n\n")
-            f.write("Written by `bench/spp/sigma_calibration.py BUILD_DIR --write` at commit %s, %s. "
+            f.write("Written by `bench/spp/sigma_calibration.py BUILD_DIR --write%s` at commit %s, %s. "
                     "What the columns mean and what the rows say: docs/spp.md, \"Standard deviation\".\n\n"
-                    % (commit, datetime.date.today().isoformat()))
+                    % (" --seeds %d" % seeds if seeds else "", commit, datetime.date.today().isoformat()))
             f.write("\n".join(lines) + "\n")
+            if spread:
+                f.write("\n## Simulated urban drive, seeds 1-%d\n\n" % seeds)
+                f.write("The drive of bench/spp/urban_spp.yaml with its seed replaced by 1..%d: the spread over the "
+                        "seeds.\n\n" % seeds)
+                f.write("\n".join(spread) + "\n")
     if "--check" in sys.argv:
         for msg in failures:
             print("FAIL " + msg, file=sys.stderr)
