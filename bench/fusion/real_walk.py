@@ -206,9 +206,9 @@ def main():
                     "inherits any error of the base coordinates the base announced, as one constant shift, and every\n"
                     "absolute solution (code positioning on broadcast orbits) sees that shift as its error. The RMS\n"
                     "columns therefore hold the offset; σ about the mean is the part a solution controls. The same\n"
-                    "unknown shift may have a vertical part, so the mean U error is not a measured bias either; still,\n"
-                    "the fused ionosphere-free modes (psr ionosphere-free, ppp) sit about 10 m below the track while\n"
-                    "the dual-frequency SPP on the same log is within a few metres of it (not investigated here).\n"
+                    "unknown shift may have a vertical part, so the mean U error is not a measured bias either. What\n"
+                    "the ionosphere-free height depends on (GPS L1/L2C against L1/L5 pairs and their group delays)\n"
+                    "is in docs/gnss_fusion.md (Measurement rows, psr).\n"
                     "The publisher's `gnss_1730_sf.pos` holds the same solutions with mean-sea-level heights (NAV-PVT\n"
                     "hMSL, 21.39 m above the ellipsoidal heights here); against it every vertical error would carry a\n"
                     "spurious -21.39 m, so it is not the reference.\n\n")

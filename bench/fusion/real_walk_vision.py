@@ -206,7 +206,8 @@ H RMS and V RMS columns hold the offset; the spread about it ("H RMS about mean"
 receiver's code errors and the estimator leave, and there the cameras help most (vio+gpsvel
 stereo against camera-less). In the vertical, the single-frequency psr rows (BeiDou's broadcast
 ionosphere) sit a few metres above the track on average and the ionosphere-free psr and ppp rows
-about 10 m below it, with or without cameras; every run starts about 4.7 m below it, where its
+about 4.5 m below it, with or without cameras (what that height depends on: docs/gnss_fusion.md,
+psr rows); every run starts about 4.7 m below it, where its
 first GNSS fix anchors the frame, and the modes without absolute position (vio+gpsvel, vio+dopp)
 stay near that. The cameras lower the velocity error in every GNSS mode.
 """

@@ -20,13 +20,16 @@ double broadcastGroupDelay(const KeplerEphemeris& eph, ObsCode code) {
   switch (eph.message) {
     case NavMessage::GpsLnav:
     case NavMessage::QzssLnav: {
-      // The LNAV clock refers to the L1/L2 P(Y) ionosphere-free combination; a single-frequency
-      // user on band f removes (f1/f)^2 TGD (IS-GPS-200N 20.3.3.3.3.2; L5 and L1C without their
-      // inter-signal corrections, which LNAV does not carry). QZSS LNAV follows the same rule
+      // The LNAV clock refers to the L1/L2 P(Y) ionosphere-free combination: L1 removes T_GD and
+      // L2 γ12 T_GD (IS-GPS-200N 20.3.3.3.3.2; L2C as L2 P(Y), without CNAV's ISC_L2C). L5 removes
+      // T_GD − ISC_L5 (IS-GPS-705J 20.3.3.3.1.2.1: ISC_L5 = t_L1P(Y) − t_L5 is a measured
+      // hardware offset, not a frequency scaling of T_GD), so without CNAV's ISC it removes T_GD,
+      // and the L1/L5 ionosphere-free pair removes T_GD as IS-GPS-705J 20.3.3.3.1.2.3 writes it.
+      // L1C likewise (IS-GPS-800J 3.5.3.9: T_GD − ISC_L1C). QZSS LNAV follows the same rules
       // (IS-QZSS-PNT-005).
       const System sys = eph.sat.system;
-      if (code.band == '1') return eph.tgd[0];
-      if (code.band == '2' || code.band == '5') return gammaOf(sys, '1', code.band) * eph.tgd[0];
+      if (code.band == '1' || code.band == '5') return eph.tgd[0];
+      if (code.band == '2') return gammaOf(sys, '1', '2') * eph.tgd[0];
       return 0.0;
     }
     case NavMessage::GalileoInav:

@@ -113,9 +113,9 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     const double smoothingFactor =
         smoother_ ? std::max(config_.smoothedCodeFactor, smoother_->noiseFactor(so.sat)) : 1.0;
     // Dual frequency: the ionosphere-free pair with the first other band tracked (`bands`: the
-    // SPP band order, GPS/QZSS L5 before L2), group delays combined alike; its noise is the
-    // single-band noise times sqrt(a1² + a2²) (2.98 for L1/L2, 2.59 for L1/L5) and it carries no
-    // ionospheric model error.
+    // SPP band order; secondCode: GPS/QZSS L2C, L5, then L2 P(Y)), group delays combined alike;
+    // its noise is the single-band noise times sqrt(a1² + a2²) (2.98 for L1/L2, 2.59 for L1/L5)
+    // and it carries no ionospheric model error.
     if (config_.ionosphere == GnssIonosphere::kDualFrequency) {
       if (const auto second = secondCode(so, order, order.size(), band, channel)) {
         const SignalObs* s2 = second->signal;

@@ -76,14 +76,28 @@ std::optional<CodeSignal> usableCode(const SatObs& so, char band, std::optional<
   return CodeSignal{s, *f};
 }
 
+bool semiCodelessL2(System sys, ObsCode code) {
+  if ((sys != System::Gps && sys != System::Qzss) || code.band != '2') return false;
+  // RINEX 3 L2 attributes of the encrypted P(Y) code: D semi-codeless, P, W Z-tracking, Y, M, N codeless.
+  return code.attr == 'D' || code.attr == 'P' || code.attr == 'W' || code.attr == 'Y' || code.attr == 'M' ||
+         code.attr == 'N';
+}
+
 std::optional<CodeSignal> secondCode(const SatObs& so, const std::string& bands, std::size_t count, char firstBand,
                                      std::optional<int> glonassChannel) {
   const std::size_t n = std::min(count, bands.size());
+  std::optional<CodeSignal> deferred;  // a semi-codeless L2 P(Y): taken only when no other band is
   for (std::size_t i = 0; i < n; ++i) {
     if (bands[i] == firstBand) continue;
-    if (auto c = usableCode(so, bands[i], glonassChannel)) return c;
+    auto c = usableCode(so, bands[i], glonassChannel);
+    if (!c) continue;
+    if (semiCodelessL2(so.sat.system, c->signal->code)) {
+      if (!deferred) deferred = c;
+      continue;
+    }
+    return c;
   }
-  return std::nullopt;
+  return deferred;
 }
 
 }  // namespace gvins

@@ -171,16 +171,16 @@ TEST(SatelliteState, CorruptRecordsGiveUnhealthyStatesNotNaNOrHangs) {
   EXPECT_TRUE(std::isfinite(glonassSatelliteState(g, g.toe + 100.0).position.norm()));
 }
 
-TEST(GroupDelay, GpsAndQzssScaleTgdByFrequency) {
+TEST(GroupDelay, GpsAndQzssFromTgd) {
   KeplerEphemeris e;
   e.sat = SatId(System::Gps, 3);
   e.tgd[0] = -1.071020960808E-08;
   const double g12 = std::pow(77.0 / 60.0, 2);    // (1575.42 / 1227.60)^2
-  const double g15 = std::pow(154.0 / 115.0, 2);  // (1575.42 / 1176.45)^2
   EXPECT_DOUBLE_EQ(broadcastGroupDelay(e, ObsCode('1', 'C')), e.tgd[0]);
   EXPECT_DOUBLE_EQ(broadcastGroupDelay(e, ObsCode('1', 'W')), e.tgd[0]);
   EXPECT_NEAR(broadcastGroupDelay(e, ObsCode('2', 'W')), g12 * e.tgd[0], 1e-22);
-  EXPECT_NEAR(broadcastGroupDelay(e, ObsCode('5', 'Q')), g15 * e.tgd[0], 1e-22);
+  // L5 is not a frequency scaling of T_GD: T_GD − ISC_L5 (IS-GPS-705J), T_GD without CNAV's ISC.
+  EXPECT_DOUBLE_EQ(broadcastGroupDelay(e, ObsCode('5', 'Q')), e.tgd[0]);
   e.sat = SatId(System::Qzss, 2);
   e.message = NavMessage::QzssLnav;
   EXPECT_NEAR(broadcastGroupDelay(e, ObsCode('2', 'L')), g12 * e.tgd[0], 1e-22);
@@ -189,6 +189,30 @@ TEST(GroupDelay, GpsAndQzssScaleTgdByFrequency) {
   const double tIf = (g12 * broadcastGroupDelay(e, ObsCode('1', 'C')) - broadcastGroupDelay(e, ObsCode('2', 'L'))) /
                      (g12 - 1.0);
   EXPECT_NEAR(tIf, 0.0, 1e-22);
+}
+
+TEST(GroupDelay, GpsL5FromSimulatedHardwareDelays) {
+  // Truth: satellite code delays on L1 P(Y), L2 P(Y) and L5 with ISC_L5 = t_L1P(Y) − t_L5 = 0
+  // (LNAV carries no ISC, so a receiver can do no better than assume it zero). The LNAV clock
+  // absorbs the L1/L2 P(Y) ionosphere-free combination and T_GD = (b1 − b2)/(1 − γ12)
+  // (IS-GPS-200N 20.3.3.3.3.2); a signal's delay relative to the clock is b_k minus that
+  // combination. The L1/L5 pair then carries T_GD (IS-GPS-705J 20.3.3.3.1.2.3), not zero as a
+  // γ15 scaling of T_GD would give.
+  const double f1 = 1575.42e6, f2 = 1227.60e6, f5 = 1176.45e6;
+  const double g12 = f1 * f1 / (f2 * f2), g15 = f1 * f1 / (f5 * f5);
+  const double b1 = 4.0e-9, b2 = 9.5e-9, b5 = b1;
+  KeplerEphemeris e;
+  e.sat = SatId(System::Gps, 23);
+  e.tgd[0] = (b1 - b2) / (1.0 - g12);
+  const double clockRef = (g12 * b1 - b2) / (g12 - 1.0);
+  EXPECT_NEAR(broadcastGroupDelay(e, ObsCode('1', 'C')), b1 - clockRef, 1e-20);
+  EXPECT_NEAR(broadcastGroupDelay(e, ObsCode('2', 'L')), b2 - clockRef, 1e-20);
+  EXPECT_NEAR(broadcastGroupDelay(e, ObsCode('5', 'Q')), b5 - clockRef, 1e-20);
+  const double a1 = g15 / (g15 - 1.0), a2 = -1.0 / (g15 - 1.0);
+  const double pairDelay =
+      a1 * broadcastGroupDelay(e, ObsCode('1', 'C')) + a2 * broadcastGroupDelay(e, ObsCode('5', 'Q'));
+  EXPECT_NEAR(pairDelay, a1 * b1 + a2 * b5 - clockRef, 1e-20);
+  EXPECT_GT(std::abs(pairDelay), 1e-9);  // metres: the term the L1/L5 pair must remove
 }
 
 TEST(GroupDelay, GalileoFromSimulatedHardwareDelays) {

@@ -32,7 +32,8 @@ TEST(GnssFusionConfig, ParsesAllKeys) {
   EXPECT_DOUBLE_EQ(c.ephemerisError[static_cast<std::size_t>(systemIndex(System::Glonass))], 5.0);
   EXPECT_DOUBLE_EQ(c.ephemerisError[static_cast<std::size_t>(systemIndex(System::Galileo))], 0.25);
   EXPECT_DOUBLE_EQ(c.ephemerisError[static_cast<std::size_t>(systemIndex(System::Gps))], SppConfig{}.ephemerisError[0]);
-  EXPECT_EQ(GnssFusionConfig{}.bands[static_cast<std::size_t>(systemIndex(System::Gps))], "152");  // L5 before L2
+  EXPECT_EQ(GnssFusionConfig{}.bands[static_cast<std::size_t>(systemIndex(System::Gps))], SppConfig{}.bands[0]);
+  EXPECT_EQ(GnssFusionConfig{}.bands[static_cast<std::size_t>(systemIndex(System::Qzss))], "152");  // L5 before L2
   EXPECT_EQ(GnssFusionConfig{}.bands[static_cast<std::size_t>(systemIndex(System::BeiDou))], SppConfig{}.bands[3]);
   EXPECT_TRUE(c.leverArmGiven);
   const GnssFusionConfig d = parseGnssFusionConfig("gnss_fusion:\n  mode: vio+dopp+psr\n");

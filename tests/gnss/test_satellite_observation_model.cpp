@@ -219,6 +219,32 @@ TEST(IonosphereFreePairing, SecondBandIsTheFirstOtherUsableOneOfTheList) {
   EXPECT_FALSE(secondCode(so, "11", 2, '1', std::nullopt));
 }
 
+TEST(SignalPairing, GpsL2CBeforeL5AndL2PYAfterIt) {
+  // The default GPS order "125": L2C pairs with L1 (the LNAV clock's own L1/L2 reference), L5
+  // when L2 is only P(Y) (semi-codeless), L2 P(Y) only without L5.
+  auto sat = [](std::initializer_list<ObsCode> codes) {
+    SatObs so;
+    so.sat = SatId(System::Gps, 23);
+    for (ObsCode c : codes) {
+      SignalObs s;
+      s.code = c;
+      s.setCode(2.2e7);
+      so.signals.push_back(s);
+    }
+    return so;
+  };
+  const SatObs civil = sat({ObsCode('1', 'C'), ObsCode('2', 'L'), ObsCode('5', 'Q')});
+  EXPECT_EQ(secondCode(civil, "125", 3, '1', std::nullopt)->signal->code, ObsCode('2', 'L'));
+  const SatObs py = sat({ObsCode('1', 'C'), ObsCode('2', 'W'), ObsCode('5', 'Q')});
+  EXPECT_EQ(secondCode(py, "125", 3, '1', std::nullopt)->signal->code, ObsCode('5', 'Q'));
+  EXPECT_EQ(secondCode(py, "125", 2, '1', std::nullopt)->signal->code, ObsCode('2', 'W'));  // L5 not in range
+  const SatObs noL5 = sat({ObsCode('1', 'C'), ObsCode('2', 'W')});
+  EXPECT_EQ(secondCode(noL5, "125", 3, '1', std::nullopt)->signal->code, ObsCode('2', 'W'));
+  EXPECT_TRUE(semiCodelessL2(System::Qzss, ObsCode('2', 'P')));
+  EXPECT_FALSE(semiCodelessL2(System::Gps, ObsCode('2', 'X')));
+  EXPECT_FALSE(semiCodelessL2(System::Glonass, ObsCode('2', 'P')));
+}
+
 TEST(SatelliteSource, TransmitTimeStateAndGroupDelayFromOneBroadcastRecord) {
   EphemerisStore nav;
   nav.add(readRinexNav(kData + "/gnss/nagoya_static_2024/base.nav.gz"));

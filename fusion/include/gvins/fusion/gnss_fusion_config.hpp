@@ -11,9 +11,10 @@
 //     elevation_mask_deg: 15              # deg (RTKLIB's and gvins-spp's default too)
 //     ionosphere: dual-frequency          # psr rows: ionosphere-free code where a second band
 //                                         # exists (else broadcast), or broadcast (Klobuchar)
-//     bands: {G: "152"}                   # per system: bands tried in order for the second signal of
-//                                         # the ionosphere-free pair (the primary band is skipped;
-//                                         # default: the SPP's order with GPS/QZSS L5 before L2)
+//     bands: {G: "125"}                   # per system: bands tried in order for the second signal of
+//                                         # the ionosphere-free pair (the primary band is skipped,
+//                                         # GPS/QZSS L2 P(Y) after the others; default: the SPP's,
+//                                         # QZSS "152")
 //     ephemeris_error_m: {G: 0.6, R: 5}   # per system: broadcast orbit/clock error (SISRE) added to
 //                                         # the psr variance (default: the SPP's ephemeris_error_m)
 //     precise_ephemeris_error_m: {G: 0.05} # the same for satellites from precise products (SP3/clock;
@@ -112,10 +113,17 @@ struct GnssFusionConfig {
   double elevationMaskDeg = 15.0;
   GnssIonosphere ionosphere = GnssIonosphere::kDualFrequency;
   /// Band order per system (index systemIndex): the ionosphere-free pair takes the first tracked
-  /// band of this list other than the primary band. Default: the SPP's, except GPS/QZSS L5 before
-  /// L2 (L1/L5 amplifies noise by 2.59 instead of 2.98 and L5 is a wideband signal, where L2 P(Y)
-  /// is tracked semi-codelessly; satellites without L5 fall back to L2).
+  /// band of this list other than the primary band (secondCode: GPS/QZSS L2 P(Y) after the other
+  /// bands). Default: the SPP's (GPS L2C, then L5, then L2 P(Y): why in
+  /// satellite_observation_model.hpp), except QZSS L5 before L2: its L5 offsets without CNAV's
+  /// ISC are not measured on a real receiver here, and on the simulated flights (no ISC modelled)
+  /// L1/L2C only adds noise against L1/L5 (the simulated L5 code is the wideband, quieter one).
   std::array<std::string, kNumSystems> bands = defaultBands();
+  static std::array<std::string, kNumSystems> defaultBands() {
+    std::array<std::string, kNumSystems> b = SppConfig{}.bands;
+    b[static_cast<std::size_t>(systemIndex(System::Qzss))] = "152";
+    return b;
+  }
   /// Broadcast orbit/clock error per system, m, added in quadrature to the psr sigma. Default:
   /// the SPP's error budget (SppConfig::ephemerisError: GPS 0.6, GLONASS 5 with its FDMA code
   /// biases, Galileo 0.3, BeiDou 1.0, QZSS 0.6 m).
@@ -124,12 +132,6 @@ struct GnssFusionConfig {
   /// (SppConfig::preciseEphemerisError: GPS/Galileo 5 cm; GLONASS 5 m for its FDMA code biases).
   std::array<double, kNumSystems> preciseEphemerisError = SppConfig{}.preciseEphemerisError;
 
-  static std::array<std::string, kNumSystems> defaultBands() {
-    std::array<std::string, kNumSystems> b = SppConfig{}.bands;
-    b[static_cast<std::size_t>(systemIndex(System::Gps))] = "152";
-    b[static_cast<std::size_t>(systemIndex(System::Qzss))] = "152";
-    return b;
-  }
   double codeSigma = 0.6;
   /// `code_weighting`: elevation or elevation-cn0 (GnssCodeWeighting). An ionosphere-free pair
   /// takes the lower C/N0 of its two bands; a single difference adds the rover's and the base's

@@ -112,12 +112,25 @@ struct CodeSignal {
   double frequency = 0.0;  ///< Hz
 };
 
+/// Whether `code` is the GPS/QZSS L2 P(Y) code (RINEX attributes D, P, W, Y, M, N), which civil
+/// receivers track semi-codelessly, unlike L2C (S, L, X).
+bool semiCodelessL2(System sys, ObsCode code);
+
 /// The best code signal on a band (SatObs::bestOnBand) when it is usable, else nullopt.
 std::optional<CodeSignal> usableCode(const SatObs& so, char band, std::optional<int> glonassChannel);
 
 /// The second band of an ionosphere-free pair: the first of `bands[0 .. count)` other than
-/// `firstBand` with a usable code. SPP (whose first band is the first usable one of the same
+/// `firstBand` with a usable code, except that a GPS/QZSS L2 P(Y) code (semiCodelessL2) comes
+/// after the other bands of that range. SPP (whose first band is the first usable one of the same
 /// list) and the fusion (whose first band is the system's primary band) pair alike through it.
+///
+/// Why GPS/QZSS L2 comes before L5 (the default lists "125") but L2 P(Y) after it: the LNAV
+/// clock refers to the L1/L2 P(Y) ionosphere-free combination, so an L1/L2 pair (L2C shares the
+/// L2 P(Y) path up to CNAV's ISC_L2C) needs no group delay, while an L1/L5 pair needs
+/// T_GD − ISC_L5-terms (IS-GPS-705J 20.3.3.3.1.2.3) whose ISCs only CNAV carries: without them
+/// each satellite keeps its own L5 hardware offset, metres on real satellites (the real walk of
+/// docs/gnss_fusion.md: the L1/L5 minus L1/L2C pair spreads by 4 m across four satellites).
+/// L2 P(Y), tracked semi-codelessly with a much higher noise, is paired only without L5.
 std::optional<CodeSignal> secondCode(const SatObs& so, const std::string& bands, std::size_t count, char firstBand,
                                      std::optional<int> glonassChannel);
 

@@ -6,8 +6,8 @@
 //
 // Fallback order per system (after the user's list; bands already in it are skipped). Bands
 // whose group delay the broadcast records in use give come first:
-//   GPS, QZSS  L1, L5, L2    LNAV T_GD scaled by γ (IS-GPS-200N 20.3.3.3.3.2; IS-GPS-705 20.3.3.3.1.2:
-//                            L5 without its ISC, which only CNAV carries)
+//   GPS, QZSS  L1, L5, L2    LNAV T_GD: L1 T_GD, L2 γ12 T_GD (IS-GPS-200N 20.3.3.3.3.2), L5 T_GD
+//                            without its ISC, which only CNAV carries (IS-GPS-705J 20.3.3.3.1.2)
 //   GLONASS    G1, G2, G3    Δτ_n on G2 (GLONASS ICD 5.1, 4.4); the CDMA G3 has none in the FDMA record
 //   Galileo    E1, E5a, E5b, E5, E6   BGD of I/NAV or F/NAV (OS SIS ICD 2.1, 5.1.5); E5 AltBOC and
 //                            E6 have none there
