@@ -22,19 +22,8 @@ double initMedian(std::vector<double> v) {
   return *mid;
 }
 
-Standstill standstill(const SriSwfConfig& cfg, std::span<const ImuSample> imu, const FeatureFrame& frame,
-                      const std::deque<FeatureFrame>& frames, Eigen::Vector3d& ma, Eigen::Vector3d& mg, int& n) {
-  const std::int64_t t1 = frame.t_ns;
-  const std::int64_t t0 = t1 - static_cast<std::int64_t>(cfg.init_window * 1e9);
-  if (!imuCovers(imu, t0, t1)) return Standstill::kNo;
-  const FeatureFrame* ref = nullptr;
-  for (const FeatureFrame& fr : frames) {
-    if (fr.t_ns >= t0) {
-      ref = &fr;
-      break;
-    }
-  }
-  if (!ref || static_cast<double>(t1 - ref->t_ns) < 0.5e9 * cfg.init_window) return Standstill::kNo;
+bool imuAtRest(const SriSwfConfig& cfg, std::span<const ImuSample> imu, std::int64_t t0, std::int64_t t1,
+               Eigen::Vector3d& ma, Eigen::Vector3d& mg, int& n) {
   ma.setZero();
   mg.setZero();
   Eigen::Vector3d sa = Eigen::Vector3d::Zero(), sg = Eigen::Vector3d::Zero();
@@ -47,14 +36,28 @@ Standstill standstill(const SriSwfConfig& cfg, std::span<const ImuSample> imu, c
     sg += s.gyro.cwiseAbs2();
     ++n;
   }
-  if (n < 10) return Standstill::kNo;
+  if (n < 10) return false;
   ma /= n;
   mg /= n;
   const Eigen::Vector3d va = (sa / n - ma.cwiseAbs2()).cwiseMax(0.0);
   const Eigen::Vector3d vg = (sg / n - mg.cwiseAbs2()).cwiseMax(0.0);
-  if (std::sqrt(va.maxCoeff()) > cfg.static_max_accel_std || std::sqrt(vg.maxCoeff()) > cfg.static_max_gyro_std) {
-    return Standstill::kNo;
+  return std::sqrt(va.maxCoeff()) <= cfg.static_max_accel_std && std::sqrt(vg.maxCoeff()) <= cfg.static_max_gyro_std;
+}
+
+Standstill standstill(const SriSwfConfig& cfg, std::span<const ImuSample> imu, const FeatureFrame& frame,
+                      const std::deque<FeatureFrame>& frames, Eigen::Vector3d& ma, Eigen::Vector3d& mg, int& n) {
+  const std::int64_t t1 = frame.t_ns;
+  const std::int64_t t0 = t1 - static_cast<std::int64_t>(cfg.init_window * 1e9);
+  if (!imuCovers(imu, t0, t1)) return Standstill::kUndecided;
+  const FeatureFrame* ref = nullptr;
+  for (const FeatureFrame& fr : frames) {
+    if (fr.t_ns >= t0) {
+      ref = &fr;
+      break;
+    }
   }
+  if (!ref || static_cast<double>(t1 - ref->t_ns) < 0.5e9 * cfg.init_window) return Standstill::kUndecided;
+  if (!imuAtRest(cfg, imu, t0, t1, ma, mg, n)) return Standstill::kNo;
   std::unordered_map<std::uint64_t, Eigen::Vector2d> refpx;
   for (const FeatureObservation& o : ref->features) refpx.emplace(o.id, o.pixel0);
   std::vector<double> par;
@@ -183,6 +186,7 @@ std::optional<InitialState> VisualInertialInitializer::fromStandstill(const Feat
   Eigen::Vector3d ma, mg;
   int n = 0;
   const Standstill st = standstill(cfg, imu, frame, frames_, ma, mg, n);
+  standstill_ = st;
   if (!(st == Standstill::kYes || (st == Standstill::kImuOnly && cfg.init_static_without_tracks))) {
     status_ = st == Standstill::kImuOnly        ? InitStatus::kStaticNoTracks
               : st == Standstill::kFeaturesMove ? InitStatus::kMovingNoAcceleration
@@ -312,7 +316,15 @@ std::optional<InitialState> VisualInertialInitializer::tryInitialize(const Featu
     frames_.pop_front();
   }
   std::optional<InitialState> s = fromStandstill(frame, imu);
-  if (!s && cfg.init_in_motion) {
+  // A start at rest is the standstill test's to decide: while its window is not complete and the
+  // IMU rests over the buffered frames, the in-motion alignment (which a 10 Hz rig completes
+  // before one init_window) would fit a velocity to stereo noise (far points of a forward camera)
+  // with the prior σ of a motion, 3 init_velocity_sigma; it waits for the standstill test.
+  Eigen::Vector3d ma, mg;
+  int n = 0;
+  const bool resting = standstill_ == Standstill::kUndecided &&
+                       imuAtRest(cfg, imu, frames_.front().t_ns, frame.t_ns, ma, mg, n);
+  if (!s && cfg.init_in_motion && !resting) {
     std::optional<MotionAlignment> a;
     if (stereo) {
       a = alignStereoInMotion(cfg, frames_, imu, ext[0], ext[1], &status_);

@@ -51,7 +51,8 @@ inline bool imuCovers(std::span<const ImuSample> imu, std::int64_t t0, std::int6
 
 /// Outcome of the standstill test.
 enum class Standstill {
-  kNo,            ///< the IMU moves (or the window is not covered yet)
+  kUndecided,     ///< the IMU does not cover the window yet, or no frame is half a window old
+  kNo,            ///< the IMU moves
   kImuOnly,       ///< the IMU is at rest (also: mean specific force within 3 static_max_accel_std of
                   ///< gravity, mean rate within init_mono_max_gyro_bias) and no frame of the window
                   ///< has 5 features or more to confirm it
@@ -60,9 +61,16 @@ enum class Standstill {
   kYes,           ///< IMU at rest and median feature displacement within static_max_parallax
 };
 
-/// Standstill test over the last init_window: accelerometer/gyro spread and the median feature
-/// displacement against the oldest frame of `frames` in the window (at least half a window old).
-/// Unless kNo, ma, mg are the mean specific force and angular rate over the window of n samples.
+/// Whether the IMU is at rest over [t0, t1]: at least 10 samples, per-axis std of the
+/// accelerometer within static_max_accel_std and of the gyro within static_max_gyro_std; ma, mg
+/// are the mean specific force and angular rate of the n samples (also when it is not at rest).
+bool imuAtRest(const SriSwfConfig& cfg, std::span<const ImuSample> imu, std::int64_t t0, std::int64_t t1,
+               Eigen::Vector3d& ma, Eigen::Vector3d& mg, int& n);
+
+/// Standstill test over the last init_window: accelerometer/gyro spread (imuAtRest) and the median
+/// feature displacement against the oldest frame of `frames` in the window (at least half a window
+/// old). Unless kNo or kUndecided, ma, mg are the mean specific force and angular rate over the
+/// window of n samples.
 Standstill standstill(const SriSwfConfig& cfg, std::span<const ImuSample> imu, const FeatureFrame& frame,
                 const std::deque<FeatureFrame>& frames, Eigen::Vector3d& ma, Eigen::Vector3d& mg, int& n);
 
@@ -135,6 +143,7 @@ class VisualInertialInitializer {
   InitStatus last_attempt_status_ = InitStatus::kCollecting;  // ... and what it found
   double attempt_interval_ = 0.0;  // s until the next attempt (back-off; 0: none yet)
   InitStatus status_ = InitStatus::kCollecting;
+  Standstill standstill_ = Standstill::kUndecided;  // the standstill test's finding on the last frame
   InitWork work_;
 };
 
