@@ -40,7 +40,7 @@ enum class GnssInsStatus : std::uint8_t {
   kNoFix,             ///< no valid SPP position this epoch
   kNoDoppler,         ///< SPP without a Doppler velocity
   kNoImu,             ///< the IMU does not cover the interval since the previous epoch (window restarted)
-  kCollecting,        ///< fewer than two epochs in the window
+  kCollecting,        ///< fewer than three epochs in the window (two leave the yaw about their velocity change open)
   kNoAcceleration,    ///< the yaw is not observable yet: too little horizontal velocity change
   kInconsistent,      ///< the fit's residuals fail the χ² test (bad Doppler, a jump)
   kAligned,           ///< a state was produced
