@@ -49,7 +49,7 @@ std::string_view gnssInsStatusText(GnssInsStatus s);
 
 struct GnssInsAlignmentConfig {
   double window = 5.0;           ///< s of epochs used at most
-  double maxYawSigmaDeg = 5.0;   ///< accepted when the yaw σ is below this ...
+  double maxYawSigmaDeg = 10.0;  ///< accepted when the yaw σ is below this ...
   double maxTiltSigmaDeg = 1.0;  ///< ... and the roll/pitch σ below this
   double velocityFloor = 0.05;   ///< m/s added (in quadrature) to the Doppler velocity σ per axis
   double positionFloor = 1.0;    ///< m added to the SPP position σ per axis
