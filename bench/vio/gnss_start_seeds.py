@@ -73,7 +73,9 @@ def evaluate(d, out, t_first):
     m = init_sweep.metrics(os.path.join(out, "metrics.csv")) if os.path.exists(os.path.join(out, "metrics.csv")) else {}
     res = {"init": m.get("init_s", NAN), "h0": NAN, "s0": NAN}
     head = []  # (t after the first frame, heading error deg, heading sigma deg)
-    if os.path.exists(os.path.join(out, "trajectory.cov.csv")) and m.get("frame_init_s", NAN) == m.get("init_s", -1):
+    # In ENU from the start: the frame "initialised" with the state (a GNSS/INS start between two
+    # frames counts from the epoch), not later by the frame initialisation of a visual start.
+    if os.path.exists(os.path.join(out, "trajectory.cov.csv")) and m.get("frame_init_s", NAN) <= m.get("init_s", NAN):
         for p, c in zip(rows(os.path.join(out, "trajectory.tum"), None), rows(os.path.join(out, "trajectory.cov.csv"))):
             g = at(p[0])
             R_NB = mul(R_NE, quat(*g[7:11]))
