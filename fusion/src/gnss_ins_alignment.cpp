@@ -212,10 +212,18 @@ std::optional<vio::ExternalInitialState> GnssInsAlignment::fit(std::span<const v
   double chi2 = 0.0;
   const Eigen::Matrix<double, 12, 12> P =
       refine(pairs, cfg_.gyroBiasSigma, cfg_.accelBiasSigma, R_NI0, bg, ba, v0fit, chi2);
+  const int dof = static_cast<int>(3 * pairs.size()) - 6;  // attitude and v_0 free; biases have priors
+  // Two epochs determine v_0 and only two attitude angles (one velocity change): the yaw about
+  // it has no information, and the inverse of the near-singular normal matrix can report any σ
+  // for it (0° was seen on the simulated walk). Nor can the residuals be tested.
+  if (dof <= 0 || !P.allFinite() || !(P.diagonal().minCoeff() > 0.0)) {
+    yawSigmaDeg_ = tiltSigmaDeg_ = std::numeric_limits<double>::quiet_NaN();
+    status_ = dof <= 0 ? GnssInsStatus::kCollecting : GnssInsStatus::kNoAcceleration;
+    return std::nullopt;
+  }
   yawSigmaDeg_ = std::sqrt(P(2, 2)) * kRadToDeg;
   tiltSigmaDeg_ = std::sqrt(std::max(P(0, 0), P(1, 1))) * kRadToDeg;
-  const int dof = static_cast<int>(3 * pairs.size()) - 6;  // attitude and v_0 free; biases have priors
-  if (dof > 0 && chi2 > sri::chiSquareQuantile(cfg_.gate, dof)) {
+  if (chi2 > sri::chiSquareQuantile(cfg_.gate, dof)) {
     status_ = GnssInsStatus::kInconsistent;
     return std::nullopt;
   }

@@ -107,6 +107,25 @@ TEST(GnssInsAlignment, ConstantVelocityLeavesTheYawOpen) {
   EXPECT_LT(al.tiltSigmaDeg(), 1.0);  // the tilt is known from gravity
 }
 
+// Two epochs fix v_0 and the attitude about one velocity change only: whatever the thresholds,
+// no state, and no yaw σ from the singular information (the inverse reported 0° on a walk).
+TEST(GnssInsAlignment, TwoEpochsAreNotEnough) {
+  const double r = 20.0, w = 0.4;
+  const auto imu = imuOf(r, w, 1.0);
+  GnssInsAlignmentConfig c;
+  c.maxYawSigmaDeg = 180.0;
+  c.maxTiltSigmaDeg = 180.0;
+  GnssInsAlignment al(c, vio::ImuNoise{}, kG);
+  EXPECT_FALSE(al.add(100'000'000, sppAt(truthAt(0.1, r, w)), imu, Eigen::Vector3d::Zero()));
+  EXPECT_FALSE(al.add(200'000'000, sppAt(truthAt(0.2, r, w)), imu, Eigen::Vector3d::Zero()));
+  EXPECT_EQ(al.status(), GnssInsStatus::kCollecting);
+  EXPECT_FALSE(al.yawSigmaDeg() < 180.0);  // none (NaN)
+  // A third epoch gives the yaw from the turn's second velocity change: a σ, large after 0.2 s.
+  EXPECT_FALSE(al.add(300'000'000, sppAt(truthAt(0.3, r, w)), imu, Eigen::Vector3d::Zero()));
+  EXPECT_TRUE(std::isfinite(al.yawSigmaDeg()));
+  EXPECT_GT(al.yawSigmaDeg(), 180.0);
+}
+
 // A window that slides for a long time (10 Hz epochs, 30 s of a straight line: 250 re-basings)
 // must keep its fit: before the re-basing kept R_0k a rotation, the products compounded their
 // rounding and the fit went to NaN after about 60 slides (seen on a simulated walk).

@@ -47,7 +47,7 @@
 //     frame_min_speed: 1.0                # m/s before the yaw guess from velocity headings
 //     ins_start: true                     # start the estimator from GNSS/INS when vision has not
 //     ins_start_window: 5                 # s of SPP/Doppler epochs the alignment uses at most
-//     ins_start_yaw_sigma_deg: 5          # accepted below this yaw σ (gnss_ins_alignment.hpp)
+//     ins_start_yaw_sigma_deg: 10         # accepted below this yaw σ, the filter's prior (gnss_ins_alignment.hpp)
 //     frame_reanchor: true                # once converged re-express the VIO state in ENU and
 //                                         # marginalize the frame block (false: keep it as a state)
 //     frame_reanchor_position_sigma: 0.5  # m, ... once the IMU's ENU position σ is below this
@@ -217,10 +217,12 @@ struct GnssFusionConfig {
   /// Start the estimator from a GNSS/INS alignment (gnss_ins_alignment.hpp) when it has not
   /// initialised from vision: SPP positions and Doppler velocities over at most insStartWindow
   /// s, accepted when the yaw σ is below insStartYawSigmaDeg; the estimator then runs in ENU and
-  /// the tight rows start at once (no frame initialisation). false: GNSS waits for the VIO.
+  /// the tight rows start at once (no frame initialisation), the alignment's attitude covariance
+  /// its prior: the filter converges the yaw from the GNSS velocity against the visual-inertial
+  /// motion (10°: docs/gnss_fusion.md "Starting from GNSS/INS"). false: GNSS waits for the VIO.
   bool insStart = true;
   double insStartWindow = 5.0;
-  double insStartYawSigmaDeg = 5.0;
+  double insStartYawSigmaDeg = 10.0;
   /// After convergence the estimator re-expresses its state in local ENU (EstimatorBackend::
   /// reanchorWorld) and the frame block is marginalized, so the GNSS rows no longer carry its 4
   /// columns; false keeps it as a state (as before 6 Dec 2026; the same estimate to first order).

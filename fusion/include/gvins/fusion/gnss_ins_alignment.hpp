@@ -40,7 +40,7 @@ enum class GnssInsStatus : std::uint8_t {
   kNoFix,             ///< no valid SPP position this epoch
   kNoDoppler,         ///< SPP without a Doppler velocity
   kNoImu,             ///< the IMU does not cover the interval since the previous epoch (window restarted)
-  kCollecting,        ///< fewer than two epochs in the window
+  kCollecting,        ///< fewer than three epochs in the window (two leave the yaw about their velocity change open)
   kNoAcceleration,    ///< the yaw is not observable yet: too little horizontal velocity change
   kInconsistent,      ///< the fit's residuals fail the χ² test (bad Doppler, a jump)
   kAligned,           ///< a state was produced
@@ -49,7 +49,7 @@ std::string_view gnssInsStatusText(GnssInsStatus s);
 
 struct GnssInsAlignmentConfig {
   double window = 5.0;           ///< s of epochs used at most
-  double maxYawSigmaDeg = 5.0;   ///< accepted when the yaw σ is below this ...
+  double maxYawSigmaDeg = 10.0;  ///< accepted when the yaw σ is below this ...
   double maxTiltSigmaDeg = 1.0;  ///< ... and the roll/pitch σ below this
   double velocityFloor = 0.05;   ///< m/s added (in quadrature) to the Doppler velocity σ per axis
   double positionFloor = 1.0;    ///< m added to the SPP position σ per axis
