@@ -657,6 +657,7 @@ bool GnssFusion<Scalar>::restartFrame(vio::EstimatorBackend<Scalar>& est, Epoch&
   e.rep.warnings.push_back(why + "; the estimator's state is dropped and " +
                            (config_.insStart ? "starts again from the GNSS/INS alignment" : "initialises again"));
   e.rep.reset = true;
+  e.rep.frameRestart = true;
   e.rep.updated = false;
   forgetState();
   generation_ = est.generation();
