@@ -110,6 +110,7 @@ void GnssFusion<Scalar>::forgetState() {
   gateRecovery_.reset();
   ambiguities_.forget();
   stage_ = GnssFusionStage::kWaitingVio;
+  frameRejections_ = 0;
   if (insAlign_) insAlign_->clear();
 }
 
@@ -588,16 +589,79 @@ bool GnssFusion<Scalar>::frameUpdate(vio::EstimatorBackend<Scalar>& est, Epoch& 
   if (spp.velocity.valid) addVelocityRows(anchor_, spp.velocity, k, kFrame, true, rows);
   const std::span<const sri::BlockId> frameIds(&frameBlock_, 1);
   // The rows are gated once the frame block has information.
+  const bool first = !est.informed(frameIds);
   std::vector<bool> acc;
-  const auto u = apply(est, rows.rows, rows.noise(), k.integrationCovariance, acc, est.informed(frameIds));
+  const auto u = apply(est, rows.rows, rows.noise(), k.integrationCovariance, acc, !first);
   rep.chi2 = static_cast<double>(u.chi2);
   rep.dof = u.dof;
   for (std::size_t i = 0; i < rows.size(); ++i) (acc[i] ? rep.frame.used : rep.frame.rejected)++;
   rep.updated = u.applied;
+  if (first && u.applied && !linearStart(est, e, rows)) return false;
+  // Frame rows gated out at two epochs in a row after the first update: the state predicted from
+  // the start disagrees with the fixes beyond its covariance (a start that was not linear, whose
+  // later updates would collapse the heading σ about a wrong estimate). One epoch is an outlier.
+  frameRejections_ = !first && !u.applied && !rows.rows.empty() ? frameRejections_ + 1 : 0;
+  if (frameRejections_ >= 2) {
+    char buf[300];
+    std::snprintf(buf, sizeof buf,
+                  "GNSS frame initialisation at %d %.3f: the SPP rows were gated out at %d epochs in a row after the "
+                  "start (χ² %.1f on %d rows): the state does not follow the fixes",
+                  e.rover.time.week(), e.rover.time.tow(), frameRejections_, rep.chi2, rep.dof);
+    frameRejections_ = 0;
+    if (restartFrame(est, e, buf)) return false;
+  }
   // Converged when the IMU's heading in ENU is known to σ_θ (enuHeadingPositionCovariance).
   const std::optional<Eigen::Matrix4d> C = enuHeadingPositionCovariance(est, frameBlock_);
   const double sth = config_.frameYawSigmaDeg * constants::kDegToRad;
   if (C && (*C)(0, 0) < sth * sth) stage_ = GnssFusionStage::kTight;
+  return true;
+}
+
+template <typename Scalar>
+bool GnssFusion<Scalar>::linearStart(vio::EstimatorBackend<Scalar>& est, Epoch& e, const GnssRowSet& rows) {
+  // The first rows meet a block without information: linearly they are fitted exactly, so what
+  // is left of them at the corrected state is the error of the linearisation.
+  GnssStateValues s;
+  if (!buildState(est, e.t_ns, s)) return true;
+  const AntennaKinematics k = antennaKinematics(s);
+  const SppSolution& spp = sppOf(e);
+  GnssRowSet after;
+  addPositionRows(anchor_, spp.position, spp.positionCovariance, k, after);
+  if (spp.velocity.valid) addVelocityRows(anchor_, spp.velocity, k, kFrame, true, after);
+  if (after.size() != rows.size()) return true;
+  Eigen::VectorXd r(static_cast<Eigen::Index>(after.size()));
+  for (std::size_t i = 0; i < after.size(); ++i) r[static_cast<Eigen::Index>(i)] = after.rows[i].residual;
+  const Eigen::LLT<Eigen::MatrixXd> llt(rows.noise());
+  if (llt.info() != Eigen::Success || !r.allFinite()) return true;
+  const double chi2 = r.dot(llt.solve(r));
+  const double bound = sri::chiSquareQuantile(config_.epochGate, static_cast<int>(r.size()));
+  if (chi2 <= bound) return true;
+  const std::array<sri::BlockId, 1> vel{est.newestImuBlocks().velocity};
+  const double sv = est.informed(vel) ? std::sqrt(static_cast<double>(est.covariance(vel).trace())) : 0.0;
+  char buf[420];
+  std::snprintf(buf, sizeof buf,
+                "GNSS frame initialisation at %d %.3f: after the first SPP update the antenna is still %.1f m and "
+                "%.2f m/s from the fix (χ² %.1f > %.1f on %d rows; IMU velocity σ %.1f m/s): the IMU state is too far "
+                "off for a linear start",
+                e.rover.time.week(), e.rover.time.tow(), r.head<3>().norm(),
+                r.size() >= 6 ? r.segment<3>(3).norm() : 0.0, chi2, bound, static_cast<int>(r.size()), sv);
+  return !restartFrame(est, e, buf);
+}
+
+template <typename Scalar>
+bool GnssFusion<Scalar>::restartFrame(vio::EstimatorBackend<Scalar>& est, Epoch& e, const std::string& why) {
+  if (!est.restart()) {  // the backend cannot: the start goes on, and the gates judge it
+    e.rep.warnings.push_back(why + "; the estimator cannot restart, the start goes on");
+    return false;
+  }
+  e.rep.warnings.push_back(why + "; the estimator's state is dropped and " +
+                           (config_.insStart ? "starts again from the GNSS/INS alignment" : "initialises again"));
+  e.rep.reset = true;
+  e.rep.frameRestart = true;
+  e.rep.updated = false;
+  forgetState();
+  generation_ = est.generation();
+  ++frameRestarts_;
   return true;
 }
 

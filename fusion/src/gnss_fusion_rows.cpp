@@ -212,7 +212,9 @@ void GnssFusion<Scalar>::applyRows(vio::EstimatorBackend<Scalar>& est, GnssEpoch
   // Re-acquisition (gnss_gate_recovery.hpp): code, phase and differences agree on a position and
   // clock shift, Dopplers on a velocity and drift shift; SPP velocity triples keep their gate.
   ReacquisitionEpoch re;
+  const int recoveries = gateRecovery_.recoveries();
   const bool reacquiring = gateRecovery_.reacquiring(rep.time);
+  rep.reacquisition.started = gateRecovery_.recoveries() > recoveries;
   if (reacquiring) {
     re.tau = gateRecovery_.sinceUpdate(rep.time);
     for (const int type : rows.types) {
@@ -222,8 +224,11 @@ void GnssFusion<Scalar>::applyRows(vio::EstimatorBackend<Scalar>& est, GnssEpoch
   const auto u = apply(est, rows.rows, rows.noise(), k.integrationCovariance, acc, true, rows.ambiguityBlocks,
                        reacquiring ? &re : nullptr);
   const bool tested = !re.selection.admitted.empty();
-  gateRecovery_.outcome(rep.time, rows.size(), u.applied, re.normal, tested ? &re.selection : nullptr,
-                        tested ? &re.rows : nullptr);
+  ReacquisitionTally tally = gateRecovery_.outcome(rep.time, rows.size(), u.applied, re.normal,
+                                                   tested ? &re.selection : nullptr, tested ? &re.rows : nullptr);
+  rep.reacquisition.admitted = tally.admitted;
+  rep.reacquisition.excluded = tally.excluded;
+  rep.reacquisition.excludedSats = std::move(tally.excludedSats);
   rep.chi2 = static_cast<double>(u.chi2);
   rep.dof = u.dof;
   rep.updated = u.applied;

@@ -217,20 +217,37 @@ std::string describeReacquisition(const ReacquisitionRows& in, const Reacquisiti
   return msg;
 }
 
-void GnssGateRecovery::outcome(const GpsTime& t, std::size_t rows, bool applied, bool normal,
-                               const ReacquisitionSelection* selection, const ReacquisitionRows* input) {
+ReacquisitionTally tallyReacquisition(const ReacquisitionRows& in, const ReacquisitionSelection& s) {
+  ReacquisitionTally out;
+  for (std::size_t i = 0; i < s.admitted.size(); ++i) {
+    if (in.group[i] == kReacquireNone || !std::isfinite(in.residual[static_cast<Eigen::Index>(i)])) continue;
+    if (s.admitted[i]) {
+      ++out.admitted;
+      continue;
+    }
+    ++out.excluded;
+    if (std::find(out.excludedSats.begin(), out.excludedSats.end(), in.sats[i]) == out.excludedSats.end())
+      out.excludedSats.push_back(in.sats[i]);
+  }
+  return out;
+}
+
+ReacquisitionTally GnssGateRecovery::outcome(const GpsTime& t, std::size_t rows, bool applied, bool normal,
+                                             const ReacquisitionSelection* selection, const ReacquisitionRows* input) {
+  ReacquisitionTally tally;
   if (applied) {
     lastUpdate_ = t;
     rejectedSince_.reset();
   } else if (rows > 0 && !rejectedSince_) {
     rejectedSince_ = t;
   }
-  if (!active_) return;
+  if (!active_) return tally;
   const bool admitted =
       selection && std::find(selection->admitted.begin(), selection->admitted.end(), true) != selection->admitted.end();
   if (admitted && input && applied) {
     ++admissions_;
-    for (const auto& g : selection->groups) rowsExcluded_ += g.offered - (g.admitted ? g.agreeing : 0);
+    tally = tallyReacquisition(*input, *selection);
+    rowsExcluded_ += tally.excluded;
     char buf[80];
     std::snprintf(buf, sizeof buf, "GNSS re-acquisition at %d %.3f: ", t.week(), t.tow());
     warnings_.push_back(buf + describeReacquisition(*input, *selection) +
@@ -243,6 +260,7 @@ void GnssGateRecovery::outcome(const GpsTime& t, std::size_t rows, bool applied,
     warnings_.emplace_back(buf);
     active_ = false;
   }
+  return tally;
 }
 
 }  // namespace gvins::fusion

@@ -373,6 +373,11 @@ class FrameLoop {
     sum.ambiguityStatesMax = std::max(sum.ambiguityStatesMax, static_cast<std::size_t>(r.ambiguities));
     sum.recordChanges += static_cast<std::size_t>(r.recordChanges);
     if (r.rtkFixed) ++sum.gnssEpochsFixed;
+    if (r.reacquisition.started) ++sum.reacquisitions;
+    sum.reacquisitionRowsAdmitted += static_cast<std::size_t>(r.reacquisition.admitted);
+    sum.reacquisitionRowsExcluded += static_cast<std::size_t>(r.reacquisition.excluded);
+    for (const SatId& sat : r.reacquisition.excludedSats) ++sum.reacquisitionExcluded[sat];
+    if (r.frameRestart) ++sum.frameRestarts;
     const GpsTime& t = g_.nextRover.time;
     out_.writeEpoch(t, r, ms);
     if (r.antennaEcef) {

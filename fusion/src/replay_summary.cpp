@@ -41,6 +41,10 @@ void ReplaySummary::writeMetrics(std::ostream& os) const {
   kv("ambiguity_states_max", static_cast<double>(ambiguityStatesMax));
   kv("code_rows_masked", static_cast<double>(codeRowsMasked));
   kv("broadcast_record_changes", static_cast<double>(recordChanges));
+  kv("gnss_reacquisitions", static_cast<double>(reacquisitions));
+  kv("gnss_reacquisition_rows_admitted", static_cast<double>(reacquisitionRowsAdmitted));
+  kv("gnss_reacquisition_rows_excluded", static_cast<double>(reacquisitionRowsExcluded));
+  kv("gnss_frame_restarts", static_cast<double>(frameRestarts));
   kv("frame_init_s", frameInitSeconds);
   kv("enu_move_s", enuMoveSeconds);
   auto acc = [&](const std::string& p, const Accuracy& a) {
@@ -131,6 +135,21 @@ void ReplaySummary::print(std::ostream& os) const {
                                      " gated out; up to " + std::to_string(ambiguityStatesMax) + " ambiguity states" +
                                      (recordChanges > 0 ? "; " + std::to_string(recordChanges) + " broadcast record changes carried over" : ""));
     if (codeRowsMasked > 0) row("C/N0 mask", std::to_string(codeRowsMasked) + " code rows dropped");
+    if (reacquisitions > 0) {
+      std::string t = std::to_string(reacquisitions) + (reacquisitions == 1 ? " recovery, " : " recoveries, ") +
+                      std::to_string(reacquisitionRowsAdmitted) + " rows admitted, " +
+                      std::to_string(reacquisitionRowsExcluded) + " excluded";
+      if (!reacquisitionExcluded.empty()) {
+        t += " (";
+        for (const auto& [sat, n] : reacquisitionExcluded) t += sat.str() + (n > 1 ? "×" + std::to_string(n) : "") + " ";
+        t.back() = ')';
+      }
+      char k[32];  // the list may be longer than row()'s buffer
+      std::snprintf(k, sizeof k, "%-30s ", "GNSS re-acquisition");
+      os << k << t << '\n';
+    }
+    if (frameRestarts > 0)
+      row("frame restarts", std::to_string(frameRestarts) + " (a start that was not linear dropped the state; warnings)");
     if (std::isfinite(frameInitSeconds)) row("frame initialised", f("%.1f s after the first frame", frameInitSeconds));
     if (std::isfinite(enuMoveSeconds)) row("estimator in ENU", f("%.1f s after the first frame", enuMoveSeconds));
   }

@@ -67,13 +67,14 @@ class ImuGnssTestBackend final : public vio::EstimatorBackend<Scalar> {
   std::uint64_t generation() const override { return generation_; }
   /// Simulates an estimator that dropped its state and started again (SriSwfEstimator::reset):
   /// every client block is gone and generation() counts up; the IMU state stays.
-  void restart() {
+  bool restart() override {
     std::vector<sri::BlockId> clients;
     for (const sri::BlockInfo& b : filter_.layout().blocks()) {
       if (b.id != blocks_.pose && b.id != blocks_.velocity && b.id != blocks_.bias) clients.push_back(b.id);
     }
     if (!clients.empty()) filter_.marginalize(clients);
     ++generation_;
+    return true;
   }
   std::int64_t newestTime() const override { return t_; }
   vio::ImuState newestImuState() const override {

@@ -11,7 +11,8 @@
 #                 names the five excluded; at most 11 of the 16 codes used while they are biased
 #                 (16); the track within 1.66 m horizontally and 8.72 m vertically of the clean
 #                 run's over the 12 s after the outage (61.05 m, 76.03 m; the vertical loses the
-#                 five satellites' geometry) bounds 3 m and 12 m
+#                 five satellites' geometry) bounds 3 m and 12 m; the end-of-run summary counts one
+#                 recovery (metrics.csv gnss_reacquisitions) and lists the five among the excluded
 #   late eph.     RXM-SFRBX of the first 40 s removed: the frame initialises 3.00 s after the
 #                 first SPP fix of the log (12.25 s) bound 5 s; from 60 s on horizontal RMS 8.16 m
 #                 against 8.01 m for the recorded log on the same epochs, bound +0.5 m; vertical
@@ -50,6 +51,16 @@ admitted=${admitted%%;*}
 for s in G10 G32 C21 E07 E26; do
   case " $excluded " in *" $s "*) ;; *) echo "FAIL $s not excluded"; fail=1 ;; esac
   case " $admitted " in *" $s "*) echo "FAIL $s admitted"; fail=1 ;; esac
+done
+# The end-of-run summary counts the re-acquisition and lists the excluded satellites (rows ×n).
+summary=$(grep -a -m1 "^GNSS re-acquisition " "$W/fault.out")
+echo "     summary: $summary"
+check "faulted re-acquisition: recoveries in metrics.csv" "$(metric gnss_reacquisitions "$W/fault/metrics.csv")" "<=" 1
+check "faulted re-acquisition: recoveries in metrics.csv (at least)" "$(metric gnss_reacquisitions "$W/fault/metrics.csv")" ">=" 1
+check "faulted re-acquisition: rows excluded in metrics.csv" "$(metric gnss_reacquisition_rows_excluded "$W/fault/metrics.csv")" ">=" 5
+listed=" $(echo "${summary#*(}" | tr -d ')' | sed 's/×[0-9]*//g') "
+for s in G10 G32 C21 E07 E26; do
+  case "$listed" in *" $s "*) echo "ok   $s listed as excluded in the summary" ;; *) echo "FAIL $s not in the summary's excluded list"; fail=1 ;; esac
 done
 check "faulted re-acquisition: most codes used while biased" "$($CMP max-used "$W/fault" 80 88.6)" "<=" 11
 read -r dh dv <<<"$($CMP max-diff "$W/fault" "$W/clean" 80 92)"

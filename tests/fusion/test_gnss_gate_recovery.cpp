@@ -115,6 +115,31 @@ TEST(GnssGateRecovery, OneRowMoreThanTheUnknownsIsTheMinimum) {
             0);
 }
 
+TEST(GnssGateRecovery, AnAppliedAdmissionTalliesTheExcludedSatellites) {
+  // The four biased satellites of FaultedMinorityIsExcluded, and a row outside the groups (left
+  // to the caller's gate, so neither admitted nor excluded by the tests).
+  const std::map<int, double> faults{{1, 40.0}, {4, -60.0}, {7, 100.0}, {10, -30.0}};
+  Epoch e = rangeEpoch(12, 20.0, 2.0, faults, 2);
+  e.rows.group[0] = kReacquireNone;
+  const auto s = selectReacquisitionRows(e.rows, 15.25, 0.3, kRowQuantile, kEpochGate);
+  const ReacquisitionTally t = tallyReacquisition(e.rows, s);
+  EXPECT_EQ(t.admitted, 7);
+  EXPECT_EQ(t.excluded, 4);
+  ASSERT_EQ(t.excludedSats.size(), 4u);
+  for (std::size_t i = 0; i < 4; ++i) EXPECT_EQ(t.excludedSats[i], e.rows.sats[3 * i + 1]) << i;
+  // Through GnssGateRecovery: counted only when the epoch was applied during a re-acquisition.
+  GnssGateRecovery g(2.0, 0.3);
+  const GpsTime t0 = GpsTime::fromWeekTow(2381, 408700.0);
+  g.outcome(t0, 12, true, true);
+  ASSERT_TRUE(g.reacquiring(t0 + 15.0));
+  EXPECT_EQ(g.outcome(t0 + 15.0, 12, false, false, &s, &e.rows).excluded, 0);  // not applied
+  const ReacquisitionTally applied = g.outcome(t0 + 15.25, 12, true, false, &s, &e.rows);
+  EXPECT_EQ(applied.admitted, 7);
+  EXPECT_EQ(applied.excluded, 4);
+  EXPECT_EQ(g.rowsExcluded(), 4);
+  EXPECT_EQ(g.admissions(), 1);
+}
+
 TEST(GnssGateRecovery, RowsOutsideTheGroupsAreLeftToTheCaller) {
   Epoch e = rangeEpoch(8, 10.0, 2.0, {}, 7);
   e.rows.group[3] = kReacquireNone;  // e.g. an SPP velocity row

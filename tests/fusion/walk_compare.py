@@ -8,6 +8,9 @@ of global.pos.
                                               the two runs' common epochs in [T0, T1)
     walk_compare.py max-used OUT T0 T1        largest number of pseudorange rows used in [T0, T1)
     walk_compare.py frame-delay OUT SPP.pos   s from the first SPP fix to the first tight epoch
+    walk_compare.py start-diff OUT OUT_B LEN  largest horizontal and vertical distance (m) between
+                                              the two runs' common epochs over the LEN s after OUT's
+                                              first tight epoch ("nan nan" without one)
     walk_compare.py drift OUT REF.pos T LEN   horizontal drift (m) of an outage [T, T+LEN): the change
                                               of the horizontal error against the reference's fixed
                                               and float epochs between the last epoch before the
@@ -97,6 +100,17 @@ def main():
         spp = min(read_pos(args[1]))
         tight = next(float(e[1]) for e in epochs(args[0]) if e[2] == "tight")
         print("%.2f" % (tight - spp))
+    elif cmd == "start-diff":
+        tight = next((float(e[1]) for e in epochs(args[0]) if e[2] == "tight"), None)
+        if tight is None:
+            print("nan nan")
+            return
+        a, b = read_pos(args[0] + "/global.pos"), read_pos(args[1] + "/global.pos")
+        common = [t for t in a if t in b and tight <= t < tight + float(args[2])]
+        if not common:
+            sys.exit("walk_compare: no common epoch")
+        d = [enu(a[t], b[t]) for t in common]
+        print("%.2f %.2f" % (max(math.hypot(x[0], x[1]) for x in d), max(abs(x[2]) for x in d)))
     elif cmd == "drift":
         t0, start, length = first_frame(args[0]), float(args[2]), float(args[3])
         est, ref = read_pos(args[0] + "/global.pos"), read_pos(args[1], 2)

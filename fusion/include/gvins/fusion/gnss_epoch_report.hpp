@@ -13,6 +13,7 @@
 #include "gvins/base/enum_names.hpp"
 #include "gvins/base/geodetic.hpp"
 #include "gvins/base/gnss_time.hpp"
+#include "gvins/base/satellite.hpp"
 #include "gvins/fusion/gnss_ins_alignment.hpp"
 
 namespace gvins::fusion {
@@ -36,6 +37,14 @@ struct GnssTypeCount {
   int masked = 0;    ///< code rows dropped below GnssFusionConfig::cn0MaskDbHz (psr, dpsr)
 };
 
+/// The re-acquisition gate in this epoch (gnss_gate_recovery.hpp).
+struct GnssReacquisitionReport {
+  bool started = false;  ///< a re-acquisition began with this epoch
+  int admitted = 0;      ///< rows applied through the widened gate and the consensus
+  int excluded = 0;      ///< rows of the consensus groups kept out in an epoch that was applied
+  std::vector<SatId> excludedSats;  ///< their satellites
+};
+
 struct GnssEpochReport {
   GpsTime time;                 ///< rover time tag
   std::int64_t t_ns = 0;        ///< measurement time used (tag − receiver clock)
@@ -47,6 +56,8 @@ struct GnssEpochReport {
   bool updated = false;         ///< at least one update applied
   bool clocksInitialized = false;  ///< this epoch
   bool reset = false;           ///< outage reset this epoch, or the estimator started a new state
+  bool frameRestart = false;    ///< the frame initialisation dropped the estimator's state (not linear)
+  GnssReacquisitionReport reacquisition;
   bool rtkFixed = false;
   std::optional<Eigen::Vector3d> antennaEcef;  ///< after the update (at t_ns)
   std::optional<Eigen::Vector3d> antennaVelocityEcef;

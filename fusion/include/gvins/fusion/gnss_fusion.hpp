@@ -76,6 +76,9 @@ class GnssFusion {
                                const EphemerisStore& nav);
 
   const GnssFusionConfig& config() const { return config_; }
+  /// Frame initialisations abandoned (linearStart, or frame rows gated out twice in a row): the
+  /// estimator restarted.
+  int frameRestarts() const { return frameRestarts_; }
   GnssFusionStage stage() const { return stage_; }
   bool clocksInitialized() const { return clocks_.valid(); }
   /// [ψ, p_NW] of the estimator's world frame in local ENU at the anchor: the frame block's
@@ -137,6 +140,15 @@ class GnssFusion {
   /// Stage kFrameInit: SPP position and velocity rows; kTight once the frame's yaw converged.
   /// False without an SPP fix.
   bool frameUpdate(vio::EstimatorBackend<Scalar>& est, Epoch& e, const AntennaKinematics& k);
+  /// After the first frame update (the block had no information, so the rows are fitted exactly
+  /// to first order): the rows again at the corrected state. When their χ² (SPP covariance)
+  /// exceeds the epoch gate the linearisation failed (an IMU state far off, e.g. after a long
+  /// stretch without aiding, and a yaw correction of tens of degrees about a distant W origin):
+  /// the estimator is restarted (restartFrame) and false returned.
+  bool linearStart(vio::EstimatorBackend<Scalar>& est, Epoch& e, const GnssRowSet& rows);
+  /// Drops the estimator's state (EstimatorBackend::restart) and the fusion's, with the warning
+  /// `why` and what follows; false if the backend cannot (the warning says so too).
+  bool restartFrame(vio::EstimatorBackend<Scalar>& est, Epoch& e, const std::string& why);
   /// Stage kTight: the rows of the configured mode (gnss_fusion_rows.cpp); false if the clocks
   /// could not be initialised.
   bool tightUpdate(vio::EstimatorBackend<Scalar>& est, Epoch& e, const GnssStateValues& s, const AntennaKinematics& k);
@@ -189,6 +201,8 @@ class GnssFusion {
   GnssFusionConfig config_;
   sri::ChiSquareQuantiles rowGateQuantile_;  // χ²(1) quantile of config_.rowGate
   GnssFusionStage stage_ = GnssFusionStage::kWaitingVio;
+  int frameRestarts_ = 0;
+  int frameRejections_ = 0;  // consecutive frame epochs gated out (frameUpdate)
   std::uint64_t generation_ = 0;  // estimator generation the ids below belong to
   GnssAnchor anchor_;
   sri::BlockId frameBlock_;

@@ -81,6 +81,14 @@ struct ReacquisitionEpoch {
   bool normal = true;
 };
 
+/// What the tests of an applied epoch admitted: consensus-group rows admitted and excluded, and
+/// the satellites of the excluded rows (in row order, a satellite once).
+struct ReacquisitionTally {
+  int admitted = 0, excluded = 0;
+  std::vector<SatId> excludedSats;
+};
+ReacquisitionTally tallyReacquisition(const ReacquisitionRows& rows, const ReacquisitionSelection& selection);
+
 /// The widened gate and the consensus of an epoch's rows (tests 1 and 2 of the file comment).
 /// rowQuantile: χ²₁ quantile of the row gate; epochGate: the probability of the joint test.
 /// Deterministic (a fixed seed).
@@ -106,7 +114,8 @@ class GnssGateRecovery {
   /// The outcome of the epoch's update. rows: how many were offered; applied: an update was
   /// applied; normal: it passed the normal gates (ends the re-acquisition); `selection`: the
   /// re-acquisition tests of the epoch and their input, if any (an admission is reported).
-  void outcome(const GpsTime& t, std::size_t rows, bool applied, bool normal,
+  /// Returns the tally of an admission (rows applied through the tests), zero otherwise.
+  ReacquisitionTally outcome(const GpsTime& t, std::size_t rows, bool applied, bool normal,
                const ReacquisitionSelection* selection = nullptr, const ReacquisitionRows* input = nullptr);
   /// Forget the history (state reset).
   void reset() {

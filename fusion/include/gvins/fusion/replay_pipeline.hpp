@@ -203,6 +203,12 @@ struct ReplaySummary {
   std::size_t phaseRowsUsed = 0, phaseRowsRejected = 0, ambiguityStatesMax = 0;
   std::size_t recordChanges = 0;  ///< broadcast record changes carried over to ambiguities
   std::size_t codeRowsMasked = 0;  ///< psr/dpsr rows dropped below cn0_mask_dbhz
+  /// GNSS re-acquisitions (gnss_gate_recovery.hpp): started, rows admitted and excluded by their
+  /// widened gate and consensus, and the excluded rows per satellite.
+  std::size_t reacquisitions = 0, reacquisitionRowsAdmitted = 0, reacquisitionRowsExcluded = 0;
+  std::map<SatId, std::size_t> reacquisitionExcluded;
+  /// Frame initialisations that dropped the estimator's state (a start that was not linear).
+  std::size_t frameRestarts = 0;
   double realTimeFactor() const { return wallSeconds > 0.0 ? datasetSeconds / wallSeconds : 0.0; }
   double estimatorMsMedian = 0.0;
   /// First processed frame to the first initialised one (s; NaN: never), the estimator's mean time

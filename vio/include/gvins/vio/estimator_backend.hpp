@@ -111,6 +111,11 @@ class EstimatorBackend {
     (void)s;
     return false;
   }
+  /// Drops the whole state (client blocks included; generation() changes) and initialises again
+  /// from the next frames or initializeFrom, keeping the buffered IMU samples: for a client whose
+  /// measurements show that the state cannot be linearised about (e.g. a long IMU-only stretch).
+  /// False (nothing changes) when the backend does not support it.
+  virtual bool restart() { return false; }
   /// The IMU samples the estimator holds (oldest first; before initialisation at least the last
   /// init_window + 2 s): for a client's own alignment before the state exists. Empty when the
   /// backend does not expose them.

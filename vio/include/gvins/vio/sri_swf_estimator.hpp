@@ -343,6 +343,10 @@ class SriSwfEstimator final : public EstimatorBackend<Scalar> {
   std::optional<ImuIntegration> integrateToNewest(std::int64_t t_ns) const override;
   std::optional<Eigen::Vector3d> angularRateAt(std::int64_t t_ns) const override;
   bool initializeFrom(const ExternalInitialState& s) override;
+  bool restart() override {
+    reset();
+    return true;
+  }
   std::span<const ImuSample> bufferedImu() const override;
 
   sri::BlockId addBlock(const sri::BlockSpec& spec, const sri::BlockEstimate<Scalar>& estimate,
