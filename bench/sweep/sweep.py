@@ -6,7 +6,8 @@ the hand-held walk), feature-track datasets of gvins-sim. Writes the results pag
 per family and mode, targets met or missed, NEES, float against double, run time) and a CSV of
 every run.
 
-  bench/sweep/sweep.py [--bin build/bin [--binaries-commit C]] [--seeds 20] [--jobs 1] [--work out/sweep]
+  bench/sweep/sweep.py [--bin build/bin [--binaries-commit C]] [--seeds 20 | --only-seeds 4,9] [--jobs 1]
+                       [--work out/sweep]
                        [--families a,b] [--modes vio,ddcp,...] [--markdown docs/results/sweep.md]
                        [--csv docs/results/sweep.csv] [--retry-failed] [--keep-data]
 
@@ -239,6 +240,8 @@ def parse_args():
                     help="commit the binaries of --bin were built from, for the page (default: this checkout's HEAD)")
     ap.add_argument("--seeds", type=int, default=20, help="seeds 1..N of every family (default 20)")
     ap.add_argument("--first-seed", type=int, default=1)
+    ap.add_argument("--only-seeds", default=None,
+                    help="comma-separated seeds (e.g. 4,9,14) instead of --first-seed/--seeds")
     ap.add_argument("--jobs", type=int, default=1, help="seeds simulated and replayed in parallel")
     ap.add_argument("--work", default=os.path.join(ROOT, "out", "sweep"))
     ap.add_argument("--families", default=",".join(f["name"] for f in fam.FAMILIES))
@@ -262,6 +265,12 @@ def parse_args():
             ap.error("--modes: unknown mode '%s' (known: %s)" % (m, ", ".join(fam.MODES)))
     if a.seeds < 1 or a.jobs < 1:
         ap.error("--seeds and --jobs must be at least 1")
+    a.seed_list = list(range(a.first_seed, a.first_seed + a.seeds))
+    if a.only_seeds is not None:
+        try:
+            a.seed_list = sorted({int(x) for x in a.only_seeds.split(",")})
+        except ValueError:
+            ap.error("--only-seeds: '%s' is not a comma-separated list of integers" % a.only_seeds)
     return a
 
 
@@ -274,8 +283,7 @@ def main():
     a.sim_digest = digest_file(os.path.join(a.bin, "gvins-sim"))
     a.replay_digest = digest_file(os.path.join(a.bin, "gvins-replay"))
     os.makedirs(a.work, exist_ok=True)
-    seeds = range(a.first_seed, a.first_seed + a.seeds)
-    tasks = [(f, s) for s in seeds for f in a.family_list]
+    tasks = [(f, s) for s in a.seed_list for f in a.family_list]
     progress = Progress(len(tasks) * len(a.mode_list), a.jobs)
     t0 = time.time()
     results = []
