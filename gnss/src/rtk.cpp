@@ -106,6 +106,7 @@ void RtkSolver::reset() {
   filter_ = Filter();
   held_.clear();
   amb_.clear();
+  iono_.clear();
   processedPairs_.clear();
   lastProcess_.reset();
   initialized_ = false;
@@ -294,11 +295,13 @@ bool RtkSolver::measurementUpdate(const Eigen::Vector3d& x0) {
       const Ambiguity& af = amb_.at(key(f.sat, f.code));
       const double ns = filter_.estimate(as.id).vector[0], nf = filter_.estimate(af.id).vector[0];
       const DdResidual res = ddPhaseResidual(dd_, d, x0);
-      m.residual()[r] = res.residual - (s.wavelength * ns - f.wavelength * nf);
+      // The phase is advanced by the ionosphere (μ I): + μ_s I_s − μ_f I_f back in the residual.
+      m.residual()[r] = res.residual - (s.wavelength * ns - f.wavelength * nf) + ddIonosphere(s, f);
       // (jacobian() of a new block reallocates: always take the block afresh.)
       m.jacobian(pos_, 3).row(r) = res.jacobian;
       m.jacobian(as.id, 1)(r, 0) = s.wavelength;
       m.jacobian(af.id, 1)(r, 0) = -f.wavelength;
+      ionosphereColumns(m, r, s, f, -1.0);
       C(r, r) = res.variance;
       for (int q = 0; q < r; ++q) {
         if (dd_.phase[static_cast<std::size_t>(ph[static_cast<std::size_t>(q)])].reference == d.reference) {
@@ -310,8 +313,11 @@ bool RtkSolver::measurementUpdate(const Eigen::Vector3d& x0) {
       const DoubleDifference& d = dd_.code[static_cast<std::size_t>(cd[static_cast<std::size_t>(r)])];
       const DdResidual res = ddCodeResidual(dd_, d, x0);
       const int row = np + r;
-      m.residual()[row] = res.residual;
+      m.residual()[row] = res.residual - ddIonosphere(dd_.sd[static_cast<std::size_t>(d.satellite)],
+                                                      dd_.sd[static_cast<std::size_t>(d.reference)]);
       m.jacobian(pos_, 3).row(row) = res.jacobian;
+      ionosphereColumns(m, row, dd_.sd[static_cast<std::size_t>(d.satellite)],
+                        dd_.sd[static_cast<std::size_t>(d.reference)], 1.0);
       C(row, row) = res.variance;
       for (int q = 0; q < r; ++q) {
         if (dd_.code[static_cast<std::size_t>(cd[static_cast<std::size_t>(q)])].reference == d.reference) {
@@ -352,11 +358,12 @@ bool RtkSolver::rejectOutlier(RtkSolution& sol) {
         if (phase) {
           const SingleDifference& f = dd_.sd[static_cast<std::size_t>(d.reference)];
           const DdResidual r = ddPhaseResidual(dd_, d, x);
-          v = r.residual - (s.wavelength * ambiguityEstimate(s) - f.wavelength * ambiguityEstimate(f));
+          v = r.residual - (s.wavelength * ambiguityEstimate(s) - f.wavelength * ambiguityEstimate(f)) +
+              ddIonosphere(s, f);
           var = r.variance;
         } else {
           const DdResidual r = ddCodeResidual(dd_, d, x);
-          v = r.residual;
+          v = r.residual - ddIonosphere(s, dd_.sd[static_cast<std::size_t>(d.reference)]);
           var = r.variance;
         }
         norm.push_back(std::abs(v) / std::sqrt(var));
@@ -559,13 +566,17 @@ RtkSolution RtkSolver::processEpoch(const ObsEpoch& rover, TransmitStates* state
     else initialize(basePos, std::max(cfg_.initialPositionSigma, 1e4), spp);
     lastTime_ = rover.time;
   } else {
-    if (elapsed(direction_, rover.time, lastTime_) > 0.0) timeUpdate(rover.time - lastTime_, spp);
+    if (elapsed(direction_, rover.time, lastTime_) > 0.0) {
+      timeUpdate(rover.time - lastTime_, spp);
+      propagateIonosphere(rover.time - lastTime_);
+    }
     lastTime_ = rover.time;
   }
   if (spp.velocity.valid) lastVelocity_ = spp.velocity.velocity;
 
   const Eigen::Vector3d x0 = positionEstimate();
   builder_.form(rover, roverSlips_, snapshot_, basePos, x0, dd_, states);
+  baseline_ = (x0 - basePos).norm();
 
   // Prefit gate on DD code (gross errors, multipath spikes), widened by the uncertainty of the
   // predicted position (a DD line-of-sight difference is at most 2 in length).
@@ -591,6 +602,7 @@ RtkSolution RtkSolver::processEpoch(const ObsEpoch& rover, TransmitStates* state
     }
   }
   if (sats.size() < 4) return single(RtkIssue::NoCommonSatellites);
+  manageIonosphere();
 
   const Eigen::Vector3d xf = updateWithOutlierRejection(x0, sol);
 

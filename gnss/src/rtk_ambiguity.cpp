@@ -97,15 +97,22 @@ std::vector<RtkSolver::ArPair> RtkSolver::arPairs(std::vector<int>& arRef) const
 }
 
 bool RtkSolver::arCovariance(const std::vector<ArPair>& pairs, Eigen::VectorXd& a, Eigen::MatrixXd& Qaa,
-                             Eigen::MatrixXd& Qxa) const {
-  // Joint covariance of [position; DD ambiguities] from the square-root factor: with F the rows
-  // of R⁻¹ of the position and of the SD ambiguities (SriFilter::covarianceFactor, ~n³/6), a DD's
-  // row is F_sat − F_ref and Q = Y Yᵀ over Y = [F_pos; F_sat − F_ref].
+                             Eigen::MatrixXd& Qxa, std::vector<int>& ionosphereRows) const {
+  // Joint covariance of [position; ionosphere; DD ambiguities] from the square-root factor: with
+  // F the rows of R⁻¹ of the position, of the SD ionosphere states (satIndex order in
+  // ionosphereRows, rows 3.. of Qxa) and of the SD ambiguities (SriFilter::covarianceFactor,
+  // ~n³/6), a DD's row is F_sat − F_ref and Q = Y Yᵀ over Y = [F_pos; F_iono; F_sat − F_ref].
   const int m = static_cast<int>(pairs.size());
   std::vector<sri::BlockId> ids{pos_};
+  ionosphereRows.clear();
+  for (const auto& [k, s] : iono_) {
+    ionosphereRows.push_back(k);
+    ids.push_back(s.id);
+  }
+  const int nx = 3 + static_cast<int>(ionosphereRows.size());
   std::unordered_map<std::uint64_t, int> rowOf;  // SD ambiguity block → row of F
   auto listed = [&](sri::BlockId id) {
-    if (rowOf.emplace(id.value, 3 + static_cast<int>(ids.size()) - 1).second) ids.push_back(id);
+    if (rowOf.emplace(id.value, 2 + static_cast<int>(ids.size())).second) ids.push_back(id);
   };
   a.resize(m);
   for (int k = 0; k < m; ++k) {
@@ -121,18 +128,27 @@ bool RtkSolver::arCovariance(const std::vector<ArPair>& pairs, Eigen::VectorXd& 
     return false;
   }
   if (F.rows() != static_cast<Eigen::Index>(ids.size()) + 2) return false;  // a block without information
-  Eigen::MatrixXd Y(3 + m, F.cols());
-  Y.topRows(3) = F.topRows(3);
+  Eigen::MatrixXd Y(nx + m, F.cols());
+  Y.topRows(nx) = F.topRows(nx);
   for (int k = 0; k < m; ++k) {
     const ArPair& p = pairs[static_cast<std::size_t>(k)];
-    Y.row(3 + k) = F.row(rowOf.at(p.satId.value)) - F.row(rowOf.at(p.refId.value));
+    Y.row(nx + k) = F.row(rowOf.at(p.satId.value)) - F.row(rowOf.at(p.refId.value));
   }
-  Eigen::MatrixXd Q = Eigen::MatrixXd::Zero(3 + m, 3 + m);
+  Eigen::MatrixXd Q = Eigen::MatrixXd::Zero(nx + m, nx + m);
   Q.selfadjointView<Eigen::Lower>().rankUpdate(Y);
   Q = Q.selfadjointView<Eigen::Lower>();
   Qaa = Q.bottomRightCorner(m, m);
-  Qxa = Q.topRightCorner(3, m);
+  Qxa = Q.topRightCorner(nx, m);
   return true;
+}
+
+double RtkSolver::conditionedIonosphere(const ConditionedFix& f, const SingleDifference& s,
+                                        const SingleDifference& r) const {
+  auto value = [&](const SingleDifference& sd) {
+    const auto it = f.ionosphere.find(satIndex(sd.sat));
+    return it == f.ionosphere.end() ? ionosphereEstimate(sd.sat) : it->second;
+  };
+  return ionosphereFactor(s) * value(s) - ionosphereFactor(r) * value(r);
 }
 
 ArStatus RtkSolver::checkFix(const std::vector<ArPair>& pairs, const RtkSolution& sol, const ConditionedFix& f) {
@@ -165,7 +181,8 @@ ArStatus RtkSolver::checkFix(const std::vector<ArPair>& pairs, const RtkSolution
     const SingleDifference& r = dd_.sd[static_cast<std::size_t>(p.ref)];
     const double nref = filter_.estimate(p.refId).vector[0];
     const double v = sdPhaseResidual(s, f.position) - sdPhaseResidual(r, f.position) -
-                     (s.wavelength * f.ambiguities[static_cast<Eigen::Index>(k)] + (s.wavelength - r.wavelength) * nref);
+                     (s.wavelength * f.ambiguities[static_cast<Eigen::Index>(k)] + (s.wavelength - r.wavelength) * nref) +
+                     conditionedIonosphere(f, s, r);
     if (std::abs(v) > cfg_.fixValidationSigmas * std::sqrt(s.phaseVariance + r.phaseVariance)) {
       ++counters_.rejectedFixes;
       return ArStatus::Rejected;
@@ -175,7 +192,9 @@ ArStatus RtkSolver::checkFix(const std::vector<ArPair>& pairs, const RtkSolution
   //    fix of a weak model) leave code residuals of several sigma.
   for (const DoubleDifference& d : dd_.code) {
     const DdResidual r = ddCodeResidual(dd_, d, f.position);
-    if (std::abs(r.residual) > cfg_.fixCodeValidationSigmas * std::sqrt(r.variance)) {
+    const double v = r.residual - conditionedIonosphere(f, dd_.sd[static_cast<std::size_t>(d.satellite)],
+                                                        dd_.sd[static_cast<std::size_t>(d.reference)]);
+    if (std::abs(v) > cfg_.fixCodeValidationSigmas * std::sqrt(r.variance)) {
       ++counters_.rejectedFixes;
       return ArStatus::Rejected;
     }
@@ -242,7 +261,8 @@ void RtkSolver::resolve(RtkSolution& sol) {
   ++counters_.arAttempts;
   Eigen::VectorXd a;
   Eigen::MatrixXd Qaa, Qxa;
-  if (!arCovariance(pairs, a, Qaa, Qxa)) return notFixed(ArStatus::NotValidated);
+  std::vector<int> ionosphereRows;
+  if (!arCovariance(pairs, a, Qaa, Qxa, ionosphereRows)) return notFixed(ArStatus::NotValidated);
 
   // 2. LAMBDA with validation and partial fixing, warm-started from the last epoch's basis.
   std::vector<std::pair<sri::BlockId, sri::BlockId>> now(static_cast<std::size_t>(m));
@@ -268,8 +288,13 @@ void RtkSolver::resolve(RtkSolution& sol) {
     const Eigen::LLT<Eigen::MatrixXd> llt(Qyy);
     if (llt.info() != Eigen::Success) return notFixed(ArStatus::NotValidated);
     const Eigen::VectorXd w = llt.solve(dy);
-    cf.position = sol.floatPosition - QxT * w;
-    const Eigen::Matrix3d P = sol.floatCovariance - QxT * llt.solve(QxT.transpose());
+    const Eigen::VectorXd dx = QxT * w;
+    cf.position = sol.floatPosition - dx.head<3>();
+    for (std::size_t i = 0; i < ionosphereRows.size(); ++i) {
+      const int k = ionosphereRows[i];
+      cf.ionosphere[k] = filter_.estimate(iono_.at(k).id).vector[0] - dx[3 + static_cast<Eigen::Index>(i)];
+    }
+    const Eigen::Matrix3d P = sol.floatCovariance - QxT.topRows(3) * llt.solve(QxT.topRows(3).transpose());
     cf.covariance = 0.5 * (P + P.transpose());
     cf.ambiguities = full ? Eigen::VectorXd(fix.values) : Eigen::VectorXd(a - QaT * w);
   }
@@ -310,8 +335,10 @@ void RtkSolver::resolve(RtkSolution& sol) {
     DoubleDifference& d = dd_.phase[i];
     const SingleDifference& f = dd_.sd[static_cast<std::size_t>(d.reference)];
     d.fixedCycles = ints[i];
+    // The DD phase's bias with its conditioned ionospheric advance (long baselines).
     d.ambiguityMeters = dd_.sd[static_cast<std::size_t>(d.satellite)].wavelength * ints[i] +
-                        (dd_.sd[static_cast<std::size_t>(d.satellite)].wavelength - f.wavelength) * ambiguityEstimate(f);
+                        (dd_.sd[static_cast<std::size_t>(d.satellite)].wavelength - f.wavelength) * ambiguityEstimate(f) -
+                        conditionedIonosphere(cf, dd_.sd[static_cast<std::size_t>(d.satellite)], f);
   }
 
   // 7. Fix-and-hold: validated, confirmed fixes only, after holdMinFixes of them in a row.

@@ -54,7 +54,7 @@ void applyAr(const Reader& r, const YAML::Node& v, const std::string& where, Rtk
 void apply(const Reader& r, const YAML::Node& rtk, RtkConfig& c) {
   static const std::set<std::string> kKeys = {
       "mode", "dynamics", "ambiguity_mode", "systems", "frequencies", "bands", "signal_matching", "elevation_mask_deg",
-      "snr_mask_dbhz", "ar", "phase_sigma_m", "code_phase_ratio", "code_system_factor", "troposphere", "base",
+      "snr_mask_dbhz", "ar", "phase_sigma_m", "code_phase_ratio", "code_system_factor", "troposphere", "ionosphere", "base",
       "cycle_slip", "ambiguity_outage_s", "outliers", "filter"};
   r.map(rtk, "rtk", kKeys, [&](const std::string& k, const std::string& full, const YAML::Node& v) {
     if (k == "mode") {
@@ -102,6 +102,13 @@ void apply(const Reader& r, const YAML::Node& rtk, RtkConfig& c) {
       });
     } else if (k == "troposphere") {
       c.troposphere = r.boolean(v, full);
+    } else if (k == "ionosphere") {
+      static const std::set<std::string> kI = {"sigma_ppm", "rate_ppm", "min_sigma_m"};
+      r.map(v, full, kI, [&](const std::string& ik, const std::string& iff, const YAML::Node& iv) {
+        if (ik == "sigma_ppm") c.ionosphereSigmaPpm = r.number(iv, iff, 0.0, 1000.0);
+        else if (ik == "rate_ppm") c.ionosphereRatePpm = r.number(iv, iff, 0.0, 1000.0);
+        else c.ionosphereMinSigma = r.number(iv, iff, 0.0, 10.0);
+      });
     } else if (k == "base") {
       static const std::set<std::string> kB = {"max_age_s", "interpolate", "max_interpolation_gap_s", "extrapolate"};
       r.map(v, full, kB, [&](const std::string& bk, const std::string& bf, const YAML::Node& bv) {

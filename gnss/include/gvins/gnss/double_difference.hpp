@@ -99,7 +99,9 @@ struct DoubleDifference {
   /// Phase only: the integer DD ambiguity N_sat − N_ref (cycles) when resolved.
   std::optional<double> fixedCycles;
   /// Phase only: λ_sat N_sat − λ_ref N_ref (m) of the fixed solution, the term ddPhaseResidual
-  /// subtracts (for GLONASS it includes the float SD ambiguity of the reference times Δλ).
+  /// subtracts (for GLONASS it includes the float SD ambiguity of the reference times Δλ; with
+  /// the ionosphere-weighted model of RtkConfig it includes minus the DD ionospheric phase advance
+  /// of the fixed solution, −(μ_sat I_sat − μ_ref I_ref)).
   std::optional<double> ambiguityMeters;
 };
 

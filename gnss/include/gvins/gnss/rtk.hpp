@@ -224,6 +224,14 @@ class RtkSolver {
     Eigen::VectorXd ambiguities;  ///< conditioned DD ambiguities of the AR set, cycles
     Eigen::Vector3d position;
     Eigen::Matrix3d covariance;
+    std::unordered_map<int, double> ionosphere;  ///< satIndex → conditioned SD slant delay on L1, m
+  };
+  /// A satellite's single-differenced slant ionospheric delay on L1 (ionosphere-weighted model,
+  /// RtkConfig::ionosphereSigmaPpm; rtk_ionosphere.cpp).
+  struct Ionosphere {
+    sri::BlockId id;
+    GpsTime lastSeen;
+    double elevation = 0.0;  ///< rad, at the last epoch seen
   };
 
   static std::uint32_t key(SatId s, ObsCode c) {
@@ -248,7 +256,7 @@ class RtkSolver {
   /// Float DD ambiguities `a` of the pairs, their covariance and cross-covariance with the
   /// position; false when a block has no information.
   bool arCovariance(const std::vector<ArPair>& pairs, Eigen::VectorXd& a, Eigen::MatrixXd& Qaa,
-                    Eigen::MatrixXd& Qxa) const;
+                    Eigen::MatrixXd& Qxa, std::vector<int>& ionosphereRows) const;
   /// Checks of the fixed solution (precision, position domain, phase and code residuals).
   ArStatus checkFix(const std::vector<ArPair>& pairs, const RtkSolution& sol, const ConditionedFix& f);
   /// Integer DD phases of dd_ implied by the conditioned AR ambiguities (NaN where not integer).
@@ -257,6 +265,26 @@ class RtkSolver {
   void hold(const std::vector<ArPair>& pairs, const AmbiguityFix& fix, const Eigen::VectorXd& a);
   Eigen::Vector3d positionEstimate() const;
   double ambiguityEstimate(const SingleDifference& sd) const;
+  // The ionosphere-weighted model (rtk_ionosphere.cpp).
+  /// Prior σ of a satellite's SD slant delay at this baseline (m); 0 when the model is off.
+  double ionosphereSigma(double elevation) const;
+  /// States for the satellites of dd_'s differences (new ones with their prior), stale ones dropped.
+  void manageIonosphere();
+  /// Random walk of the ionosphere states over dt (s).
+  void propagateIonosphere(double dt);
+  /// The SD slant delay state of a satellite (0 without one) and its block (invalid without one).
+  double ionosphereEstimate(SatId sat) const;
+  sri::BlockId ionosphereBlock(SatId sat) const;
+  /// μ = (λ / λ_L1)²: the delay of the SD's signal per metre of L1 delay (0 for an unknown wavelength).
+  static double ionosphereFactor(const SingleDifference& sd);
+  /// μ_s I_s − μ_r I_r of a DD at the state estimates (the code delay; the phase advance).
+  double ddIonosphere(const SingleDifference& s, const SingleDifference& r) const;
+  /// μ_s I_s − μ_r I_r at the ionosphere conditioned on a fix (the state estimate where f has none).
+  double conditionedIonosphere(const ConditionedFix& f, const SingleDifference& s, const SingleDifference& r) const;
+  /// Jacobian of row `row` of a DD (satellite s, reference r) w.r.t. their ionosphere states:
+  /// sign μ_s and −sign μ_r (code: sign +1; phase: −1).
+  void ionosphereColumns(sri::Measurement<double>& m, int row, const SingleDifference& s, const SingleDifference& r,
+                         double sign) const;
 
   const EphemerisStore& nav_;
   RtkConfig cfg_;
@@ -279,6 +307,8 @@ class RtkSolver {
   std::optional<Eigen::Vector3d> lastVelocity_;
   std::unordered_map<std::uint32_t, Ambiguity> amb_;
   std::unordered_set<std::uint32_t> forced_;  // ambiguities to re-initialise (post-fit outliers)
+  std::unordered_map<int, Ionosphere> iono_;  // by satIndex
+  double baseline_ = 0.0;  // m, rover-base distance of the current epoch
   DdEpoch dd_;
   BaseSnapshot snapshot_;
   /// The fixed DD phases of the last process() epoch that ended fixed (differencesWithHeldFix).

@@ -104,6 +104,23 @@ struct RtkConfig {
   /// at the rover's elevation; Elevation: the phase model times the ratio squared.
   WeightingScheme codeWeighting = WeightingScheme::Elevation;
   bool troposphere = true;  ///< Saastamoinen/Niell slant delays at both receivers
+  /// Ionosphere-weighted model (Odijk 2002, "Fast precise GPS positioning in the presence of
+  /// ionospheric delays", PhD thesis, TU Delft; Teunissen & Montenbruck (eds.) 2017, Springer
+  /// Handbook of GNSS, ch. 23): one state per satellite for the single-differenced slant
+  /// ionospheric delay I on L1 (m), which delays the code by μ I and advances the phase by μ I,
+  /// μ = (λ / λ_L1)². Prior σ = ionosphereSigmaPpm · 1e-6 · baseline · F(el) (F the broadcast
+  /// model's obliquity, klobuchar.hpp), random walk ionosphereRatePpm · 1e-6 · baseline · F(el)
+  /// per √s. Without it the double differences take the differential ionosphere as zero, which
+  /// biases the float ambiguities by tenths of a cycle on baselines of several km: on the
+  /// simulated flights with the base 7.5-9.3 km away (bench/sweep family uav_base_1_10km) no
+  /// epoch fixed. States only while the zenith prior σ reaches ionosphereMinSigma (m; 0: on every
+  /// baseline): by default from 5 km. On shorter baselines the model costs fixes where few
+  /// satellites are left (GEONET 0759-3040, 3.34 km, 35° mask: 33 instead of 55 fixed epochs of
+  /// 120, tests/gnss/test_rtk.cpp RtkIntegrity), while the ionosphere-fixed model fixes them right.
+  /// ionosphereSigmaPpm 0 = off (the ionosphere-fixed model on every baseline).
+  double ionosphereSigmaPpm = 1.0;
+  double ionosphereRatePpm = 0.05;
+  double ionosphereMinSigma = 0.005;
 
   // --- Base station.
   double maxAge = 30.0;             ///< s, oldest base data used with a rover epoch
@@ -167,6 +184,7 @@ const char* toString(SignalMatching m);
 ///     code_phase_ratio: 100
 ///     code_system_factor: {R: 1.5}
 ///     troposphere: true
+///     ionosphere: {sigma_ppm: 1, rate_ppm: 0.05, min_sigma_m: 0.005}
 ///     base: {max_age_s: 30, interpolate: true, max_interpolation_gap_s: 60, extrapolate: true}
 ///     cycle_slip: {lli: true, max_gap_s: 60, geometry_free: true, geometry_free_m: 0.05,
 ///                  geometry_free_rate_mps: 0.0005, doppler: true, doppler_m: 0.6,
