@@ -84,8 +84,10 @@ case "$cmd" in
       name=$(basename "$f")
       corpus="$ROOT/tests/data/fuzz/${name#fuzz_}"
       work=$(mktemp -d)
+      dict=()
+      [ -f "$corpus.dict" ] && dict=(-dict="$corpus.dict")  # the format's keywords and magic bytes
       echo "== $name for ${secs}s (seeds: $corpus)"
-      "$f" -max_total_time="$secs" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+      "$f" -max_total_time="$secs" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 "${dict[@]}" \
         "$work" "$corpus" 2>&1 | tail -n 3
       rm -rf "$work"
     done

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <ostream>
 
 #include "gvins/base/constants.hpp"
@@ -15,6 +16,9 @@ namespace gvins {
 namespace {
 
 constexpr double kKnotsPerMps = 3600.0 / 1852.0;  // 1 international nautical mile = 1852 m
+// Largest speed over ground written (knots, 51 km/s): a larger horizontal velocity is no ground
+// speed, and its digits would overflow the field; speed and course are then left empty.
+constexpr double kMaxSpeedKnots = 99999.999;
 
 /// UTC of a GPST instant rounded to hundredths of a second (rounded before the calendar split so
 /// that seconds never read 60).
@@ -156,12 +160,13 @@ std::string nmeaRmc(const PositionSolution& s, std::string_view talker) {
   b += ',';
   appendAngle(b, g.lon * constants::kRadToDeg, 3, 'E', 'W');
   b += ',';
-  if (s.velocity && s.velocity->allFinite()) {
-    const Eigen::Vector3d enu = ecefToEnuRotation(g.lat, g.lon) * *s.velocity;
-    const double speed = std::hypot(enu[0], enu[1]);
-    double course = std::atan2(enu[0], enu[1]) * constants::kRadToDeg;
+  std::optional<Eigen::Vector3d> enu;
+  if (s.velocity && s.velocity->allFinite()) enu = ecefToEnuRotation(g.lat, g.lon) * *s.velocity;
+  const double knots = enu ? std::hypot((*enu)[0], (*enu)[1]) * kKnotsPerMps : 0.0;
+  if (enu && knots <= kMaxSpeedKnots) {  // false for NaN too
+    double course = std::atan2((*enu)[0], (*enu)[1]) * constants::kRadToDeg;
     if (course < 0.0) course += 360.0;
-    std::snprintf(f, sizeof f, "%.3f,%.2f", speed * kKnotsPerMps, course >= 359.995 ? 0.0 : course);
+    std::snprintf(f, sizeof f, "%.3f,%.2f", knots, course >= 359.995 ? 0.0 : course);
     b += f;
   } else {
     b += ',';

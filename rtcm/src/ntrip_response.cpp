@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <string_view>
 
 #include "gvins/rtcm/ntrip_error.hpp"
 
@@ -168,11 +169,16 @@ void NtripResponse::feed(std::span<const std::uint8_t> bytes, std::vector<std::u
         state_ = State::Raw;
         break;
       }
-      case State::SourceTable:
+      case State::SourceTable: {
+        // Search only the new bytes (and the end marker's length before them): a caster that
+        // sends its table a byte at a time must not cost a scan of the whole table per byte.
+        constexpr std::string_view kEnd = "ENDSOURCETABLE";
+        const std::size_t from = table_.size() >= kEnd.size() ? table_.size() - (kEnd.size() - 1) : 0;
         table_ += buf_;
         buf_.clear();
-        if (table_.find("ENDSOURCETABLE") != std::string::npos || table_.size() > kMaxSourceTable) failSourceTable();
+        if (table_.find(kEnd, from) != std::string::npos || table_.size() > kMaxSourceTable) failSourceTable();
         return;
+      }
       case State::Raw:
         payload.insert(payload.end(), buf_.begin(), buf_.end());
         buf_.clear();

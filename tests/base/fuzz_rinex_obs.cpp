@@ -9,6 +9,8 @@
 #include "gvins/base/rinex_obs_reader.hpp"
 #include "gvins/base/rinex_obs_writer.hpp"
 
+#include "../fuzz/parse_error_check.hpp"
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return 0;
   // First byte selects the reader options; the rest is the file.
@@ -29,7 +31,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       ++epochs;
     }
     w.finish();
-  } catch (const gvins::ParseError&) {
+  } catch (const gvins::ParseError& e) {
+    gvins::fuzz::checkParseError(e, "fuzz.obs", text);
     return 0;
   }
   // Re-read what was written: it must parse, with the same number of epochs.

@@ -9,6 +9,8 @@
 
 #include "gvins/ephemeris/antex.hpp"
 
+#include "../fuzz/parse_error_check.hpp"
+
 namespace {
 
 void check(bool ok) {
@@ -29,7 +31,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   gvins::AntexData atx;
   try {
     atx = gvins::parseAntex(text, "fuzz.atx");
-  } catch (const gvins::ParseError&) {
+  } catch (const gvins::ParseError& e) {
+    gvins::fuzz::checkParseError(e, "fuzz.atx", text);
     return 0;
   }
   volatile double sink = 0.0;

@@ -9,6 +9,8 @@
 
 #include "gvins/ephemeris/bias_sinex.hpp"
 
+#include "../fuzz/parse_error_check.hpp"
+
 namespace {
 
 void check(bool ok) {
@@ -22,7 +24,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   gvins::BiasSinexData bia;
   try {
     bia = gvins::parseBiasSinex(text, "fuzz.bia");
-  } catch (const gvins::ParseError&) {
+  } catch (const gvins::ParseError& e) {
+    gvins::fuzz::checkParseError(e, "fuzz.bia", text);
     return 0;
   }
   volatile double sink = 0.0;

@@ -9,12 +9,15 @@
 #include "gvins/ephemeris/precise_ephemeris.hpp"
 #include "gvins/ephemeris/rinex_clock.hpp"
 
+#include "../fuzz/parse_error_check.hpp"
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   gvins::ClockData clk;
   try {
     clk = gvins::parseRinexClock(text, "fuzz.clk");
-  } catch (const gvins::ParseError&) {
+  } catch (const gvins::ParseError& e) {
+    gvins::fuzz::checkParseError(e, "fuzz.clk", text);
     return 0;
   }
   gvins::PreciseEphemeris pe;

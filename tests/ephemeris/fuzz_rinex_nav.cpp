@@ -8,12 +8,15 @@
 
 #include "gvins/ephemeris/ephemeris_store.hpp"
 
+#include "../fuzz/parse_error_check.hpp"
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   gvins::NavData nav;
   try {
     nav = gvins::parseRinexNav(text, "fuzz.nav");
-  } catch (const gvins::ParseError&) {
+  } catch (const gvins::ParseError& e) {
+    gvins::fuzz::checkParseError(e, "fuzz.nav", text);
     return 0;
   }
   gvins::EphemerisStore store;

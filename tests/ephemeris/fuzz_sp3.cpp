@@ -9,12 +9,15 @@
 #include "gvins/ephemeris/precise_ephemeris.hpp"
 #include "gvins/ephemeris/sp3.hpp"
 
+#include "../fuzz/parse_error_check.hpp"
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   gvins::Sp3Data sp3;
   try {
     sp3 = gvins::parseSp3(text, "fuzz.sp3");
-  } catch (const gvins::ParseError&) {
+  } catch (const gvins::ParseError& e) {
+    gvins::fuzz::checkParseError(e, "fuzz.sp3", text);
     return 0;
   }
   gvins::PreciseEphemeris pe(gvins::PreciseEphemerisOptions{4, 330.0, 100.0});

@@ -11,6 +11,8 @@
 #include "gvins/fusion/replay_pipeline.hpp"
 #include "gvins/fusion/sim_dataset_info.hpp"
 
+#include "../fuzz/parse_error_check.hpp"
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
   const std::string_view text(reinterpret_cast<const char*>(data) + 1, size - 1);
@@ -29,7 +31,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         gvins::fusion::parseSimDatasetInfo(text, "dataset.yaml");
         break;
     }
-  } catch (const gvins::ParseError&) {
+  } catch (const gvins::ParseError& e) {
+    static constexpr const char* kFiles[] = {"features.csv", "replay.yaml", "groundtruth_ecef.csv", "dataset.yaml"};
+    gvins::fuzz::checkParseError(e, kFiles[data[0] % 4], text);
   }
   return 0;
 }

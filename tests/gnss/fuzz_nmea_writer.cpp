@@ -46,7 +46,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   s.age = take(p, n);
   const double q = take(p, n);
   s.quality = static_cast<gvins::SolutionQuality>(std::isfinite(q) ? static_cast<int>(std::fabs(std::fmod(q, 7.0))) : 0);
-  s.numSatellites = static_cast<int>(std::isfinite(q) ? std::fmod(q * 1000.0, 1000.0) : 0);
+  // fmod first: q * 1000 may overflow to infinity, and fmod(inf) is NaN, whose cast is undefined.
+  s.numSatellites = static_cast<int>(std::isfinite(q) ? std::fmod(q, 1.0) * 1000.0 : 0);
   if (n >= 24) {
     Eigen::Vector3d v;
     for (int i = 0; i < 3; ++i) v[i] = take(p, n);

@@ -5,10 +5,14 @@
 #include "gvins/base/parse_error.hpp"
 #include "gvins/gnss/spp_config.hpp"
 
+#include "../fuzz/parse_error_check.hpp"
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string_view text(reinterpret_cast<const char*>(data), size);
   try {
-    gvins::parseSppConfig(std::string_view(reinterpret_cast<const char*>(data), size), "fuzz.yaml");
-  } catch (const gvins::ParseError&) {
+    gvins::parseSppConfig(text, "fuzz.yaml");
+  } catch (const gvins::ParseError& e) {
+    gvins::fuzz::checkParseError(e, "fuzz.yaml", text);
   }
   return 0;
 }

@@ -173,6 +173,23 @@ TEST(Nmea, RmcSpeedCourse) {
   const auto n = parseSentence(nmeaRmc(s));
   EXPECT_EQ(n[7], "");
   EXPECT_EQ(n[8], "");
+  // 50 km/s west is still written (97192.0 kn, course 270); a horizontal velocity beyond 99999.999
+  // kn is no ground speed: speed and course are left empty, not cut to the field buffer (found by
+  // fuzz_nmea_writer: 1e88 m/s gave a 163-character sentence with a truncated number).
+  s.velocity = r.transpose() * Eigen::Vector3d(-50000.0, 0.0, 0.0);
+  const auto fast = parseSentence(nmeaRmc(s));
+  ASSERT_EQ(fast.size(), 14u);
+  EXPECT_NEAR(std::stod(fast[7]), 50000.0 * 3600.0 / 1852.0, 1e-3);
+  EXPECT_NEAR(std::stod(fast[8]), 270.0, 0.01);
+  for (double v : {52000.0, 1e88, 1e300}) {
+    s.velocity = r.transpose() * Eigen::Vector3d(v, v, 0.0);
+    const std::string sentence = nmeaRmc(s);
+    const auto huge = parseSentence(sentence);
+    ASSERT_EQ(huge.size(), 14u) << sentence;
+    EXPECT_EQ(huge[7], "") << sentence;
+    EXPECT_EQ(huge[8], "") << sentence;
+    EXPECT_EQ(huge[2], "A");  // the position is still valid
+  }
 }
 
 TEST(Nmea, WriterWritesBothSentencesPerEpoch) {

@@ -2,7 +2,7 @@
 // checked, so mostly framing and resynchronisation), odd = one message payload handed straight
 // to the message decoders (past the CRC gate). Bit 1 selects strict mode (ParseError expected),
 // the next bits the chunk size. Nothing may crash, hang or leak; malformed content must surface
-// as a recorded issue or a ParseError only.
+// as a recorded issue or a ParseError (naming the stream, byte offset and field) only.
 #include <cstdint>
 #include <cstdlib>
 
@@ -32,9 +32,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     dec.finish();
     while (dec.poll()) {
     }
-  } catch (const gvins::ParseError&) {
+  } catch (const gvins::ParseError& e) {
     if (!opt.strict) std::abort();  // only strict mode may throw
+    // The error names the stream, the frame's byte offset and the field.
+    if (e.file() != opt.streamName || e.line() < 0 || e.line() >= static_cast<std::int64_t>(size) ||
+        e.field().empty())
+      std::abort();
   }
   if (dec.stats().issues.size() > opt.maxIssues) std::abort();
+  for (const gvins::rtcm::DecodeIssue& i : dec.stats().issues) {
+    if (i.field.empty() || i.what.empty() || i.offset < 0 || i.offset >= static_cast<std::int64_t>(size)) std::abort();
+  }
   return 0;
 }

@@ -164,6 +164,34 @@ TEST(NtripResponse, ErrorsAreClassified) {
   EXPECT_EQ(kindOf(many).first, Kind::Protocol);
 }
 
+TEST(NtripResponse, SourceTableEndIsFoundAcrossPieces) {
+  // The end marker is searched in the new bytes only: it must still be found when it straddles
+  // pieces, at exactly the byte that completes it, and not before.
+  const std::string head = "SOURCETABLE 200 OK\r\n\r\n";
+  const std::string table = "STR;AAA;x\r\nSTR;ENDSOURCETABL;y\r\nSTR;BBB;z\r\nENDSOURCETABLE\r\n";
+  const std::string text = head + table;
+  const std::size_t last = text.rfind("ENDSOURCETABLE") + std::string_view("ENDSOURCETABLE").size() - 1;
+  for (std::size_t piece : {std::size_t{1}, std::size_t{2}, std::size_t{5}, std::size_t{13}, std::size_t{14}}) {
+    NtripResponse r("MNT");
+    std::vector<std::uint8_t> payload;
+    std::size_t thrownAt = 0;
+    std::string message;
+    try {
+      for (std::size_t pos = 0; pos < text.size(); pos += piece) {
+        thrownAt = std::min(pos + piece, text.size()) - 1;
+        r.feed(bytesOf(std::string_view(text).substr(pos, piece)), payload);
+      }
+    } catch (const NtripError& e) {
+      EXPECT_EQ(e.kind(), Kind::MountpointNotFound);
+      message = e.what();
+    }
+    // The piece that holds the marker's last byte is the one that throws.
+    EXPECT_EQ(thrownAt, std::min(last / piece * piece + piece, text.size()) - 1)
+        << "piece " << piece;
+    EXPECT_NE(message.find("3 mountpoints: AAA, ENDSOURCETABL, BBB"), std::string::npos) << message;
+  }
+}
+
 // ---- a scripted caster on loopback -------------------------------------------------------------
 
 class ScriptedCaster {

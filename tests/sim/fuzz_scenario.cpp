@@ -7,12 +7,15 @@
 #include "gvins/base/parse_error.hpp"
 #include "gvins/sim/scenario.hpp"
 
+#include "../fuzz/parse_error_check.hpp"
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
   try {
     const gvins::sim::Scenario sc = gvins::sim::parseScenario(text, "fuzz.yaml");
     (void)sc;
-  } catch (const gvins::ParseError&) {
+  } catch (const gvins::ParseError& e) {
+    gvins::fuzz::checkParseError(e, "fuzz.yaml", text);
   }
   return 0;
 }

@@ -80,5 +80,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (frameBytes + st.skippedBytes != st.bytes) std::abort();  // every byte is a frame's or skipped
   const auto& ds = dec.stats();
   if (ds.stream.bytes != static_cast<std::int64_t>(n) || ds.epochs != epochs) std::abort();
+  // Every malformed message noted names its frame's offset and the field.
+  for (const auto& i : ds.issues) {
+    if (i.field.empty() || i.what.empty() || i.offset < 0 || i.offset >= static_cast<std::int64_t>(n)) std::abort();
+  }
   return 0;
 }

@@ -9,6 +9,8 @@
 #include "gvins/vio/euroc_csv.hpp"
 #include "gvins/vio/tum_trajectory.hpp"
 
+#include "../fuzz/parse_error_check.hpp"
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
   const std::string_view text(reinterpret_cast<const char*>(data) + 1, size - 1);
@@ -40,7 +42,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         gvins::vio::parseTumTrajectory(text, "traj.txt", gvins::vio::TumTimeUnit::Nanoseconds);
         break;
     }
-  } catch (const gvins::ParseError&) {
+  } catch (const gvins::ParseError& e) {
+    static constexpr const char* kFiles[] = {"imu.csv", "cam.csv", "gt.csv", "traj.txt", "traj.txt"};
+    gvins::fuzz::checkParseError(e, kFiles[data[0] % 5], text);
   }
   return 0;
 }

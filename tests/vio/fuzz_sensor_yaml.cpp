@@ -6,6 +6,8 @@
 #include "gvins/base/parse_error.hpp"
 #include "gvins/vio/sensor_yaml.hpp"
 
+#include "../fuzz/parse_error_check.hpp"
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;
   const std::string_view text(reinterpret_cast<const char*>(data) + 1, size - 1);
@@ -21,7 +23,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         gvins::vio::parseKalibrCamchain(text, "camchain.yaml");
         break;
     }
-  } catch (const gvins::ParseError&) {
+  } catch (const gvins::ParseError& e) {
+    gvins::fuzz::checkParseError(e, data[0] % 3 == 2 ? "camchain.yaml" : "sensor.yaml", text);
   }
   return 0;
 }
