@@ -23,8 +23,8 @@
 #   outages       GNSS removed at 20, 50, 80 and 110 s for 15 s each: the rows re-acquire after
 #                 the drift ("re-acquiring" warning) and H RMS 7.18 m (bound 10; without the
 #                 re-acquisition every epoch after the second outage was gated out and the error
-#                 grew past 150 m); single outages at 40 and 100 s drift 6.3 and 9.6 m
-#                 (vio+dopp+ppp at 100 s: 8.2 m), bound 12 m (walk_compare.py drift)
+#                 grew past 150 m); single outages at 40 and 100 s drift 6.3 and 9.3 m
+#                 (vio+dopp+ppp at 100 s: 6.3 m), bound 12 m (walk_compare.py drift)
 #   tests/fusion/real_walk_quirks.sh BIN_DIR TEST_DATA_DIR PYTHON3
 set -u
 BIN=$1
