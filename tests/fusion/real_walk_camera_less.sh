@@ -19,9 +19,7 @@ BIN=$1
 DATA=$2
 . "$(dirname "$0")/real_walk_common.sh"
 walk_dataset "$W/ds"
-"$BIN/gvins-replay" "$W/ds" --mode vio+dopp+psr --config "$W/sf.yaml" --rover "$UBX" \
-  --truth-pos "$REF" --imu-gaps warn -q -o "$W/psr" >"$W/psr.out" 2>&1 ||
-  { cat "$W/psr.out"; exit 1; }
+walk_replay psr vio+dopp+psr --config "$W/sf.yaml"
 M=$W/psr/metrics.csv
 grep -q "camera-less" "$W/psr.out" || { echo "FAIL the summary does not say camera-less"; fail=1; }
 check frames_initialized "$(metric frames_initialized "$M")" ">=" 1300
@@ -39,18 +37,14 @@ grep -q "joins late" "$W/psr.out" || { echo "FAIL no notice of a system joining 
 # GPS pairs L1 C/A with L2C (the LNAV clock's own L1/L2 reference); with L1/L5 pairs, whose ISCs
 # only CNAV carries, the mean height was -7.3 m, and -10.0 m before T_GD was applied to L5 unscaled
 # (docs/gnss_fusion.md, psr rows).
-"$BIN/gvins-replay" "$W/ds" --mode vio+dopp+psr --rover "$UBX" \
-  --truth-pos "$REF" --imu-gaps warn -q -o "$W/if" >"$W/if.out" 2>&1 ||
-  { cat "$W/if.out"; exit 1; }
+walk_replay if vio+dopp+psr
 I=$W/if/metrics.csv
 check if_global_horizontal_rmse_m "$(metric global_horizontal_rmse_m "$I")" "<=" 9
 check if_global_vertical_rmse_m "$(metric global_vertical_rmse_m "$I")" "<=" 6
 # vio+dopp+ppp on broadcast orbits and clocks (no products of the day): H 6.89 m, V 4.43 m RMS
 # (mean U -4.4 m; -11.1 m with L1/L5 pairs and the scaled L5 T_GD), velocity 0.206 m/s
 # (ionosphere-free pairs of GPS and Galileo, BeiDou single-frequency B3I).
-"$BIN/gvins-replay" "$W/ds" --mode vio+dopp+ppp --rover "$UBX" \
-  --truth-pos "$REF" --imu-gaps warn -q -o "$W/ppp" >"$W/ppp.out" 2>&1 ||
-  { cat "$W/ppp.out"; exit 1; }
+walk_replay ppp vio+dopp+ppp
 P=$W/ppp/metrics.csv
 check ppp_global_horizontal_rmse_m "$(metric global_horizontal_rmse_m "$P")" "<=" 9
 check ppp_global_vertical_rmse_m "$(metric global_vertical_rmse_m "$P")" "<=" 6

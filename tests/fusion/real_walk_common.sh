@@ -34,5 +34,14 @@ walk_dataset() {
   walk_imu "$1/mav0/imu0/data.csv"
   cp "$WALK/imu0_sensor.yaml" "$1/mav0/imu0/sensor.yaml"
 }
+# walk_replay NAME MODE [REPLAY OPTIONS...]: the walk dataset $W/ds replayed with the log as the
+# rover against the reference into $W/NAME (its output in $W/NAME.out, shown when it fails).
+walk_replay() {
+  local name=$1 mode=$2
+  shift 2
+  "$BIN/gvins-replay" "$W/ds" --mode "$mode" "$@" --rover "$UBX" \
+    --truth-pos "$REF" --imu-gaps warn -q -o "$W/$name" >"$W/$name.out" 2>&1 ||
+    { cat "$W/$name.out"; exit 1; }
+}
 # Single-frequency fusion with the broadcast ionosphere.
 printf 'gnss_fusion:\n  ionosphere: broadcast\n' >"$W/sf.yaml"
