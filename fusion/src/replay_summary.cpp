@@ -79,9 +79,9 @@ void ReplaySummary::writeMetrics(std::ostream& os) const {
 void ReplaySummary::print(std::ostream& os) const {
   char b[200];
   os << "------------------------------------------------------------\n";
-  auto row = [&](const char* k, const std::string& v) {
-    std::snprintf(b, sizeof b, "%-30s %s\n", k, v.c_str());
-    os << b;
+  auto row = [&](const char* k, const std::string& v) {  // the value streamed whole, however long
+    std::snprintf(b, sizeof b, "%-30s ", k);
+    os << b << v << '\n';
   };
   auto f = [&](const char* fmt, double v) {
     std::snprintf(b, sizeof b, fmt, v);
@@ -144,9 +144,7 @@ void ReplaySummary::print(std::ostream& os) const {
         for (const auto& [sat, n] : reacquisitionExcluded) t += sat.str() + (n > 1 ? "×" + std::to_string(n) : "") + " ";
         t.back() = ')';
       }
-      char k[32];  // the list may be longer than row()'s buffer
-      std::snprintf(k, sizeof k, "%-30s ", "GNSS re-acquisition");
-      os << k << t << '\n';
+      row("GNSS re-acquisition", t);
     }
     if (frameRestarts > 0)
       row("frame restarts", std::to_string(frameRestarts) + " (a start that was not linear dropped the state; warnings)");
