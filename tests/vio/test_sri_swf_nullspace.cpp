@@ -26,6 +26,7 @@
 #include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
+#include "gvins/vio/external_initial_state.hpp"
 #include "gvins/vio/sri_swf_estimator.hpp"
 #include "vio_sim_scene.hpp"
 
@@ -177,6 +178,88 @@ TEST(SriSwfNullspace, FloatUpdatesKeepTheNullspace) {
     ASSERT_TRUE(f.step.count(k)) << k;
     EXPECT_LT(f.step.at(k).max_gain, 1e-3) << k;
   }
+}
+
+// Yaw σ of the newest pose about the world z axis, rad.
+double yawSigma(const SriSwfEstimator<double>& est) {
+  const Eigen::Matrix3d Rw = est.newestImuState().R_WI;
+  const Eigen::Matrix3d Pt = est.poseCovariance().topLeftCorner<3, 3>();
+  return std::sqrt(Eigen::Vector3d::UnitZ().dot(Rw * Pt * Rw.transpose() * Eigen::Vector3d::UnitZ()));
+}
+
+struct ExternalStartRun {
+  double sigma0 = 0;     // yaw σ right after initializeFrom, rad
+  double sigma = 0;      // after 4 s of frames, rad
+  double visual = 0;     // Σ log(σ_after / σ_before) over the visual steps (< 0: yaw information gained)
+  int visual_steps = 0;
+};
+
+// Started from outside (EstimatorBackend::initializeFrom, as the GNSS/INS start does) at the
+// first frame with the true state turned 4° in yaw, a 10° yaw prior and no information on the
+// velocity (σ 20 m/s: a velocity prior in the world frame would carry yaw information that vision
+// legitimately turns into the body-frame direction of travel), then 4 s of frames alone.
+ExternalStartRun runExternalStart(const test::SimScene& sc, const SriSwfConfig& cfg) {
+  SriSwfEstimator<double> est(cfg);
+  const std::int64_t t0 = sc.frames.front().t_ns;
+  std::size_t k = 0;
+  while (k < sc.imu.size() && sc.imu[k].t_ns <= t0 + 20'000'000) est.addImu(sc.imu[k++]);
+  ExternalInitialState x;
+  x.state = sc.truth(t0);
+  const Eigen::Matrix3d Rz = Eigen::AngleAxisd(4.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  x.state.R_WI = Rz * x.state.R_WI;
+  x.state.v_WI = Rz * x.state.v_WI;
+  const double sy = 10.0 * M_PI / 180.0, st = 0.5 * M_PI / 180.0;
+  const Eigen::Matrix3d Pw = Eigen::Vector3d(st * st, st * st, sy * sy).asDiagonal();
+  x.covariance.block<3, 3>(ImuErr::kTheta, ImuErr::kTheta) = x.state.R_WI.transpose() * Pw * x.state.R_WI;
+  x.covariance.block<3, 3>(ImuErr::kPos, ImuErr::kPos).diagonal().setConstant(1.0);
+  x.covariance.block<3, 3>(ImuErr::kVel, ImuErr::kVel).diagonal().setConstant(20.0 * 20.0);
+  x.covariance.block<3, 3>(ImuErr::kBg, ImuErr::kBg).diagonal().setConstant(0.005 * 0.005);
+  x.covariance.block<3, 3>(ImuErr::kBa, ImuErr::kBa).diagonal().setConstant(0.1 * 0.1);
+  ExternalStartRun run;
+  if (!est.initializeFrom(x)) return run;
+  run.sigma0 = yawSigma(est);
+  double before = run.sigma0;
+  est.setStepObserver([&](const char* step) {
+    const double s = yawSigma(est);
+    const std::string name(step);
+    if (name == "msckf_update" || name == "slam_update" || name == "slam_init") {
+      run.visual += std::log(s / before);
+      ++run.visual_steps;
+    }
+    before = s;
+  });
+  for (const FeatureFrame& fr : sc.frames) {
+    if (fr.t_ns <= t0) continue;
+    if (static_cast<double>(fr.t_ns - t0) * 1e-9 > 4.0) break;
+    while (k < sc.imu.size() && sc.imu[k].t_ns <= fr.t_ns + 20'000'000) est.addImu(sc.imu[k++]);
+    est.processFrame(fr);
+  }
+  run.sigma = yawSigma(est);
+  std::fprintf(stderr, "  first_estimate_delay %.1f s: yaw sigma %.3f deg at the start, %.3f deg after 4 s (%d visual steps, "
+               "sum of their log ratios %.3g)\n", cfg.first_estimate_delay, run.sigma0 * 180 / M_PI, run.sigma * 180 / M_PI,
+               run.visual_steps, run.visual);
+  return run;
+}
+
+// Vision alone cannot observe the global yaw: after an external start with a wide yaw prior the
+// visual updates must leave the yaw σ as it was. With first estimates from the first clone
+// (first_estimate_delay 0) they do (measured 10.000° -> 9.976°, the gyro's share). Within the
+// default delay (2 s; docs/vio_estimator.md) the clones are linearised at their current estimates
+// while the IMU rows keep the points they were propagated at, and the visual rows then gain yaw
+// information no measurement carries (measured 10° -> 0.62° in 4 s); harmless after a visual
+// initialisation, whose yaw is the gauge, not after an external start.
+TEST(SriSwfNullspace, ExternalStartVisualUpdatesKeepTheYawSigmaWithFirstEstimates) {
+  const test::SimScene& sc = scene().sc;
+  SriSwfConfig cfg = sc.config();
+  cfg.first_estimate_delay = 0.0;
+  const ExternalStartRun fej = runExternalStart(sc, cfg);
+  ASSERT_NEAR(fej.sigma0, 10.0 * M_PI / 180.0, 1e-3 * fej.sigma0);
+  EXPECT_GT(fej.visual_steps, 100);
+  EXPECT_GT(fej.sigma, 0.99 * fej.sigma0);
+  EXPECT_GT(fej.visual, -0.01);
+  // The default delay, for the record of the limitation (a fix makes this fail: then assert as above).
+  const ExternalStartRun delayed = runExternalStart(sc, sc.config());
+  EXPECT_LT(delayed.sigma, 0.2 * delayed.sigma0);
 }
 
 }  // namespace
