@@ -19,20 +19,14 @@ namespace {
 
 constexpr double kC = constants::kSpeedOfLight;
 
-/// White noise and multipath of a code of zenith sigma `sigma` (m²): `elevation` weighting,
-/// sigma² (0.5 + 0.5 / sin² el); `elevation-cn0`, the elevation + C/N0 model of
-/// measurement_weighting.hpp (a = b = sigma / √2, no system factor: the ephemeris error carries
-/// the system's part here), which falls back to the elevation model without a C/N0.
-double codeNoiseVariance(const GnssFusionConfig& c, double sigma, System sys, double elevation, double cn0) {
-  if (c.codeWeighting == GnssCodeWeighting::kElevationCn0) {
-    MeasurementWeighting w;
-    w.scheme = WeightingScheme::ElevationSnr;
-    w.a = w.b = sigma * std::sqrt(0.5);
-    w.systemFactor.fill(1.0);
-    return w.codeVariance(sys, elevation, cn0);
-  }
-  const double sinEl = std::max(std::sin(elevation), 0.1);
-  return sigma * sigma * (0.5 + 0.5 / (sinEl * sinEl));
+/// The code noise model of the shared weighting (measurement_weighting.hpp) at zenith sigma
+/// `sigma` split evenly: `elevation` weighting, sigma² (½ + ½ / sin² el); `elevation-cn0`, the
+/// elevation + C/N0 model (falls back to the elevation model without a C/N0). No system factor:
+/// the ephemeris error carries the system's part here.
+MeasurementWeighting codeWeighting(const GnssFusionConfig& c, double sigma) {
+  return MeasurementWeighting::evenSplit(
+      c.codeWeighting == GnssCodeWeighting::kElevationCn0 ? WeightingScheme::ElevationSnr : WeightingScheme::Elevation,
+      sigma);
 }
 
 /// C/N0 of a signal, dB-Hz (0 unknown).
@@ -112,10 +106,12 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
     // to `smoothed_code_factor` of the raw sigma.
     const double smoothingFactor =
         smoother_ ? std::max(config_.smoothedCodeFactor, smoother_->noiseFactor(so.sat)) : 1.0;
+    const MeasurementWeighting weighting = codeWeighting(config_, config_.codeSigma * smoothingFactor);
     // Dual frequency: the ionosphere-free pair with the first other band tracked (`bands`: the
     // SPP band order; secondCode: GPS/QZSS L2C, L5, then L2 P(Y)), group delays combined alike;
-    // its noise is the single-band noise times sqrt(a1² + a2²) (2.98 for L1/L2, 2.59 for L1/L5)
-    // and it carries no ionospheric model error.
+    // its noise is a1² var(P1) + a2² var(P2), each band with its own C/N0 (the SPP's combination
+    // variance; 2.98² times one band's for L1/L2 at equal C/N0), and it carries no ionospheric
+    // model error.
     if (config_.ionosphere == GnssIonosphere::kDualFrequency) {
       if (const auto second = secondCode(so, order, order.size(), band, channel)) {
         const SignalObs* s2 = second->signal;
@@ -129,12 +125,12 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
         m.code2 = s2->code;
         m.ifA1 = c.a1;
         m.ifA2 = c.a2;
-        // The lower C/N0 of the two bands where both are known.
         const double cn02 = cn0Of(*s2);
+        m.codeVariance =
+            weighting.combinationCodeVariance(so.sat.system, m.azel.elevation, c.a1, m.cn0, c.a2, cn02) +
+            ephemerisVariance;
+        // The pair's C/N0 (the C/N0 mask): the lower of the two bands where both are known.
         if (cn02 > 0.0 && (m.cn0 <= 0.0 || cn02 < m.cn0)) m.cn0 = cn02;
-        m.codeVariance = codeNoiseVariance(config_, config_.codeSigma * c.noiseFactor() * smoothingFactor, so.sat.system,
-                                           m.azel.elevation, m.cn0) +
-                         ephemerisVariance;
         // vio+dopp+ppp: the ionosphere-free phase of the same bands (the phase of another
         // tracking mode on a band only shifts the float ambiguity).
         if (config_.mode == GnssFusionMode::kDoppPpp) {
@@ -155,9 +151,8 @@ std::vector<SatelliteModel> GnssFusion<Scalar>::satelliteModels(const ObsEpoch& 
       // evaluated only here (an ionosphere-free pair needs none), and 30 % of it in the code
       // variance (Klobuchar corrects about half of the delay; IS-GPS-200N 20.3.3.5.2.5).
       m.ionosphere = singleFrequency ? terms.ionosphere.slant : model.ionosphere(so.sat.system, m.azel, *f).slant;
-      m.codeVariance =
-          codeNoiseVariance(config_, config_.codeSigma * smoothingFactor, so.sat.system, m.azel.elevation, m.cn0) +
-          std::pow(0.3 * m.ionosphere, 2) + ephemerisVariance;
+      m.codeVariance = weighting.codeVariance(so.sat.system, m.azel.elevation, m.cn0) +
+                       std::pow(0.3 * m.ionosphere, 2) + ephemerisVariance;
     }
     m.dopplerVariance = std::pow(config_.dopplerSigma, 2) * (0.5 + 0.5 / (sinEl * sinEl));
     const SignalObs* d = s->hasDoppler() ? s : nullptr;

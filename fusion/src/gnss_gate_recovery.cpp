@@ -245,9 +245,7 @@ ReacquisitionTally GnssGateRecovery::outcome(const GpsTime& t, std::size_t rows,
   const bool admitted =
       selection && std::find(selection->admitted.begin(), selection->admitted.end(), true) != selection->admitted.end();
   if (admitted && input && applied) {
-    ++admissions_;
     tally = tallyReacquisition(*input, *selection);
-    rowsExcluded_ += tally.excluded;
     char buf[80];
     std::snprintf(buf, sizeof buf, "GNSS re-acquisition at %d %.3f: ", t.week(), t.tow());
     warnings_.push_back(buf + describeReacquisition(*input, *selection) +

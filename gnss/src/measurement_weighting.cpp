@@ -22,6 +22,14 @@ double shape(const MeasurementWeighting& w, double a2, double b2, double elevati
 }
 }  // namespace
 
+MeasurementWeighting MeasurementWeighting::evenSplit(WeightingScheme scheme, double sigma) {
+  MeasurementWeighting w;
+  w.scheme = scheme;
+  w.a = w.b = sigma * std::sqrt(0.5);
+  w.systemFactor.fill(1.0);
+  return w;
+}
+
 double MeasurementWeighting::codeVariance(System sys, double elevation, double snr) const {
   const double f = systemFactor[systemIndex(sys)];
   return f * f * shape(*this, a * a, b * b, elevation, snr);

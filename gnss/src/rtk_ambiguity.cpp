@@ -142,15 +142,6 @@ bool RtkSolver::arCovariance(const std::vector<ArPair>& pairs, Eigen::VectorXd& 
   return true;
 }
 
-double RtkSolver::conditionedIonosphere(const ConditionedFix& f, const SingleDifference& s,
-                                        const SingleDifference& r) const {
-  auto value = [&](const SingleDifference& sd) {
-    const auto it = f.ionosphere.find(satIndex(sd.sat));
-    return it == f.ionosphere.end() ? ionosphereEstimate(sd.sat) : it->second;
-  };
-  return ionosphereFactor(s) * value(s) - ionosphereFactor(r) * value(r);
-}
-
 ArStatus RtkSolver::checkFix(const std::vector<ArPair>& pairs, const RtkSolution& sol, const ConditionedFix& f) {
   // 1. Precision: a fix must determine the position. Partial fixing can fix combinations that
   //    the geometry does not see (with few satellites and one epoch of code, the n − 3
@@ -182,7 +173,7 @@ ArStatus RtkSolver::checkFix(const std::vector<ArPair>& pairs, const RtkSolution
     const double nref = filter_.estimate(p.refId).vector[0];
     const double v = sdPhaseResidual(s, f.position) - sdPhaseResidual(r, f.position) -
                      (s.wavelength * f.ambiguities[static_cast<Eigen::Index>(k)] + (s.wavelength - r.wavelength) * nref) +
-                     conditionedIonosphere(f, s, r);
+                     ddIonosphere(s, r, &f.ionosphere);
     if (std::abs(v) > cfg_.fixValidationSigmas * std::sqrt(s.phaseVariance + r.phaseVariance)) {
       ++counters_.rejectedFixes;
       return ArStatus::Rejected;
@@ -192,8 +183,8 @@ ArStatus RtkSolver::checkFix(const std::vector<ArPair>& pairs, const RtkSolution
   //    fix of a weak model) leave code residuals of several sigma.
   for (const DoubleDifference& d : dd_.code) {
     const DdResidual r = ddCodeResidual(dd_, d, f.position);
-    const double v = r.residual - conditionedIonosphere(f, dd_.sd[static_cast<std::size_t>(d.satellite)],
-                                                        dd_.sd[static_cast<std::size_t>(d.reference)]);
+    const double v = r.residual - ddIonosphere(dd_.sd[static_cast<std::size_t>(d.satellite)],
+                                               dd_.sd[static_cast<std::size_t>(d.reference)], &f.ionosphere);
     if (std::abs(v) > cfg_.fixCodeValidationSigmas * std::sqrt(r.variance)) {
       ++counters_.rejectedFixes;
       return ArStatus::Rejected;
@@ -338,7 +329,7 @@ void RtkSolver::resolve(RtkSolution& sol) {
     // The DD phase's bias with its conditioned ionospheric advance (long baselines).
     d.ambiguityMeters = dd_.sd[static_cast<std::size_t>(d.satellite)].wavelength * ints[i] +
                         (dd_.sd[static_cast<std::size_t>(d.satellite)].wavelength - f.wavelength) * ambiguityEstimate(f) -
-                        conditionedIonosphere(cf, dd_.sd[static_cast<std::size_t>(d.satellite)], f);
+                        ddIonosphere(dd_.sd[static_cast<std::size_t>(d.satellite)], f, &cf.ionosphere);
   }
 
   // 7. Fix-and-hold: validated, confirmed fixes only, after holdMinFixes of them in a row.

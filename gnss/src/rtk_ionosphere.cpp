@@ -22,11 +22,15 @@ double RtkSolver::ionosphereSigma(double elevation) const {
   return zenith * klobucharObliquity(std::max(elevation, 0.0));
 }
 
-double RtkSolver::ionosphereFactor(const SingleDifference& sd) {
+double ionosphereDelayFactor(double wavelength) {
   static const double l1 = *carrierWavelength(System::Gps, '1');
-  if (!(sd.wavelength > 0.0)) return 0.0;
-  const double r = sd.wavelength / l1;
+  if (!(wavelength > 0.0)) return 0.0;
+  const double r = wavelength / l1;
   return r * r;
+}
+
+double ddIonosphericDelay(double wavelengthS, double ionosphereS, double wavelengthR, double ionosphereR) {
+  return ionosphereDelayFactor(wavelengthS) * ionosphereS - ionosphereDelayFactor(wavelengthR) * ionosphereR;
 }
 
 double RtkSolver::ionosphereEstimate(SatId sat) const {
@@ -39,16 +43,24 @@ sri::BlockId RtkSolver::ionosphereBlock(SatId sat) const {
   return it == iono_.end() ? sri::BlockId{} : it->second.id;
 }
 
-double RtkSolver::ddIonosphere(const SingleDifference& s, const SingleDifference& r) const {
-  return ionosphereFactor(s) * ionosphereEstimate(s.sat) - ionosphereFactor(r) * ionosphereEstimate(r.sat);
+double RtkSolver::ddIonosphere(const SingleDifference& s, const SingleDifference& r,
+                               const std::unordered_map<int, double>* conditioned) const {
+  auto value = [&](SatId sat) {
+    if (conditioned) {
+      const auto it = conditioned->find(satIndex(sat));
+      if (it != conditioned->end()) return it->second;
+    }
+    return ionosphereEstimate(sat);
+  };
+  return ddIonosphericDelay(s.wavelength, value(s.sat), r.wavelength, value(r.sat));
 }
 
 void RtkSolver::ionosphereColumns(sri::Measurement<double>& m, int row, const SingleDifference& s,
                                   const SingleDifference& r, double sign) const {
   const sri::BlockId is = ionosphereBlock(s.sat), ir = ionosphereBlock(r.sat);
   // (jacobian() of a new block reallocates: take the block afresh each time.)
-  if (is.valid()) m.jacobian(is, 1)(row, 0) += sign * ionosphereFactor(s);
-  if (ir.valid()) m.jacobian(ir, 1)(row, 0) -= sign * ionosphereFactor(r);
+  if (is.valid()) m.jacobian(is, 1)(row, 0) += sign * ionosphereDelayFactor(s.wavelength);
+  if (ir.valid()) m.jacobian(ir, 1)(row, 0) -= sign * ionosphereDelayFactor(r.wavelength);
 }
 
 void RtkSolver::manageIonosphere() {

@@ -820,6 +820,7 @@ void SppSolver::Fit::reportCovariance() {
   in.ionosphereCorrelationLength = re.ionosphereCorrelationLength;
   in.dof = sol.dof;
   in.minVarianceFactor = re.minVarianceFactor;
+  in.excessCorrelation = re.excessCorrelation;
   const detail::ReportedCovariance rc = detail::reportedCovariance(in, cfg.covarianceScaling);
   sol.varianceFactor = rc.varianceFactor;
   sol.positionCovariance = rc.covariance.topLeftCorner<3, 3>();

@@ -27,11 +27,13 @@ namespace {
 using Reader = YamlReader;
 
 void applyReportedError(const Reader& r, const YAML::Node& v, const std::string& full, ReportedErrorModel& m) {
-  static const std::set<std::string> kE = {"enabled", "noise_scale", "ionosphere_correlation_km", "min_variance_factor"};
+  static const std::set<std::string> kE = {"enabled", "noise_scale", "ionosphere_correlation_km", "min_variance_factor",
+                                          "excess_correlation"};
   r.map(v, full, kE, [&](const std::string& ek, const std::string& ef, const YAML::Node& ev) {
     if (ek == "enabled") m.enabled = r.boolean(ev, ef);
     else if (ek == "noise_scale") m.noiseScale = r.number(ev, ef, 0.0, 100.0);
     else if (ek == "min_variance_factor") m.minVarianceFactor = r.number(ev, ef, 0.0, 1.0);
+    else if (ek == "excess_correlation") m.excessCorrelation = r.number(ev, ef, 0.0, 1.0);
     else m.ionosphereCorrelationLength = r.number(ev, ef, 1.0, 1e5) * 1e3;
   });
 }

@@ -142,7 +142,19 @@ ReportedCovariance reportedCovariance(const ReportedInputs& in, const Covariance
           std::max(out.varianceFactor, medianVarianceFactor(in, kept, excluded, a, g0, rIndAll, rCommonAll));
     }
   }
-  out.covariance = out.varianceFactor * g * rInd * g.transpose() + g * rCommon * g.transpose() + in.q * nIsb * in.q;
+  const double k = out.varianceFactor;
+  if (k > 1.0 && in.excessCorrelation > 0.0) {
+    // The excess over the noise model, correlated by rho between the rows (one sign: delays that
+    // are never negative): R_exc = (1 - rho) D + rho s s^T, scaled so that its expectation in the
+    // residuals is the excess (k - 1) E_ind that k found.
+    const Eigen::VectorXd sd = rIndependent.cwiseSqrt();
+    const Eigen::MatrixXd rExcess = (1.0 - in.excessCorrelation) * rInd + in.excessCorrelation * sd * sd.transpose();
+    const double eExcess = expected(rExcess);
+    out.excessFactor = eExcess > 0.0 ? (k - 1.0) * eInd / eExcess : 0.0;
+    out.covariance = g * (rInd + out.excessFactor * rExcess + rCommon) * g.transpose() + in.q * nIsb * in.q;
+  } else {
+    out.covariance = k * g * rInd * g.transpose() + g * rCommon * g.transpose() + in.q * nIsb * in.q;
+  }
   out.covariance = 0.5 * (out.covariance + out.covariance.transpose());
   return out;
 }

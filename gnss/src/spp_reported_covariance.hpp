@@ -37,11 +37,13 @@ struct ReportedInputs {
   double ionosphereCorrelationLength = 1.0;  ///< m, between pierce points
   int dof = 0;  ///< degrees of freedom of the fit (no variance factor without)
   double minVarianceFactor = 1.0;  ///< floor of the independent part's variance factor
+  double excessCorrelation = 0.0;  ///< rho of the excess over the noise model (k > 1) between rows
 };
 
 struct ReportedCovariance {
   Eigen::MatrixXd covariance;   ///< k G R G^T + the prior rows' own share
   double varianceFactor = 1.0;  ///< k, of the independent part
+  double excessFactor = 0.0;    ///< x, of the excess R_exc (0 when k <= 1 or rho = 0)
   double chi2 = 0.0;            ///< weighted a-priori residuals (measurements, ionosphere prior)
   double expectedChi2 = 0.0;    ///< its expectation under R (before k)
 };
@@ -70,6 +72,9 @@ Eigen::MatrixXd rowErrorCovariance(const std::vector<ReportedRow>& rows, double 
 /// (v_i^2 - E_common,i) / E_ind,i divided by the median of chi-square with one degree of freedom
 /// (0.4549): a scale estimate that a minority of faults cannot move and the truncation cannot
 /// bias (cf. the MAD scale of robust estimation, Huber 1981, Robust Statistics, ch. 5).
+/// With k > 1 and excessCorrelation rho > 0 the excess k - 1 is not independent: the covariance
+/// is G (R_ind + x R_exc + R_common) G^T + (prior rows), R_exc = (1 - rho) R_ind + rho s s^T
+/// (s_i = sqrt(R_ind,ii)), x = (k - 1) E_ind / E_exc with E_exc its expectation in the residuals.
 ReportedCovariance reportedCovariance(const ReportedInputs& in, const CovarianceScaling& scaling);
 
 }  // namespace gvins::detail

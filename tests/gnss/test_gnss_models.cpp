@@ -248,4 +248,10 @@ TEST(Statistics, WeightingModels) {
   EXPECT_NEAR(w.codeVariance(System::Gps, 0.5, 0.0), 0.09 + 0.16 / std::pow(std::sin(0.5), 2), 1e-12);  // no C/N0
   w.scheme = WeightingScheme::Elevation;
   EXPECT_NEAR(w.dopplerVariance(System::Gps, 0.5 * constants::kPi, 0.0), w.dopplerSigma * w.dopplerSigma, 1e-15);
+  // One zenith sigma split evenly (the fusion's code model): sigma² (1/2 + 1/2 / sin² el) for
+  // every system, and with C/N0 sigma²/2 (10^((45 - C/N0)/10) + 1 / sin² el).
+  const MeasurementWeighting e = MeasurementWeighting::evenSplit(WeightingScheme::Elevation, 0.6);
+  EXPECT_NEAR(e.codeVariance(System::Glonass, 30.0 * kDegToRad, 0.0), 0.36 * (0.5 + 0.5 / 0.25), 1e-12);
+  const MeasurementWeighting es = MeasurementWeighting::evenSplit(WeightingScheme::ElevationSnr, 0.6);
+  EXPECT_NEAR(es.codeVariance(System::Sbas, 30.0 * kDegToRad, 35.0), 0.18 * (10.0 + 4.0), 1e-12);
 }

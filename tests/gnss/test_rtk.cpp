@@ -124,6 +124,26 @@ int rtklibFixed(const std::string& file) {
 // ---------------------------------------------------------------------------------------------
 // Nagoya, 0.99 m baseline.
 
+// The double-differenced ionospheric delay of the ionosphere-weighted model against the
+// first-order delay written from the slant TEC: 40.3 TEC / f² (IS-GPS-200N 20.3.3.3.3.2), with
+// the frequencies of the ICDs: GPS L1/L2/L5, and GLONASS G1 FDMA channels +3 and -4 (1602 MHz +
+// k 0.5625 MHz, GLONASS ICD 5.1), whose pair of different frequencies in one DD is the case
+// where the factors matter most.
+TEST(RtkIonosphere, DoubleDifferencedDelayFromTheSlantTec) {
+  const double c = constants::kSpeedOfLight;
+  const double fL1 = 1575.42e6, fL2 = 1227.60e6, fL5 = 1176.45e6;
+  const double fG3 = 1602.0e6 + 3 * 0.5625e6, fGm4 = 1602.0e6 - 4 * 0.5625e6;
+  const double tecS = 23.0e16, tecR = 17.5e16;  // SD slant TEC of the two satellites, electrons/m²
+  auto delay = [](double tec, double f) { return 40.3 * tec / (f * f); };
+  const double iS = delay(tecS, fL1), iR = delay(tecR, fL1);  // the SD delays on L1 (the states)
+  for (const auto& [fs, fr] : {std::pair{fL1, fL1}, {fL2, fL2}, {fL5, fL5}, {fG3, fGm4}, {fGm4, fG3}}) {
+    const double expected = delay(tecS, fs) - delay(tecR, fr);
+    EXPECT_NEAR(ddIonosphericDelay(c / fs, iS, c / fr, iR), expected, 1e-9 * std::abs(expected)) << fs << " " << fr;
+  }
+  EXPECT_NEAR(ionosphereDelayFactor(c / fL2), std::pow(fL1 / fL2, 2), 1e-12);  // 1.647
+  EXPECT_EQ(ionosphereDelayFactor(0.0), 0.0);  // unknown wavelength
+}
+
 TEST(RtkNagoya, KinematicFixesEveryEpochWithinOneCentimetre) {
   const Dataset& d = nagoya();
   const RunResult r = runRtk(d, nagoyaConfig(), d.base, 0, 301);

@@ -37,7 +37,8 @@ TEST(SppConfig, ParsesEveryKey) {
       "  velocity: false\n"
       "  carrier_smoothing_s: 60\n"
       "  allow_unhealthy: true\n"
-      "  reported_error: {enabled: false, noise_scale: 0.5, ionosphere_correlation_km: 1500, min_variance_factor: 0.5}\n";
+      "  reported_error: {enabled: false, noise_scale: 0.5, ionosphere_correlation_km: 1500, min_variance_factor: 0.5,\n"
+      "                   excess_correlation: 0.25}\n";
   const SppConfig c = parseSppConfig(y, "all.yaml");
   EXPECT_TRUE(c.useSystem(System::Gps) && c.useSystem(System::Galileo) && c.useSystem(System::BeiDou));
   EXPECT_FALSE(c.useSystem(System::Glonass) || c.useSystem(System::Qzss));
@@ -66,6 +67,7 @@ TEST(SppConfig, ParsesEveryKey) {
   EXPECT_EQ(c.reportedError.noiseScale, 0.5);
   EXPECT_DOUBLE_EQ(c.reportedError.ionosphereCorrelationLength, 1500e3);
   EXPECT_EQ(c.reportedError.minVarianceFactor, 0.5);
+  EXPECT_EQ(c.reportedError.excessCorrelation, 0.25);
   EXPECT_FALSE(c.ionosphereEstimation.enabled);
   EXPECT_EQ(c.maxGdop, 20.0);
   EXPECT_FALSE(c.qzssUsesGpsClock);
@@ -127,6 +129,7 @@ TEST(SppConfig, ErrorsNameFileLineAndKey) {
   expectError("spp:\n  reported_error: {noise_scale: -1}\n", 2, "spp.reported_error.noise_scale", "outside");
   expectError("spp:\n  reported_error: {scale: 1}\n", 2, "spp.reported_error.scale", "unknown key");
   expectError("spp:\n  reported_error: {min_variance_factor: 2}\n", 2, "spp.reported_error.min_variance_factor", "outside");
+  expectError("spp:\n  reported_error: {excess_correlation: -0.1}\n", 2, "spp.reported_error.excess_correlation", "outside");
   expectError("spp:\n  carrier_smoothing_s: -1\n", 2, "spp.carrier_smoothing_s", "");
   expectError("spp: [1, 2\n", 2, "YAML", "");
   expectError("- a\n- b\n", 1, "", "map");

@@ -124,16 +124,16 @@ class GnssGateRecovery {
     active_ = false;
   }
   const std::vector<std::string>& warnings() const { return warnings_; }
-  int recoveries() const { return recoveries_; }     ///< re-acquisitions started
-  int admissions() const { return admissions_; }     ///< epochs applied through the re-acquisition gate
-  int rowsExcluded() const { return rowsExcluded_; } ///< consensus-group rows kept out by those tests
+  /// Re-acquisitions started. The rows admitted and excluded are not counted here: outcome()
+  /// returns them per epoch (GnssFusion's epoch report, summed by the replay summary).
+  int recoveries() const { return recoveries_; }
 
  private:
   double after_, acceleration_;
   std::optional<GpsTime> rejectedSince_, lastUpdate_, activeSince_;
   bool active_ = false;
   std::vector<std::string> warnings_;
-  int recoveries_ = 0, admissions_ = 0, rowsExcluded_ = 0;
+  int recoveries_ = 0;
 };
 
 }  // namespace gvins::fusion

@@ -27,6 +27,10 @@ struct MeasurementWeighting {
   /// Per-system factor f_sys (index systemIndex): GLONASS FDMA codes and SBAS are noisier.
   std::array<double, kNumSystems> systemFactor{1.0, 1.5, 1.0, 1.0, 1.0, 3.0, 1.5};
 
+  /// The model of one zenith sigma (m, at the reference C/N0) split evenly between the two parts,
+  /// a = b = sigma / sqrt(2) (Elevation: sigma^2 (1/2 + 1/2 / sin^2 el)), without system factors
+  /// (for users that carry the system's part elsewhere, e.g. in the ephemeris error).
+  static MeasurementWeighting evenSplit(WeightingScheme scheme, double sigma);
   /// Pseudorange variance (m^2) for a system, elevation (rad) and C/N0 (dB-Hz, <= 0: unknown).
   double codeVariance(System sys, double elevation, double snr) const;
   /// Variance (m^2) of the combination a1 P1 + a2 P2 of two pseudoranges of one satellite with

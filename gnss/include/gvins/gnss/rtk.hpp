@@ -128,6 +128,15 @@ struct RtkCounters {
   std::int64_t unconfirmedFixes = 0;    ///< marginal first fixes held back one epoch
 };
 
+/// μ = (λ / λ_L1)²: the first-order ionospheric delay of a signal of wavelength λ (m) per metre of
+/// delay on GPS L1 (the delay is proportional to 1/f²; IS-GPS-200N 20.3.3.3.3.2); 0 for an unknown
+/// wavelength.
+double ionosphereDelayFactor(double wavelength);
+/// The double-differenced first-order ionospheric delay μ_s I_s − μ_r I_r (m) of a satellite's
+/// signal (wavelength λ_s, m) and the reference's (λ_r), from their single-differenced slant delays
+/// on L1, I_s and I_r (m): the code is delayed by it, the phase advanced.
+double ddIonosphericDelay(double wavelengthS, double ionosphereS, double wavelengthR, double ionosphereR);
+
 class RtkSolver {
  public:
   /// Float solutions with a larger position standard deviation (m, √trace) are not reported.
@@ -275,12 +284,11 @@ class RtkSolver {
   /// The SD slant delay state of a satellite (0 without one) and its block (invalid without one).
   double ionosphereEstimate(SatId sat) const;
   sri::BlockId ionosphereBlock(SatId sat) const;
-  /// μ = (λ / λ_L1)²: the delay of the SD's signal per metre of L1 delay (0 for an unknown wavelength).
-  static double ionosphereFactor(const SingleDifference& sd);
-  /// μ_s I_s − μ_r I_r of a DD at the state estimates (the code delay; the phase advance).
-  double ddIonosphere(const SingleDifference& s, const SingleDifference& r) const;
-  /// μ_s I_s − μ_r I_r at the ionosphere conditioned on a fix (the state estimate where f has none).
-  double conditionedIonosphere(const ConditionedFix& f, const SingleDifference& s, const SingleDifference& r) const;
+  /// μ_s I_s − μ_r I_r of a DD (ddIonosphericDelay; the code delay, the phase advance) at the
+  /// state estimates, or, where `conditioned` (satIndex → SD delay: ConditionedFix::ionosphere)
+  /// has a satellite, at its value conditioned on a fix.
+  double ddIonosphere(const SingleDifference& s, const SingleDifference& r,
+                      const std::unordered_map<int, double>* conditioned = nullptr) const;
   /// Jacobian of row `row` of a DD (satellite s, reference r) w.r.t. their ionosphere states:
   /// sign μ_s and −sign μ_r (code: sign +1; phase: −1).
   void ionosphereColumns(sri::Measurement<double>& m, int row, const SingleDifference& s, const SingleDifference& r,

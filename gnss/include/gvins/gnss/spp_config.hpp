@@ -88,7 +88,12 @@ struct CovarianceScaling {
 /// 1 does not let them: one epoch's residuals have few degrees of freedom and errors correlated
 /// over many epochs, and below 1 the ionosphere-free sigma (nothing correlated left to carry it)
 /// was optimistic on the real walk (docs/spp.md). The correlated part is never scaled down:
-/// residuals do not show it. Calibration: bench/spp/sigma_calibration.py,
+/// residuals do not show it. The excess k > 1 over the noise model is taken as correlated
+/// between satellites by `excessCorrelation` rho, R_exc = (1 - rho) D + rho s s^T (D the
+/// independent variances, s their square roots): non-line-of-sight delays are never negative,
+/// and their common mean goes into the clock and the height unseen by the residuals; its scale is
+/// (k - 1) E_ind / E_exc, the same excess of the residuals' expectation. 0.5: the squared mean
+/// of an exponentially distributed delay is half its second moment. Calibration: bench/spp/sigma_calibration.py,
 /// docs/results/spp_sigma.md. Disabled: the a-priori covariance (H^T W H)^-1 scaled by the
 /// variance factor of the weights (all errors independent), conservative by large factors on
 /// open sky.
@@ -97,6 +102,7 @@ struct ReportedErrorModel {
   double noiseScale = 1.0;
   double ionosphereCorrelationLength = 2000e3;  ///< m
   double minVarianceFactor = 1.0;
+  double excessCorrelation = 0.5;
 };
 
 /// A common correction to the broadcast ionosphere model's zenith delay, estimated with the
@@ -197,7 +203,7 @@ struct SppConfig {
 ///     ionosphere_estimation: {enabled: true, prior_fraction: 1.0, min_prior_sigma_m: 0.3}
 ///     covariance_scaling: {enabled: true, prior_dof: 2}
 ///     reported_error: {enabled: true, noise_scale: 1, ionosphere_correlation_km: 2000,
-///                      min_variance_factor: 1}
+///                      min_variance_factor: 1, excess_correlation: 0.5}
 ///     max_gdop: 30
 ///     isb_prior_sigma_m: 2
 ///     isb_random_walk_m2ps: 0.01
