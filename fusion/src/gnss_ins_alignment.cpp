@@ -42,7 +42,7 @@ void GnssInsAlignment::clear() {
   epochs_.clear();
   pending_.clear();
   status_ = GnssInsStatus::kCollecting;
-  yawSigmaDeg_ = tiltSigmaDeg_ = std::numeric_limits<double>::quiet_NaN();
+  yawSigmaDeg_ = tiltSigmaDeg_ = varianceFactor_ = std::numeric_limits<double>::quiet_NaN();
 }
 
 void GnssInsAlignment::dropOldest() {
@@ -141,42 +141,77 @@ bool GnssInsAlignment::integrateInto(Epoch e, std::span<const vio::ImuSample> im
 namespace {
 
 /// One epoch of the fit: u_k = v_N(t_k) − g_N Δt_k (N) = v_N(t_0) + R_NI0 (β_0k + Jg_k bg + Ja_k ba),
-/// weight w_k (independent per epoch; the first epoch's velocity is an unknown like the others).
+/// weight matrix W_k (independent per epoch; the first epoch's velocity is an unknown like the others).
 struct Pair {
   Eigen::Vector3d u, beta;
   Eigen::Matrix3d Jg, Ja;
-  double w = 0.0;
+  Eigen::Matrix3d W;
 };
 
+Eigen::Vector3d residual(const Pair& p, const Eigen::Matrix3d& R, const Eigen::Vector3d& bg, const Eigen::Vector3d& ba,
+                         const Eigen::Vector3d& v0) {
+  return p.u - v0 - R * (p.beta + p.Jg * bg + p.Ja * ba);
+}
+
 /// Gauss-Newton on [δθ (world), bg, ba, v_0] from R (Wahba), zero biases and v0, with the bias
-/// priors; returns the 12×12 covariance and the weighted residual sum.
+/// priors and a step halved until the cost does not grow (a yaw the window barely observes, a
+/// straight line, otherwise takes steps that leave the residuals larger); returns the 12×12
+/// covariance and the weighted residual sum, both at the returned state.
 Eigen::Matrix<double, 12, 12> refine(const std::vector<Pair>& pairs, double sbg, double sba, Eigen::Matrix3d& R,
                                      Eigen::Vector3d& bg, Eigen::Vector3d& ba, Eigen::Vector3d& v0, double& chi2) {
   using M = Eigen::Matrix<double, 12, 12>;
   using V = Eigen::Matrix<double, 12, 1>;
+  const auto priorCost = [&](const Eigen::Vector3d& g, const Eigen::Vector3d& a) {
+    return g.squaredNorm() / (sbg * sbg) + a.squaredNorm() / (sba * sba);
+  };
+  const auto dataCost = [&](const Eigen::Matrix3d& R1, const Eigen::Vector3d& g, const Eigen::Vector3d& a,
+                            const Eigen::Vector3d& v) {
+    double c = 0.0;
+    for (const Pair& p : pairs) {
+      const Eigen::Vector3d r = residual(p, R1, g, a, v);
+      c += r.dot(p.W * r);
+    }
+    return c;
+  };
   M H;
-  for (int it = 0; it < 6; ++it) {
+  V g;
+  const auto linearize = [&]() {
     H.setZero();
-    V g = V::Zero();
-    chi2 = 0.0;
+    g.setZero();
     for (const Pair& p : pairs) {
       const Eigen::Vector3d bt = p.beta + p.Jg * bg + p.Ja * ba;
-      const Eigen::Vector3d r = p.u - v0 - R * bt;
+      const Eigen::Vector3d r = residual(p, R, bg, ba, v0);
       Eigen::Matrix<double, 3, 12> A;  // r(x ⊞ d) ≈ r + A d
       A << vio::so3::skew(R * bt), -R * p.Jg, -R * p.Ja, -Eigen::Matrix3d::Identity();
-      H += p.w * A.transpose() * A;
-      g -= p.w * A.transpose() * r;
-      chi2 += p.w * r.squaredNorm();
+      H += A.transpose() * p.W * A;
+      g -= A.transpose() * p.W * r;
     }
     H.block<3, 3>(3, 3).diagonal().array() += 1.0 / (sbg * sbg);
     H.block<3, 3>(6, 6).diagonal().array() += 1.0 / (sba * sba);
     g.segment<3>(3) -= bg / (sbg * sbg);
     g.segment<3>(6) -= ba / (sba * sba);
+  };
+  chi2 = dataCost(R, bg, ba, v0);
+  double cost = chi2 + priorCost(bg, ba);
+  linearize();
+  for (int it = 0; it < 8; ++it) {
     const V d = H.ldlt().solve(g);
-    R = vio::so3::exp(d.head<3>()) * R;
-    bg += d.segment<3>(3);
-    ba += d.segment<3>(6);
-    v0 += d.segment<3>(9);
+    bool stepped = false;
+    for (double s = 1.0; s > 1e-3 && !stepped; s *= 0.5) {
+      const Eigen::Matrix3d R1 = vio::so3::exp(s * d.head<3>()) * R;
+      const Eigen::Vector3d bg1 = bg + s * d.segment<3>(3), ba1 = ba + s * d.segment<3>(6), v1 = v0 + s * d.segment<3>(9);
+      const double c1 = dataCost(R1, bg1, ba1, v1);
+      if (!(c1 + priorCost(bg1, ba1) <= cost)) continue;
+      R = R1;
+      bg = bg1;
+      ba = ba1;
+      v0 = v1;
+      chi2 = c1;
+      cost = c1 + priorCost(bg1, ba1);
+      stepped = true;
+    }
+    if (!stepped) break;
+    linearize();
     if (d.norm() < 1e-10) break;
   }
   return H.ldlt().solve(M::Identity());
@@ -191,18 +226,21 @@ std::optional<vio::ExternalInitialState> GnssInsAlignment::fit(std::span<const v
   const Eigen::Vector3d g_N(0.0, 0.0, -gravity_);
   const Epoch& e0 = epochs_.front();
   const Eigen::Vector3d v0 = R_NE * e0.v_N;
-  const auto velVar = [&](const Epoch& e) {
-    return (R_NE * e.Cv * R_NE.transpose()).trace() / 3.0 + cfg_.velocityFloor * cfg_.velocityFloor;
+  const double na = noise_.accelerometer_noise_density;
+  // Each epoch's Doppler velocity with its full ENU covariance (the vertical is typically three
+  // times the horizontal σ) and the accelerometer white noise over dt.
+  const auto velCov = [&](const Epoch& e, double dt) -> Eigen::Matrix3d {
+    return R_NE * e.Cv * R_NE.transpose() +
+           Eigen::Matrix3d::Identity() * (cfg_.velocityFloor * cfg_.velocityFloor + na * na * dt);
   };
-  const double var0 = velVar(e0);
+  const double var0 = velCov(e0, 0.0).trace() / 3.0;
   std::vector<Pair> pairs;
   Eigen::Matrix3d B = Eigen::Matrix3d::Zero();  // Wahba's start: velocity changes since epoch 0
   for (const Epoch& e : epochs_) {
     const double dt = static_cast<double>(e.t_ns - e0.t_ns) * 1e-9;
-    const double na = noise_.accelerometer_noise_density;
-    // The velocity noise and the accelerometer white noise over dt.
-    pairs.push_back({R_NE * e.v_N - g_N * dt, e.beta_0k, e.Jb_g, e.Jb_a, 1.0 / (velVar(e) + na * na * dt)});
-    B += (pairs.back().u - v0) * e.beta_0k.transpose() / (var0 + velVar(e));
+    const Eigen::Matrix3d C = velCov(e, dt);
+    pairs.push_back({R_NE * e.v_N - g_N * dt, e.beta_0k, e.Jb_g, e.Jb_a, C.inverse()});
+    B += (pairs.back().u - v0) * e.beta_0k.transpose() / (var0 + C.trace() / 3.0);
   }
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(B, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
@@ -210,20 +248,38 @@ std::optional<vio::ExternalInitialState> GnssInsAlignment::fit(std::span<const v
   Eigen::Matrix3d R_NI0 = svd.matrixU() * D * svd.matrixV().transpose();
   Eigen::Vector3d bg = Eigen::Vector3d::Zero(), ba = Eigen::Vector3d::Zero(), v0fit = v0;
   double chi2 = 0.0;
-  const Eigen::Matrix<double, 12, 12> P =
-      refine(pairs, cfg_.gyroBiasSigma, cfg_.accelBiasSigma, R_NI0, bg, ba, v0fit, chi2);
+  Eigen::Matrix<double, 12, 12> P = refine(pairs, cfg_.gyroBiasSigma, cfg_.accelBiasSigma, R_NI0, bg, ba, v0fit, chi2);
   const int dof = static_cast<int>(3 * pairs.size()) - 6;  // attitude and v_0 free; biases have priors
   // Two epochs determine v_0 and only two attitude angles (one velocity change): the yaw about
   // it has no information, and the inverse of the near-singular normal matrix can report any σ
   // for it (0° was seen on the simulated walk). Nor can the residuals be tested.
   if (dof <= 0 || !P.allFinite() || !(P.diagonal().minCoeff() > 0.0)) {
-    yawSigmaDeg_ = tiltSigmaDeg_ = std::numeric_limits<double>::quiet_NaN();
+    yawSigmaDeg_ = tiltSigmaDeg_ = varianceFactor_ = std::numeric_limits<double>::quiet_NaN();
     status_ = dof <= 0 ? GnssInsStatus::kCollecting : GnssInsStatus::kNoAcceleration;
     return std::nullopt;
   }
+  // The variance factor of the velocities (a posteriori variance of unit weight): a receiver's
+  // Doppler velocity covariance can be optimistic by several times (the real hand-held u-blox
+  // walk: χ²/dof 3-6 against it). The fit is repeated with the covariances scaled by it, so that
+  // the attitude and bias σ are those of the scatter the window shows; never scaled down.
+  varianceFactor_ = std::max(1.0, chi2 / dof);
+  if (varianceFactor_ > 1.0) {
+    for (Pair& p : pairs) p.W /= varianceFactor_;
+    P = refine(pairs, cfg_.gyroBiasSigma, cfg_.accelBiasSigma, R_NI0, bg, ba, v0fit, chi2);
+  }
+  // Consistency: the scatter within what a Doppler velocity can be off by (maxVarianceFactor),
+  // and no epoch an outlier against the scaled covariance (χ²(3) at the gate, Bonferroni over
+  // the window's epochs): a jump or a bad Doppler velocity rejects the window.
+  double worst = 0.0;
+  for (const Pair& p : pairs) {
+    const Eigen::Vector3d r = residual(p, R_NI0, bg, ba, v0fit);
+    worst = std::max(worst, r.dot(p.W * r));
+  }
+  const double epochBound =
+      sri::chiSquareQuantile(1.0 - (1.0 - cfg_.gate) / static_cast<double>(pairs.size()), 3);
   yawSigmaDeg_ = std::sqrt(P(2, 2)) * kRadToDeg;
   tiltSigmaDeg_ = std::sqrt(std::max(P(0, 0), P(1, 1))) * kRadToDeg;
-  if (chi2 > sri::chiSquareQuantile(cfg_.gate, dof)) {
+  if (!P.allFinite() || !(varianceFactor_ <= cfg_.maxVarianceFactor) || !(worst <= epochBound)) {
     status_ = GnssInsStatus::kInconsistent;
     return std::nullopt;
   }
@@ -253,7 +309,8 @@ std::optional<vio::ExternalInitialState> GnssInsAlignment::fit(std::span<const v
   C.block<3, 3>(vio::ImuErr::kPos, vio::ImuErr::kPos) =
       R_NE * eK.Cp * R_NE.transpose() + Eigen::Matrix3d::Identity() * cfg_.positionFloor * cfg_.positionFloor;
   C.block<3, 3>(vio::ImuErr::kVel, vio::ImuErr::kVel) =
-      R_NE * eK.Cv * R_NE.transpose() + Eigen::Matrix3d::Identity() * cfg_.velocityFloor * cfg_.velocityFloor;
+      varianceFactor_ * R_NE * eK.Cv * R_NE.transpose() +
+      Eigen::Matrix3d::Identity() * cfg_.velocityFloor * cfg_.velocityFloor;
   C.block<6, 6>(vio::ImuErr::kBg, vio::ImuErr::kBg) = P.block<6, 6>(3, 3);
   C = 0.5 * (C + C.transpose()).eval();
   status_ = GnssInsStatus::kAligned;

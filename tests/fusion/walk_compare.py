@@ -11,6 +11,10 @@ of global.pos.
     walk_compare.py start-diff OUT OUT_B LEN  largest horizontal and vertical distance (m) between
                                               the two runs' common epochs over the LEN s after OUT's
                                               first tight epoch ("nan nan" without one)
+    walk_compare.py restart OUT               s after the first frame of the first frame restart (the
+                                              first epoch reset back to waiting-vio) and s from it to
+                                              the next tight epoch ("nan nan" without a restart, "T nan"
+                                              without a start after it)
     walk_compare.py drift OUT REF.pos T LEN   horizontal drift (m) of an outage [T, T+LEN): the change
                                               of the horizontal error against the reference's fixed
                                               and float epochs between the last epoch before the
@@ -111,6 +115,15 @@ def main():
             sys.exit("walk_compare: no common epoch")
         d = [enu(a[t], b[t]) for t in common]
         print("%.2f %.2f" % (max(math.hypot(x[0], x[1]) for x in d), max(abs(x[2]) for x in d)))
+    elif cmd == "restart":
+        t0, ep = first_frame(args[0]), list(epochs(args[0]))
+        k = next((i for i, e in enumerate(ep) if e[15] == "1" and e[2] == "waiting-vio"), None)
+        if k is None:
+            print("nan nan")
+            return
+        tr = float(ep[k][1])
+        ts = next((float(e[1]) for e in ep[k:] if e[2] == "tight"), None)
+        print("%.2f %s" % (tr - t0, "nan" if ts is None else "%.2f" % (ts - tr)))
     elif cmd == "drift":
         t0, start, length = first_frame(args[0]), float(args[2]), float(args[3])
         est, ref = read_pos(args[0] + "/global.pos"), read_pos(args[1], 2)

@@ -13,11 +13,14 @@
 // the gyro and accelerometer biases (β_0k first order in them, priors σ_bg, σ_ba): a gyro bias
 // tilts the integrated terms by bg Δt, which the Doppler velocities see as g bg Δt²/2. The
 // gravity term makes the tilt observable at once; the yaw needs a horizontal velocity change
-// (acceleration, a turn). Weights w_k from the Doppler velocity covariances and the
-// accelerometer noise over Δt_k.
-// Observability test: the window is accepted when the yaw and tilt σ from that information are
-// below the configured limits and the weighted residuals pass a χ² test; otherwise status()
-// says what is missing.
+// (acceleration, a turn). Weights from each epoch's Doppler velocity covariance (full, ENU) and
+// the accelerometer noise over Δt_k, scaled by the window's variance factor f = max(1, χ²/dof)
+// (a posteriori variance of unit weight; e.g. Teunissen, "Adjustment theory", 2000): a
+// receiver's velocity covariance can be optimistic by several times, and the attitude σ must be
+// that of the scatter the window shows.
+// Observability test: the window is accepted when the yaw and tilt σ (with f) are below the
+// configured limits, f below maxVarianceFactor and no epoch an outlier against the scaled
+// covariance; otherwise status() says what is missing.
 #pragma once
 
 #include <cstdint>
@@ -55,7 +58,11 @@ struct GnssInsAlignmentConfig {
   double positionFloor = 1.0;    ///< m added to the SPP position σ per axis
   double gyroBiasSigma = 0.005;  ///< rad/s, prior of the (unestimated) gyro bias
   double accelBiasSigma = 0.1;   ///< m/s², prior of the (unestimated) accelerometer bias
-  double gate = 0.9999;          ///< χ² probability of the residual test
+  double gate = 0.9999;          ///< χ² probability of the per-epoch outlier test (over the window)
+  /// Largest variance factor accepted: the Doppler velocities may scatter about the IMU by this
+  /// many times their reported variance (σ 4×); more is a window that does not fit (a wrong IMU
+  /// time or rig, a jump).
+  double maxVarianceFactor = 16.0;
 };
 
 class GnssInsAlignment {
@@ -72,6 +79,8 @@ class GnssInsAlignment {
   /// Attitude σ of the last fit (deg; NaN before one): yaw and the larger of roll/pitch.
   double yawSigmaDeg() const { return yawSigmaDeg_; }
   double tiltSigmaDeg() const { return tiltSigmaDeg_; }
+  /// Variance factor of the last fit's velocities, max(1, χ²/dof) (NaN before one).
+  double varianceFactor() const { return varianceFactor_; }
   void clear();
 
  private:
@@ -96,7 +105,7 @@ class GnssInsAlignment {
   std::deque<Epoch> epochs_;
   std::deque<Epoch> pending_;  // not yet covered by the IMU
   GnssInsStatus status_ = GnssInsStatus::kCollecting;
-  double yawSigmaDeg_, tiltSigmaDeg_;
+  double yawSigmaDeg_, tiltSigmaDeg_, varianceFactor_;
 };
 
 }  // namespace gvins::fusion
