@@ -533,14 +533,24 @@ void GnssFusion<Scalar>::feedRtk(Epoch& e, const ObsEpoch* base) {
   const bool newBase = base && (!lastBase_ || base->time > *lastBase_);
   if (newBase) {
     if (baseSmoother_) {
+      // The smoothed base codes from Doppler-checked epochs (the smoother's slip detector tests
+      // the Doppler), as the rover's are checked at the input; Ddcp's RTK module keeps the raw
+      // base epoch and its own check.
       ObsEpoch b = *base;
+      baseDoppler_.apply(b, e.nav.glonassChannels());
       baseSmoother_->apply(b, e.nav.glonassChannels());
       (codeRtk_ ? codeRtk_ : rtk_)->addBaseEpoch(b);
     }
     if (!baseSmoother_ || codeRtk_) rtk_->addBaseEpoch(*base);
     lastBase_ = base->time;
-    const std::vector<std::string>& w = rtk_->base().doppler().warnings();  // the base's Doppler check
-    for (; baseWarned_ < w.size(); ++baseWarned_) e.rep.warnings.push_back(w[baseWarned_]);
+    // The base's Doppler check: the RTK module's on the raw base epochs, else the fusion's.
+    if (!baseSmoother_ || codeRtk_) {
+      const std::vector<std::string>& w = rtk_->base().doppler().warnings();
+      for (; baseWarned_ < w.size(); ++baseWarned_) e.rep.warnings.push_back(w[baseWarned_]);
+    } else {
+      const std::vector<std::string>& w = baseDoppler_.warnings();
+      for (; baseCheckWarned_ < w.size(); ++baseCheckWarned_) e.rep.warnings.push_back(w[baseCheckWarned_]);
+    }
   }
   const std::optional<GpsTime> lastRun = rtk_->lastProcessTime();
   e.rtkDeferred = e.fullRtk && newBase && config_.rtkHoldFix && rtk_->hasHeldFix() && lastRun &&

@@ -235,6 +235,8 @@ class GnssFusion {
   std::size_t gateWarned_ = 0;
   ObsEpoch checkedRover_;      // the rover epoch after the Doppler check
   std::size_t baseWarned_ = 0;  // warnings of rtk_'s base Doppler check already reported
+  DopplerConsistency baseDoppler_{"base"};  // the base epochs before the base smoother (dpsr, ddcp)
+  std::size_t baseCheckWarned_ = 0;        // its warnings already reported
   std::optional<GpsTime> lastBase_;
   GnssBaseClock baseClock_;  // c·dt_b per clock system of the dpsr rows (gnss_base_clock.hpp)
   std::unique_ptr<CarrierSmoother> smoother_, baseSmoother_;  // carrierSmoothing > 0: psr, dpsr, ddcp
