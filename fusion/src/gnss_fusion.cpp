@@ -457,11 +457,11 @@ const ObsEpoch& GnssFusion<Scalar>::prepareRover(const ObsEpoch& roverInput, con
   roverDoppler_.apply(checkedRover_, nav.glonassChannels());
   rep.warnings.assign(roverDoppler_.warnings().begin() + static_cast<std::ptrdiff_t>(warned), roverDoppler_.warnings().end());
   const ObsEpoch& roverRaw = checkedRover_;
-  // Carrier-smoothed codes for the psr rows, and for the dpsr rows on both receivers (every epoch,
-  // also before the VIO is ready, so that the arcs are long when the rows start). Ddcp keeps the
-  // raw codes: its RTK filter estimates the ambiguities from phase minus code, which smoothing
-  // would correlate in time.
-  const bool smoothDifferences = config_.mode == GnssFusionMode::kDoppDpsr;
+  // Carrier-smoothed codes for the psr rows, and for the SD code rows of dpsr and ddcp on both
+  // receivers (every epoch, also before the VIO is ready, so that the arcs are long when the rows
+  // start). Ddcp's RTK module takes the raw codes (Epoch::roverRaw, the raw base): its filter
+  // estimates the ambiguities from phase minus code, which smoothing would correlate in time.
+  const bool smoothDifferences = config_.usesDifferences();
   const bool ppp = config_.mode == GnssFusionMode::kDoppPpp;
   if (ppp) {
     // Arcs of the float ambiguities (every epoch, also before the VIO is ready); raw codes.
@@ -496,9 +496,16 @@ void GnssFusion<Scalar>::useNavigation(const EphemerisStore& nav) {
     RtkConfig rtkConfig;
     if (config_.codeWeighting == GnssCodeWeighting::kElevationCn0) rtkConfig.codeWeighting = WeightingScheme::ElevationSnr;
     rtk_ = std::make_unique<RtkSolver>(nav, rtkConfig);
-    rtk_->setRoverDopplerCheckedByCaller();  // checked at the input (prepareRover), once
+    // Ddcp with smoothing: the SD code rows from the smoothed codes of both receivers, formed as
+    // dpsr forms them (RtkSolver::differences), beside the RTK module on the raw ones.
+    codeRtk_.reset();
+    if (config_.mode == GnssFusionMode::kDoppDdcp && baseSmoother_) codeRtk_ = std::make_unique<RtkSolver>(nav, rtkConfig);
+    for (RtkSolver* r : {rtk_.get(), codeRtk_.get()}) {
+      if (!r) continue;
+      r->setRoverDopplerCheckedByCaller();  // checked at the input (prepareRover), once
+      if (config_.basePosition) r->setBasePosition(*config_.basePosition);
+    }
     baseWarned_ = 0;
-    if (config_.basePosition) rtk_->setBasePosition(*config_.basePosition);
   }
 }
 
@@ -512,8 +519,8 @@ const SppSolution& GnssFusion<Scalar>::sppOf(Epoch& e) {
 
 template <typename Scalar>
 void GnssFusion<Scalar>::runRtk(Epoch& e) {
+  // (The epoch counts as fixed only where tightUpdate applies the DD phases of a validated fix.)
   const RtkSolution rtk = rtk_->process(e.roverRaw, &e.states);
-  e.rep.rtkFixed = rtk.quality == SolutionQuality::Fix;
   e.baseAge = rtk.age;
   e.rtkProcessed = true;
 }
@@ -526,15 +533,24 @@ void GnssFusion<Scalar>::feedRtk(Epoch& e, const ObsEpoch* base) {
   const bool newBase = base && (!lastBase_ || base->time > *lastBase_);
   if (newBase) {
     if (baseSmoother_) {
+      // The smoothed base codes from Doppler-checked epochs (the smoother's slip detector tests
+      // the Doppler), as the rover's are checked at the input; Ddcp's RTK module keeps the raw
+      // base epoch and its own check.
       ObsEpoch b = *base;
+      baseDoppler_.apply(b, e.nav.glonassChannels());
       baseSmoother_->apply(b, e.nav.glonassChannels());
-      rtk_->addBaseEpoch(b);
-    } else {
-      rtk_->addBaseEpoch(*base);
+      (codeRtk_ ? codeRtk_ : rtk_)->addBaseEpoch(b);
     }
+    if (!baseSmoother_ || codeRtk_) rtk_->addBaseEpoch(*base);
     lastBase_ = base->time;
-    const std::vector<std::string>& w = rtk_->base().doppler().warnings();  // the base's Doppler check
-    for (; baseWarned_ < w.size(); ++baseWarned_) e.rep.warnings.push_back(w[baseWarned_]);
+    // The base's Doppler check: the RTK module's on the raw base epochs, else the fusion's.
+    if (!baseSmoother_ || codeRtk_) {
+      const std::vector<std::string>& w = rtk_->base().doppler().warnings();
+      for (; baseWarned_ < w.size(); ++baseWarned_) e.rep.warnings.push_back(w[baseWarned_]);
+    } else {
+      const std::vector<std::string>& w = baseDoppler_.warnings();
+      for (; baseCheckWarned_ < w.size(); ++baseCheckWarned_) e.rep.warnings.push_back(w[baseCheckWarned_]);
+    }
   }
   const std::optional<GpsTime> lastRun = rtk_->lastProcessTime();
   e.rtkDeferred = e.fullRtk && newBase && config_.rtkHoldFix && rtk_->hasHeldFix() && lastRun &&
@@ -548,6 +564,7 @@ void GnssFusion<Scalar>::resetAfterOutage(vio::EstimatorBackend<Scalar>& est, Gn
   baseClock_.reset();
   zwd_.marginalize(est);
   if (rtk_) rtk_->reset();
+  if (codeRtk_) codeRtk_->reset();
   ambiguities_.dropAll(est);
   rep.reset = true;
   lastUpdate_.reset();

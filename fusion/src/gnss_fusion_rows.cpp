@@ -165,11 +165,29 @@ void GnssFusion<Scalar>::addDifferenceRows(Epoch& e, const AntennaKinematics& k,
   if (e.fullRtk && !e.rtkProcessed) {
     int heldFixed = 0;
     e.baseAge = rtk_->differencesWithHeldFix(e.roverRaw, k.x_E, heldFixed, &e.states);
-    e.rep.rtkFixed = heldFixed > 0;
     if (e.rtkDeferred && !rtk_->phasePairsAsProcessed()) runRtk(e);
   }
-  if (!e.baseAge || !config_.usesDifferences() || *e.baseAge > config_.maxBaseAge) return;
+  // The code rows of dpsr and ddcp alike: the single differences of the carrier-smoothed codes
+  // where configured (Ddcp's RTK module keeps the raw ones; codeRtk_ forms the smoothed ones).
+  std::optional<double> codeAge = e.baseAge;
+  if (codeRtk_) codeAge = codeRtk_->differences(e.rover, k.x_E, &e.states);
+  if (codeAge && config_.usesDifferences() && *codeAge <= config_.maxBaseAge) {
+    addSdCodeRows(e, (codeRtk_ ? codeRtk_ : rtk_)->measurements(), k, clk, rows);
+  }
+  if (config_.mode != GnssFusionMode::kDoppDdcp || !e.baseAge || *e.baseAge > config_.maxBaseAge) return;
+  // The DD phases with the integers of a validated fix, as many as the RTK module's ambiguity
+  // resolution fixes at least (applicableFixedPhases); fewer are no fix.
   const DdEpoch& dd = rtk_->measurements();
+  const std::vector<DoubleDifference> phase = applicableFixedPhases(dd, rtk_->config().ar);
+  if (phase.empty()) return;
+  std::vector<GnssRow> group;
+  for (const DoubleDifference& d : phase) group.push_back(ddPhaseRow(dd, d, k));
+  rows.addCorrelated(group, kDdcp, ddCovariance(dd, phase, true));
+}
+
+template <typename Scalar>
+void GnssFusion<Scalar>::addSdCodeRows(Epoch& e, const DdEpoch& dd, const AntennaKinematics& k,
+                                       const Eigen::VectorXd& clk, GnssRowSet& rows) {
   const int n = static_cast<int>(clocks_.systems().size());
   // Base clock per system from the base code OMCs, continued over the signals common with the
   // previous epoch, so that satellites joining or leaving do not move it (gnss_base_clock.hpp).
@@ -194,15 +212,6 @@ void GnssFusion<Scalar>::addDifferenceRows(Epoch& e, const AntennaKinematics& k,
     r.clockBias = c;
     rows.add(r, kDpsr, r.variance);
   }
-  if (config_.mode != GnssFusionMode::kDoppDdcp || !e.rep.rtkFixed) return;
-  std::vector<DoubleDifference> phase;
-  for (const DoubleDifference& d : dd.phase) {
-    if (d.ambiguityMeters) phase.push_back(d);
-  }
-  if (phase.empty()) return;
-  std::vector<GnssRow> group;
-  for (const DoubleDifference& d : phase) group.push_back(ddPhaseRow(dd, d, k));
-  rows.addCorrelated(group, kDdcp, ddCovariance(dd, phase, true));
 }
 
 template <typename Scalar>
@@ -261,6 +270,10 @@ bool GnssFusion<Scalar>::tightUpdate(vio::EstimatorBackend<Scalar>& est, Epoch& 
   if (config_.mode == GnssFusionMode::kDoppPpp && clocks_.valid()) addPhaseRows(est, e, models, k, clk, rows);
   addDifferenceRows(e, k, clk, rows);
   if (!rows.empty()) applyRows(est, e.rep, k, rows);
+  // Fixed: the DD phases of a validated fix were applied, at least as many as a fix has
+  // (applicableFixedPhases); fewer left by the row gate are not a fix either.
+  e.rep.rtkFixed = config_.mode == GnssFusionMode::kDoppDdcp && e.rep.updated &&
+                   e.rep.ddcp.used >= std::max(1, rtk_->config().ar.minFixed);
   // Ambiguities of satellites without a phase row for a while (set, masked, lost).
   ambiguities_.dropStale(est, e.rover.time, 10.0);
   e.rep.ambiguities = static_cast<int>(ambiguities_.size());
@@ -278,6 +291,8 @@ bool GnssFusion<Scalar>::tightUpdate(vio::EstimatorBackend<Scalar>& est, Epoch& 
                                             const AntennaKinematics&, const Eigen::VectorXd&, GnssRowSet&);         \
   template void GnssFusion<S>::addDifferenceRows(Epoch&, const AntennaKinematics&, const Eigen::VectorXd&,          \
                                                  GnssRowSet&);                                                      \
+  template void GnssFusion<S>::addSdCodeRows(Epoch&, const DdEpoch&, const AntennaKinematics&,                      \
+                                             const Eigen::VectorXd&, GnssRowSet&);                                  \
   template void GnssFusion<S>::applyRows(vio::EstimatorBackend<S>&, GnssEpochReport&, const AntennaKinematics&,     \
                                          GnssRowSet&);                                                              \
   template bool GnssFusion<S>::tightUpdate(vio::EstimatorBackend<S>&, Epoch&, const GnssStateValues&,               \

@@ -57,6 +57,15 @@ std::optional<ReductionStart> embedBasis(const std::vector<std::pair<sri::BlockI
 
 }  // namespace
 
+std::vector<DoubleDifference> applicableFixedPhases(const DdEpoch& dd, const AmbiguityResolutionOptions& ar) {
+  std::vector<DoubleDifference> out;
+  for (const DoubleDifference& d : dd.phase) {
+    if (d.fixedCycles && d.ambiguityMeters) out.push_back(d);
+  }
+  if (static_cast<int>(out.size()) < std::max(1, ar.minFixed)) out.clear();
+  return out;
+}
+
 std::vector<RtkSolver::ArPair> RtkSolver::arPairs(std::vector<int>& arRef) const {
   // Eligible SDs per group and the DD pairs (AR reference, satellite).
   std::vector<char> inPhase(dd_.sd.size(), 0);

@@ -141,6 +141,11 @@ struct RunResult {
   double isbErr = 0.0;  // RMS error of the drifting system's inter-system bias (IsbDrift), m
   std::vector<std::string> dopplerWarnings;  // the fusion's rover Doppler check (all epochs)
   DopplerConsistencyCounts doppler;
+  // Every epoch processed: flight time, the antenna after it, its DD phase rows used, fixed flag.
+  std::vector<double> epochTime;
+  std::vector<std::optional<Vector3d>> epochAntenna;
+  std::vector<int> epochDdcpRows, epochDpsrRows;
+  std::vector<bool> epochFixed;
 };
 
 /// An inter-system bias that drifts: from flight time `from` on, `rate` (m/s) times the elapsed
@@ -234,6 +239,11 @@ RunResult run(GnssFusionConfig cfg, const SatelliteCut& cut = {}, const Ephemeri
     out.dopplerWarnings.insert(out.dopplerWarnings.end(), r.warnings.begin(), r.warnings.end());
     out.resets += r.reset;
     out.last = &e;
+    out.epochTime.push_back(tf);
+    out.epochAntenna.push_back(r.antennaEcef);
+    out.epochDdcpRows.push_back(r.ddcp.used);
+    out.epochDpsrRows.push_back(r.dpsr.used);
+    out.epochFixed.push_back(r.rtkFixed);
     micros += r.elapsedMicroseconds;
     ++nAll;
     if (r.stage == GnssFusionStage::kTight && !tight) {
@@ -915,6 +925,92 @@ TEST(GnssFusionSim, FlippedDopplerIsCorrectedAtTheInput) {
   EXPECT_EQ(d.fixedEpochs, c.fixedEpochs);
   EXPECT_EQ(d.ddcp.used, c.ddcp.used);
   EXPECT_EQ(d.posRms, c.posRms);
+}
+
+}  // namespace
+}  // namespace gvins::fusion
+
+namespace gvins::fusion {
+namespace {
+
+// Ddcp's code rows are dpsr's: the carrier-smoothed codes of rover and base through the same row
+// builder and weights (before, Ddcp fused the raw codes until its first fix: 0.24 m against
+// 0.08 m 3-D here, ModesTable). Up to the first DD phase row both modes give the same antenna,
+// epoch by epoch (to the transmit-time difference of raw and smoothed codes, micrometres), with
+// the same SD code rows.
+// And a fix is applied, the epoch flagged fixed, only with at least ar.min_fixed (4) DD integers
+// (applicableFixedPhases): from 50 s of flight on the rover keeps the two highest GPS satellites
+// (the phase reference of the GPS groups and one more), whose DDs on the held fix (one per band)
+// are no fix; before they were applied and the epochs counted as fixed.
+TEST(GnssFusionSim, DdcpCodeRowsAreDpsrsAndSmallHeldFixesAreNoFix) {
+  const Scenario& sc = scenario();
+  // Half-cycle flags on every rover phase for the first 40 s: no integer fixing (the RTK module's
+  // AR skips such signals), while the carrier smoothing goes on; then Ddcp fixes.
+  auto halfCycles = [](ObsEpoch& obs, double tf) {
+    if (tf >= 40.0) return;
+    for (SatObs& so : obs.sats) {
+      for (SignalObs& sig : so.signals) {
+        if (sig.hasPhase()) sig.lli |= 2;
+      }
+    }
+  };
+  const RunResult dpsr = run<double>(mode(GnssFusionMode::kDoppDpsr), {}, nullptr, -1.0, {}, false, halfCycles);
+  const RunResult ddcp = run<double>(mode(GnssFusionMode::kDoppDdcp), {}, nullptr, -1.0, {}, false, halfCycles);
+  ASSERT_EQ(dpsr.epochAntenna.size(), ddcp.epochAntenna.size());
+  int compared = 0, withCodeRows = 0, fixed = 0;
+  double maxDiff = 0.0;
+  for (std::size_t i = 0; i < ddcp.epochAntenna.size() && ddcp.epochDdcpRows[i] == 0; ++i) {
+    if (!ddcp.epochAntenna[i] || !dpsr.epochAntenna[i]) continue;
+    maxDiff = std::max(maxDiff, (*ddcp.epochAntenna[i] - *dpsr.epochAntenna[i]).norm());
+    ++compared;
+    if (ddcp.epochDpsrRows[i] > 0) {
+      ++withCodeRows;
+      EXPECT_EQ(ddcp.epochDpsrRows[i], dpsr.epochDpsrRows[i]) << "epoch " << i;
+    }
+  }
+  for (std::size_t i = 0; i < ddcp.epochFixed.size(); ++i) {
+    if (!ddcp.epochFixed[i]) continue;
+    ++fixed;
+    EXPECT_GE(ddcp.epochDdcpRows[i], 4) << "epoch " << i;
+  }
+  std::fprintf(stderr,
+               "ddcp = dpsr over %d epochs before the first DD phase row, %d with SD code rows (max %.2g m); %d fixed "
+               "epochs\n",
+               compared, withCodeRows, maxDiff, fixed);
+  EXPECT_GE(compared, 100);
+  EXPECT_GE(withCodeRows, 80);
+  EXPECT_LT(maxDiff, 1e-4);
+  EXPECT_GT(fixed, 100);
+
+  // The two highest GPS satellites at the start (the GPS phase references: the highest continuous
+  // satellite, kept while usable).
+  const sim::GnssSimEpoch* first = nullptr;
+  for (const sim::GnssSimEpoch& e : sc.epochs) {
+    if (e.role == sim::GnssReceiverRole::Rover) {
+      first = &e;
+      break;
+    }
+  }
+  ASSERT_NE(first, nullptr);
+  std::vector<std::pair<double, SatId>> gps;
+  for (std::size_t i = 0; i < first->obs.sats.size(); ++i) {
+    if (first->obs.sats[i].sat.system == System::Gps) gps.emplace_back(first->truth.sats[i].azel.elevation, first->obs.sats[i].sat);
+  }
+  ASSERT_GE(gps.size(), 2u);
+  std::sort(gps.rbegin(), gps.rend());
+  const RunResult cut = run<double>(mode(GnssFusionMode::kDoppDdcp), SatelliteCut{50.0, {gps[0].second, gps[1].second}});
+  int fixedBefore = 0, after = 0;
+  for (std::size_t i = 0; i < cut.epochFixed.size(); ++i) {
+    if (cut.epochTime[i] <= 50.0) {
+      fixedBefore += cut.epochFixed[i];
+      continue;
+    }
+    ++after;
+    EXPECT_FALSE(cut.epochFixed[i]) << "flight time " << cut.epochTime[i];
+    EXPECT_EQ(cut.epochDdcpRows[i], 0) << "flight time " << cut.epochTime[i];
+  }
+  EXPECT_GT(fixedBefore, 50);
+  EXPECT_GT(after, 50);
 }
 
 }  // namespace

@@ -926,3 +926,35 @@ TEST(TransmitStatesShared, SameStatesAndTheSameRtkSolution) {
   }
   EXPECT_GE(compared, 100);
 }
+
+// The DD phases a user of the differences may apply as a fix (the fusion's Ddcp rows): those with
+// the integer of a validated fix, and only as many as the ambiguity resolution fixes at least
+// (ar.minFixed): a partial or held fix that leaves three DD integers is no fix at min_fixed 4.
+TEST(RtkApplicableFix, AtLeastMinFixedDdIntegers) {
+  DdEpoch e;
+  for (int i = 0; i < 6; ++i) e.phase.push_back(DoubleDifference{0, i + 1, std::nullopt, std::nullopt});
+  auto fix = [&](int n) {
+    for (int i = 0; i < 6; ++i) {
+      e.phase[static_cast<std::size_t>(i)].fixedCycles = i < n ? std::optional<double>(3.0 - i) : std::nullopt;
+      e.phase[static_cast<std::size_t>(i)].ambiguityMeters = i < n ? std::optional<double>(0.19 * (3.0 - i)) : std::nullopt;
+    }
+  };
+  AmbiguityResolutionOptions ar;
+  ASSERT_EQ(ar.minFixed, 4);  // the default of RtkConfig::ar
+  fix(3);
+  EXPECT_TRUE(applicableFixedPhases(e, ar).empty());
+  ar.minFixed = 3;
+  const std::vector<DoubleDifference> three = applicableFixedPhases(e, ar);
+  ASSERT_EQ(three.size(), 3u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(three[static_cast<std::size_t>(i)].satellite, i + 1);
+    EXPECT_EQ(*three[static_cast<std::size_t>(i)].fixedCycles, 3.0 - i);
+  }
+  ar.minFixed = 4;
+  fix(5);  // the sixth DD has no integer: not applied
+  EXPECT_EQ(applicableFixedPhases(e, ar).size(), 5u);
+  e.phase[1].ambiguityMeters.reset();  // an integer without its metres is incomplete: not applied
+  EXPECT_EQ(applicableFixedPhases(e, ar).size(), 4u);
+  fix(0);
+  EXPECT_TRUE(applicableFixedPhases(e, ar).empty());
+}

@@ -163,6 +163,10 @@ class GnssFusion {
   GnssAmbiguityArc& newAmbiguity(vio::EstimatorBackend<Scalar>& est, const SatelliteModel& m, const GpsTime& arcStart);
   /// Dpsr and ddcp rows from the RTK module's differences.
   void addDifferenceRows(Epoch& e, const AntennaKinematics& k, const Eigen::VectorXd& clk, GnssRowSet& rows);
+  /// The SD code rows of the differences `dd` (dpsr and ddcp alike), with the base clock per
+  /// system; C/N0-masked ones are counted in the report.
+  void addSdCodeRows(Epoch& e, const DdEpoch& dd, const AntennaKinematics& k, const Eigen::VectorXd& clk,
+                     GnssRowSet& rows);
   /// Applies the tight stage's rows; counts them and restarts ambiguities rejected too often.
   void applyRows(vio::EstimatorBackend<Scalar>& est, GnssEpochReport& rep, const AntennaKinematics& k,
                  GnssRowSet& rows);
@@ -215,6 +219,9 @@ class GnssFusion {
   std::unique_ptr<SppSolver> spp_;
   std::unique_ptr<GnssInsAlignment> insAlign_;  // insStart: before the estimator is initialised
   std::unique_ptr<RtkSolver> rtk_;
+  // Ddcp with carrier smoothing: the SD code rows' differences of the smoothed codes (rtk_ runs on
+  // the raw ones); dpsr's come from rtk_ itself.
+  std::unique_ptr<RtkSolver> codeRtk_;
   DopplerConsistency roverDoppler_{"rover"};
   // Primary signals taken from another band than the system's usual one (signal_choice.hpp),
   // each reported once in the epoch's warnings.
@@ -228,9 +235,11 @@ class GnssFusion {
   std::size_t gateWarned_ = 0;
   ObsEpoch checkedRover_;      // the rover epoch after the Doppler check
   std::size_t baseWarned_ = 0;  // warnings of rtk_'s base Doppler check already reported
+  DopplerConsistency baseDoppler_{"base"};  // the base epochs before the base smoother (dpsr, ddcp)
+  std::size_t baseCheckWarned_ = 0;        // its warnings already reported
   std::optional<GpsTime> lastBase_;
   GnssBaseClock baseClock_;  // c·dt_b per clock system of the dpsr rows (gnss_base_clock.hpp)
-  std::unique_ptr<CarrierSmoother> smoother_, baseSmoother_;  // carrierSmoothing > 0: psr, dpsr
+  std::unique_ptr<CarrierSmoother> smoother_, baseSmoother_;  // carrierSmoothing > 0: psr, dpsr, ddcp
   ObsEpoch smoothed_;
   // vio+dopp+ppp: one float ambiguity state per satellite arc; the arcs (cycle slips, gaps, signal
   // changes, code-carrier jumps) are those of a CarrierSmoother run on a copy of the rover epochs.

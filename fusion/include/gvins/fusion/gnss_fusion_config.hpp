@@ -20,8 +20,8 @@
 //     precise_ephemeris_error_m: {G: 0.05} # the same for satellites from precise products (SP3/clock;
 //                                         # default: the SPP's precise_ephemeris_error_m)
 //     code_sigma: 0.6                     # m at zenith; variance (a² + a²/sin²(el)) style
-//     carrier_smoothing: 100              # s, Hatch window of the psr/dpsr codes (default; 0 = raw;
-//                                         # vio+dopp+ppp and ddcp use raw codes)
+//     carrier_smoothing: 100              # s, Hatch window of the psr/dpsr/ddcp codes (default; 0 = raw;
+//                                         # vio+dopp+ppp and ddcp's RTK module use raw codes)
 //     smoothed_code_factor: 1.0           # floor of the smoothed code's sigma / code_sigma
 //     phase_sigma: 0.003                  # m at zenith, one band (vio+dopp+ppp; ×2.6–3 for the pair)
 //     ambiguity_sigma: 30                 # m, prior 1-sigma of a new float ambiguity (vio+dopp+ppp)
@@ -140,8 +140,9 @@ struct GnssFusionConfig {
   /// `cn0_mask_dbhz`: code rows (psr, dpsr) of signals with a C/N0 below this are dropped
   /// (counted as GnssTypeCount::masked); 0 = off. An ionosphere-free pair: its lower C/N0.
   double cn0MaskDbHz = 0.0;
-  /// Carrier smoothing of the pseudoranges (psr modes; dpsr: rover and base): Hatch window in s,
-  /// 0 = raw codes (CarrierSmoother); ddcp keeps raw codes. 100 s as in RTCA DO-229E; the
+  /// Carrier smoothing of the pseudoranges (psr modes; dpsr and ddcp: rover and base of the SD
+  /// code rows; ddcp's RTK module keeps raw codes): Hatch window in s, 0 = raw codes
+  /// (CarrierSmoother). 100 s as in RTCA DO-229E; the
   /// ionosphere-free pair of smoothed codes has no ionospheric divergence, a single-frequency one
   /// lags by about 2 T dI/dt.
   double carrierSmoothing = 100.0;

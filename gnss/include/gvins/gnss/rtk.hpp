@@ -137,6 +137,16 @@ double ionosphereDelayFactor(double wavelength);
 /// on L1, I_s and I_r (m): the code is delayed by it, the phase advanced.
 double ddIonosphericDelay(double wavelengthS, double ionosphereS, double wavelengthR, double ionosphereR);
 
+/// The DD phases of `dd` (RtkSolver::measurements()) that a user of the differences may apply as
+/// fixed (the fusion's Ddcp rows): those that carry the integer of a validated fix (resolve() or
+/// the held fix of differencesWithHeldFix; their failure rate is bounded by the validation of
+/// `ar`: fixed-failure-rate ratio test, partial subsets at `ar.partialSuccessRate`), and only
+/// when there are at least `ar.minFixed` of them, the smallest set the ambiguity resolution fixes
+/// at all. Fewer (a partial fix whose combinations leave two or three DDs integer, a held fix whose
+/// other satellites have set or slipped) are not a fix: a set that small can be wrong with a high
+/// ratio, and it hardly determines the position. Empty when too few.
+std::vector<DoubleDifference> applicableFixedPhases(const DdEpoch& dd, const AmbiguityResolutionOptions& ar);
+
 class RtkSolver {
  public:
   /// Float solutions with a larger position standard deviation (m, √trace) are not reported.
