@@ -516,7 +516,9 @@ TEST(GnssFusionSim, CodeVarianceOfEachSignalFromItsOwnCn0) {
       ASSERT_GT(n, 1000);
       // The simulated bands differ in C/N0 (by more than 1 dB in 1281 of 3014 pairs): a model
       // that took one C/N0 for both would fail here under elevation-cn0.
-      if (iono == GnssIonosphere::kDualFrequency) EXPECT_GT(unequal, n / 4);
+      if (iono == GnssIonosphere::kDualFrequency) {
+        EXPECT_GT(unequal, n / 4);
+      }
     }
   }
 }
