@@ -3,14 +3,18 @@
 // computed by a bit-serial division by the ICD's generator polynomial (30.3.5.1), decoded back;
 // every single flipped bit caught; malformed layouts counted; the walk log's CNAV against itself
 // (the same message on L2C and L5), against its LNAV (T_GD, clock) and against the values an
-// independent Python decoder read from it.
+// independent Python decoder read from it; the two ionosphere-free pairs of each satellite.
 #include <gtest/gtest.h>
 
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <map>
+#include <variant>
 
 #include "gvins/base/parse_error.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
+#include "gvins/ephemeris/satellite_state.hpp"
 #include "gvins/ubx/navigation_assembler.hpp"
 #include "gvins/ubx/ubx_decoder.hpp"
 #include "independent_ubx_scan.hpp"
@@ -248,6 +252,59 @@ TEST(SfrbxCnav, WalkLogType30) {
     ++compared;
   }
   EXPECT_GE(compared, 2);
+}
+
+// The walk log through the decoder: per GPS satellite with L1 C/A, L2C and L5 Q, the difference of
+// its two ionosphere-free pairs after the group delays, P_IF(L1,L5) − P_IF(L1,L2C), is the
+// receiver's inter-frequency bias, one constant for all satellites (plus code noise and
+// multipath, averaged over the epochs). With the CNAV ISCs the per-satellite means agree to about
+// a metre; with T_GD alone on L5 (no ISC) they spread by metres.
+TEST(SfrbxCnav, WalkLogPairsAgreeAcrossSatellites) {
+  Decoder dec;
+  dec.feed(testing::readBytes(dataDir() / "ubx" / "gnss_1730.ubx"));
+  dec.finish();
+  EphemerisStore store;
+  std::vector<ObsEpoch> epochs;
+  while (auto d = dec.poll()) {
+    if (auto* u = std::get_if<NavDataUpdate>(&*d)) u->addTo(store);
+    if (auto* e = std::get_if<ObsEpoch>(&*d)) epochs.push_back(std::move(*e));
+  }
+  const double kC = 299792458.0, f1 = 1575.42e6, f2 = 1227.60e6, f5 = 1176.45e6;
+  const double g12 = f1 * f1 / (f2 * f2), g15 = f1 * f1 / (f5 * f5);
+  const ObsCode c1('1', 'C'), c2('2', 'L'), c5('5', 'Q');
+  std::map<int, std::array<double, 3>> sum;  // with ISCs, T_GD alone, epochs
+  for (const ObsEpoch& e : epochs) {
+    for (const SatObs& so : e.sats) {
+      if (so.sat.system != System::Gps) continue;
+      const SignalObs *s1 = so.find(c1), *s2 = so.find(c2), *s5 = so.find(c5);
+      const KeplerEphemeris* k = store.selectKepler(so.sat, e.time);
+      const CnavGroupDelays* c = store.cnavGroupDelays(so.sat, e.time);
+      if (!s1 || !s2 || !s5 || !s1->hasCode() || !s2->hasCode() || !s5->hasCode() || !k || !c) continue;
+      auto pair = [&](const SignalObs& s, double g, const CnavGroupDelays* isc) {
+        const double p1 = s1->pseudorange - kC * broadcastGroupDelay(*k, c1, isc);
+        const double p2 = s.pseudorange - kC * broadcastGroupDelay(*k, s.code, isc);
+        return (g * p1 - p2) / (g - 1.0);
+      };
+      auto& a = sum[so.sat.prn];
+      a[0] += pair(*s5, g15, c) - pair(*s2, g12, c);
+      a[1] += pair(*s5, g15, nullptr) - pair(*s2, g12, nullptr);
+      a[2] += 1.0;
+    }
+  }
+  ASSERT_GE(sum.size(), 4u);
+  double lo[2] = {1e9, 1e9}, hi[2] = {-1e9, -1e9};
+  for (const auto& [prn, a] : sum) {
+    ASSERT_GE(a[2], 50.0) << prn;
+    for (int k = 0; k < 2; ++k) {
+      const double m = a[static_cast<std::size_t>(k)] / a[2];
+      std::printf("G%02d %s %.2f m over %.0f epochs\n", prn, k == 0 ? "with ISCs " : "T_GD alone", m, a[2]);
+      lo[k] = std::min(lo[k], m);
+      hi[k] = std::max(hi[k], m);
+    }
+  }
+  std::printf("spread: with ISCs %.2f m, T_GD alone %.2f m\n", hi[0] - lo[0], hi[1] - lo[1]);
+  EXPECT_LT(hi[0] - lo[0], 1.5);
+  EXPECT_GT(hi[1] - lo[1], 4.0);
 }
 
 }  // namespace
