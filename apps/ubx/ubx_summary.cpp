@@ -34,7 +34,7 @@ void printNavigationSources(std::ostream& out, const ubx::NavigationAssembler& n
     out << "  " << std::left << std::setw(14) << ids << std::setw(19) << ubx::signalName(src.gnssId, src.sigId)
         << std::setw(26) << info.message << std::right << std::setw(10) << c.messages;
     if (info.decoded) {
-      out << std::setw(9) << c.ephemerides << std::setw(12) << c.parityFailures + c.crcFailures << std::setw(9)
+      out << std::setw(9) << c.ephemerides + c.groupDelays << std::setw(12) << c.parityFailures + c.crcFailures << std::setw(9)
           << c.unknownMessages;
     }
     out << "\n";
@@ -88,7 +88,7 @@ void printSummary(std::ostream& out, const ubx::Decoder& dec, const SummaryExtra
       << " with unresolved half cycle, " << st.clockResets << " receiver clock resets\n";
   const ubx::NavigationCounts nc = dec.navigationCounts();
   out << "SFRBX          " << st.sfrbx << " navigation messages: " << st.ephemerides << " ephemerides, "
-      << nc.parityFailures << " parity and " << nc.crcFailures << " CRC failures, " << nc.skipped
+      << nc.groupDelays << " CNAV group delay sets, " << nc.parityFailures << " parity and " << nc.crcFailures << " CRC failures, " << nc.skipped
       << " of systems not decoded, " << st.sfrbxUndated << " before the first RAWX epoch (no receive time)\n";
   printNavigationSources(out, dec.navigationAssembler());
   if (ex.navPvt > 0) {

@@ -409,7 +409,38 @@ double EphemerisStore::groupDelay(SatId sat, ObsCode code, const GpsTime& t,
     return g ? broadcastGroupDelay(*g, code) : 0.0;
   }
   const auto* e = selectKepler(sat, t, policy);
-  return e ? broadcastGroupDelay(*e, code) : 0.0;
+  return e ? broadcastGroupDelay(*e, code, cnavGroupDelays(sat, t)) : 0.0;
+}
+
+void EphemerisStore::add(const CnavGroupDelays& cnav) {
+  if (!cnav.sat.valid() || (cnav.sat.system != System::Gps && cnav.sat.system != System::Qzss)) return;
+  if (cnav_.size() < static_cast<std::size_t>(numSatIndices())) cnav_.resize(numSatIndices());
+  auto& list = cnav_[satIndex(cnav.sat)];
+  auto it = std::upper_bound(list.begin(), list.end(), cnav.time,
+                             [](const GpsTime& t, const CnavRun& r) { return t < r.first.time; });
+  if (it != list.begin()) {
+    CnavRun& before = *std::prev(it);
+    if (before.first.sameCorrections(cnav)) {
+      if (before.lastSeen < cnav.time) before.lastSeen = cnav.time;
+      return;
+    }
+  }
+  if (it != list.end() && it->first.sameCorrections(cnav)) {  // the same, seen earlier than known
+    it->first = cnav;
+    return;
+  }
+  list.insert(it, CnavRun{cnav, cnav.time});
+}
+
+const CnavGroupDelays* EphemerisStore::cnavGroupDelays(SatId sat, const GpsTime& t) const {
+  if (!sat.valid() || cnav_.empty()) return nullptr;
+  const auto& list = cnav_[satIndex(sat)];
+  auto it = std::upper_bound(list.begin(), list.end(), t,
+                             [](const GpsTime& x, const CnavRun& r) { return x < r.first.time; });
+  if (it == list.begin()) return nullptr;
+  const CnavRun& r = *std::prev(it);
+  const double age = r.lastSeen < t ? t - r.lastSeen : 0.0;
+  return age <= kCnavGroupDelayMaxAge ? &r.first : nullptr;
 }
 
 std::vector<SatId> EphemerisStore::satellites() const {

@@ -2,6 +2,8 @@
 #include "gvins/base/signal.hpp"
 #include "gvins/ephemeris/satellite_state.hpp"
 
+#include <optional>
+
 namespace gvins {
 namespace {
 
@@ -14,24 +16,51 @@ double gammaOf(System sys, char bandA, char bandB) {
   return r * r;
 }
 
+// GPS/QZSS (IS-QZSS-PNT-005 follows the same rules). The LNAV and the CNAV clocks both refer to
+// the L1/L2 P(Y) ionosphere-free pair (IS-GPS-200N 20.3.3.3.3.2, 30.3.3.2.3): L1 P(Y) removes T_GD
+// and L2 P(Y) γ12 T_GD. Every other signal x is referred to L1 P(Y) by its inter-signal
+// correction ISC_x = t_L1P(Y) − t_x of CNAV message type 30 (IS-GPS-200N 30.3.3.3.1.1.1,
+// IS-GPS-705J 20.3.3.3.1.2.1), so it removes T_GD − ISC_x — L2C too: ISC_L2C is referred to
+// L1 P(Y), not to L2 P(Y), and (Δt_SV)L2C = Δt_SV − T_GD + ISC_L2C:
+//   L1 C/A: T_GD − ISC_L1C/A;  L2C: T_GD − ISC_L2C;  L5 I5: T_GD − ISC_L5I5;  L5 Q5: T_GD − ISC_L5Q5.
+// An ionosphere-free pair combines these per-signal delays: (γ D1 − D2)/(γ − 1) =
+// T_GD + (ISC_2 − γ ISC_L1C/A)/(γ − 1), which is the − c T_GD and c (ISC_2 − γ ISC_L1C/A)/(1 − γ)
+// of the ICDs' pair formulas (IS-GPS-200N 30.3.3.3.1.1.2 with γ12 for L1 C/A + L2C,
+// IS-GPS-705J 20.3.3.3.1.2.3 with γ15 for L1 C/A + L5).
+// L5 I+Q tracking (5X) takes the mean of the I5 and Q5 corrections (a model choice: the two
+// components are sent with equal power; the ICDs give no ISC for the sum).
+// Without a CNAV message (or where it says "not available"): L1 C/A and L1C remove T_GD
+// (IS-GPS-800J 3.5.3.9: T_GD − ISC_L1C, its ISC only in CNAV-2), L2C γ12 T_GD as L2 P(Y), and L5
+// T_GD — not a frequency scaling of T_GD, as ISC_L5 is a measured hardware offset. T_GD: the CNAV
+// message's own (2^-35 s steps against LNAV's 2^-31 s) when it has one.
+double gpsGroupDelay(const KeplerEphemeris& eph, ObsCode code, const CnavGroupDelays* cnav) {
+  if (cnav && cnav->sat != eph.sat) cnav = nullptr;
+  const double tgd = cnav && cnav->tgd ? *cnav->tgd : eph.tgd[0];
+  std::optional<double> isc;
+  if (cnav) {
+    const char a = code.attr;
+    if (code.band == '1' && a == 'C') isc = cnav->iscL1ca;
+    if (code.band == '2' && (a == 'S' || a == 'L' || a == 'X')) isc = cnav->iscL2c;
+    if (code.band == '5' && a == 'I') isc = cnav->iscL5i5;
+    if (code.band == '5' && a == 'Q') isc = cnav->iscL5q5;
+    if (code.band == '5' && a == 'X' && cnav->iscL5i5 && cnav->iscL5q5) isc = 0.5 * (*cnav->iscL5i5 + *cnav->iscL5q5);
+  }
+  if (isc) return tgd - *isc;
+  switch (code.band) {
+    case '1':
+    case '5': return tgd;
+    case '2': return gammaOf(eph.sat.system, '1', '2') * tgd;
+    default: return 0.0;
+  }
+}
+
 }  // namespace
 
-double broadcastGroupDelay(const KeplerEphemeris& eph, ObsCode code) {
+double broadcastGroupDelay(const KeplerEphemeris& eph, ObsCode code, const CnavGroupDelays* cnav) {
   switch (eph.message) {
     case NavMessage::GpsLnav:
-    case NavMessage::QzssLnav: {
-      // The LNAV clock refers to the L1/L2 P(Y) ionosphere-free combination: L1 removes T_GD and
-      // L2 γ12 T_GD (IS-GPS-200N 20.3.3.3.3.2; L2C as L2 P(Y), without CNAV's ISC_L2C). L5 removes
-      // T_GD − ISC_L5 (IS-GPS-705J 20.3.3.3.1.2.1: ISC_L5 = t_L1P(Y) − t_L5 is a measured
-      // hardware offset, not a frequency scaling of T_GD), so without CNAV's ISC it removes T_GD,
-      // and the L1/L5 ionosphere-free pair removes T_GD as IS-GPS-705J 20.3.3.3.1.2.3 writes it.
-      // L1C likewise (IS-GPS-800J 3.5.3.9: T_GD − ISC_L1C). QZSS LNAV follows the same rules
-      // (IS-QZSS-PNT-005).
-      const System sys = eph.sat.system;
-      if (code.band == '1' || code.band == '5') return eph.tgd[0];
-      if (code.band == '2') return gammaOf(sys, '1', '2') * eph.tgd[0];
-      return 0.0;
-    }
+    case NavMessage::QzssLnav:
+      return gpsGroupDelay(eph, code, cnav);
     case NavMessage::GalileoInav:
     case NavMessage::GalileoFnav: {
       // Satellite hardware delays b1, b5 (E5a), b7 (E5b). BGD(E1,E5a) = (b5 - b1)/(g15 - 1),

@@ -53,7 +53,7 @@ std::optional<TransmitState> satelliteAtTransmit(const EphemerisStore& nav, SatI
 double transmitGroupDelay(const EphemerisStore& nav, const TransmitState& tx, SatId sat, ObsCode code) {
   if (const auto osb = nav.preciseCodeBias(tx.state, sat, code, tx.transmitTime)) return *osb;
   if (tx.glonass) return broadcastGroupDelay(*tx.glonass, code);
-  if (tx.kepler) return broadcastGroupDelay(*tx.kepler, code);
+  if (tx.kepler) return broadcastGroupDelay(*tx.kepler, code, nav.cnavGroupDelays(sat, tx.transmitTime));
   return 0.0;
 }
 

@@ -296,3 +296,48 @@ TEST(EphemerisStore, SwitchesJumpNoMoreThanTheBroadcastError) {
     EXPECT_LT(jumps[sys].maxSisre, 5.0) << systemName(sys);
   }
 }
+
+// CNAV message type 30: the latest message at or before the time asked for; repetitions extend
+// how long its corrections are known; an old one is not used; groupDelay applies it.
+TEST(EphemerisStore, CnavGroupDelaysLatestAtOrBefore) {
+  const NavData nav = readRinexNav(kNagoya);
+  const SatId g = nav.kepler.front().sat;
+  ASSERT_EQ(g.system, System::Gps);
+  EphemerisStore s;
+  s.add(nav);
+  const GpsTime t0 = nav.kepler.front().toe;
+  auto message = [&](double dt, double iscL1ca) {
+    CnavGroupDelays c;
+    c.sat = g;
+    c.time = t0 + dt;
+    c.tgd = nav.kepler.front().tgd[0];
+    c.iscL1ca = iscL1ca;
+    return c;
+  };
+  const std::uint64_t rev = s.revision();
+  s.add(message(0.0, 1e-9));
+  s.add(message(48.0, 1e-9));    // a repetition
+  s.add(message(600.0, -2e-9));  // new corrections
+  s.add(message(-30.0, 1e-9));   // the first values, seen earlier than known
+  EXPECT_EQ(s.revision(), rev);  // no record choice changed
+  EXPECT_EQ(s.cnavGroupDelays(g, t0 - 31.0), nullptr);
+  ASSERT_NE(s.cnavGroupDelays(g, t0 - 30.0), nullptr);
+  EXPECT_EQ(s.cnavGroupDelays(g, t0 - 30.0)->time, t0 - 30.0);
+  EXPECT_EQ(s.cnavGroupDelays(g, t0 + 599.0)->iscL1ca, 1e-9);
+  EXPECT_EQ(s.cnavGroupDelays(g, t0 + 600.0)->iscL1ca, -2e-9);
+  EXPECT_EQ(s.cnavGroupDelays(SatId(System::Gps, g.prn % 32 + 1), t0 + 600.0), nullptr);
+  EXPECT_NE(s.cnavGroupDelays(g, t0 + 600.0 + kCnavGroupDelayMaxAge), nullptr);
+  EXPECT_EQ(s.cnavGroupDelays(g, t0 + 601.0 + kCnavGroupDelayMaxAge), nullptr);
+  // groupDelay: L1 C/A T_GD − ISC_L1C/A (the message's T_GD) where a message is known, T_GD
+  // before.
+  const double tgd = nav.kepler.front().tgd[0];
+  ASSERT_NE(s.selectKepler(g, t0 - 60.0), nullptr);
+  EXPECT_EQ(s.groupDelay(g, ObsCode('1', 'C'), t0 - 60.0), s.selectKepler(g, t0 - 60.0)->tgd[0]);
+  EXPECT_EQ(s.groupDelay(g, ObsCode('1', 'C'), t0 + 60.0), tgd - 1e-9);
+  EXPECT_EQ(s.groupDelay(g, ObsCode('1', 'C'), t0 + 900.0), tgd + 2e-9);
+  // Only GPS and QZSS take CNAV group delays.
+  CnavGroupDelays galileo = message(0.0, 1e-9);
+  galileo.sat = SatId(System::Galileo, 1);
+  s.add(galileo);
+  EXPECT_EQ(s.cnavGroupDelays(galileo.sat, t0 + 1.0), nullptr);
+}

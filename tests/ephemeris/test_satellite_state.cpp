@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -213,6 +214,69 @@ TEST(GroupDelay, GpsL5FromSimulatedHardwareDelays) {
       a1 * broadcastGroupDelay(e, ObsCode('1', 'C')) + a2 * broadcastGroupDelay(e, ObsCode('5', 'Q'));
   EXPECT_NEAR(pairDelay, a1 * b1 + a2 * b5 - clockRef, 1e-20);
   EXPECT_GT(std::abs(pairDelay), 1e-9);  // metres: the term the L1/L5 pair must remove
+}
+
+TEST(GroupDelay, GpsCnavIscsFromSimulatedHardwareDelays) {
+  // Truth: satellite code delays on L1 P(Y), L2 P(Y), L1 C/A, L2C, L5 I5 and L5 Q5 (values of
+  // the size the walk log's CNAV messages imply). The clock absorbs the L1/L2 P(Y) pair; T_GD =
+  // (b1P − b2P)/(1 − γ12) and ISC_x = t_L1P(Y) − t_x = b1P − b_x (IS-GPS-200N 30.3.3.3.1.1.1,
+  // IS-GPS-705J 20.3.3.3.1.2.1). Every signal's delay relative to the clock is b_x − clockRef.
+  const double f1 = 1575.42e6, f2 = 1227.60e6, f5 = 1176.45e6;
+  const double g12 = f1 * f1 / (f2 * f2), g15 = f1 * f1 / (f5 * f5);
+  const double b1p = 2.0e-9, b2p = 16.1e-9, b1ca = 2.2e-9, b2c = 16.3e-9, b5i = 2.5e-9, b5q = 2.4e-9;
+  const double clockRef = (g12 * b1p - b2p) / (g12 - 1.0);
+  KeplerEphemeris e;
+  e.sat = SatId(System::Gps, 23);
+  e.tgd[0] = 1e-9;  // LNAV's T_GD: replaced by the CNAV message's own
+  CnavGroupDelays c;
+  c.sat = e.sat;
+  c.tgd = (b1p - b2p) / (1.0 - g12);
+  c.iscL1ca = b1p - b1ca;
+  c.iscL2c = b1p - b2c;
+  c.iscL5i5 = b1p - b5i;
+  c.iscL5q5 = b1p - b5q;
+  const std::pair<ObsCode, double> truth[] = {
+      {ObsCode('1', 'W'), b1p}, {ObsCode('2', 'W'), b2p}, {ObsCode('1', 'C'), b1ca}, {ObsCode('2', 'L'), b2c},
+      {ObsCode('2', 'S'), b2c}, {ObsCode('2', 'X'), b2c}, {ObsCode('5', 'I'), b5i},  {ObsCode('5', 'Q'), b5q},
+      {ObsCode('5', 'X'), 0.5 * (b5i + b5q)}};
+  for (const auto& [code, b] : truth) EXPECT_NEAR(broadcastGroupDelay(e, code, &c), b - clockRef, 1e-20) << code.str();
+  // The ICDs' pair formulas, PR = (PR_2 − γ PR_L1C/A + c (ISC_2 − γ ISC_L1C/A))/(1 − γ) − c T_GD
+  // (IS-GPS-200N 30.3.3.3.1.1.2, IS-GPS-705J 20.3.3.3.1.2.3), on pseudoranges made of a range,
+  // a first-order ionosphere and the delays: both they and the pair of per-signal corrections
+  // give the range.
+  const double kC = 299792458.0, range = 2.2e7, iono = 7.3;
+  auto pr = [&](double b, double f) { return range + iono * (f1 / f) * (f1 / f) + kC * (b - clockRef); };
+  const struct {
+    ObsCode code;
+    double b, f, g, isc;
+  } pairs[] = {{ObsCode('2', 'L'), b2c, f2, g12, *c.iscL2c}, {ObsCode('5', 'Q'), b5q, f5, g15, *c.iscL5q5}};
+  for (const auto& p : pairs) {
+    const double icd = (pr(p.b, p.f) - p.g * pr(b1ca, f1) + kC * (p.isc - p.g * *c.iscL1ca)) / (1.0 - p.g) - kC * *c.tgd;
+    EXPECT_NEAR(icd, range, 1e-6) << p.code.str();
+    const double a1 = p.g / (p.g - 1.0), a2 = -1.0 / (p.g - 1.0);
+    const double ours = a1 * (pr(b1ca, f1) - kC * broadcastGroupDelay(e, ObsCode('1', 'C'), &c)) +
+                        a2 * (pr(p.b, p.f) - kC * broadcastGroupDelay(e, p.code, &c));
+    EXPECT_NEAR(ours, range, 1e-6) << p.code.str();
+    // Without the message the L1/L5 pair keeps metres of error (the L1/L2C pair here only the
+    // 0.2 ns by which L1 C/A and L2C differ from the P(Y) signals).
+    if (p.code.band != '5') continue;
+    const double lnav = a1 * (pr(b1ca, f1) - kC * broadcastGroupDelay(e, ObsCode('1', 'C'))) +
+                        a2 * (pr(p.b, p.f) - kC * broadcastGroupDelay(e, p.code));
+    EXPECT_GT(std::abs(lnav - range), 1.0) << p.code.str();
+  }
+  // "Not available" fields keep the LNAV rule (with the message's T_GD); another satellite's
+  // message is not used.
+  c.iscL2c.reset();
+  EXPECT_NEAR(broadcastGroupDelay(e, ObsCode('2', 'L'), &c), g12 * *c.tgd, 1e-22);
+  CnavGroupDelays other = c;
+  other.sat = SatId(System::Gps, 24);
+  EXPECT_EQ(broadcastGroupDelay(e, ObsCode('1', 'C'), &other), e.tgd[0]);
+  // Galileo and BeiDou records ignore it.
+  KeplerEphemeris gal;
+  gal.sat = SatId(System::Galileo, 23);
+  gal.message = NavMessage::GalileoInav;
+  gal.tgd = {1e-9, 2e-9};
+  EXPECT_EQ(broadcastGroupDelay(gal, ObsCode('1', 'C'), &c), broadcastGroupDelay(gal, ObsCode('1', 'C')));
 }
 
 TEST(GroupDelay, GalileoFromSimulatedHardwareDelays) {

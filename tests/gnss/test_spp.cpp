@@ -566,6 +566,57 @@ TEST(Spp, SubsetsOfSystemsAndTwoFrequencies) {
   EXPECT_GT((s1.position - o.position).norm(), 2.0);
 }
 
+// GPS L1 C/A + L5 Q5 ionosphere-free pairs with the CNAV inter-signal corrections: pseudoranges
+// carry the satellite delays the ICD defines for the CNAV clock reference (T_GD − ISC_x, x = L1 C/A
+// and L5 Q5, ISC_L5Q5 of 4-11 ns as on the walk log's satellites) and a first-order ionosphere.
+// With the messages in the store SPP lands on the truth; without them (T_GD alone on L5) the
+// unremoved (ISC_L5 − γ15 ISC_L1C/A)/(γ15 − 1) goes into the position.
+TEST(Spp, GpsL1L5PairsWithCnavIscs) {
+  SimOptions o;
+  o.position = kNagoyaRover;
+  ObsEpoch e = simulate(nagoyaNav(), kNagoyaTime, o);
+  EphemerisStore withCnav = nagoyaNav();
+  const double f1 = *carrierFrequency(System::Gps, '1'), f5 = *carrierFrequency(System::Gps, '5');
+  ObsEpoch d;
+  d.time = e.time;
+  for (const SatObs& so : e.sats) {
+    if (so.sat.system != System::Gps) continue;
+    const KeplerEphemeris* k = nagoyaNav().selectKepler(so.sat, e.time);
+    ASSERT_NE(k, nullptr);
+    CnavGroupDelays c;
+    c.sat = so.sat;
+    c.time = e.time - 100.0;
+    c.iscL1ca = -0.3e-9 * (so.sat.prn % 4);
+    c.iscL5q5 = (4.0 + so.sat.prn % 8) * 1e-9;
+    withCnav.add(c);
+    const auto st = nagoyaNav().satelliteState(so.sat, d.time - 0.07);
+    const double iono = 2.0 / std::sin(azimuthElevation(o.position, st->position).elevation);
+    // simulate() applied the LNAV T_GD on L1 C/A: remove it, apply the ICD's delays.
+    const double geom = so.signals[0].pseudorange - kC * k->tgd[0];
+    SatObs& out = d.add(so.sat);
+    SignalObs s1{ObsCode('1', 'C')}, s5{ObsCode('5', 'Q')};
+    s1.setCode(geom + kC * (k->tgd[0] - *c.iscL1ca) + iono);
+    s5.setCode(geom + kC * (k->tgd[0] - *c.iscL5q5) + iono * (f1 / f5) * (f1 / f5));
+    s1.setSnr(45.0);
+    s5.setSnr(45.0);
+    out.signals = {s1, s5};
+  }
+  ASSERT_GE(d.sats.size(), 6u);
+  SppConfig c = plainConfig();
+  c.systems = parseSystemLetters("G");
+  c.frequencies = 3;  // the default GPS bands "125": L5 is the third (gvins-spp --freq 3)
+  c.ionosphere = IonosphereOption::DualFrequency;
+  const SppSolution s = SppSolver(withCnav, c).solve(d);
+  ASSERT_TRUE(s.valid());
+  EXPECT_LT((s.position - o.position).norm(), 0.05);
+  int ifCount = 0;
+  for (const auto& r : s.satellites) ifCount += r.use == SatelliteUse::Used && r.ionosphereFree;
+  EXPECT_EQ(ifCount, static_cast<int>(d.sats.size()));
+  const SppSolution lnavOnly = SppSolver(nagoyaNav(), c).solve(d);
+  ASSERT_TRUE(lnavOnly.valid());
+  EXPECT_GT((lnavOnly.position - o.position).norm(), 1.0);
+}
+
 TEST(Spp, DegenerateEpochsGiveStatusesNotCrashes) {
   SppSolver solver(nagoyaNav());
   ObsEpoch empty;

@@ -2,7 +2,9 @@
 // 2-byte little-endian length and that many payload bytes; byte 0 selects whether a receive time
 // is known (bit 0) and how far it advances per record (other bits). parseSfrbx may throw only
 // SfrbxError; the assembler must never throw, and every record it emits must be finite (BeiDou:
-// D2 records only for GEO satellites). Seed geo_beidou_d2.bin: the D2 pages of test_sfrbx_d2.cpp.
+// D2 records only for GEO satellites; CNAV group delays in range and dated). Seed geo_beidou_d2.bin:
+// the D2 pages of test_sfrbx_d2.cpp; walk_gps_cnav.bin: 24 GPS CNAV messages of the walk log
+// (types 10, 11, 30, 33 on L2 CM and L5 I).
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -35,6 +37,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       // BeiDou: D2 records for GEO satellites only, D1 for the others.
       if (e.sat.system == gvins::System::BeiDou &&
           (e.message == gvins::NavMessage::BeiDouD2) != gvins::isBeiDouGeo(e.sat)) std::abort();
+    }
+    // CNAV type 30: GPS/QZSS only, dated within half a week of the receive time, every delay
+    // inside the 13-bit range of 2^-35 s (|value| <= 4095 units; -4096 means "not available").
+    for (const auto& c : u.cnav) {
+      if (c.sat.system != gvins::System::Gps && c.sat.system != gvins::System::Qzss) std::abort();
+      if (!(mode & 1) || !(std::abs(c.time - t) <= 302400.0) || !std::isfinite(c.af0)) std::abort();
+      for (const auto& v : {c.tgd, c.iscL1ca, c.iscL2c, c.iscL5i5, c.iscL5q5})
+        if (v && !(std::abs(*v) <= std::ldexp(4095.0, -35))) std::abort();
     }
     for (const auto& g : u.glonass)
       if (!std::isfinite(g.position.norm()) || !std::isfinite(g.tauN)) std::abort();

@@ -1,5 +1,6 @@
 // libFuzzer target: the UBX framer and the UBX decoder (mixed-stream splitter, RAWX, NAV, ESF,
-// SFRBX hand-off) on arbitrary bytes fed in arbitrary chunks. Every frame the framer returns must
+// SFRBX hand-off; seed walk_cnav.bin: a RAWX epoch and GPS CNAV frames of the walk log) on
+// arbitrary bytes fed in arbitrary chunks. Every frame the framer returns must
 // carry a valid checksum and lie inside the input; the counters must add up; the decoder must
 // neither crash nor hang and must account for every byte. Every NAV-PVT delivered must have
 // its fields in range, a solution kind that agrees with its flags, and a GPST (the week rules of

@@ -69,7 +69,7 @@ TEST(UbxTool, InfoCountsEqualTheIndependentScan) {
   EXPECT_NE(out.find("14 epochs"), std::string::npos) << out;
 }
 
-// The SFRBX rows per gnssId/sigId: the walk log's sources not decoded, and BeiDou D2 (GEO) pages
+// The SFRBX rows per gnssId/sigId: the walk log's sources decoded or not, and BeiDou D2 (GEO) pages
 // (no real log holds them: the synthetic log of test_sfrbx_d2.cpp).
 TEST(UbxTool, InfoBreaksSfrbxDownBySource) {
   auto row = [](const std::string& out, const std::string& ids) {
@@ -78,7 +78,11 @@ TEST(UbxTool, InfoBreaksSfrbxDownBySource) {
   };
   const auto [walk, rc] = run(kTool + " info " + (dataDir() / "ubx/gnss_1730.ubx").string());
   ASSERT_EQ(rc, 0);
-  EXPECT_NE(walk.find("1699 of systems not decoded"), std::string::npos) << walk;
+  EXPECT_NE(walk.find("44 CNAV group delay sets, 0 parity and 0 CRC failures, 1551 of systems not decoded"),
+            std::string::npos) << walk;
+  // GPS L5 CNAV: 108 messages, 32 of type 30 (the Python tally of test_sfrbx_cnav.cpp).
+  EXPECT_NE(row(walk, "0/6").find("CNAV (L5)                        108       32           0        0"),
+            std::string::npos) << walk;
   const std::string b2a = row(walk, "3/8");
   EXPECT_NE(b2a.find("B-CNAV2 (not decoded)"), std::string::npos) << walk;
   EXPECT_EQ(b2a.substr(b2a.find_last_not_of(' ') - 3), " 364") << walk;  // no records, no checks

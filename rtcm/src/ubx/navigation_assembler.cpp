@@ -4,20 +4,32 @@
 #include "beidou_d2.hpp"
 #include "galileo_inav.hpp"
 #include "glonass_strings.hpp"
+#include "gps_cnav.hpp"
 #include "gps_lnav.hpp"
 #include "gvins/ephemeris/ephemeris_store.hpp"
 #include "gvins/ubx/ubx_signals.hpp"
 
 namespace gvins::ubx {
+namespace {
+
+// u-blox sigIds of the CNAV signals (interface description, "Signal identifiers"): GPS L2 CL/CM
+// (3, 4), L5 I/Q (6, 7); QZSS L2 CM/CL (4, 5), L5 I/Q (8, 9).
+bool isCnavSignal(System system, std::uint8_t sigId) {
+  if (system == System::Gps) return sigId == 3 || sigId == 4 || sigId == 6 || sigId == 7;
+  return sigId == 4 || sigId == 5 || sigId == 8 || sigId == 9;
+}
+
+}  // namespace
 
 bool NavDataUpdate::empty() const {
-  return kepler.empty() && glonass.empty() && !ionosphere.gps && !ionosphere.qzss && !ionosphere.beidou &&
+  return kepler.empty() && glonass.empty() && cnav.empty() && !ionosphere.gps && !ionosphere.qzss && !ionosphere.beidou &&
          !ionosphere.galileo;
 }
 
 void NavDataUpdate::addTo(EphemerisStore& store) const {
   for (const KeplerEphemeris& e : kepler) store.add(e);
   for (const GlonassEphemeris& g : glonass) store.add(g);
+  for (const CnavGroupDelays& c : cnav) store.add(c);
   IonosphereParameters& iono = store.ionosphere();
   if (ionosphere.gps) iono.gps = ionosphere.gps;
   if (ionosphere.qzss) iono.qzss = ionosphere.qzss;
@@ -27,6 +39,7 @@ void NavDataUpdate::addTo(EphemerisStore& store) const {
 
 struct NavigationAssembler::State {
   detail::GpsLnavDecoder lnav;
+  detail::GpsCnavDecoder cnav;
   detail::GalileoInavDecoder inav;
   detail::BeidouD1Decoder d1;
   detail::BeidouD2Decoder d2;
@@ -47,6 +60,7 @@ NavigationCounts& NavigationCounts::operator+=(const NavigationCounts& o) {
   skipped += o.skipped;
   ephemerides += o.ephemerides;
   ionosphere += o.ionosphere;
+  groupDelays += o.groupDelays;
   return *this;
 }
 
@@ -78,10 +92,16 @@ void NavigationAssembler::dispatch(const SfrbxMessage& msg, System system, const
   switch (system) {
     case System::Gps:
     case System::Qzss:
-      // L1 C/A LNAV only (sigId 0); L2C/L5 CNAV and QZSS L1S are not decoded.
-      if (msg.sigId != 0) break;
+      // L1 C/A LNAV (sigId 0) and L2C/L5 CNAV (GPS sigId 3, 4, 6, 7; QZSS 4, 5, 8, 9); QZSS L1S
+      // (sigId 1) is not decoded.
+      if (msg.sigId == 0) {
+        if (!sat.valid()) return void(++c.unknownMessages);
+        state_->lnav.add(msg, sat, receiveTime, out, c);
+        return;
+      }
+      if (!isCnavSignal(system, msg.sigId)) break;
       if (!sat.valid()) return void(++c.unknownMessages);
-      state_->lnav.add(msg, sat, receiveTime, out, c);
+      state_->cnav.add(msg, sat, receiveTime, out, c);
       return;
     case System::Galileo:
       // I/NAV on E1-B (sigId 1) and E5b-I (sigId 5); F/NAV (E5a) and E6 are not decoded.

@@ -15,8 +15,8 @@ NavigationSourceInfo navigationSourceInfo(const NavigationSource& s) {
   switch (s.gnssId) {
     case 0:  // GPS
       if (s.sigId == 0) return decoded("LNAV");
-      if (s.sigId == 3 || s.sigId == 4) return notDecoded("CNAV (L2C)");
-      if (s.sigId == 6 || s.sigId == 7) return notDecoded("CNAV (L5)");
+      if (s.sigId == 3 || s.sigId == 4) return decoded("CNAV (L2C)");
+      if (s.sigId == 6 || s.sigId == 7) return decoded("CNAV (L5)");
       break;
     case 1: return notDecoded("SBAS");
     case 2:  // Galileo
@@ -32,8 +32,8 @@ NavigationSourceInfo navigationSourceInfo(const NavigationSource& s) {
     case 5:  // QZSS
       if (s.sigId == 0) return decoded("LNAV");
       if (s.sigId == 1) return notDecoded("L1S SLAS");
-      if (s.sigId == 4 || s.sigId == 5) return notDecoded("CNAV (L2C)");
-      if (s.sigId == 8 || s.sigId == 9) return notDecoded("CNAV (L5)");
+      if (s.sigId == 4 || s.sigId == 5) return decoded("CNAV (L2C)");
+      if (s.sigId == 8 || s.sigId == 9) return decoded("CNAV (L5)");
       break;
     case 6:  // GLONASS
       if (s.sigId == 0 || s.sigId == 2) return decoded("strings");

@@ -13,6 +13,7 @@
 #include "gvins/ephemeris/kepler_ephemeris.hpp"
 #include "gvins/ephemeris/antex.hpp"
 #include "gvins/ephemeris/bias_sinex.hpp"
+#include "gvins/ephemeris/cnav_group_delays.hpp"
 #include "gvins/ephemeris/precise_ephemeris.hpp"
 #include "gvins/ephemeris/rinex_nav.hpp"
 #include "gvins/ephemeris/satellite_state.hpp"
@@ -115,9 +116,18 @@ class EphemerisStore {
   std::optional<SatelliteState> ssrState(SatId sat, const GpsTime& t,
                                          const EphemerisSelection& policy = {}) const;
 
-  /// Group delay (s) for a pseudorange on `code` from the record selected at t (0 if none).
+  /// Group delay (s) for a pseudorange on `code` from the record selected at t and, for GPS/QZSS,
+  /// the CNAV group delays at t (cnavGroupDelays) (0 if no record).
   double groupDelay(SatId sat, ObsCode code, const GpsTime& t,
                     const EphemerisSelection& policy = {}) const;
+
+  /// Adds the group delays of a GPS/QZSS CNAV message type 30. A message that repeats the
+  /// corrections of the one before it (same satellite) only extends how long those are known.
+  /// Does not change revision(): no record choice depends on it.
+  void add(const CnavGroupDelays& cnav);
+  /// The latest CNAV message type 30 of a satellite at or before t (its time <= t), unless its
+  /// corrections were last seen more than kCnavGroupDelayMaxAge before t; nullptr if none.
+  const CnavGroupDelays* cnavGroupDelays(SatId sat, const GpsTime& t) const;
 
   /// Satellites with at least one record.
   std::vector<SatId> satellites() const;
@@ -141,6 +151,11 @@ class EphemerisStore {
  private:
   std::vector<std::vector<KeplerEphemeris>> kepler_;   // indexed by satIndex, sorted by toe
   std::vector<std::vector<GlonassEphemeris>> glonass_;
+  struct CnavRun {
+    CnavGroupDelays first;  // the first message with these corrections
+    GpsTime lastSeen;       // the last message that repeated them
+  };
+  std::vector<std::vector<CnavRun>> cnav_;  // indexed by satIndex, sorted by time
   IonosphereParameters iono_;
   GlonassChannels channels_;
   std::optional<int> leapSeconds_;

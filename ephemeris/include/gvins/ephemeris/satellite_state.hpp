@@ -5,6 +5,7 @@
 
 #include "gvins/base/gnss_time.hpp"
 #include "gvins/base/signal.hpp"
+#include "gvins/ephemeris/cnav_group_delays.hpp"
 #include "gvins/ephemeris/glonass_ephemeris.hpp"
 #include "gvins/ephemeris/kepler_ephemeris.hpp"
 
@@ -44,10 +45,12 @@ inline constexpr double kGlonassDefaultStep = 30.0;
 SatelliteState glonassSatelliteState(const GlonassEphemeris& eph, const GpsTime& t, double maxStep);
 
 /// Broadcast group delay to subtract from SatelliteState::clockBias for a pseudorange on `code`,
-/// in seconds: GPS/QZSS L1 TGD, L2 gamma*TGD (IS-GPS-200 20.3.3.3.3.2); Galileo BGD(E1,E5a) for
-/// F/NAV, BGD(E1,E5b) for I/NAV scaled per band (OS SIS ICD 5.1.5); BeiDou TGD1 for B1I, TGD2
-/// for B2I, 0 for B3I (BDS-SIS-ICD B1I 5.2.4.10). 0 where the record carries none.
-double broadcastGroupDelay(const KeplerEphemeris& eph, ObsCode code);
+/// in seconds: GPS/QZSS L1 TGD, L2 gamma*TGD (IS-GPS-200 20.3.3.3.3.2), L5 TGD; with `cnav` (CNAV
+/// message type 30 of the same satellite) L1 C/A, L2C and L5 I5/Q5 TGD − ISC of the signal
+/// (IS-GPS-200 30.3.3.3.1.1, IS-GPS-705 20.3.3.3.1.2); Galileo
+/// BGD(E1,E5a) for F/NAV, BGD(E1,E5b) for I/NAV scaled per band (OS SIS ICD 5.1.5); BeiDou TGD1
+/// for B1I, TGD2 for B2I, 0 for B3I (BDS-SIS-ICD B1I 5.2.4.10). 0 where the record carries none.
+double broadcastGroupDelay(const KeplerEphemeris& eph, ObsCode code, const CnavGroupDelays* cnav = nullptr);
 
 /// GLONASS: 0 for G1 (tauN refers to L1), deltaTauN for G2 (GLONASS ICD 5.1, 4.4: the L2 signal
 /// leaves the satellite deltaTauN after the L1 signal of the same epoch); 0 for other bands.

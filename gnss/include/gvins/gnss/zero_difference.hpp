@@ -47,7 +47,8 @@ std::optional<TransmitState> satelliteAtTransmit(const EphemerisStore& nav, SatI
 
 /// Group delay (s) of a code of the satellite of `tx`: the precise code bias (OSB) that goes with
 /// precise clocks or the SSR code bias that goes with SSR clocks (EphemerisStore::preciseCodeBias),
-/// else the broadcast group delay of the record of `tx`.
+/// else the broadcast group delay of the record of `tx` (GPS/QZSS: with the store's CNAV
+/// inter-signal corrections at the transmit time, EphemerisStore::cnavGroupDelays).
 double transmitGroupDelay(const EphemerisStore& nav, const TransmitState& tx, SatId sat, ObsCode code);
 
 /// Geometric range |r_s − r| plus the Sagnac term for a satellite position in the ECEF frame of

@@ -1,8 +1,9 @@
 // Assembles broadcast ephemerides from UBX-RXM-SFRBX navigation data: keeps the partial
 // subframes/pages/strings of each satellite and emits a record once all parts with matching issue
 // of data have arrived. GPS/QZSS LNAV (IS-GPS-200), Galileo I/NAV (OS SIS ICD), BeiDou D1/D2
-// (BDS-SIS-ICD B1I), GLONASS L1/L2 OF strings (GLONASS ICD 5.1). SBAS messages are counted and
-// skipped. Records are filled exactly as the RTCM decoder and the RINEX reader fill them.
+// (BDS-SIS-ICD B1I), GLONASS L1/L2 OF strings (GLONASS ICD 5.1); of GPS/QZSS CNAV on L2C and L5
+// (IS-GPS-200 appendix III, IS-GPS-705) every message's CRC and message type 30 (group delays and
+// inter-signal corrections). SBAS messages are counted and skipped. Records are filled exactly as the RTCM decoder and the RINEX reader fill them.
 #pragma once
 
 #include <array>
@@ -15,6 +16,7 @@
 
 #include "gvins/base/gnss_time.hpp"
 #include "gvins/base/satellite.hpp"
+#include "gvins/ephemeris/cnav_group_delays.hpp"
 #include "gvins/ephemeris/glonass_ephemeris.hpp"
 #include "gvins/ephemeris/ionosphere_parameters.hpp"
 #include "gvins/ephemeris/kepler_ephemeris.hpp"
@@ -30,11 +32,13 @@ namespace gvins::ubx {
 struct NavDataUpdate {
   std::vector<KeplerEphemeris> kepler;
   std::vector<GlonassEphemeris> glonass;
+  /// GPS/QZSS CNAV message type 30 group delays and inter-signal corrections.
+  std::vector<CnavGroupDelays> cnav;
   /// Ionosphere parameters completed by this message (only the systems set are new).
   IonosphereParameters ionosphere;
 
   bool empty() const;
-  /// Adds the records to the store and sets the ionosphere parameters present here.
+  /// Adds the records and group delays to the store and sets the ionosphere parameters present here.
   void addTo(EphemerisStore& store) const;
 };
 
@@ -42,13 +46,14 @@ struct NavDataUpdate {
 struct NavigationCounts {
   std::uint64_t messages = 0;         ///< SFRBX messages of the system
   std::uint64_t parityFailures = 0;   ///< GPS/QZSS parity, BeiDou BCH, GLONASS Hamming failures
-  std::uint64_t crcFailures = 0;      ///< Galileo I/NAV CRC-24Q failures
+  std::uint64_t crcFailures = 0;      ///< Galileo I/NAV and GPS/QZSS CNAV CRC-24Q failures
   std::uint64_t incompleteSets = 0;   ///< partial sets dropped unused (another issue of data or frame came first)
   std::uint64_t unknownMessages = 0;  ///< unhandled pages/subframes/strings, bad layout, unknown signals
-  std::uint64_t skipped = 0;          ///< messages not decoded: SBAS, NavIC, GPS/QZSS CNAV,
+  std::uint64_t skipped = 0;          ///< messages not decoded: SBAS, NavIC, QZSS L1S,
                                       ///< Galileo F/NAV and E6, BeiDou B-CNAV1/2, GLONASS CDMA
   std::uint64_t ephemerides = 0;      ///< complete records emitted
   std::uint64_t ionosphere = 0;       ///< ionosphere parameter sets emitted
+  std::uint64_t groupDelays = 0;      ///< CNAV message type 30 group delay sets emitted
 
   NavigationCounts& operator+=(const NavigationCounts& o);
 };
