@@ -1,7 +1,8 @@
 // Issue 43: in the GNSS modes a flight replayed from mid-cruise (mono camera: constant velocity,
 // no mono scale, no standstill) starts from the GNSS/INS alignment (gnss_ins_alignment.hpp)
 // within 5 s of its first GNSS epoch, and is as accurate afterwards as the same flight started on
-// the ground. Checked against the simulator's ground truth. The hand-held walk started in motion
+// the ground. Checked against the simulator's ground truth. The take-off started on the ground
+// starts the GNSS during its vertical climb. The hand-held walk started in motion
 // (config/handheld_walk.yaml) starts from GNSS/INS too, within 5 s of its first GNSS epoch, with its
 // heading and heading σ checked against the truth.
 #include <gtest/gtest.h>
@@ -101,6 +102,9 @@ TEST(GnssStart, CruiseStartInitialisesFromGnssIns) {
 // started from the ground: the VIO initialises at the standstill, and the GNSS frame starts at its
 // first epoch, its yaw a nuisance until the horizontal motion gives its heading, instead of
 // waiting for that motion (docs/gnss_fusion.md "Stages"); as accurate as the later start.
+// Measured (7 Dec 2026, vio+dopp+psr, seed 3): GNSS start 1.00 s after the first frame, global
+// RMSE 0.578 m (horizontal 0.099 m) from then on, against 13.80 s and 0.772 m (0.084 m) waiting
+// for the motion. 3.5 s of CPU in Release.
 TEST(GnssStart, TakeOffStartsTheGnssBeforeTheHorizontalMotion) {
   const ReplaySummary early = replay("takeoff", 0.0, true);
   const ReplaySummary late = replay("takeoff_wait", 0.0, true, dataset(), 0.0, kLever, false);
