@@ -148,8 +148,11 @@ bool GnssFusion<Scalar>::startFrame(vio::EstimatorBackend<Scalar>& est, const Sp
   const AntennaKinematics k = antennaKinematics(s);  // yaw 0, p_NW 0: p_N = p_W
   const Eigen::Vector3d vN = anchor_.R_EN.transpose() * spp.velocity.velocity;
   const double minV = config_.frameMinSpeed;
-  const bool moving = vN.head<2>().norm() >= minV && k.v_N.head<2>().norm() >= minV;
-  if (!moving && !config_.frameStartAtRest) return false;
+  const bool sppMoving = vN.head<2>().norm() >= minV, imuMoving = k.v_N.head<2>().norm() >= minV;
+  const bool moving = sppMoving && imuMoving;
+  // At rest (horizontally) only when both agree: one moving and the other not is an IMU velocity
+  // far off (e.g. just after a visual initialisation in cruise), no start to make yet.
+  if (!moving && (!config_.frameStartAtRest || sppMoving || imuMoving)) return false;
   const double yaw = moving ? std::atan2(vN.y(), vN.x()) - std::atan2(k.v_N.y(), k.v_N.x()) : 0.0;
   const Eigen::Vector3d pN = anchor_.R_EN.transpose() * (spp.position - anchor_.ecef);
   Eigen::Matrix<Scalar, Eigen::Dynamic, 1> x(4);
@@ -674,7 +677,17 @@ bool GnssFusion<Scalar>::linearStart(vio::EstimatorBackend<Scalar>& est, Epoch& 
   if (after.size() != rows.size()) return true;
   Eigen::VectorXd r(static_cast<Eigen::Index>(after.size()));
   for (std::size_t i = 0; i < after.size(); ++i) r[static_cast<Eigen::Index>(i)] = after.rows[i].residual;
-  const Eigen::LLT<Eigen::MatrixXd> llt(rows.noise());
+  Eigen::MatrixXd noise = rows.noise();
+  if (yawPending_) {  // the yaw's nuisance (apply) moves the rows too
+    Eigen::MatrixXd N(static_cast<Eigen::Index>(after.size()), 4);
+    for (std::size_t i = 0; i < after.size(); ++i) {
+      const auto& d = after.rows[i].dh_dpv;
+      N.row(static_cast<Eigen::Index>(i)) << d[0] * yawSpread_[0], d[1] * yawSpread_[0], d[3] * yawSpread_[1],
+          d[4] * yawSpread_[1];
+    }
+    noise += N * N.transpose();
+  }
+  const Eigen::LLT<Eigen::MatrixXd> llt(noise);
   if (llt.info() != Eigen::Success || !r.allFinite()) return true;
   const double chi2 = r.dot(llt.solve(r));
   const double bound = sri::chiSquareQuantile(config_.epochGate, static_cast<int>(r.size()));
