@@ -111,6 +111,8 @@ void GnssFusion<Scalar>::forgetState() {
   ambiguities_.forget();
   stage_ = GnssFusionStage::kWaitingVio;
   frameRejections_ = 0;
+  yawPending_ = false;
+  startedAtRest_ = false;
   if (insAlign_) insAlign_->clear();
 }
 
@@ -146,15 +148,30 @@ bool GnssFusion<Scalar>::startFrame(vio::EstimatorBackend<Scalar>& est, const Sp
   const AntennaKinematics k = antennaKinematics(s);  // yaw 0, p_NW 0: p_N = p_W
   const Eigen::Vector3d vN = anchor_.R_EN.transpose() * spp.velocity.velocity;
   const double minV = config_.frameMinSpeed;
-  if (vN.head<2>().norm() < minV || k.v_N.head<2>().norm() < minV) return false;
-  const double yaw = std::atan2(vN.y(), vN.x()) - std::atan2(k.v_N.y(), k.v_N.x());
+  const bool sppMoving = vN.head<2>().norm() >= minV, imuMoving = k.v_N.head<2>().norm() >= minV;
+  const bool moving = sppMoving && imuMoving;
+  // At rest (horizontally) only when both agree: one moving and the other not is an IMU velocity
+  // far off (e.g. just after a visual initialisation in cruise), no start to make yet.
+  if (!moving && (!config_.frameStartAtRest || sppMoving || imuMoving)) return false;
+  const double yaw = moving ? std::atan2(vN.y(), vN.x()) - std::atan2(k.v_N.y(), k.v_N.x()) : 0.0;
   const Eigen::Vector3d pN = anchor_.R_EN.transpose() * (spp.position - anchor_.ecef);
   Eigen::Matrix<Scalar, Eigen::Dynamic, 1> x(4);
   x[0] = static_cast<Scalar>(std::remainder(yaw, 2.0 * constants::kPi));
   x.template tail<3>() = (pN - yawRotation(yaw) * k.p_N).template cast<Scalar>();
-  // Paper Sec. III-A: uninformative ("infinite covariance") prior.
-  frameBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_frame", 4), sri::BlockEstimate<Scalar>::fromVector(x),
-                             sri::Prior<Scalar>::uninformative());
+  // Paper Sec. III-A: uninformative ("infinite covariance") prior. Without the headings the yaw
+  // keeps the circle's σ as its prior instead, so that the block is informed (gated, with a
+  // covariance) once the rows reach p_NW; the rows never inform the yaw (apply) until
+  // headingFromMotion gives it a value.
+  yawPending_ = !moving;
+  startedAtRest_ = !moving;
+  yawCentre_ = k.p_N;  // p_W,r (yaw 0, p_NW 0)
+  auto prior = sri::Prior<Scalar>::uninformative();
+  if (yawPending_) {
+    typename sri::Prior<Scalar>::Matrix S = sri::Prior<Scalar>::Matrix::Zero(1, 4);
+    S(0, 0) = static_cast<Scalar>(1.0 / kFrameYawPriorSigma);
+    prior = sri::Prior<Scalar>::sqrtInformation(S);
+  }
+  frameBlock_ = est.addBlock(sri::BlockSpec::vector("gnss_frame", 4), sri::BlockEstimate<Scalar>::fromVector(x), prior);
   return true;
 }
 
@@ -191,7 +208,9 @@ bool GnssFusion<Scalar>::frameKnownInEnu(const vio::EstimatorBackend<Scalar>& es
   const std::optional<Eigen::Matrix4d> C = enuHeadingPositionCovariance(est, frameBlock_);
   if (!C) return false;  // not informed (yet)
   const Eigen::Vector4d var = C->diagonal();
-  const double sth = config_.frameYawSigmaDeg * constants::kDegToRad;
+  // After a start at rest the position is known before the heading: the move then waits for the
+  // heading to be known well (the local outputs keep the frame of the move, its error with them).
+  const double sth = (startedAtRest_ ? config_.frameReanchorYawSigmaDeg : config_.frameYawSigmaDeg) * constants::kDegToRad;
   const double sp = config_.frameReanchorPositionSigma;
   return var[0] < sth * sth && var.tail<3>().maxCoeff() < sp * sp;
 }
@@ -359,6 +378,23 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
     lay.fill(r, HJ.row(i).head(dim));
     HJ.row(i).tail<9>() = r.H_earlier;
   }
+  // The frame's yaw while it is a nuisance (yawPending_): uniform on the circle about its guess
+  // ψ̂, it turns the antenna's horizontal ENU position and velocity about the W origin,
+  // Rz(ψ) x_h = Rz(ψ̂) x_h + n with E n = 0, E n nᵀ = |x_h|² I₂ (x_h: p_W,r or v_W,r). Its column
+  // leaves the rows and n joins the nuisance (4 columns, σ |p_h| and |v_h|, yawSpread_: p_h the
+  // displacement since the frame's start, the constant offset before it being p_NW's), projected
+  // out like the integration error: the rows do not inform a yaw whose value is a guess, and
+  // carry what it may move, also far from linear (half a turn).
+  const bool yawNuisance = yawPending_ && lay.frameAt >= 0;
+  const int ny = yawNuisance ? 4 : 0;
+  Eigen::MatrixXd Ny(nr, ny);
+  if (yawNuisance) {
+    HJ.col(lay.frameAt).setZero();
+    for (Eigen::Index i = 0; i < nr; ++i) {
+      const auto& d = rows[static_cast<std::size_t>(i)].dh_dpv;
+      Ny.row(i) << d[0] * yawSpread_[0], d[1] * yawSpread_[0], d[3] * yawSpread_[1], d[4] * yawSpread_[1];
+    }
+  }
   Eigen::VectorXd gateVar(nr);  // σ² + J Σ_k Jᵀ + h P hᵀ per row
   if (haveP) {
     // The products as matrices first: nested in the coefficient-wise expression Eigen would
@@ -367,6 +403,7 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
     const Eigen::Matrix<double, Eigen::Dynamic, 9> JS = HJ.rightCols<9>() * intCov;
     gateVar = HP.cwiseProduct(HJ.leftCols(dim)).rowwise().sum() + JS.cwiseProduct(HJ.rightCols<9>()).rowwise().sum() +
               noise.diagonal();
+    if (yawNuisance) gateVar += Ny.rowwise().squaredNorm();
   }
   std::vector<int> keep;
   for (std::size_t i = 0; i < rows.size(); ++i) {
@@ -404,11 +441,13 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
   // enters as a 9-column nuisance J L_k (Σ_k = L_k L_kᵀ) with prior rows I and is projected out:
   // exactly the rows that the full Σ would give, without the n³ Cholesky of Σ.
   const auto nk = static_cast<Eigen::Index>(keep.size());
-  Eigen::MatrixXd A(nk, dim + 9 + 1);  // [h | J | r]
+  const Eigen::Index rc = dim + 9 + ny;  // the residual's column
+  Eigen::MatrixXd A(nk, rc + 1);        // [h | J | yaw nuisance | r]
   for (Eigen::Index j = 0; j < nk; ++j) {
     const auto i = static_cast<std::size_t>(keep[static_cast<std::size_t>(j)]);
     A.row(j).head(dim + 9) = HJ.row(static_cast<Eigen::Index>(i));
-    A(j, dim + 9) = rows[i].residual;
+    if (yawNuisance) A.row(j).segment(dim + 9, ny) = Ny.row(static_cast<Eigen::Index>(i));
+    A(j, rc) = rows[i].residual;
   }
   if (!whitenRows(A, noise, keep)) return u;
   // L_k of the (positive semi-definite) integration covariance.
@@ -419,21 +458,24 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
   const Eigen::Matrix<double, 9, 9> Lk =
       ldlt.transpositionsP().transpose() * (L * ldlt.vectorD().cwiseMax(0.0).cwiseSqrt().asDiagonal());
   const bool nuisance = Lk.norm() > 0.0;
-  sri::Measurement<Scalar> m(static_cast<int>(nk) + (nuisance ? 9 : 0));
+  const int ni = nuisance ? 9 : 0;
+  const int nn = ni + ny;
+  sri::Measurement<Scalar> m(static_cast<int>(nk) + nn);
   for (std::size_t bi = 0, col = 0; bi < lay.blocks.size(); col += static_cast<std::size_t>(lay.dims[bi]), ++bi) {
     const auto c = static_cast<Eigen::Index>(col);
     const int d = lay.dims[bi];
     if (bi >= lay.nImu && A.middleCols(c, d).isZero(0.0)) continue;  // e.g. the lever arm without excitation
     m.jacobian(lay.blocks[bi], d).topRows(nk) = A.middleCols(c, d).template cast<Scalar>();
   }
-  m.residual().head(nk) = A.col(dim + 9).template cast<Scalar>();
-  if (nuisance) {
-    auto N = m.nuisance(9);
-    N.topRows(nk) = (A.middleCols(dim, 9) * Lk).template cast<Scalar>();
-    N.bottomRows(9).setIdentity();
+  m.residual().head(nk) = A.col(rc).template cast<Scalar>();
+  if (nn > 0) {
+    auto N = m.nuisance(nn);
+    if (nuisance) N.topLeftCorner(nk, 9) = (A.middleCols(dim, 9) * Lk).template cast<Scalar>();
+    if (yawNuisance) N.block(0, ni, nk, ny) = A.middleCols(dim + 9, ny).template cast<Scalar>();
+    N.bottomRows(nn).setIdentity();  // their priors: N(0, I) in these units
   }
   m.setWhitened();
-  if (nuisance) m.projectNuisance(nullptr, sri::Measurement<Scalar>::NuisanceProjection::kHouseholder);
+  if (nn > 0) m.projectNuisance(nullptr, sri::Measurement<Scalar>::NuisanceProjection::kHouseholder);
   u = est.update(m, gate ? config_.epochGate : 1.0);
   if (readmitted) {
     // Rejected by the normal epoch gate: the widened joint χ² of the consensus stands for it.
@@ -631,6 +673,10 @@ bool GnssFusion<Scalar>::frameUpdate(vio::EstimatorBackend<Scalar>& est, Epoch& 
   const std::optional<Eigen::Matrix4d> C = enuHeadingPositionCovariance(est, frameBlock_);
   const double sth = config_.frameYawSigmaDeg * constants::kDegToRad;
   if (C && (*C)(0, 0) < sth * sth) stage_ = GnssFusionStage::kTight;
+  // Yaw a nuisance: the modes with range rows go tight once the frame's position is informed (the
+  // rows keep projecting the yaw out); the others keep the SPP rows until the yaw converged.
+  const bool ranges = config_.usesPseudorange() || config_.usesDifferences();
+  if (yawPending_ && ranges && C) stage_ = GnssFusionStage::kTight;
   return true;
 }
 
@@ -648,7 +694,17 @@ bool GnssFusion<Scalar>::linearStart(vio::EstimatorBackend<Scalar>& est, Epoch& 
   if (after.size() != rows.size()) return true;
   Eigen::VectorXd r(static_cast<Eigen::Index>(after.size()));
   for (std::size_t i = 0; i < after.size(); ++i) r[static_cast<Eigen::Index>(i)] = after.rows[i].residual;
-  const Eigen::LLT<Eigen::MatrixXd> llt(rows.noise());
+  Eigen::MatrixXd noise = rows.noise();
+  if (yawPending_) {  // the yaw's nuisance (apply) moves the rows too
+    Eigen::MatrixXd N(static_cast<Eigen::Index>(after.size()), 4);
+    for (std::size_t i = 0; i < after.size(); ++i) {
+      const auto& d = after.rows[i].dh_dpv;
+      N.row(static_cast<Eigen::Index>(i)) << d[0] * yawSpread_[0], d[1] * yawSpread_[0], d[3] * yawSpread_[1],
+          d[4] * yawSpread_[1];
+    }
+    noise += N * N.transpose();
+  }
+  const Eigen::LLT<Eigen::MatrixXd> llt(noise);
   if (llt.info() != Eigen::Success || !r.allFinite()) return true;
   const double chi2 = r.dot(llt.solve(r));
   const double bound = sri::chiSquareQuantile(config_.epochGate, static_cast<int>(r.size()));
@@ -750,9 +806,16 @@ GnssEpochReport GnssFusion<Scalar>::processEpoch(vio::EstimatorBackend<Scalar>& 
     worldChange_ = est.reanchorWorld(frameBlock_);
     frameBlock_ = {};
   }
+  if (yawPending_ && frameBlock_.valid()) headingFromMotion(est, e);
   GnssStateValues s;
   if (!buildState(est, e.t_ns, s)) return finish();
   AntennaKinematics k = antennaKinematics(s);
+  if (yawPending_) {
+    // The antenna's horizontal displacement in W since the frame's start (its offset from the W
+    // origin then is a constant that p_NW absorbs) and its horizontal velocity.
+    const Eigen::Vector3d pW = yawRotation(s.yaw).transpose() * (k.p_N - s.p_NW);
+    yawSpread_ << (pW - yawCentre_).head<2>().norm(), k.v_N.head<2>().norm();
+  }
   if (stage_ == GnssFusionStage::kFrameInit) {
     if (!frameUpdate(est, e, k)) return finish();
   } else if (!tightUpdate(est, e, s, k)) {

@@ -194,6 +194,10 @@ bool stageKey(GnssFusionConfig& c, const Fields& F, const std::string& key, cons
     c.frameYawSigmaDeg = positive(v, f);
   } else if (key == "frame_min_speed") {
     c.frameMinSpeed = number(v, f);
+  } else if (key == "frame_reanchor_yaw_sigma_deg") {
+    c.frameReanchorYawSigmaDeg = positive(v, f);
+  } else if (key == "frame_start_at_rest") {
+    c.frameStartAtRest = rd.boolean(v, f);
   } else if (key == "ins_start") {
     c.insStart = rd.boolean(v, f);
   } else if (key == "ins_start_window") {
@@ -243,7 +247,7 @@ GnssFusionConfig parseGnssFusionConfig(std::string_view yaml, const std::string&
       "carrier_smoothing", "smoothed_code_factor", "phase_sigma", "ambiguity_sigma", "ambiguity_reset_rejections", "max_ambiguities", "phase_windup", "rtk_hold_fix", "rtk_revalidate_interval", "broadcast_ambiguity_random_walk", "broadcast_record_changes", "estimate_zwd", "zwd_sigma", "zwd_random_walk",
       "doppler_sigma",
       "clock_bias_random_walk", "clock_drift_random_walk", "isb_random_walk", "isb_renewal_interval", "row_gate", "epoch_gate", "frame_yaw_sigma_deg",
-      "frame_min_speed", "ins_start", "ins_start_window", "ins_start_yaw_sigma_deg", "frame_reanchor", "frame_reanchor_position_sigma", "outage_reset", "reacquire_after", "reacquire_acceleration", "late_system_min_satellites", "clock_ransac_threshold", "base_position", "max_base_age"};
+      "frame_min_speed", "frame_start_at_rest", "ins_start", "ins_start_window", "ins_start_yaw_sigma_deg", "frame_reanchor", "frame_reanchor_position_sigma", "frame_reanchor_yaw_sigma_deg", "outage_reset", "reacquire_after", "reacquire_acceleration", "late_system_min_satellites", "clock_ransac_threshold", "base_position", "max_base_age"};
   if (const YAML::Node section = root["gnss_fusion"]) {
     if (!section.IsMap()) rd.fail(section, "gnss_fusion", "'gnss_fusion' must be a map");
     rd.map(section, "", kKeys, entry);

@@ -15,6 +15,10 @@
 
 namespace gvins::fusion {
 
+/// σ of the frame yaw's prior while it is a nuisance (GnssFusionConfig::frameStartAtRest): that
+/// of a yaw uniform on the circle, π/√3 rad.
+inline constexpr double kFrameYawPriorSigma = 1.8137993642342178;
+
 /// The kinds of rows, counted per kind in GnssEpochReport.
 enum GnssRowType : int { kPsr, kDopp, kDpsr, kDdcp, kVel, kFrame, kPhase };
 

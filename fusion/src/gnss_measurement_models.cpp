@@ -84,6 +84,7 @@ GnssRow chainRow(const AntennaKinematics& k, const RowVector3d& dh_dpN, const Ro
   r.H_frame = d * k.J_frame;
   r.H_lever = d * k.J_lever;
   r.H_earlier = d * k.J_earlier;
+  r.dh_dpv = d;
   return r;
 }
 

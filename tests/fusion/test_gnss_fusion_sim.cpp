@@ -708,11 +708,10 @@ TEST(GnssFusionSim, PhaseResidualsAtTruthWithWindup) {
 
 // Float PPP (vio+dopp+ppp) with the precise products: raw ionosphere-free codes plus
 // ionosphere-free carrier phases with one float ambiguity per satellite arc and a zenith wet
-// delay state. Against the carrier-smoothed psr rows: the phases halve the velocity error, and the
-// ambiguities match the simulator's integers. Measured (seed 2024, phases with wind-up): psr
-// 0.296 m / 0.050 m/s, ppp 0.363 m / 0.027 m/s, float 0.365 m / 0.027 m/s, broadcast only
-// 0.955 m / 0.028 m/s (ambiguity random walk; 1.137 m without), ambiguities 0.20 m RMS between
-// GPS satellites;
+// delay state. Against the carrier-smoothed psr rows: the phases lower the velocity error, and the
+// ambiguities match the simulator's integers. Measured (seed 2024, phases with wind-up, the frame
+// started at rest): psr 0.334 m / 0.018 m/s, ppp 0.424 m / 0.014 m/s, float 0.425 m / 0.014 m/s,
+// broadcast only 0.853 m / 0.014 m/s, ambiguities 0.18 m RMS between GPS satellites;
 // on this 90 s flight the float ambiguities have not converged, so the position is still that of
 // the averaged codes (docs/gnss_fusion.md, "Float PPP").
 TEST(GnssFusionSim, FloatPppWithPreciseProducts) {
@@ -732,7 +731,9 @@ TEST(GnssFusionSim, FloatPppWithPreciseProducts) {
   EXPECT_GT(ppp.phase.used, 5 * ppp.epochs);
   EXPECT_LT(ppp.phase.rejected, ppp.phase.used / 50);
   EXPECT_TRUE(ppp.zwd.has_value());
-  EXPECT_LT(ppp.velRms, 0.7 * psr.velRms);  // measured 0.027 vs 0.050 m/s (IMU-only backend, no vision)
+  // Measured 0.014 vs 0.018 m/s (IMU-only backend, no vision; 0.027 vs 0.050 m/s before the frame
+  // started at rest, 0.8 s after the first epoch).
+  EXPECT_LT(ppp.velRms, 0.9 * psr.velRms);
   EXPECT_LT(ppp.posRms, 0.6);
   EXPECT_LT(pppFloat.posRms, 0.6);
   EXPECT_NEAR(pppFloat.velRms, ppp.velRms, 0.3 * ppp.velRms);
@@ -740,7 +741,7 @@ TEST(GnssFusionSim, FloatPppWithPreciseProducts) {
                pppBroadcast.velRms, pppBroadcast.phase.used, pppBroadcast.phase.rejected);
   EXPECT_GT(pppBroadcast.phase.used, 5 * pppBroadcast.epochs);
   EXPECT_LT(pppBroadcast.phase.rejected, pppBroadcast.phase.used / 50);
-  EXPECT_LT(pppBroadcast.velRms, 0.7 * psr.velRms);
+  EXPECT_LT(pppBroadcast.velRms, 0.9 * psr.velRms);
   // Ambiguities against the simulator's (GPS L1/L5: a1 λ1 N1 + a2 λ2 N2), differenced between
   // satellites so that the receiver clock (which shares the common part) drops out: what is left
   // is the position and troposphere error along the lines of sight, decimetres; a wrong
@@ -866,11 +867,13 @@ TEST(GnssFusionSim, ThreeSatellitesStillHelp) {
   ASSERT_GT(with3.epochs, 100);
   std::fprintf(stderr, "after 30 s: velocity RMS %.3f m/s with 3 satellites, %.3f m/s without GNSS (%d Doppler rows used)\n",
                with3.velRms, none.velRms, with3.dopp.used);
-  // Measured (seed 2024): 0.53 m/s with three satellites (three range rates for velocity and
-  // clock drift: the IMU dynamics carry the rest), 6.1 m/s without GNSS.
+  // Measured (seed 2024): 0.42 m/s with three satellites (three range rates for velocity and
+  // clock drift: the IMU dynamics carry the rest), 1.11 m/s without GNSS (0.53 and 6.1 m/s
+  // before the frame started at rest: its SPP rows from 0.8 s on leave the IMU biases better
+  // known at 30 s).
   EXPECT_GT(with3.dopp.used, 2 * with3.epochs);
   EXPECT_LT(with3.velRms, 1.0);
-  EXPECT_LT(with3.velRms, 0.2 * none.velRms);
+  EXPECT_LT(with3.velRms, 0.5 * none.velRms);
 }
 
 // A drifting inter-system bias (Galileo's code and phase 1.5 m later over the minute after 15 s):

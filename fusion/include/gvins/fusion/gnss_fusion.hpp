@@ -6,7 +6,11 @@
 //   2. Frame initialisation (stage kFrameInit): client block [ψ, p_NW] with an uninformative prior
 //      added at the first SPP fix with enough speed (yaw guess from the velocity headings), updated
 //      with the SPP position/velocity predicted through the IMU integration until the σ of the
-//      IMU's heading in ENU (ψ + its yaw in W) < σ_θ. Then
+//      IMU's heading in ENU (ψ + its yaw in W) < σ_θ. Without that speed yet (a vertical take-off,
+//      a start at rest; frameStartAtRest) the block starts at the first fix anyway, its yaw a
+//      nuisance of its wide prior that no row informs (every row's yaw column is projected out
+//      with that σ) until the headings give its value (headingFromMotion); the modes with range
+//      rows go tight at once. Once converged
 //      (frameReanchor) the estimator re-expresses its state in ENU and the block is marginalized
 //      (EstimatorBackend::reanchorWorld, an exact change of variables): as in the paper the frame
 //      leaves the state, but its information moves into the poses, so the VIO's yaw and position
@@ -172,6 +176,11 @@ class GnssFusion {
                  GnssRowSet& rows);
   bool buildState(const vio::EstimatorBackend<Scalar>& est, std::int64_t t_ns, GnssStateValues& s) const;
   bool startFrame(vio::EstimatorBackend<Scalar>& est, const SppSolution& spp, std::int64_t t_ns);
+  /// While the frame's yaw is a nuisance (yawPending_): once the SPP and the IMU velocities both
+  /// move horizontally at frameMinSpeed, the yaw gets the difference of their headings as its
+  /// value, with the same wide prior (the rows had not informed it), p_NW moved so that the
+  /// antenna's ENU position stays, and the rows estimate it from then on (gnss_frame_heading.cpp).
+  void headingFromMotion(vio::EstimatorBackend<Scalar>& est, Epoch& e);
   /// Not initialised: feeds the epoch to the GNSS/INS alignment and, once it has a state, starts
   /// the estimator from it in ENU (gnss_fusion_ins_start.cpp); the tight stage follows at once.
   void startFromGnss(vio::EstimatorBackend<Scalar>& est, const ObsEpoch& rover, GnssEpochReport& rep);
@@ -207,6 +216,10 @@ class GnssFusion {
   GnssFusionStage stage_ = GnssFusionStage::kWaitingVio;
   int frameRestarts_ = 0;
   int frameRejections_ = 0;  // consecutive frame epochs gated out (frameUpdate)
+  bool yawPending_ = false;  // the frame's yaw is a nuisance of its prior, not yet given a value (startFrame)
+  bool startedAtRest_ = false;  // the frame started with its yaw pending (frameReanchorYawSigmaDeg)
+  Eigen::Vector2d yawSpread_ = Eigen::Vector2d::Zero();  // |p_h| since yawCentre_, |v_h| of the antenna (apply)
+  Eigen::Vector3d yawCentre_ = Eigen::Vector3d::Zero();  // the antenna in W at the frame's start
   std::uint64_t generation_ = 0;  // estimator generation the ids below belong to
   GnssAnchor anchor_;
   sri::BlockId frameBlock_;

@@ -45,12 +45,14 @@
 //     epoch_gate: 0.99999                 # chi-square probability of the stacked rows
 //     frame_yaw_sigma_deg: 3              # convergence threshold σ_θ
 //     frame_min_speed: 1.0                # m/s before the yaw guess from velocity headings
+//     frame_start_at_rest: true           # start the frame below frame_min_speed, the yaw a nuisance
 //     ins_start: true                     # start the estimator from GNSS/INS when vision has not
 //     ins_start_window: 5                 # s of SPP/Doppler epochs the alignment uses at most
 //     ins_start_yaw_sigma_deg: 10         # accepted below this yaw σ, the filter's prior (gnss_ins_alignment.hpp)
 //     frame_reanchor: true                # once converged re-express the VIO state in ENU and
 //                                         # marginalize the frame block (false: keep it as a state)
 //     frame_reanchor_position_sigma: 0.5  # m, ... once the IMU's ENU position σ is below this
+//     frame_reanchor_yaw_sigma_deg: 0.3   # ... and, after a start at rest, the heading σ below this
 //     outage_reset: 60                    # s without GNSS update: clocks/ambiguities reset
 //     reacquire_after: 2                  # s with every row gated out, or without update: re-acquisition (0: never)
 //     reacquire_acceleration: 0.3         # m/s², unmodelled acceleration that widens its gate with time
@@ -215,6 +217,13 @@ struct GnssFusionConfig {
   double epochGate = 0.99999;
   double frameYawSigmaDeg = 3.0;
   double frameMinSpeed = 1.0;
+  /// Start the frame at the first SPP fix with Doppler also when the antenna or the IMU moves
+  /// horizontally slower than frameMinSpeed (a take-off climbing vertically, a vehicle at rest):
+  /// the yaw is then a nuisance of its wide prior (σ π/√3, the circle's) that no row informs,
+  /// until both speeds pass frameMinSpeed and the headings give its first value; position, clocks
+  /// and the vertical start at once (docs/gnss_fusion.md "Stages"). false: the frame waits for
+  /// that speed.
+  bool frameStartAtRest = true;
   /// Start the estimator from a GNSS/INS alignment (gnss_ins_alignment.hpp) when it has not
   /// initialised from vision: SPP positions and Doppler velocities over at most insStartWindow
   /// s, accepted when the yaw σ is below insStartYawSigmaDeg; the estimator then runs in ENU and
@@ -232,6 +241,10 @@ struct GnssFusionConfig {
   /// pose and the frame) is below this too (m): the raw rows first correct the SPP-level position
   /// of the initialisation.
   double frameReanchorPositionSigma = 0.5;
+  /// After a start at rest (frameStartAtRest) the position is known before the heading: the move
+  /// waits for the heading σ below this (deg) instead of frameYawSigmaDeg, since the local
+  /// outputs keep the frame of the move and its heading error with it.
+  double frameReanchorYawSigmaDeg = 0.3;
   double outageReset = 60.0;
   double clockRansacThreshold = 5.0;
   std::optional<Eigen::Vector3d> basePosition;

@@ -78,6 +78,8 @@ struct GnssRow {
   Eigen::Matrix<double, 1, 4> H_frame = Eigen::Matrix<double, 1, 4>::Zero();
   Eigen::Matrix<double, 1, 3> H_lever = Eigen::Matrix<double, 1, 3>::Zero();
   Eigen::Matrix<double, 1, 9> H_earlier = Eigen::Matrix<double, 1, 9>::Zero();
+  /// ∂h/∂[p_N, v_N] of the antenna (chainRow): the yaw's nuisance before the frame has a yaw.
+  Eigen::Matrix<double, 1, 6> dh_dpv = Eigen::Matrix<double, 1, 6>::Zero();
   int clockBias = -1;       ///< index of the clock-bias entry touched (coefficient +1), -1: none
   int ambiguity = -1;       ///< index of the float-ambiguity block touched (coefficient +1), -1: none
   double H_tropo = 0.0;     ///< coefficient of the zenith wet delay residual (wet mapping function)
