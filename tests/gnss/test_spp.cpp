@@ -269,11 +269,10 @@ SppConfig simulationNoiseConfig() {
 // Mean NEES of the positions of SPP solutions (config c) of `trials` simulated epochs 10 s apart
 // at the Nagoya rover (pseudorange noise sigma `noise`, random seed `seed`); each epoch and its
 // solution are also handed to `visit`.
+// As below with the simulation options `o` (their position is the Nagoya rover's).
 template <class Visit>
-double meanNees(const SppConfig& c, double noise, unsigned seed, int trials, Visit visit) {
-  SimOptions o;
+double meanNees(const SppConfig& c, SimOptions o, unsigned seed, int trials, Visit visit) {
   o.position = kNagoyaRover;
-  o.noise = noise;
   std::mt19937 rng(seed);
   o.rng = &rng;
   double nees = 0.0;
@@ -289,6 +288,13 @@ double meanNees(const SppConfig& c, double noise, unsigned seed, int trials, Vis
     nees += d.dot(s.positionCovariance.ldlt().solve(d));
   }
   return nees / trials;
+}
+
+template <class Visit>
+double meanNees(const SppConfig& c, double noise, unsigned seed, int trials, Visit visit) {
+  SimOptions o;
+  o.noise = noise;
+  return meanNees(c, o, seed, trials, visit);
 }
 
 TEST(Spp, CovarianceIsConsistentWithSimulatedNoise) {
@@ -359,27 +365,12 @@ TEST(Spp, ExcessCorrelationDescribesOneSidedDelays) {
   SppConfig correlated = independent;
   correlated.reportedError.excessCorrelation = SppConfig{}.reportedError.excessCorrelation;
   ASSERT_EQ(correlated.reportedError.excessCorrelation, 0.5);
-  auto nees = [&](const SppConfig& c, double delay, double noise, unsigned seed) {
+  auto nees = [](const SppConfig& c, double delay, double noise, unsigned seed) {
     SimOptions o;
-    o.position = kNagoyaRover;
     o.noise = noise;
     o.oneSidedDelay = delay;
     o.perElevation = true;
-    std::mt19937 rng(seed);
-    o.rng = &rng;
-    double sum = 0.0;
-    const int trials = 300;
-    for (int i = 0; i < trials; ++i) {
-      const ObsEpoch e = simulate(nagoyaNav(), kNagoyaTime + i * 10.0, o);
-      SppSolver solver(nagoyaNav(), c);
-      solver.setInitialPosition(kNagoyaRover);
-      const SppSolution s = solver.solve(e);
-      EXPECT_TRUE(s.valid());
-      if (!s.valid()) continue;
-      const Eigen::Vector3d d = s.position - o.position;
-      sum += d.dot(s.positionCovariance.ldlt().solve(d));
-    }
-    return sum / trials;
+    return meanNees(c, o, seed, 300, [](const ObsEpoch&, const SppSolution&) {});
   };
   const double withCorrelation = nees(correlated, 0.9, 0.3, 3), withoutCorrelation = nees(independent, 0.9, 0.3, 3);
   // The price where the excess is independent (noise 3x the model, no delay, as in
