@@ -267,9 +267,8 @@ SppConfig simulationNoiseConfig() {
 }
 
 // Mean NEES of the positions of SPP solutions (config c) of `trials` simulated epochs 10 s apart
-// at the Nagoya rover (pseudorange noise sigma `noise`, random seed `seed`); each epoch and its
-// solution are also handed to `visit`.
-// As below with the simulation options `o` (their position is the Nagoya rover's).
+// at the Nagoya rover (simulation options `o`, random seed `seed`); each epoch and its solution
+// are also handed to `visit`.
 template <class Visit>
 double meanNees(const SppConfig& c, SimOptions o, unsigned seed, int trials, Visit visit) {
   o.position = kNagoyaRover;
@@ -290,6 +289,7 @@ double meanNees(const SppConfig& c, SimOptions o, unsigned seed, int trials, Vis
   return nees / trials;
 }
 
+// The same with pseudorange noise σ `noise` (m) as the only error.
 template <class Visit>
 double meanNees(const SppConfig& c, double noise, unsigned seed, int trials, Visit visit) {
   SimOptions o;
