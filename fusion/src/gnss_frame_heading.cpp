@@ -18,11 +18,9 @@ void GnssFusion<Scalar>::headingFromMotion(vio::EstimatorBackend<Scalar>& est, E
   const Eigen::Vector3d vN = anchor_.R_EN.transpose() * spp.velocity.velocity;
   const double minV = config_.frameMinSpeed;
   if (vN.head<2>().norm() < minV || k.v_N.head<2>().norm() < minV) return;
-  // The same guess as startFrame's: the heading of the SPP velocity minus that of the IMU's
-  // velocity in W (k.v_N = Rz(ψ̂) v_W).
+  // The same guess as startFrame's, about the current value (k.v_N = Rz(ψ̂) v_W).
   const double yaw0 = s.yaw;
-  const double yaw = std::remainder(yaw0 + std::atan2(vN.y(), vN.x()) - std::atan2(k.v_N.y(), k.v_N.x()),
-                                    2.0 * constants::kPi);
+  const double yaw = std::remainder(yaw0 + velocityHeadingDifference(vN, k.v_N), 2.0 * constants::kPi);
   // p_NW so that the ENU position the rows determined stays: that of the antenna at the frame's
   // start, c (in W), p_NW + Rz(ψ) c; its displacement since (vertical at first, then the start
   // of the horizontal motion, predicted with the yaw's guess) turns with the new yaw.

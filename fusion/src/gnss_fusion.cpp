@@ -153,7 +153,7 @@ bool GnssFusion<Scalar>::startFrame(vio::EstimatorBackend<Scalar>& est, const Sp
   // At rest (horizontally) only when both agree: one moving and the other not is an IMU velocity
   // far off (e.g. just after a visual initialisation in cruise), no start to make yet.
   if (!moving && (!config_.frameStartAtRest || sppMoving || imuMoving)) return false;
-  const double yaw = moving ? std::atan2(vN.y(), vN.x()) - std::atan2(k.v_N.y(), k.v_N.x()) : 0.0;
+  const double yaw = moving ? velocityHeadingDifference(vN, k.v_N) : 0.0;
   const Eigen::Vector3d pN = anchor_.R_EN.transpose() * (spp.position - anchor_.ecef);
   Eigen::Matrix<Scalar, Eigen::Dynamic, 1> x(4);
   x[0] = static_cast<Scalar>(std::remainder(yaw, 2.0 * constants::kPi));
@@ -390,10 +390,7 @@ vio::BackendUpdate<Scalar> GnssFusion<Scalar>::apply(vio::EstimatorBackend<Scala
   Eigen::MatrixXd Ny(nr, ny);
   if (yawNuisance) {
     HJ.col(lay.frameAt).setZero();
-    for (Eigen::Index i = 0; i < nr; ++i) {
-      const auto& d = rows[static_cast<std::size_t>(i)].dh_dpv;
-      Ny.row(i) << d[0] * yawSpread_[0], d[1] * yawSpread_[0], d[3] * yawSpread_[1], d[4] * yawSpread_[1];
-    }
+    Ny = yawNuisanceColumns(rows);
   }
   Eigen::VectorXd gateVar(nr);  // σ² + J Σ_k Jᵀ + h P hᵀ per row
   if (haveP) {
@@ -574,6 +571,8 @@ void GnssFusion<Scalar>::feedRtk(Epoch& e, const ObsEpoch* base) {
   // in the tight stage): the ambiguities are constant along the arcs.
   const bool newBase = base && (!lastBase_ || base->time > *lastBase_);
   if (newBase) {
+    // The RTK module takes the raw base epochs unless they are smoothed for it (dpsr).
+    const bool rawBase = !baseSmoother_ || codeRtk_;
     if (baseSmoother_) {
       // The smoothed base codes from Doppler-checked epochs (the smoother's slip detector tests
       // the Doppler), as the rover's are checked at the input; Ddcp's RTK module keeps the raw
@@ -583,10 +582,10 @@ void GnssFusion<Scalar>::feedRtk(Epoch& e, const ObsEpoch* base) {
       baseSmoother_->apply(b, e.nav.glonassChannels());
       (codeRtk_ ? codeRtk_ : rtk_)->addBaseEpoch(b);
     }
-    if (!baseSmoother_ || codeRtk_) rtk_->addBaseEpoch(*base);
+    if (rawBase) rtk_->addBaseEpoch(*base);
     lastBase_ = base->time;
     // The base's Doppler check: the RTK module's on the raw base epochs, else the fusion's.
-    if (!baseSmoother_ || codeRtk_) {
+    if (rawBase) {
       const std::vector<std::string>& w = rtk_->base().doppler().warnings();
       for (; baseWarned_ < w.size(); ++baseWarned_) e.rep.warnings.push_back(w[baseWarned_]);
     } else {
@@ -681,6 +680,17 @@ bool GnssFusion<Scalar>::frameUpdate(vio::EstimatorBackend<Scalar>& est, Epoch& 
 }
 
 template <typename Scalar>
+Eigen::MatrixXd GnssFusion<Scalar>::yawNuisanceColumns(const std::vector<GnssRow>& rows) const {
+  Eigen::MatrixXd N(static_cast<Eigen::Index>(rows.size()), 4);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const auto& d = rows[i].dh_dpv;
+    N.row(static_cast<Eigen::Index>(i)) << d[0] * yawSpread_[0], d[1] * yawSpread_[0], d[3] * yawSpread_[1],
+        d[4] * yawSpread_[1];
+  }
+  return N;
+}
+
+template <typename Scalar>
 bool GnssFusion<Scalar>::linearStart(vio::EstimatorBackend<Scalar>& est, Epoch& e, const GnssRowSet& rows) {
   // The first rows meet a block without information: linearly they are fitted exactly, so what
   // is left of them at the corrected state is the error of the linearisation.
@@ -696,12 +706,7 @@ bool GnssFusion<Scalar>::linearStart(vio::EstimatorBackend<Scalar>& est, Epoch& 
   for (std::size_t i = 0; i < after.size(); ++i) r[static_cast<Eigen::Index>(i)] = after.rows[i].residual;
   Eigen::MatrixXd noise = rows.noise();
   if (yawPending_) {  // the yaw's nuisance (apply) moves the rows too
-    Eigen::MatrixXd N(static_cast<Eigen::Index>(after.size()), 4);
-    for (std::size_t i = 0; i < after.size(); ++i) {
-      const auto& d = after.rows[i].dh_dpv;
-      N.row(static_cast<Eigen::Index>(i)) << d[0] * yawSpread_[0], d[1] * yawSpread_[0], d[3] * yawSpread_[1],
-          d[4] * yawSpread_[1];
-    }
+    const Eigen::MatrixXd N = yawNuisanceColumns(after.rows);
     noise += N * N.transpose();
   }
   const Eigen::LLT<Eigen::MatrixXd> llt(noise);
@@ -734,7 +739,6 @@ bool GnssFusion<Scalar>::restartFrame(vio::EstimatorBackend<Scalar>& est, Epoch&
   e.rep.updated = false;
   forgetState();
   generation_ = est.generation();
-  ++frameRestarts_;
   return true;
 }
 

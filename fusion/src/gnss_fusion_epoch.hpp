@@ -3,6 +3,7 @@
 // (the rows of the tight stage).
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -18,6 +19,12 @@ namespace gvins::fusion {
 /// σ of the frame yaw's prior while it is a nuisance (GnssFusionConfig::frameStartAtRest): that
 /// of a yaw uniform on the circle, π/√3 rad.
 inline constexpr double kFrameYawPriorSigma = 1.8137993642342178;
+
+/// The frame's yaw guess from motion: the heading of the SPP velocity `vSpp` minus that of the
+/// IMU's velocity `vImu`, both in ENU as the frame currently turns W (rad, not wrapped).
+inline double velocityHeadingDifference(const Eigen::Vector3d& vSpp, const Eigen::Vector3d& vImu) {
+  return std::atan2(vSpp.y(), vSpp.x()) - std::atan2(vImu.y(), vImu.x());
+}
 
 /// The kinds of rows, counted per kind in GnssEpochReport.
 enum GnssRowType : int { kPsr, kDopp, kDpsr, kDdcp, kVel, kFrame, kPhase };

@@ -180,7 +180,7 @@ Eigen::Matrix<double, 12, 12> refine(const std::vector<Pair>& pairs, double sbg,
     g.setZero();
     for (const Pair& p : pairs) {
       const Eigen::Vector3d bt = p.beta + p.Jg * bg + p.Ja * ba;
-      const Eigen::Vector3d r = residual(p, R, bg, ba, v0);
+      const Eigen::Vector3d r = p.u - v0 - R * bt;  // residual() with its bias-corrected term at hand
       Eigen::Matrix<double, 3, 12> A;  // r(x ⊞ d) ≈ r + A d
       A << vio::so3::skew(R * bt), -R * p.Jg, -R * p.Ja, -Eigen::Matrix3d::Identity();
       H += A.transpose() * p.W * A;

@@ -62,13 +62,7 @@ double medianVarianceFactor(const ReportedInputs& in, const std::vector<Eigen::I
     b.block(r, 0, 1, nf) = -in.rows[order[r]].h.transpose() * g0;
     b(r, r) = 1.0;
   }
-  Eigen::MatrixXd ri(nAll, nAll), rc(nAll, nAll);
-  for (Eigen::Index i = 0; i < nAll; ++i) {
-    for (Eigen::Index j = 0; j < nAll; ++j) {
-      ri(i, j) = rIndAll(order[i], order[j]);
-      rc(i, j) = rCommonAll(order[i], order[j]);
-    }
-  }
+  const Eigen::MatrixXd ri = rIndAll(order, order), rc = rCommonAll(order, order);
   const Eigen::VectorXd dInd = (b * ri * b.transpose()).diagonal(), dCommon = (b * rc * b.transpose()).diagonal();
   std::vector<double> q;
   for (Eigen::Index i = 0; i < nAll; ++i) {
@@ -103,12 +97,8 @@ ReportedCovariance reportedCovariance(const ReportedInputs& in, const Covariance
   Eigen::MatrixXd rIndAll = Eigen::MatrixXd::Zero(rAll.rows(), rAll.cols());
   for (Eigen::Index i = 0; i < rAll.rows(); ++i) rIndAll(i, i) = in.rows[i].independentVariance;
   const Eigen::MatrixXd rCommonAll = rAll - rIndAll;
-  Eigen::MatrixXd rCommon(n, n);
-  Eigen::VectorXd rIndependent(n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    rIndependent[i] = rIndAll(kept[i], kept[i]);
-    for (Eigen::Index j = 0; j < n; ++j) rCommon(i, j) = rCommonAll(kept[i], kept[j]);
-  }
+  const Eigen::MatrixXd rCommon = rCommonAll(kept, kept);
+  const Eigen::VectorXd rIndependent = rIndAll.diagonal()(kept);
   // Information of the prior rows: the normal matrix minus the measurements' share; the
   // inter-system bias priors are what remains after the ionosphere prior.
   const Eigen::MatrixXd nFinal = symmetricInverse(in.q);

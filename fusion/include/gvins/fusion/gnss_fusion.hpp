@@ -80,9 +80,6 @@ class GnssFusion {
                                const EphemerisStore& nav);
 
   const GnssFusionConfig& config() const { return config_; }
-  /// Frame initialisations abandoned (linearStart, or frame rows gated out twice in a row): the
-  /// estimator restarted.
-  int frameRestarts() const { return frameRestarts_; }
   GnssFusionStage stage() const { return stage_; }
   bool clocksInitialized() const { return clocks_.valid(); }
   /// [ψ, p_NW] of the estimator's world frame in local ENU at the anchor: the frame block's
@@ -153,6 +150,10 @@ class GnssFusion {
   /// Drops the estimator's state (EstimatorBackend::restart) and the fusion's, with the warning
   /// `why` and what follows; false if the backend cannot (the warning says so too).
   bool restartFrame(vio::EstimatorBackend<Scalar>& est, Epoch& e, const std::string& why);
+  /// The four nuisance columns of the frame's pending yaw for `rows` (apply): the ENU offset a
+  /// uniform yaw gives the antenna's horizontal displacement and velocity, σ yawSpread_, through
+  /// each row's dh_dpv.
+  Eigen::MatrixXd yawNuisanceColumns(const std::vector<GnssRow>& rows) const;
   /// Stage kTight: the rows of the configured mode (gnss_fusion_rows.cpp); false if the clocks
   /// could not be initialised.
   bool tightUpdate(vio::EstimatorBackend<Scalar>& est, Epoch& e, const GnssStateValues& s, const AntennaKinematics& k);
@@ -214,7 +215,6 @@ class GnssFusion {
   GnssFusionConfig config_;
   sri::ChiSquareQuantiles rowGateQuantile_;  // χ²(1) quantile of config_.rowGate
   GnssFusionStage stage_ = GnssFusionStage::kWaitingVio;
-  int frameRestarts_ = 0;
   int frameRejections_ = 0;  // consecutive frame epochs gated out (frameUpdate)
   bool yawPending_ = false;  // the frame's yaw is a nuisance of its prior, not yet given a value (startFrame)
   bool startedAtRest_ = false;  // the frame started with its yaw pending (frameReanchorYawSigmaDeg)
