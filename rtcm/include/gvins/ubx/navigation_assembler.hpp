@@ -66,8 +66,15 @@ struct NavigationSource {
   friend auto operator<=>(const NavigationSource&, const NavigationSource&) = default;
 };
 
+/// The decoder of NavigationAssembler a source goes to (None: not decoded).
+enum class NavigationDecoder : std::uint8_t { None, Lnav, Cnav, GalileoInav, BeidouD1, BeidouD2, GlonassStrings };
+
+/// The one table of what each source carries: the decoder it goes to. NavigationAssembler routes
+/// by it and navigationSourceInfo names it.
+NavigationDecoder navigationDecoder(const NavigationSource& source);
+
 /// The message a source carries and whether the assembler decodes it: "LNAV", "I/NAV",
-/// "D1 (MEO/IGSO)", "D2 (GEO)", "strings" or e.g. "CNAV (not decoded)", "B-CNAV1 (not decoded)".
+/// "D1 (MEO/IGSO)", "D2 (GEO)", "strings" or e.g. "F/NAV (not decoded)", "B-CNAV1 (not decoded)".
 struct NavigationSourceInfo {
   std::string message;
   bool decoded = false;
@@ -98,8 +105,8 @@ class NavigationAssembler {
   const std::map<NavigationSource, NavigationCounts>& countsBySource() const { return bySource_; }
 
  private:
-  void dispatch(const SfrbxMessage& msg, System system, const GpsTime& receiveTime, NavDataUpdate& out,
-                NavigationCounts& c);
+  void dispatch(const SfrbxMessage& msg, const NavigationSource& source, System system, const GpsTime& receiveTime,
+                NavDataUpdate& out, NavigationCounts& c);
 
   struct State;
   std::unique_ptr<State> state_;
