@@ -259,7 +259,9 @@ def main():
                     "moves faster than 0.8 m/s, σψ from the velocity covariance: mean |e|/σψ is 0.80 and the share\n"
                     "within 2σψ 0.95 for an honest σ. Outages: 15 s windows starting every 5 s from 35 to 105 s, one\n"
                     "per run; drift as in the table above, σ = √(σE² + σN²) reported at the window's last epoch\n"
-                    "(mean drift/σ 0.89 for an honest σ, Rayleigh).\n\n")
+                    "(mean drift/σ 0.89 for an honest σ, Rayleigh). The IMU noise the estimator is told is the\n"
+                    "recording's (`imu0_sensor.yaml`, `bench/fusion/walk_imu_noise.py`: the sensor's noise at rest\n"
+                    "plus the sample-time noise of its log).\n\n")
             f.write(cons)
 
 
