@@ -67,35 +67,37 @@ Eigen::Vector3d GnssFusion<Scalar>::leverArm(const vio::EstimatorBackend<Scalar>
 }
 
 template <typename Scalar>
-std::optional<Eigen::Matrix3d> GnssFusion<Scalar>::antennaCovariance(const vio::EstimatorBackend<Scalar>& est,
-                                                                     std::int64_t t_ns) const {
+std::optional<Eigen::Matrix<double, 6, 6>> GnssFusion<Scalar>::antennaCovariance(const vio::EstimatorBackend<Scalar>& est,
+                                                                                 std::int64_t t_ns) const {
   if (!current(est) || !est.initialized() || (!frameBlock_.valid() && !worldChange_)) return std::nullopt;
   GnssStateValues s;
   if (!buildState(est, t_ns, s)) return std::nullopt;
   const AntennaKinematics k = antennaKinematics(s);
-  // Rows 0..2 of the kinematics' Jacobians (p_N) over the blocks, in the order listed.
+  // The kinematics' Jacobians of [p_N; v_N] over the blocks, in the order listed.
   const vio::ImuBlocks ib = est.newestImuBlocks();
   std::vector<sri::BlockId> blocks{ib.pose, ib.velocity, ib.bias};
-  Eigen::Matrix<double, 3, Eigen::Dynamic> J(3, 22);
-  J.leftCols<15>() = k.J_imu.template topRows<3>();
+  Eigen::Matrix<double, 6, Eigen::Dynamic> J(6, 22);
+  J.leftCols<15>() = k.J_imu;
   Eigen::Index n = 15;
   if (frameBlock_.valid()) {
     blocks.push_back(frameBlock_);
-    J.middleCols<4>(n) = k.J_frame.template topRows<3>();
+    J.middleCols<4>(n) = k.J_frame;
     n += 4;
   }
   if (lever_.valid()) {
     blocks.push_back(lever_.block());
-    J.middleCols<3>(n) = k.J_lever.template topRows<3>();
+    J.middleCols<3>(n) = k.J_lever;
     n += 3;
   }
   const std::span<const sri::BlockId> ids(blocks);
   if (!est.informed(ids)) return std::nullopt;  // a block without information yet (sri_filter.hpp)
   const Eigen::MatrixXd P = est.covariance(ids).template cast<double>();
   const auto Jb = J.leftCols(n);
-  const Eigen::Matrix<double, 3, 9> Je = k.J_earlier.template topRows<3>();
-  const Eigen::Matrix3d C_N = Jb * P * Jb.transpose() + Je * k.integrationCovariance * Je.transpose();
-  return Eigen::Matrix3d(k.R_EN * C_N * k.R_EN.transpose());
+  const Eigen::Matrix<double, 6, 6> C_N = Jb * P * Jb.transpose() + k.J_earlier * k.integrationCovariance * k.J_earlier.transpose();
+  Eigen::Matrix<double, 6, 6> R = Eigen::Matrix<double, 6, 6>::Zero();
+  R.topLeftCorner<3, 3>() = k.R_EN;
+  R.bottomRightCorner<3, 3>() = k.R_EN;
+  return Eigen::Matrix<double, 6, 6>(R * C_N * R.transpose());
 }
 
 template <typename Scalar>

@@ -111,6 +111,7 @@ class ReplayOutputs {
                             : ((r.dpsr.used + r.ddcp.used) > 0 ? SolutionQuality::Float : SolutionQuality::Single);
     ps.numSatellites = std::max({r.psr.used, r.dopp.used, r.dpsr.used, r.ddcp.used, r.phase.used});
     ps.velocity = r.antennaVelocityEcef;
+    ps.velocityCovariance = o.antennaVelocityCovarianceEcef;
     posWriter_->write(ps);
     if (nmeaWriter_) nmeaWriter_->write(ps);
     const Eigen::Vector3d v = r.antennaVelocityEcef ? *r.antennaVelocityEcef : Eigen::Vector3d::Zero();

@@ -17,16 +17,24 @@
 #                 alignment starts again at the walker's next turn: measured 2.5, 17.0 and 11.5 s
 #                 after the restart (72.7, 76.2, 81.4 s in; 50 s late walks straight until 93 s),
 #                 bounds 5, 20 and 15 s; the start is good, the track within 3 m horizontally and
-#                 8 m vertically of the recorded log's over the 10 s after it (measured 0.75/3.28,
-#                 0.83/1.55, 1.37/4.89 m; 30-40 s late, no restart: 1.46/5.92 m). Before the
+#                 8 m vertically of the recorded log's over the 10 s after it (measured 0.87/3.45,
+#                 0.71/1.03, 1.50/5.01 m; with the IMU's static noise figures alone 0.72/3.10,
+#                 0.83/1.53, 1.31/4.62 m; 30-40 s late, no restart: 1.46/5.92 m). Before the
 #                 alignment took the velocities' variance factor it rejected every window of this
 #                 walk and nothing started after the restart; before the restart, 45 s late started
 #                 73.7 s in and left the track 37 m off at 94 s.
 #   outages       GNSS removed at 20, 50, 80 and 110 s for 15 s each: the rows re-acquire after
-#                 the drift ("re-acquiring" warning) and H RMS 7.18 m (bound 10; without the
-#                 re-acquisition every epoch after the second outage was gated out and the error
-#                 grew past 150 m); single outages at 40 and 100 s drift 6.3 and 9.3 m
-#                 (vio+dopp+ppp at 100 s: 6.3 m), bound 12 m (walk_compare.py drift)
+#                 the drift ("re-acquiring" warning) and H RMS 9.52 m (bound 11; 8.54 m with the
+#                 IMU's static noise figures alone; without the re-acquisition every epoch after
+#                 the second outage was gated out and the error grew past 150 m); single
+#                 outages at 40, 60, 80 and 100 s drift 8.3, 0.3, 2.4 and 11.0 m (vio+dopp+ppp
+#                 at 100 s: 5.0 m), bound 13 m (walk_compare.py drift). Each drift is at most
+#                 3x the horizontal σ the run reported at the window's end (walk_compare.py
+#                 outage-sigma; measured 1.45, 0.06, 0.44, 2.11, ppp 1.12 with σ 5.7, 5.4, 5.4,
+#                 5.2, 4.5 m). With the IMU's static noise
+#                 figures alone (before imu0_sensor.yaml took the log's sample-time noise,
+#                 bench/fusion/walk_imu_noise.py) the drifts were 6.3, 2.7, 1.6, 9.3 (ppp 7.5) m
+#                 against σ 2.1-2.5 m: 2.53, 1.29, 0.69, 4.36 (ppp 3.56) σ, failing this bound.
 #   tests/fusion/real_walk_quirks.sh BIN_DIR TEST_DATA_DIR PYTHON3
 set -u
 BIN=$1
@@ -89,14 +97,19 @@ done
 replay outages "$UBX" --gnss-outage 20,15 --gnss-outage 50,15 --gnss-outage 80,15 --gnss-outage 110,15
 has "outage epochs counted" "$W/outages.out" "240 in simulated outages"
 has "re-acquisition reported" "$W/outages.out" "re-acquiring through the widened gate"
-check "outages: H RMS m" "$(metric global_horizontal_rmse_m "$W/outages/metrics.csv")" "<=" 10
-# The drift of single 15 s outages (bench/fusion/real_walk.py table 2: 6.34 and 9.57 m with
-# vio+dopp+psr, 8.16 m with vio+dopp+ppp at 100 s); bound 12 m.
-for at in 40 100; do
+check "outages: H RMS m" "$(metric global_horizontal_rmse_m "$W/outages/metrics.csv")" "<=" 11
+# The drift of single 15 s outages (bench/fusion/real_walk.py table 2) and its ratio to the
+# reported horizontal σ at the window's end; bounds 13 m and 3.
+outage_checks() {  # label out start
+  read -r d _ r <<<"$("$PY" "$HERE/walk_compare.py" outage-sigma "$2" "$REF" "$3" 15)"
+  check "$1 outage at $3 s: horizontal drift m" "$d" "<=" 13
+  check "$1 outage at $3 s: drift / reported horizontal sigma" "$r" "<=" 3
+}
+for at in 40 60 80 100; do
   replay "outage$at" "$UBX" --gnss-outage "$at,15"
-  check "outage at $at s: horizontal drift m" "$("$PY" "$HERE/walk_compare.py" drift "$W/outage$at" "$REF" "$at" 15)" "<=" 12
+  outage_checks vio+dopp+psr "$W/outage$at" "$at"
 done
 "$BIN/gvins-replay" "$W/ds" --mode vio+dopp+ppp --rover "$UBX" --truth-pos "$REF" --imu-gaps warn -q -o "$W/ppp100" \
   --gnss-outage 100,15 >"$W/ppp100.out" 2>&1 || { cat "$W/ppp100.out"; exit 1; }
-check "vio+dopp+ppp outage at 100 s: horizontal drift m" "$("$PY" "$HERE/walk_compare.py" drift "$W/ppp100" "$REF" 100 15)" "<=" 12
+outage_checks vio+dopp+ppp "$W/ppp100" 100
 exit $fail

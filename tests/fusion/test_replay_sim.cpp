@@ -291,9 +291,8 @@ TEST(ReplaySim, LockOutResetsVioButNotWhileGnssHoldsTheState) {
   EXPECT_LT(ddcp.summary.global.positionRmse, 0.1);
 }
 
-// global.pos carries the estimator's antenna position covariance (the joint marginal covariance
-// of the blocks the antenna position depends on, GnssFusion::antennaCovariance): nonzero in every
-// row, growing over the 60 s outage (VIO alone), and compared per east/north/up axis with the
+// global.pos carries the estimator's antenna position and velocity covariance (the joint marginal
+// covariance of the blocks they depend on, GnssFusion::antennaCovariance): nonzero in every row, growing over the 60 s outage (VIO alone), and compared per east/north/up axis with the
 // actual error against the simulation's truth of each rover epoch.
 TEST(ReplaySim, GlobalPosCovarianceDescribesTheError) {
   const ReplayRun r = replay<double>("cov", config(GnssFusionMode::kDoppDpsr));
@@ -327,7 +326,8 @@ TEST(ReplaySim, GlobalPosCovarianceDescribesTheError) {
     if (it == truth.end()) continue;
     const Eigen::Vector3d e = R * (s.position - it->second);
     const Eigen::Matrix3d C = R * s.positionCovariance * R.transpose();
-    if (C.diagonal().minCoeff() <= 0.0) {
+    // The velocity covariance rides along (same marginal, rows 3..5 of the kinematics).
+    if (C.diagonal().minCoeff() <= 0.0 || (s.velocity && s.velocityCovariance.diagonal().minCoeff() <= 0.0)) {
       ++zero;
       continue;
     }

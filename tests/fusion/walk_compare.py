@@ -23,6 +23,15 @@ of global.pos.
                                               reference's fixed and float epochs from T0 on (the
                                               epochs that OUT_B also has, if given)
 
+    walk_compare.py consistency OUT REF.pos   consistency of global.pos's reported covariances
+                                              (consistency() below): "nees share95 heading_ratio
+                                              heading_share2 heading_rms_deg heading_sigma_deg
+                                              pos_nees epochs moving positions"
+    walk_compare.py outage-sigma OUT REF.pos T LEN  horizontal drift of the outage [T, T+LEN) as
+                                              `drift`, the horizontal σ the run reported at the
+                                              window's last epoch (√(σE² + σN²)) and their ratio:
+                                              "drift sigma ratio"
+
 REF.pos: the walk's reference track with ellipsoidal heights (gvins-ubx to-pos of the log's
 NAV-PVT, $REF of real_walk_common.sh).
 """
@@ -56,6 +65,128 @@ def read_pos(path, max_q=9, dh=0.0):
         if int(float(t[5])) <= max_q:
             out[sow(t[0], t[1])] = (float(t[2]), float(t[3]), float(t[4]) + dh)
     return out
+
+
+def signed_square(x):
+    """The covariance entry of a .pos off-diagonal column (RTKLIB writes sign(c)·√|c|)."""
+    return x * abs(x)
+
+
+def read_solutions(path, max_q=9):
+    """{GPST s of week: (lat, lon, h, Q, P, v, V)} of a .pos file with velocity columns, P and V
+    the position and velocity covariances in east, north, up (3×3 lists; the file's order is
+    north, east, up), v the velocity (east, north, up) or None where the file has nan."""
+    out = {}
+    for line in open(path):
+        if line.startswith("%") or not line.strip():
+            continue
+        t = line.split()
+        q = int(float(t[5]))
+        if q > max_q or len(t) < 24:
+            continue
+        c = [float(x) for x in t[7:13]] + [float(x) for x in t[18:24]]
+        neu = lambda d, o: [[d[0] ** 2, signed_square(o[0]), signed_square(o[2])],
+                            [signed_square(o[0]), d[1] ** 2, signed_square(o[1])],
+                            [signed_square(o[2]), signed_square(o[1]), d[2] ** 2]]
+        perm = [1, 0, 2]  # east, north, up from north, east, up
+        to_enu = lambda m: [[m[perm[i]][perm[j]] for j in range(3)] for i in range(3)]
+        v = [float(t[16]), float(t[15]), float(t[17])]
+        out[sow(t[0], t[1])] = (float(t[2]), float(t[3]), float(t[4]), q, to_enu(neu(c[0:3], c[3:6])),
+                                None if any(math.isnan(x) for x in v) else v, to_enu(neu(c[6:9], c[9:12])))
+    return out
+
+
+def quadratic_inverse(e, m):
+    """eᵀ M⁻¹ e of a 2- or 3-vector e and a symmetric positive definite M (nan if M is singular)."""
+    if len(e) == 2:
+        det = m[0][0] * m[1][1] - m[0][1] * m[1][0]
+        if det <= 0:
+            return float("nan")
+        return (m[1][1] * e[0] ** 2 - 2 * m[0][1] * e[0] * e[1] + m[0][0] * e[1] ** 2) / det
+    cof = [[m[(i + 1) % 3][(j + 1) % 3] * m[(i + 2) % 3][(j + 2) % 3] - m[(i + 1) % 3][(j + 2) % 3] * m[(i + 2) % 3][(j + 1) % 3]
+            for j in range(3)] for i in range(3)]
+    det = sum(m[0][j] * cof[0][j] for j in range(3))
+    if det <= 0:
+        return float("nan")
+    return sum(e[i] * cof[j][i] * e[j] for i in range(3) for j in range(3)) / det
+
+
+CHI2_95 = {2: 5.991, 3: 7.815}  # 95 % quantiles of χ² with 2 and 3 degrees of freedom
+MOVING_MPS = 0.8                # horizontal reference speed above which the velocity heading is compared
+STEP = 0.25                     # s between the log's epochs (4 Hz)
+
+
+def heading_and_sigma(v, m):
+    """Velocity heading atan2(vE, vN) (rad) and its σ from the velocity covariance m (east,
+    north, up) through the gradient (vN, −vE)/(vE² + vN²)."""
+    s2 = v[0] ** 2 + v[1] ** 2
+    g = [v[1] / s2, -v[0] / s2]
+    return math.atan2(v[0], v[1]), math.sqrt(g[0] ** 2 * m[0][0] + 2 * g[0] * g[1] * m[0][1] + g[1] ** 2 * m[1][1])
+
+
+def consistency(out, ref_path, moving=MOVING_MPS):
+    """The run's reported antenna covariances (global.pos) against the reference's fixed epochs.
+    Velocity: the reference is the difference of the fixed positions at t ± 0.25 s over 0.5 s
+    (the mean velocity over that interval; the receiver's NAV-PVT velocity lags its own positions
+    by about 0.14 s, 0.1 m/s RMS per axis on this walk, so it is no reference at 0.05 m/s), the
+    run's the trapezoidal mean of its velocities at t − 0.25, t, t + 0.25 s with the covariance
+    reported at t (the reference's noise, millimetres per epoch, is neglected: the figures are
+    upper bounds). Returns {"nees": mean 3-D velocity NEES (3 if consistent), "share95": share of
+    epochs within χ²₃'s 95 % bound (0.95), "heading_ratio": mean |ψ error| / σψ of the velocity
+    heading ψ = atan2(vE, vN) where the reference moves faster than `moving` m/s horizontally
+    (√(2/π) ≈ 0.80 if consistent), "heading_share2": share with |error| <= 2 σψ (0.95),
+    "heading_rms_deg", "heading_sigma_deg" (RMS of σψ), "pos_nees": mean 2-D NEES of the
+    horizontal position error about its mean over the run (the reference's unknown constant
+    offset removed; 2 if consistent), "epochs" (velocity), "moving", "positions"}; None without
+    common epochs."""
+    est, ref = read_solutions(out + "/global.pos"), read_solutions(ref_path, 1)
+    nees, ratio, share2, dpsi, spsi = [], [], [], [], []
+    for t in sorted(ref):
+        a, c = t - STEP, t + STEP
+        if a not in ref or c not in ref or any(u not in est or est[u][5] is None for u in (a, t, c)):
+            continue
+        m = est[t][6]
+        if m[0][0] <= 0:
+            continue
+        vr = [x / (c - a) for x in enu(ref[c][:3], ref[a][:3])]
+        ve = [0.25 * est[a][5][i] + 0.5 * est[t][5][i] + 0.25 * est[c][5][i] for i in range(3)]
+        nees.append(quadratic_inverse([ve[i] - vr[i] for i in range(3)], m))
+        if math.hypot(vr[0], vr[1]) > moving:
+            psi, sigma = heading_and_sigma(ve, m)
+            err = math.remainder(psi - math.atan2(vr[0], vr[1]), 2 * math.pi)
+            ratio.append(abs(err) / sigma)
+            share2.append(abs(err) <= 2 * sigma)
+            dpsi.append(err)
+            spsi.append(sigma)
+    pos = [(enu(est[t][:3], ref[t][:3]), est[t][4]) for t in sorted(ref) if t in est and est[t][4][0][0] > 0]
+    if not nees or not pos:
+        return None
+    mean = lambda x: sum(x) / len(x) if x else float("nan")
+    rms = lambda x: math.degrees(math.sqrt(mean([y * y for y in x]))) if x else float("nan")
+    off = [mean([e[i] for e, _ in pos]) for i in range(2)]
+    pn = [quadratic_inverse([e[0] - off[0], e[1] - off[1]], [p[0][:2], p[1][:2]]) for e, p in pos]
+    return {"nees": mean(nees), "share95": mean([x <= CHI2_95[3] for x in nees]), "heading_ratio": mean(ratio),
+            "heading_share2": mean(share2), "heading_rms_deg": rms(dpsi), "heading_sigma_deg": rms(spsi),
+            "pos_nees": mean(pn), "epochs": len(nees), "moving": len(ratio), "positions": len(pn)}
+
+
+def outage_sigma(out, ref_path, start, length):
+    """(horizontal drift, reported horizontal σ at the window's last epoch, drift / σ) of the
+    outage [start, start + length): the drift as `drift` (the change of the horizontal error
+    against the reference's fixed and float epochs between the last epoch before the window and
+    the window's last epoch), σ = √(σE² + σN²) of global.pos at that last epoch."""
+    t0 = first_frame(out)
+    est, ref = read_solutions(out + "/global.pos"), read_pos(ref_path, 2)
+    common = sorted(t for t in est if t in ref)
+    before = [t for t in common if t - t0 < start]
+    inside = [t for t in common if start <= t - t0 < start + length]
+    if not before or not inside:
+        sys.exit("walk_compare: no reference epoch before or inside the window")
+    e0, e1 = enu(est[before[-1]][:3], ref[before[-1]]), enu(est[inside[-1]][:3], ref[inside[-1]])
+    drift = math.hypot(e1[0] - e0[0], e1[1] - e0[1])
+    p = est[inside[-1]][4]
+    sigma = math.sqrt(p[0][0] + p[1][1])
+    return drift, sigma, drift / sigma if sigma > 0 else float("inf")
 
 
 def ecef(p):
@@ -144,6 +275,15 @@ def main():
         d = [enu(est[t], ref[t]) for t in common]
         print("%.2f %.2f" % (math.sqrt(sum(x[0] ** 2 + x[1] ** 2 for x in d) / len(d)),
                              math.sqrt(sum(x[2] ** 2 for x in d) / len(d))))
+    elif cmd == "consistency":
+        c = consistency(args[0], args[1])
+        if c is None:
+            sys.exit("walk_compare: no common epoch with velocities")
+        print("%.3f %.3f %.3f %.3f %.2f %.2f %.3f %d %d %d" % tuple(c[k] for k in (
+            "nees", "share95", "heading_ratio", "heading_share2", "heading_rms_deg", "heading_sigma_deg", "pos_nees",
+            "epochs", "moving", "positions")))
+    elif cmd == "outage-sigma":
+        print("%.2f %.2f %.2f" % outage_sigma(args[0], args[1], float(args[2]), float(args[3])))
     else:
         sys.exit(__doc__)
 

@@ -104,12 +104,12 @@ class GnssFusion {
   const std::vector<System>& clockSystems() const { return clocks_.systems(); }
   /// Antenna position/velocity (ECEF) at time t_ns from the current estimates (frame needed).
   std::optional<AntennaKinematics> antennaAt(const vio::EstimatorBackend<Scalar>& est, std::int64_t t_ns) const;
-  /// Covariance (ECEF, m²) of the antenna position at t_ns (e.g. GnssEpochReport::t_ns):
-  /// J P Jᵀ + J_k Σ_k J_kᵀ, with P the joint marginal covariance of only the blocks the position
-  /// depends on (newest pose, velocity and bias; the frame and the lever arm when they are
-  /// states), Σ_k the IMU integration noise from t_ns to the newest state. nullopt before the
-  /// frame exists, or while one of those blocks has no information yet.
-  std::optional<Eigen::Matrix3d> antennaCovariance(const vio::EstimatorBackend<Scalar>& est, std::int64_t t_ns) const;
+  /// Covariance (ECEF; m², m²/s, m²/s²) of the antenna position and velocity [p; v] at t_ns
+  /// (e.g. GnssEpochReport::t_ns): J P Jᵀ + J_k Σ_k J_kᵀ, with P the joint marginal covariance of
+  /// only the blocks they depend on (newest pose, velocity and bias; the frame and the lever arm
+  /// when they are states), Σ_k the IMU integration noise from t_ns to the newest state. nullopt
+  /// before the frame exists, or while one of those blocks has no information yet.
+  std::optional<Eigen::Matrix<double, 6, 6>> antennaCovariance(const vio::EstimatorBackend<Scalar>& est, std::int64_t t_ns) const;
   /// Satellite models of an epoch at antenna position x (for tests and diagnostics); `states`
   /// (optional): the epoch's satellite states, shared with the single differences.
   std::vector<SatelliteModel> satelliteModels(const ObsEpoch& rover, const EphemerisStore& nav,

@@ -86,7 +86,8 @@ class ReplayEstimator {
 /// Result of one GNSS epoch as the outputs need it: the fusion's report and the antenna's covariance.
 struct ReplayGnssOutcome {
   GnssEpochReport report;
-  Eigen::Matrix3d antennaCovarianceEcef = Eigen::Matrix3d::Zero();  ///< zero if unknown
+  Eigen::Matrix3d antennaCovarianceEcef = Eigen::Matrix3d::Zero();          ///< position, zero if unknown
+  Eigen::Matrix3d antennaVelocityCovarianceEcef = Eigen::Matrix3d::Zero();  ///< velocity, zero if unknown
 };
 
 /// What the pipeline needs from the GNSS fusion.

@@ -55,7 +55,10 @@ class GnssFusionReplayClient final : public ReplayGnss {
     ReplayGnssOutcome o;
     o.report = fusion_.processEpoch(est_, rover, base, nav);
     if (o.report.antennaEcef) {
-      if (const auto c = fusion_.antennaCovariance(est_, o.report.t_ns)) o.antennaCovarianceEcef = *c;
+      if (const auto c = fusion_.antennaCovariance(est_, o.report.t_ns)) {
+        o.antennaCovarianceEcef = c->template topLeftCorner<3, 3>();
+        o.antennaVelocityCovarianceEcef = c->template bottomRightCorner<3, 3>();
+      }
     }
     return o;
   }
