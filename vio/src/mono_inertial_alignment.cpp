@@ -30,11 +30,11 @@ namespace gvins::vio {
 // The metric scale comes from the accelerometer, so the motion needs acceleration; the
 // alignment is rejected if the scale is not positive, the free |g| is more than 1 m/s² off, the
 // parallax is below 2°, fewer than 20 features are tracked through the window, or the scale's
-// relative 1-σ (fit residuals, gravity direction free) exceeds init_mono_max_scale_sigma, or
-// if a constant accelerometer error of init_mono_accel_error would move the scale by more than
-// that (excitation test). Step 0 estimates the gyro bias first (init_mono_gyro_bias). Without
-// those two a weakly accelerating flight passed the fit's check at a scale 35-40 % off
-// (docs/vio_estimator.md, "Initialisation").
+// relative 1-σ exceeds init_mono_max_scale_sigma: the fit residuals' part (gravity direction free)
+// and the accelerometer's part (the scale change a constant error of init_mono_accel_error along
+// the worst body axis gives) combined. Step 0 estimates the gyro bias first
+// (init_mono_gyro_bias). Without those a weakly accelerating flight passed the fit's check at a
+// scale 35-40 % off (docs/vio_estimator.md, "Initialisation").
 namespace {
 
 Eigen::Vector3d ray(const Eigen::Vector2d& n) { return Eigen::Vector3d(n.x(), n.y(), 1.0).normalized(); }
@@ -48,7 +48,7 @@ class MonoWindow {
              std::span<const ImuSample> imu, const CameraExtrinsic& e0)
       : cfg_(cfg), frames_(frames), first_(first), M_(cfg.init_mono_motion_frames - 1), t0_(frames[first].t_ns),
         imu_(imu), e0_(e0), R0_(static_cast<std::size_t>(M_)), alpha_(static_cast<std::size_t>(M_)),
-        dts_(static_cast<std::size_t>(M_)), integs_(static_cast<std::size_t>(M_)) {
+        alphaBa_(static_cast<std::size_t>(M_)), dts_(static_cast<std::size_t>(M_)), integs_(static_cast<std::size_t>(M_)) {
     integrateAll(Eigen::Vector3d::Zero());
     // Rays in I_0 of every feature of F_0.
     for (const FeatureObservation& o : frames_[first_].features) f0_.emplace(o.id, e0_.R_IC * ray(o.normalized0));
@@ -65,6 +65,7 @@ class MonoWindow {
       integs_[static_cast<std::size_t>(j)] = integ;
       R0_[static_cast<std::size_t>(j)] = integ.gamma();
       alpha_[static_cast<std::size_t>(j)] = integ.alpha();
+      alphaBa_[static_cast<std::size_t>(j)] = -integ.biasJacobian().block<3, 3>(3, 3);
       dts_[static_cast<std::size_t>(j)] = static_cast<double>(Fj.t_ns - t0_) * 1e-9;
     }
     imu_intervals_ += integ.intervals();
@@ -92,6 +93,7 @@ class MonoWindow {
   const CameraExtrinsic& e0_;
   std::vector<Eigen::Matrix3d> R0_;
   std::vector<Eigen::Vector3d> alpha_;
+  std::vector<Eigen::Matrix3d> alphaBa_;  // dα_j / d(accelerometer error in the body): ∫∫ R_0(t)
   std::vector<double> dts_;
   std::vector<ImuIntegration> integs_;
   std::unordered_map<std::uint64_t, Eigen::Vector3d> f0_;
@@ -265,7 +267,8 @@ std::optional<InitStatus> MonoWindow::cameraCentres() {
 
 // 3. s c̄_j − v₀ Δt_j − ½ g Δt_j² = α_j + (R_0j − I) p_IC; x = [s; v₀; g] or, with g = G·dir
 // + T δ, [s; v₀; δ]. Returns the 1-σ of s from the fit residuals.
-// da: a constant acceleration error added to every α_j (the excitation test).
+// da: a constant accelerometer error in the body frame, added to every α_j through ∫∫ R_0(t)
+// (the excitation test; a body that turns carries it round, so it does not stay along gravity).
 double MonoWindow::solve(const Eigen::Vector3d& g0, const Eigen::MatrixXd& T, Eigen::Matrix<double, 7, 1>& x,
                          const Eigen::Vector3d& da) const {
   const int M = M_;
@@ -278,7 +281,7 @@ double MonoWindow::solve(const Eigen::Vector3d& g0, const Eigen::MatrixXd& T, Ei
     J.col(0) = cbar_[static_cast<std::size_t>(j)];
     J.block(0, 1, 3, 3) = -dt * Eigen::Matrix3d::Identity();
     J.rightCols(nx - 4) = -0.5 * dt * dt * T;
-    const Eigen::Vector3d y = alpha_[static_cast<std::size_t>(j)] + 0.5 * dt * dt * da +
+    const Eigen::Vector3d y = alpha_[static_cast<std::size_t>(j)] + alphaBa_[static_cast<std::size_t>(j)] * da +
                               (R0_[static_cast<std::size_t>(j)] - Eigen::Matrix3d::Identity()) * e0_.p_IC +
                               0.5 * dt * dt * g0;
     A += J.transpose() * J;
@@ -291,7 +294,7 @@ double MonoWindow::solve(const Eigen::Vector3d& g0, const Eigen::MatrixXd& T, Ei
   for (int j = 0; j < M; ++j) {
     const double dt = dts_[static_cast<std::size_t>(j)];
     const Eigen::Vector3d e = x(0) * cbar_[static_cast<std::size_t>(j)] - dt * x.segment(1, 3) -
-                              0.5 * dt * dt * x.tail(3) - (alpha_[static_cast<std::size_t>(j)] + 0.5 * dt * dt * da) -
+                              0.5 * dt * dt * x.tail(3) - (alpha_[static_cast<std::size_t>(j)] + alphaBa_[static_cast<std::size_t>(j)] * da) -
                               (R0_[static_cast<std::size_t>(j)] - Eigen::Matrix3d::Identity()) * e0_.p_IC;
     rss += e.squaredNorm();
   }
@@ -320,7 +323,8 @@ bool MonoWindow::align(Eigen::Matrix<double, 7, 1>& x, double& sSigma, const Eig
 
 std::optional<MotionAlignment> alignMonoInMotion(const SriSwfConfig& cfg, const std::deque<FeatureFrame>& init_frames,
                                                  std::span<const ImuSample> imu, const CameraExtrinsic& e0,
-                                                 InitStatus* why, std::int64_t* imu_intervals) {
+                                                 InitStatus* why, std::int64_t* imu_intervals,
+                                                 MonoAlignmentQuality* quality) {
   auto fail = [why](InitStatus r) {
     if (why) *why = r;
     return std::nullopt;
@@ -343,14 +347,18 @@ std::optional<MotionAlignment> alignMonoInMotion(const SriSwfConfig& cfg, const 
   Eigen::Matrix<double, 7, 1> x;
   double sSigma = 0.0;
   if (!w.align(x, sSigma, Eigen::Vector3d::Zero())) return fail(InitStatus::kInconsistent);
-  if (sSigma > cfg.init_mono_max_scale_sigma * x(0)) return fail(InitStatus::kTooLittleAcceleration);
+  if (quality) *quality = MonoAlignmentQuality{N, static_cast<double>(tN - t0) * 1e-9, x(0), sSigma / x(0), 0.0};
+  const double bound = cfg.init_mono_max_scale_sigma;
+  if (sSigma > bound * x(0)) return fail(InitStatus::kTooLittleAcceleration);
   // Excitation: the scale a constant accelerometer error of init_mono_accel_error (bias, and the
   // tilt that a wrong gravity direction leaves) along each body axis would give. The fit's own
   // residuals cannot show such a systematic error; with weak acceleration it moves the scale
-  // by tens of percent while the residuals stay small.
+  // by tens of percent while the residuals stay small. It is the accelerometer's part of the
+  // scale's σ, combined with the residuals' part.
   double sensitivity = 0.0;
+  auto combined = [&] { return std::hypot(sSigma / x(0), sensitivity); };
   if (cfg.init_mono_accel_error > 0.0) {
-    for (int k = 0; k < 3 && sensitivity <= cfg.init_mono_max_scale_sigma; ++k) {
+    for (int k = 0; k < 3 && combined() <= bound; ++k) {
       Eigen::Matrix<double, 7, 1> xk;
       double sk = 0.0;
       sensitivity = w.align(xk, sk, cfg.init_mono_accel_error * Eigen::Vector3d::Unit(k))
@@ -358,9 +366,10 @@ std::optional<MotionAlignment> alignMonoInMotion(const SriSwfConfig& cfg, const 
                         : std::numeric_limits<double>::infinity();
     }
   }
-  if (sensitivity > cfg.init_mono_max_scale_sigma) return fail(InitStatus::kTooLittleAcceleration);
+  if (quality) quality->sensitivity = sensitivity;
+  if (combined() > bound) return fail(InitStatus::kTooLittleAcceleration);
   const Eigen::Vector3d gb = x.tail(3);
-  return MotionAlignment{t0, tN, gb, Eigen::Vector3d(x.segment(1, 3)), bg};
+  return MotionAlignment{t0, tN, gb, Eigen::Vector3d(x.segment(1, 3)), bg, combined()};
 }
 
 }  // namespace gvins::vio

@@ -210,7 +210,7 @@ std::optional<InitialState> VisualInertialInitializer::fromStandstill(const Feat
 
 // State from an in-motion alignment: gravity and velocity in the IMU frame at t0
 // (attitude from gravity, yaw 0), propagated to tN; tilt prior 1.5× init_tilt_sigma, velocity
-// prior 3× init_velocity_sigma.
+// prior 3× init_velocity_sigma and (mono) the scale's relative σ times the speed.
 InitialState VisualInertialInitializer::fromMotion(const MotionAlignment& a, std::span<const ImuSample> imu) const {
   const SriSwfConfig& cfg = cfg_;
   ImuState s;
@@ -222,7 +222,8 @@ InitialState VisualInertialInitializer::fromMotion(const MotionAlignment& a, std
   const double tilt = 1.5 * cfg.init_tilt_sigma;
   const Eigen::Matrix3d Pw =
       Eigen::Vector3d(tilt * tilt, tilt * tilt, cfg.init_yaw_sigma * cfg.init_yaw_sigma).asDiagonal();
-  return InitialState{s, Pw, 3.0 * cfg.init_velocity_sigma, cfg.init_gyro_bias_sigma};
+  const double sigma_v = std::hypot(3.0 * cfg.init_velocity_sigma, a.scale_sigma * s.v_WI.norm());
+  return InitialState{s, Pw, sigma_v, cfg.init_gyro_bias_sigma};
 }
 
 

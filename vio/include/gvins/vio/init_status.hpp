@@ -10,7 +10,8 @@ enum class InitStatus {
   kInitialized,         ///< the estimator runs
   kCollecting,          ///< too few frames or IMU samples buffered for any test yet
   kStaticNoTracks,      ///< the IMU is at rest but too few tracks to confirm it (static init off)
-  kMovingNoAcceleration,///< the IMU sees no excitation but the features move (constant velocity)
+  kMovingNoAcceleration,///< the IMU sees no excitation but the features move: constant velocity or
+                        ///< acceleration, the degenerate motion of mono VIO (scale unobservable)
   kTooFewTracks,        ///< too few features tracked through the alignment window
   kTooLittleParallax,   ///< tracked, but the camera has not moved enough relative to the depth
   kTooLittleAcceleration,///< structure is there, but the scale is not observable from the accelerometer
@@ -24,7 +25,7 @@ constexpr std::string_view initStatusText(InitStatus s) {
     case InitStatus::kInitialized: return "initialised";
     case InitStatus::kCollecting: return "collecting";
     case InitStatus::kStaticNoTracks: return "static, no tracks";
-    case InitStatus::kMovingNoAcceleration: return "constant velocity";
+    case InitStatus::kMovingNoAcceleration: return "constant velocity/acceleration (scale unobservable)";
     case InitStatus::kTooFewTracks: return "too few tracks";
     case InitStatus::kTooLittleParallax: return "too little parallax";
     case InitStatus::kTooLittleAcceleration: return "too little acceleration";

@@ -110,17 +110,18 @@ struct SriSwfConfig {
   bool init_mono_in_motion = true;
   int init_motion_frames = 10;         ///< frames used by the stereo in-motion alignment
   int init_mono_motion_frames = 20;    ///< frames used by the mono in-motion alignment (≥ 5)
-  /// Mono in-motion alignment: largest relative 1-σ of the metric scale (from the fit's residuals
-  /// with the gravity direction free) that is accepted; below it the motion lacked acceleration.
+  /// Mono in-motion alignment: largest relative 1-σ of the metric scale that is accepted: the
+  /// fit's residual σ (gravity direction free) and the scale change under init_mono_accel_error
+  /// combined (root sum of squares); above it the motion lacked acceleration.
   double init_mono_max_scale_sigma = 0.05;
   /// Mono in-motion alignment: estimate the gyro bias first from the epipolar constraints of the
   /// window (its rotations come from the gyro), and start the state with it; a result above
   /// init_mono_max_gyro_bias (rad/s) is discarded as degenerate.
   bool init_mono_gyro_bias = true;
   double init_mono_max_gyro_bias = 0.1;
-  /// Mono in-motion alignment, excitation test: a constant accelerometer error of this size (m/s²;
-  /// bias plus the tilt left by a wrong gravity direction) along any body axis must not move the
-  /// scale by more than init_mono_max_scale_sigma; 0: no test.
+  /// Mono in-motion alignment, excitation: the scale change a constant accelerometer error of
+  /// this size (m/s²; bias plus the tilt left by a wrong gravity direction) along the worst body
+  /// axis gives is the accelerometer's part of the scale's σ (init_mono_max_scale_sigma); 0: none.
   double init_mono_accel_error = 0.1;
   /// The mono alignment is tried only when the accelerometer's excitation over its window
   /// (accelerationChange, visual_inertial_initializer.hpp) reaches this (m/s²; 0: always), ...

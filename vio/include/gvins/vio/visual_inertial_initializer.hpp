@@ -23,13 +23,15 @@
 namespace gvins::vio {
 
 /// Result of an in-motion alignment over frames t0..tN: gravity and velocity in the IMU frame at
-/// t0 and the gyro bias it used (zero when not estimated).
+/// t0, the gyro bias it used (zero when not estimated) and the relative 1-σ of its metric scale
+/// (mono; 0: stereo, whose scale is the baseline's).
 struct MotionAlignment {
   std::int64_t t0 = 0;
   std::int64_t tN = 0;
   Eigen::Vector3d gravity_I0 = Eigen::Vector3d::Zero();
   Eigen::Vector3d velocity_I0 = Eigen::Vector3d::Zero();
   Eigen::Vector3d gyro_bias = Eigen::Vector3d::Zero();
+  double scale_sigma = 0.0;
 };
 
 /// The state an initialisation starts the filter from: the IMU state at the newest frame and its
@@ -83,12 +85,23 @@ std::optional<MotionAlignment> alignStereoInMotion(const SriSwfConfig& cfg, cons
                                                    std::span<const ImuSample> imu, const CameraExtrinsic& e0,
                                                    const CameraExtrinsic& e1, InitStatus* why = nullptr);
 
+/// Figures of a mono in-motion alignment that reached the scale (mono_inertial_alignment.cpp).
+struct MonoAlignmentQuality {
+  int frames = 0;            ///< frames aligned
+  double span_s = 0.0;       ///< first to last of them
+  double scale = 0.0;        ///< metres per unit of the up-to-scale structure
+  double scale_sigma = 0.0;  ///< relative 1-σ of the scale from the fit's residuals (gravity direction free)
+  double sensitivity = 0.0;  ///< relative scale change under init_mono_accel_error (largest over the axes)
+};
+
 /// Mono in-motion alignment over the last init_mono_motion_frames frames (mono_inertial_alignment.cpp).
 /// `why` (if given) receives the reason of a failure; `imu_intervals` (if given) is increased by
-/// the IMU sample intervals integrated (one pass over the window, two with a gyro bias).
+/// the IMU sample intervals integrated (one pass over the window, two with a gyro bias);
+/// `quality` (if given) receives the scale's figures once the fit ran (also when they reject it).
 std::optional<MotionAlignment> alignMonoInMotion(const SriSwfConfig& cfg, const std::deque<FeatureFrame>& init_frames,
                                                  std::span<const ImuSample> imu, const CameraExtrinsic& e0,
-                                                 InitStatus* why = nullptr, std::int64_t* imu_intervals = nullptr);
+                                                 InitStatus* why = nullptr, std::int64_t* imu_intervals = nullptr,
+                                                 MonoAlignmentQuality* quality = nullptr);
 
 /// The excitation of the accelerometer over [t0, t1]: the largest distance (m/s²) of a 0.1 s mean
 /// of the specific force, rotated into the IMU frame at t0 by the gyro, from the mean of those
