@@ -155,6 +155,34 @@ def gnss_rows(path):
     return {"gnss_rows_per_epoch": sum(rows) / len(rows)} if rows else {}
 
 
+def fixed_errors(ecef_path, truth_path, limit=0.10):
+    """Integrity of the fixed epochs (issue 39): the epochs of global_ecef.csv flagged RTK-fixed
+    and how many of them are more than `limit` m (3-D) from the simulated antenna track."""
+    if not (os.path.exists(ecef_path) and os.path.exists(truth_path)):
+        return {}
+    truth = {}
+    with open(truth_path) as f:
+        for line in f:
+            if line.startswith("#"):
+                continue
+            c = line.split(",")
+            truth[round(int(c[0]) / 1e6)] = (float(c[11]), float(c[12]), float(c[13]))  # ms -> antenna_E
+    fixed = far = 0
+    with open(ecef_path) as f:
+        for line in f:
+            if line.startswith("#"):
+                continue
+            c = line.strip().split(",")
+            if c[-1] != "1":
+                continue
+            t = truth.get(round((int(c[0]) * 604800 + float(c[1])) * 1e3))
+            if t is None:
+                continue
+            fixed += 1
+            far += sum((float(c[2 + i]) - t[i]) ** 2 for i in range(3)) > limit * limit
+    return {"fixed_epochs_checked": fixed, "fixed_epochs_over_0.10m": far}
+
+
 def tail(text, n=3):
     lines = [l for l in text.strip().splitlines() if l.strip()]
     return " | ".join(lines[-n:])[-400:]
@@ -196,6 +224,8 @@ def run_seed(a, family, seed, modes, progress):
             if p.returncode == 0 and os.path.exists(mpath):
                 res.update(status="ok", error=None, metrics=read_metrics(mpath))
                 res["metrics"].update(gnss_rows(os.path.join(out, "gnss_epochs.csv")))
+                res["metrics"].update(fixed_errors(os.path.join(out, "global_ecef.csv"),
+                                                   os.path.join(data, "truth", "groundtruth_ecef.csv")))
             else:
                 res["error"] = "gvins-replay exit %d: %s" % (p.returncode, tail(p.stdout))
             for f in os.listdir(out) if os.path.isdir(out) else []:  # keep only what the page needs

@@ -121,6 +121,8 @@ struct GnssFusion<Scalar>::Epoch {
   /// the held fix too, unless its DD phases differ from that run's (then the module runs there).
   bool rtkDeferred = false;
   std::optional<double> baseAge;
+  /// Ddcp: the fixed DD phases of rtk_'s differences given as rows (their kDdcp rows, in order).
+  std::vector<DoubleDifference> ddcpPhases;
   GpsTime tMeas;          ///< the tag minus the receiver clock
   std::int64_t t_ns = 0;  ///< tMeas, at most the newest state's time
 };

@@ -175,14 +175,14 @@ void GnssFusion<Scalar>::addDifferenceRows(Epoch& e, const AntennaKinematics& k,
     addSdCodeRows(e, (codeRtk_ ? codeRtk_ : rtk_)->measurements(), k, clk, rows);
   }
   if (config_.mode != GnssFusionMode::kDoppDdcp || !e.baseAge || *e.baseAge > config_.maxBaseAge) return;
-  // The DD phases with the integers of a validated fix, as many as the RTK module's ambiguity
-  // resolution fixes at least (applicableFixedPhases); fewer are no fix.
+  // The DD phases with the integers of a validated fix, as many and of as many satellites as a
+  // fix of the RTK module needs (applicableFixedPhases); fewer are no fix.
   const DdEpoch& dd = rtk_->measurements();
-  const std::vector<DoubleDifference> phase = applicableFixedPhases(dd, rtk_->config().ar);
-  if (phase.empty()) return;
+  e.ddcpPhases = applicableFixedPhases(dd, rtk_->config());
+  if (e.ddcpPhases.empty()) return;
   std::vector<GnssRow> group;
-  for (const DoubleDifference& d : phase) group.push_back(ddPhaseRow(dd, d, k));
-  rows.addCorrelated(group, kDdcp, ddCovariance(dd, phase, true));
+  for (const DoubleDifference& d : e.ddcpPhases) group.push_back(ddPhaseRow(dd, d, k));
+  rows.addCorrelated(group, kDdcp, ddCovariance(dd, e.ddcpPhases, true));
 }
 
 template <typename Scalar>
@@ -216,8 +216,7 @@ void GnssFusion<Scalar>::addSdCodeRows(Epoch& e, const DdEpoch& dd, const Antenn
 
 template <typename Scalar>
 void GnssFusion<Scalar>::applyRows(vio::EstimatorBackend<Scalar>& est, GnssEpochReport& rep,
-                                   const AntennaKinematics& k, GnssRowSet& rows) {
-  std::vector<bool> acc;
+                                   const AntennaKinematics& k, GnssRowSet& rows, std::vector<bool>& acc) {
   // Re-acquisition (gnss_gate_recovery.hpp): code, phase and differences agree on a position and
   // clock shift, Dopplers on a velocity and drift shift; SPP velocity triples keep their gate.
   ReacquisitionEpoch re;
@@ -269,11 +268,18 @@ bool GnssFusion<Scalar>::tightUpdate(vio::EstimatorBackend<Scalar>& est, Epoch& 
   if (sppVel && sppVel->velocity.valid) addVelocityRows(anchor_, sppVel->velocity, k, kVel, false, rows);
   if (config_.mode == GnssFusionMode::kDoppPpp && clocks_.valid()) addPhaseRows(est, e, models, k, clk, rows);
   addDifferenceRows(e, k, clk, rows);
-  if (!rows.empty()) applyRows(est, e.rep, k, rows);
-  // Fixed: the DD phases of a validated fix were applied, at least as many as a fix has
-  // (applicableFixedPhases); fewer left by the row gate are not a fix either.
+  std::vector<bool> acc;
+  if (!rows.empty()) applyRows(est, e.rep, k, rows, acc);
+  // Fixed: the DD phases of a validated fix were applied, as many and spanning as many
+  // satellites as a fix needs (applicableFixedPhases); fewer left by the row gate are no fix.
+  std::vector<DoubleDifference> applied;
+  for (std::size_t i = 0, j = 0; i < acc.size(); ++i) {
+    if (rows.types[i] != kDdcp) continue;
+    if (acc[i]) applied.push_back(e.ddcpPhases[j]);
+    ++j;
+  }
   e.rep.rtkFixed = config_.mode == GnssFusionMode::kDoppDdcp && e.rep.updated &&
-                   e.rep.ddcp.used >= std::max(1, rtk_->config().ar.minFixed);
+                   isFixSet(rtk_->measurements(), applied, rtk_->config());
   // Ambiguities of satellites without a phase row for a while (set, masked, lost).
   ambiguities_.dropStale(est, e.rover.time, 10.0);
   e.rep.ambiguities = static_cast<int>(ambiguities_.size());
@@ -294,7 +300,7 @@ bool GnssFusion<Scalar>::tightUpdate(vio::EstimatorBackend<Scalar>& est, Epoch& 
   template void GnssFusion<S>::addSdCodeRows(Epoch&, const DdEpoch&, const AntennaKinematics&,                      \
                                              const Eigen::VectorXd&, GnssRowSet&);                                  \
   template void GnssFusion<S>::applyRows(vio::EstimatorBackend<S>&, GnssEpochReport&, const AntennaKinematics&,     \
-                                         GnssRowSet&);                                                              \
+                                         GnssRowSet&, std::vector<bool>&);                                          \
   template bool GnssFusion<S>::tightUpdate(vio::EstimatorBackend<S>&, Epoch&, const GnssStateValues&,               \
                                            const AntennaKinematics&);
 GVINS_INSTANTIATE(float)

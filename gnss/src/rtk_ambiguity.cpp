@@ -57,12 +57,49 @@ std::optional<ReductionStart> embedBasis(const std::vector<std::pair<sri::BlockI
 
 }  // namespace
 
-std::vector<DoubleDifference> applicableFixedPhases(const DdEpoch& dd, const AmbiguityResolutionOptions& ar) {
+int fixedSatelliteSpan(const DdEpoch& dd, const std::vector<DoubleDifference>& phases) {
+  // Satellites as nodes, DDs as edges: the independent directions are the nodes less the
+  // connected sets (union-find over the satellites' indices).
+  std::vector<SatId> sats;
+  auto node = [&](int sdIndex) {
+    const SatId s = dd.sd.at(static_cast<std::size_t>(sdIndex)).sat;
+    const auto it = std::find(sats.begin(), sats.end(), s);
+    if (it != sats.end()) return static_cast<int>(it - sats.begin());
+    sats.push_back(s);
+    return static_cast<int>(sats.size()) - 1;
+  };
+  std::vector<int> parent;
+  auto root = [&](int i) {
+    while (parent[static_cast<std::size_t>(i)] != i) i = parent[static_cast<std::size_t>(i)];
+    return i;
+  };
+  int sets = 0;
+  for (const DoubleDifference& d : phases) {
+    const int a = node(d.reference), b = node(d.satellite);
+    while (parent.size() < sats.size()) {
+      parent.push_back(static_cast<int>(parent.size()));
+      ++sets;
+    }
+    const int ra = root(a), rb = root(b);
+    if (ra != rb) {
+      parent[static_cast<std::size_t>(ra)] = rb;
+      --sets;
+    }
+  }
+  return sats.empty() ? 0 : static_cast<int>(sats.size()) - sets + 1;
+}
+
+bool isFixSet(const DdEpoch& dd, const std::vector<DoubleDifference>& phases, const RtkConfig& cfg) {
+  return static_cast<int>(phases.size()) >= std::max(1, cfg.ar.minFixed) &&
+         fixedSatelliteSpan(dd, phases) >= cfg.arMinSatellites;
+}
+
+std::vector<DoubleDifference> applicableFixedPhases(const DdEpoch& dd, const RtkConfig& cfg) {
   std::vector<DoubleDifference> out;
   for (const DoubleDifference& d : dd.phase) {
     if (d.fixedCycles && d.ambiguityMeters) out.push_back(d);
   }
-  if (static_cast<int>(out.size()) < std::max(1, ar.minFixed)) out.clear();
+  if (!isFixSet(dd, out, cfg)) out.clear();
   return out;
 }
 
@@ -303,9 +340,17 @@ void RtkSolver::resolve(RtkSolution& sol) {
   const ArStatus check = checkFix(pairs, sol, cf);
   if (check != ArStatus::Fixed) return notFixed(check);
 
+  //    Too few DD integers, or of too few satellites, do not determine the position (isFixSet:
+  //    the rule of applicableFixedPhases).
+  const std::vector<double> ints = ddIntegers(pairs, arRef, cf);
+  std::vector<DoubleDifference> integer;
+  for (std::size_t i = 0; i < dd_.phase.size(); ++i) {
+    if (std::isfinite(ints[i])) integer.push_back(dd_.phase[i]);
+  }
+  if (!isFixSet(dd_, integer, cfg_)) return notFixed(ArStatus::TooFewAmbiguities);
+
   // 5. Confirmation: a marginal fix right after an epoch without a validated fix waits for the
   //    next epoch to fix the same integers on the same arcs (no DD integer may differ).
-  const std::vector<double> ints = ddIntegers(pairs, arRef, cf);
   for (std::size_t i = 0; i < dd_.phase.size(); ++i) {
     if (std::isfinite(ints[i])) fixNow_.emplace_back(pairOf(dd_.phase[i]), ints[i]);
   }

@@ -25,7 +25,7 @@ using Reader = YamlReader;  // base/yaml_reader.hpp
 void applyAr(const Reader& r, const YAML::Node& v, const std::string& where, RtkConfig& c) {
   static const std::set<std::string> kKeys = {
       "systems", "elevation_mask_deg", "min_lock", "validation", "ratio_threshold", "max_failure_rate", "partial",
-      "partial_success_rate", "min_fixed", "max_partial_attempts", "max_search_nodes", "hold_min_fixes",
+      "partial_success_rate", "min_fixed", "min_satellites", "max_partial_attempts", "max_search_nodes", "hold_min_fixes",
       "hold_sigma_cycles", "validation_sigmas", "ffrt_samples", "max_fixed_sigma_m", "position_test_alpha",
       "code_validation_sigmas", "confirm_ratio_factor"};
   r.map(v, where, kKeys, [&](const std::string& k, const std::string& f, const YAML::Node& x) {
@@ -38,6 +38,7 @@ void applyAr(const Reader& r, const YAML::Node& v, const std::string& where, Rtk
     else if (k == "partial") c.ar.partial = r.boolean(x, f);
     else if (k == "partial_success_rate") c.ar.partialSuccessRate = r.number(x, f, 0.5, 1.0);
     else if (k == "min_fixed") c.ar.minFixed = r.integer(x, f, 1, 1000);
+    else if (k == "min_satellites") c.arMinSatellites = r.integer(x, f, 2, 1000);
     else if (k == "max_partial_attempts") c.ar.maxPartialAttempts = r.integer(x, f, 0, 1000);
     else if (k == "max_search_nodes") c.ar.maxNodes = r.integer(x, f, 100, 100000000);
     else if (k == "hold_min_fixes") c.holdMinFixes = r.integer(x, f, 1, 100000);

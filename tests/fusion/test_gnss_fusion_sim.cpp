@@ -938,6 +938,25 @@ TEST(GnssFusionSim, FlippedDopplerIsCorrectedAtTheInput) {
 namespace gvins::fusion {
 namespace {
 
+/// The GPS satellites of the first rover epoch, highest first.
+std::vector<SatId> highestGpsAtStart(const Scenario& sc) {
+  const sim::GnssSimEpoch* first = nullptr;
+  for (const sim::GnssSimEpoch& e : sc.epochs) {
+    if (e.role == sim::GnssReceiverRole::Rover) {
+      first = &e;
+      break;
+    }
+  }
+  std::vector<std::pair<double, SatId>> gps;
+  for (std::size_t i = 0; first && i < first->obs.sats.size(); ++i) {
+    if (first->obs.sats[i].sat.system == System::Gps) gps.emplace_back(first->truth.sats[i].azel.elevation, first->obs.sats[i].sat);
+  }
+  std::sort(gps.rbegin(), gps.rend());
+  std::vector<SatId> out;
+  for (const auto& [el, sat] : gps) out.push_back(sat);
+  return out;
+}
+
 // Ddcp's code rows are dpsr's: the carrier-smoothed codes of rover and base through the same row
 // builder and weights (before, Ddcp fused the raw codes until its first fix: 0.24 m against
 // 0.08 m 3-D here, ModesTable). Up to the first DD phase row both modes give the same antenna,
@@ -948,7 +967,6 @@ namespace {
 // (the phase reference of the GPS groups and one more), whose DDs on the held fix (one per band)
 // are no fix; before they were applied and the epochs counted as fixed.
 TEST(GnssFusionSim, DdcpCodeRowsAreDpsrsAndSmallHeldFixesAreNoFix) {
-  const Scenario& sc = scenario();
   // Half-cycle flags on every rover phase for the first 40 s: no integer fixing (the RTK module's
   // AR skips such signals), while the carrier smoothing goes on; then Ddcp fixes.
   auto halfCycles = [](ObsEpoch& obs, double tf) {
@@ -989,21 +1007,32 @@ TEST(GnssFusionSim, DdcpCodeRowsAreDpsrsAndSmallHeldFixesAreNoFix) {
 
   // The two highest GPS satellites at the start (the GPS phase references: the highest continuous
   // satellite, kept while usable).
-  const sim::GnssSimEpoch* first = nullptr;
-  for (const sim::GnssSimEpoch& e : sc.epochs) {
-    if (e.role == sim::GnssReceiverRole::Rover) {
-      first = &e;
-      break;
-    }
-  }
-  ASSERT_NE(first, nullptr);
-  std::vector<std::pair<double, SatId>> gps;
-  for (std::size_t i = 0; i < first->obs.sats.size(); ++i) {
-    if (first->obs.sats[i].sat.system == System::Gps) gps.emplace_back(first->truth.sats[i].azel.elevation, first->obs.sats[i].sat);
-  }
+  const std::vector<SatId> gps = highestGpsAtStart(scenario());
   ASSERT_GE(gps.size(), 2u);
-  std::sort(gps.rbegin(), gps.rend());
-  const RunResult cut = run<double>(mode(GnssFusionMode::kDoppDdcp), SatelliteCut{50.0, {gps[0].second, gps[1].second}});
+  const RunResult cut = run<double>(mode(GnssFusionMode::kDoppDdcp), SatelliteCut{50.0, {gps[0], gps[1]}});
+  int fixedBefore = 0, after = 0;
+  for (std::size_t i = 0; i < cut.epochFixed.size(); ++i) {
+    if (cut.epochTime[i] <= 50.0) {
+      fixedBefore += cut.epochFixed[i];
+      continue;
+    }
+    ++after;
+    EXPECT_FALSE(cut.epochFixed[i]) << "flight time " << cut.epochTime[i];
+    EXPECT_EQ(cut.epochDdcpRows[i], 0) << "flight time " << cut.epochTime[i];
+  }
+  EXPECT_GT(fixedBefore, 50);
+  EXPECT_GT(after, 50);
+}
+
+// A fix needs DD integers of at least ar.min_satellites (4) satellites, three DD directions
+// (fixedSatelliteSpan, the RTK module's own rule): from 50 s of flight the rover keeps the three
+// highest GPS satellites, whose DDs on both bands are four integers (at least ar.min_fixed) but
+// two directions: they leave the position along the third float. Before the rule those epochs
+// took the held integers and were flagged fixed.
+TEST(GnssFusionSim, DdcpFixOfThreeSatellitesIsNoFix) {
+  const std::vector<SatId> gps = highestGpsAtStart(scenario());
+  ASSERT_GE(gps.size(), 3u);
+  const RunResult cut = run<double>(mode(GnssFusionMode::kDoppDdcp), SatelliteCut{50.0, {gps[0], gps[1], gps[2]}});
   int fixedBefore = 0, after = 0;
   for (std::size_t i = 0; i < cut.epochFixed.size(); ++i) {
     if (cut.epochTime[i] <= 50.0) {

@@ -932,6 +932,8 @@ TEST(TransmitStatesShared, SameStatesAndTheSameRtkSolution) {
 // (ar.minFixed): a partial or held fix that leaves three DD integers is no fix at min_fixed 4.
 TEST(RtkApplicableFix, AtLeastMinFixedDdIntegers) {
   DdEpoch e;
+  e.sd.resize(7);
+  for (int i = 0; i < 7; ++i) e.sd[static_cast<std::size_t>(i)].sat = SatId(System::Gps, i + 1);
   for (int i = 0; i < 6; ++i) e.phase.push_back(DoubleDifference{0, i + 1, std::nullopt, std::nullopt});
   auto fix = [&](int n) {
     for (int i = 0; i < 6; ++i) {
@@ -939,22 +941,53 @@ TEST(RtkApplicableFix, AtLeastMinFixedDdIntegers) {
       e.phase[static_cast<std::size_t>(i)].ambiguityMeters = i < n ? std::optional<double>(0.19 * (3.0 - i)) : std::nullopt;
     }
   };
-  AmbiguityResolutionOptions ar;
-  ASSERT_EQ(ar.minFixed, 4);  // the default of RtkConfig::ar
+  RtkConfig cfg;
+  ASSERT_EQ(cfg.ar.minFixed, 4);  // the defaults
+  ASSERT_EQ(cfg.arMinSatellites, 4);
   fix(3);
-  EXPECT_TRUE(applicableFixedPhases(e, ar).empty());
-  ar.minFixed = 3;
-  const std::vector<DoubleDifference> three = applicableFixedPhases(e, ar);
+  EXPECT_TRUE(applicableFixedPhases(e, cfg).empty());
+  cfg.ar.minFixed = 3;
+  const std::vector<DoubleDifference> three = applicableFixedPhases(e, cfg);
   ASSERT_EQ(three.size(), 3u);
   for (int i = 0; i < 3; ++i) {
     EXPECT_EQ(three[static_cast<std::size_t>(i)].satellite, i + 1);
     EXPECT_EQ(*three[static_cast<std::size_t>(i)].fixedCycles, 3.0 - i);
   }
-  ar.minFixed = 4;
+  cfg.ar.minFixed = 4;
   fix(5);  // the sixth DD has no integer: not applied
-  EXPECT_EQ(applicableFixedPhases(e, ar).size(), 5u);
+  EXPECT_EQ(applicableFixedPhases(e, cfg).size(), 5u);
   e.phase[1].ambiguityMeters.reset();  // an integer without its metres is incomplete: not applied
-  EXPECT_EQ(applicableFixedPhases(e, ar).size(), 4u);
+  EXPECT_EQ(applicableFixedPhases(e, cfg).size(), 4u);
   fix(0);
-  EXPECT_TRUE(applicableFixedPhases(e, ar).empty());
+  EXPECT_TRUE(applicableFixedPhases(e, cfg).empty());
+}
+
+// A fix determines the 3-D position only with DD integers of at least arMinSatellites (4)
+// satellites, three independent DD directions: both frequencies of three satellites give four DD
+// integers but two directions (no fix); a fourth satellite makes it one. Across systems each
+// system's reference adds no direction: GPS 3 + Galileo 2 satellites span 4, GPS 2 + Galileo 2 span 3.
+TEST(RtkApplicableFix, IntegersSpanFourSatellites) {
+  const SatId g1(System::Gps, 1), g2(System::Gps, 2), g3(System::Gps, 3), g4(System::Gps, 4);
+  const SatId e1(System::Galileo, 1), e2(System::Galileo, 2);
+  DdEpoch e;
+  for (const SatId s : {g1, g2, g3, g1, g2, g3, g4, e1, e2, e1, e2}) {
+    e.sd.emplace_back();
+    e.sd.back().sat = s;
+  }
+  auto dd = [](int ref, int sat) { return DoubleDifference{ref, sat, 2.0, 0.38}; };
+  RtkConfig cfg;
+  e.phase = {dd(0, 1), dd(0, 2), dd(3, 4), dd(3, 5)};  // L1 and L2 of G01-G03
+  EXPECT_EQ(fixedSatelliteSpan(e, e.phase), 3);
+  EXPECT_TRUE(applicableFixedPhases(e, cfg).empty());
+  e.phase.push_back(dd(0, 6));  // G04 on L1
+  EXPECT_EQ(fixedSatelliteSpan(e, e.phase), 4);
+  EXPECT_EQ(applicableFixedPhases(e, cfg).size(), 5u);
+  e.phase = {dd(0, 1), dd(3, 4), dd(7, 8), dd(9, 10)};  // G01-G02 and E01-E02, two frequencies each
+  EXPECT_EQ(fixedSatelliteSpan(e, e.phase), 3);
+  EXPECT_TRUE(applicableFixedPhases(e, cfg).empty());
+  e.phase = {dd(0, 1), dd(0, 2), dd(3, 5), dd(7, 8)};  // G01-G03 and E01-E02
+  EXPECT_EQ(fixedSatelliteSpan(e, e.phase), 4);
+  EXPECT_EQ(applicableFixedPhases(e, cfg).size(), 4u);
+  cfg.arMinSatellites = 5;  // configurable
+  EXPECT_TRUE(applicableFixedPhases(e, cfg).empty());
 }

@@ -241,6 +241,7 @@ TEST(RtkConfig, ExampleFileHoldsTheDefaultsAndEveryKeyParses) {
   EXPECT_EQ(ex.frequencies, def.frequencies);
   EXPECT_DOUBLE_EQ(ex.elevationMask, def.elevationMask);
   EXPECT_DOUBLE_EQ(ex.ar.ratioThreshold, def.ar.ratioThreshold);
+  EXPECT_EQ(ex.arMinSatellites, def.arMinSatellites);
   EXPECT_DOUBLE_EQ(ex.phaseSigmaA, def.phaseSigmaA);
   EXPECT_DOUBLE_EQ(ex.maxAge, def.maxAge);
   EXPECT_DOUBLE_EQ(ex.slip.geometryFreeThreshold, def.slip.geometryFreeThreshold);
@@ -251,7 +252,7 @@ TEST(RtkConfig, ExampleFileHoldsTheDefaultsAndEveryKeyParses) {
       "rtk:\n  mode: static\n  dynamics: constant-velocity\n  ambiguity_mode: fix-and-hold\n  systems: GE\n"
       "  frequencies: 3\n  bands: {E: \"175\"}\n  elevation_mask_deg: 10\n"
       "  ar: {systems: G, validation: ratio+success-rate, ratio_threshold: 2.5, max_failure_rate: 0.01,\n"
-      "       partial: false, min_fixed: 6, hold_min_fixes: 3, hold_sigma_cycles: 0.001, validation_sigmas: 5}\n"
+      "       partial: false, min_fixed: 6, min_satellites: 5, hold_min_fixes: 3, hold_sigma_cycles: 0.001, validation_sigmas: 5}\n"
       "  phase_sigma_m: {a: 0.002, b: 0.004}\n  code_phase_ratio: 200\n  code_system_factor: {E: 2}\n"
       "  troposphere: false\n  base: {max_age_s: 5, interpolate: false, extrapolate: false}\n"
       "  cycle_slip: {doppler: false, geometry_free_m: 0.03}\n  ambiguity_outage_s: 10\n"
@@ -270,6 +271,7 @@ TEST(RtkConfig, ExampleFileHoldsTheDefaultsAndEveryKeyParses) {
   EXPECT_DOUBLE_EQ(c.ar.ratioThreshold, 2.5);
   EXPECT_FALSE(c.ar.partial);
   EXPECT_EQ(c.ar.minFixed, 6);
+  EXPECT_EQ(c.arMinSatellites, 5);
   EXPECT_EQ(c.holdMinFixes, 3);
   EXPECT_DOUBLE_EQ(c.fixValidationSigmas, 5.0);
   EXPECT_DOUBLE_EQ(c.phaseSigmaB, 0.004);

@@ -173,8 +173,9 @@ class GnssFusion {
   void addSdCodeRows(Epoch& e, const DdEpoch& dd, const AntennaKinematics& k, const Eigen::VectorXd& clk,
                      GnssRowSet& rows);
   /// Applies the tight stage's rows; counts them and restarts ambiguities rejected too often.
+  /// `accepted`: per row, whether the gate kept it.
   void applyRows(vio::EstimatorBackend<Scalar>& est, GnssEpochReport& rep, const AntennaKinematics& k,
-                 GnssRowSet& rows);
+                 GnssRowSet& rows, std::vector<bool>& accepted);
   bool buildState(const vio::EstimatorBackend<Scalar>& est, std::int64_t t_ns, GnssStateValues& s) const;
   bool startFrame(vio::EstimatorBackend<Scalar>& est, const SppSolution& spp, std::int64_t t_ns);
   /// While the frame's yaw is a nuisance (yawPending_): once the SPP and the IMU velocities both

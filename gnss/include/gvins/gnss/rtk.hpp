@@ -70,7 +70,8 @@ const char* toString(RtkIssue i);
 /// Outcome of ambiguity resolution in an epoch with a float solution.
 enum class ArStatus : std::uint8_t {
   Off,                ///< AR disabled
-  TooFewAmbiguities,  ///< fewer eligible DD ambiguities than `ar.minFixed`
+  TooFewAmbiguities,  ///< fewer eligible DD ambiguities than `ar.minFixed`, or a fix whose DD
+                      ///< integers span fewer satellites than `arMinSatellites`
   NotValidated,       ///< no (partial) integer solution passed the ratio / success-rate test
   Rejected,           ///< an accepted solution failed the residual check at the fixed position
   Imprecise,          ///< the fixed position's sigma exceeds maxFixedSigma (fix not used)
@@ -137,15 +138,27 @@ double ionosphereDelayFactor(double wavelength);
 /// on L1, I_s and I_r (m): the code is delayed by it, the phase advanced.
 double ddIonosphericDelay(double wavelengthS, double ionosphereS, double wavelengthR, double ionosphereR);
 
+/// The satellites a set of DD phases of `dd` spans for the position: one more than the number of
+/// independent DD directions (e_sat − e_ref), i.e. the distinct satellites of their references
+/// and satellites less one for every further set joined by no DD (a reference per system). Both
+/// frequencies of a satellite count once: the DDs of two satellites on two frequencies span 2.
+int fixedSatelliteSpan(const DdEpoch& dd, const std::vector<DoubleDifference>& phases);
+
+/// Whether DD phases of `dd` with validated integers make a fix: at least `cfg.ar.minFixed` of
+/// them, spanning at least `cfg.arMinSatellites` satellites (fixedSatelliteSpan). The one rule of
+/// RtkSolver's fixes, applicableFixedPhases and the fusion's fixed epochs.
+bool isFixSet(const DdEpoch& dd, const std::vector<DoubleDifference>& phases, const RtkConfig& cfg);
+
 /// The DD phases of `dd` (RtkSolver::measurements()) that a user of the differences may apply as
 /// fixed (the fusion's Ddcp rows): those that carry the integer of a validated fix (resolve() or
 /// the held fix of differencesWithHeldFix; their failure rate is bounded by the validation of
-/// `ar`: fixed-failure-rate ratio test, partial subsets at `ar.partialSuccessRate`), and only
-/// when there are at least `ar.minFixed` of them, the smallest set the ambiguity resolution fixes
-/// at all. Fewer (a partial fix whose combinations leave two or three DDs integer, a held fix whose
-/// other satellites have set or slipped) are not a fix: a set that small can be wrong with a high
-/// ratio, and it hardly determines the position. Empty when too few.
-std::vector<DoubleDifference> applicableFixedPhases(const DdEpoch& dd, const AmbiguityResolutionOptions& ar);
+/// `cfg.ar`: fixed-failure-rate ratio test, partial subsets at `ar.partialSuccessRate`), and only
+/// when they make a fix (isFixSet: at least `ar.minFixed` of them spanning at least
+/// `arMinSatellites` satellites). Fewer (a partial fix
+/// whose combinations leave two or three DDs integer, a held fix whose other satellites have set
+/// or slipped, both frequencies of two or three satellites) are not a fix: a set that small can be
+/// wrong with a high ratio, and it does not determine the 3-D position. Empty when too few.
+std::vector<DoubleDifference> applicableFixedPhases(const DdEpoch& dd, const RtkConfig& cfg);
 
 class RtkSolver {
  public:

@@ -71,6 +71,10 @@ struct RtkConfig {
   double arElevationMask = 15.0 * constants::kDegToRad;  ///< rad
   int arMinLock = 0;  ///< epochs an ambiguity must have been estimated before it takes part in AR
   AmbiguityResolutionOptions ar;
+  /// A fix needs DD integers that span at least this many satellites (fixedSatelliteSpan, rtk.hpp):
+  /// 4 = three independent DD directions, the fewest that determine a 3-D position. Integers of
+  /// fewer satellites (e.g. both frequencies of two satellites: four DDs, one direction) are no fix.
+  int arMinSatellites = 4;
   int holdMinFixes = 10;           ///< consecutive fixed epochs before fix-and-hold constrains
   double holdSigmaCycles = 0.01;   ///< standard deviation of the hold constraints, cycles
   /// A fixed solution is accepted only if every double-differenced phase residual at the fixed
@@ -175,8 +179,8 @@ const char* toString(SignalMatching m);
 ///     snr_mask_dbhz: 0
 ///     ar: {systems: GECJ, elevation_mask_deg: 15, min_lock: 0, validation: fixed-failure-rate,
 ///          ratio_threshold: 3, max_failure_rate: 0.001, partial: true,
-///          partial_success_rate: 0.999, min_fixed: 4, hold_min_fixes: 10,
-///          hold_sigma_cycles: 0.01, validation_sigmas: 4, ffrt_samples: 4000,
+///          partial_success_rate: 0.999, min_fixed: 4, min_satellites: 4,
+///          hold_min_fixes: 10, hold_sigma_cycles: 0.01, validation_sigmas: 4, ffrt_samples: 4000,
 ///          max_fixed_sigma_m: 0.1, position_test_alpha: 0, code_validation_sigmas: 8,
 ///          confirm_ratio_factor: 2}   # validation: fixed-failure-rate | ratio | success-rate |
 ///                                     #             ratio+success-rate
