@@ -8,9 +8,10 @@
 # with a margin:
 #   fit: antenna 1.4 cm RMS from the track, velocity increments 0.10 m/s RMS, gyro bias within
 #     0.16 mrad/s of the mean gyro of the standing first second (gvins-imu info), walking along -y;
-#   vio (stereo): 0.07 m horizontal RMSE against the fitted trajectory (4-DoF aligned);
-#   vio+dopp+psr, broadcast ionosphere: stereo H 7.97 m, V 3.65 m, velocity 0.195 m/s;
-#     camera-less on the same folder: velocity 0.204 m/s. (With BeiDou B1I only, before the
+#   vio (stereo): 0.04 m horizontal RMSE against the fitted trajectory (4-DoF aligned);
+#   vio+dopp+psr, broadcast ionosphere: stereo H 7.97 m, V 3.88 m, velocity 0.194 m/s;
+#     camera-less on the same folder: velocity 0.212 m/s (the IMU noise of imu0_sensor.yaml, with
+#     the log's sample-time noise). (With BeiDou B1I only, before the
 #     signal fallback brought the receiver's BeiDou B3I and the late-arriving systems into the
 #     fusion: H 7.92 m, stereo 0.19 against camera-less 0.26 m/s.) The horizontal RMS is mostly
 #     the offset every absolute solution has from the RTK track (6-10 m, its base station is not
