@@ -518,7 +518,6 @@ Eigen::Vector3d RtkSolver::updateWithOutlierRejection(Eigen::Vector3d x0, RtkSol
 }
 
 RtkSolution RtkSolver::processEpoch(const ObsEpoch& rover, TransmitStates* states) {
-  fixBefore_ = std::move(fixNow_);
   fixNow_.clear();
   RtkSolution sol;
   sol.time = rover.time;
@@ -642,6 +641,7 @@ RtkSolution RtkSolver::processEpoch(const ObsEpoch& rover, TransmitStates* state
     sol.velocityCovariance = filter_.covariance(vid);
   }
   resolve(sol);
+  rememberFix();
   for (const DoubleDifference& d : dd_.phase) processedPairs_.push_back(pairOf(d));
   // The fix to hold (differencesWithHeldFix): the DD phases that got an ambiguity.
   if (sol.quality == SolutionQuality::Fix) {

@@ -280,6 +280,29 @@ void RtkSolver::hold(const std::vector<ArPair>& pairs, const AmbiguityFix& fix, 
   ++counters_.holdUpdates;
 }
 
+void RtkSolver::rememberFix() {
+  // A pair's arcs are part of its key (a detected slip starts a new arc); a flagged signal or an
+  // ambiguity re-initialised by the post-fit test this epoch (forced_: an undetected slip?) ends
+  // what an earlier fix says about it. This epoch's fix is of the arcs as they are now.
+  auto reinitialised = [&](int sd) {
+    const SingleDifference& s = dd_.sd[static_cast<std::size_t>(sd)];
+    return forced_.count(key(s.sat, s.code)) > 0;
+  };
+  std::vector<std::pair<HeldPair, double>> kept;
+  for (const DoubleDifference& d : dd_.phase) {
+    const HeldPair p = pairOf(d);
+    const auto now = std::find_if(fixNow_.begin(), fixNow_.end(), [&](const auto& e) { return e.first == p; });
+    if (now != fixNow_.end()) {
+      kept.push_back(*now);
+      continue;
+    }
+    if (flagged(d) || reinitialised(d.satellite) || reinitialised(d.reference)) continue;
+    const auto before = std::find_if(fixMemory_.begin(), fixMemory_.end(), [&](const auto& e) { return e.first == p; });
+    if (before != fixMemory_.end()) kept.push_back(*before);
+  }
+  fixMemory_ = std::move(kept);
+}
+
 void RtkSolver::resolve(RtkSolution& sol) {
   if (cfg_.ambiguityMode == AmbiguityMode::Off) {
     sol.ar = ArStatus::Off;
@@ -349,15 +372,16 @@ void RtkSolver::resolve(RtkSolution& sol) {
   }
   if (!isFixSet(dd_, integer, cfg_)) return notFixed(ArStatus::TooFewAmbiguities);
 
-  // 5. Confirmation: a marginal fix right after an epoch without a validated fix waits for the
-  //    next epoch to fix the same integers on the same arcs (no DD integer may differ).
+  // 5. Confirmation: a marginal fix needs another validated fix of the same integers on the same
+  //    arcs, an earlier one (fixMemory_: the integers are constant on an arc) or the next epoch's
+  //    (this epoch's integers are remembered); no DD integer may differ.
   for (std::size_t i = 0; i < dd_.phase.size(); ++i) {
     if (std::isfinite(ints[i])) fixNow_.emplace_back(pairOf(dd_.phase[i]), ints[i]);
   }
   if (fix.ratio < cfg_.confirmRatioFactor * fix.criticalRatio) {
     int same = 0, differ = 0;
     for (const auto& [p, n] : fixNow_) {
-      for (const auto& [q, n0] : fixBefore_) {
+      for (const auto& [q, n0] : fixMemory_) {
         if (p == q) (n == n0 ? same : differ) += 1;
       }
     }

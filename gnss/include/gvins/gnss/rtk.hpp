@@ -19,8 +19,9 @@
 //      conditioned on the fixed integer combinations. It is a fix only if it passes every check
 //      of the fixed solution: its 3-D sigma is at most `maxFixedSigma` (a partial fix must
 //      determine the position), it agrees with the float position in the float covariance
-//      (χ²(3) test), every DD phase of the AR set and every DD code fits it; a marginal first fix
-//      waits for the next epoch's fix of the same integers. In fix-and-hold mode only such
+//      (χ²(3) test), every DD phase of the AR set and every DD code fits it; a marginal fix is
+//      confirmed by another validated fix of the same integers on the same arcs (an earlier one,
+//      else it waits for the next epoch's). In fix-and-hold mode only such
 //      validated, confirmed fixes are fed back as constraints.
 //
 // Epochs may be processed backward in time (setTimeDirection: the backward pass of the combined
@@ -76,7 +77,7 @@ enum class ArStatus : std::uint8_t {
   Rejected,           ///< an accepted solution failed the residual check at the fixed position
   Imprecise,          ///< the fixed position's sigma exceeds maxFixedSigma (fix not used)
   Inconsistent,       ///< the fixed position disagrees with the float one (position-domain test)
-  Unconfirmed,        ///< a marginal first fix, reported as float until the next epoch confirms it
+  Unconfirmed,        ///< a marginal fix no earlier fix confirms, reported as float until the next epoch's does
   Fixed,              ///< the whole eligible set
   PartialFixed,       ///< a subset (decorrelated combinations)
 };
@@ -126,7 +127,7 @@ struct RtkCounters {
   std::int64_t rejectedFixes = 0;       ///< by the residual checks at the fixed position
   std::int64_t impreciseFixes = 0;      ///< fixes that left the position sigma above maxFixedSigma
   std::int64_t inconsistentFixes = 0;   ///< by the position-domain test
-  std::int64_t unconfirmedFixes = 0;    ///< marginal first fixes held back one epoch
+  std::int64_t unconfirmedFixes = 0;    ///< marginal fixes without an earlier fix of the same integers
 };
 
 /// μ = (λ / λ_L1)²: the first-order ionospheric delay of a signal of wavelength λ (m) per metre of
@@ -370,10 +371,15 @@ class RtkSolver {
   void detectSlips(const ObsEpoch& rover, const GlonassChannels& channels);
   RtkSolution processEpoch(const ObsEpoch& rover, TransmitStates* states);
   int consecutiveFixes_ = 0;
-  /// DD integers of the validated fix of the previous and of this process() epoch (empty when
-  /// that epoch had none): what a marginal first fix is confirmed by. Kept across resets (the
-  /// integer of a DD on the same arcs does not depend on the filter).
-  std::vector<std::pair<HeldPair, double>> fixBefore_, fixNow_;
+  /// DD integers of this process() epoch's validated fix (fixNow_), and of the latest validated
+  /// fix of each DD pair formed in every process() epoch since (fixMemory_: the integer of a DD on
+  /// the same arcs does not change, so any earlier validated fix of it confirms a marginal first
+  /// fix). Kept across resets (the integer does not depend on the filter).
+  std::vector<std::pair<HeldPair, double>> fixMemory_, fixNow_;
+  /// After resolve(): fixMemory_ takes this epoch's fixNow_ and keeps the earlier integers of this
+  /// epoch's other DD phases whose signals are not flagged and whose ambiguities the post-fit
+  /// test did not re-initialise.
+  void rememberFix();
   /// Previous resolution's DD ambiguities (SD block ids of satellite and reference) and its
   /// reduced basis: the next epoch's LAMBDA starts from it (ReductionStart) while none of these
   /// pairs has gone (new pairs enter with unit vectors).

@@ -92,8 +92,9 @@ struct RtkConfig {
   /// that has run for minutes is optimistic, its error correlated in time — Nagoya, continuous
   /// AR: float 0.17 m from the correct fix with sigma 0.03 m — so the test rejects right fixes).
   double fixPositionTestAlpha = 0.0;
-  /// A first fix (no validated fix in the previous epoch) whose ratio is below this factor times
-  /// its critical ratio is reported as float until the next epoch's fix confirms its integers.
+  /// A fix whose ratio is below this factor times its critical ratio needs another validated fix
+  /// of the same DD integers on the same arcs: an earlier one (any epoch since, while the arcs
+  /// continue), else it is reported as float and the next epoch's fix may confirm it.
   double confirmRatioFactor = 2.0;
 
   // --- Measurement model.
