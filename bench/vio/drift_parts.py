@@ -22,15 +22,10 @@ import math
 import os
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from gnss_start_seeds import quat  # noqa: E402  (unit quaternion w, x, y, z -> rotation matrix)
+
 SEGMENT_M = 100.0  # the longest segment of vio::EvaluationOptions::segmentLengths
-
-
-def quat_to_r(w, x, y, z):
-    n = math.sqrt(w * w + x * x + y * y + z * z)
-    w, x, y, z = w / n, x / n, y / n, z / n
-    return [[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]]
 
 
 def rt_times(r, v):
@@ -61,7 +56,7 @@ def matched(dataset, run):
         i = bisect.bisect_left(t_ref, e[0] - 1e-6)
         if i < len(t_ref) and abs(t_ref[i] - e[0]) < 1e-3:
             g = truth[i]
-            out.append((e[1:4], quat_to_r(e[7], e[4], e[5], e[6]), g[1:4], quat_to_r(*g[4:8])))
+            out.append((e[1:4], quat(e[7], e[4], e[5], e[6]), g[1:4], quat(*g[4:8])))
     if len(out) < 2:
         sys.exit("%s: fewer than 2 poses matched to the truth of %s" % (run, dataset))
     return out

@@ -957,6 +957,23 @@ std::vector<SatId> highestGpsAtStart(const Scenario& sc) {
   return out;
 }
 
+// Fixed epochs before the satellite cut at `cutTime`, and after it neither a fixed epoch nor a DD
+// phase row (at least 50 epochs each side).
+void expectFixedUntilTheCutAndNoFixAfter(const RunResult& cut, double cutTime) {
+  int fixedBefore = 0, after = 0;
+  for (std::size_t i = 0; i < cut.epochFixed.size(); ++i) {
+    if (cut.epochTime[i] <= cutTime) {
+      fixedBefore += cut.epochFixed[i];
+      continue;
+    }
+    ++after;
+    EXPECT_FALSE(cut.epochFixed[i]) << "flight time " << cut.epochTime[i];
+    EXPECT_EQ(cut.epochDdcpRows[i], 0) << "flight time " << cut.epochTime[i];
+  }
+  EXPECT_GT(fixedBefore, 50);
+  EXPECT_GT(after, 50);
+}
+
 // Ddcp's code rows are dpsr's: the carrier-smoothed codes of rover and base through the same row
 // builder and weights (before, Ddcp fused the raw codes until its first fix: 0.24 m against
 // 0.08 m 3-D here, ModesTable). Up to the first DD phase row both modes give the same antenna,
@@ -1010,18 +1027,7 @@ TEST(GnssFusionSim, DdcpCodeRowsAreDpsrsAndSmallHeldFixesAreNoFix) {
   const std::vector<SatId> gps = highestGpsAtStart(scenario());
   ASSERT_GE(gps.size(), 2u);
   const RunResult cut = run<double>(mode(GnssFusionMode::kDoppDdcp), SatelliteCut{50.0, {gps[0], gps[1]}});
-  int fixedBefore = 0, after = 0;
-  for (std::size_t i = 0; i < cut.epochFixed.size(); ++i) {
-    if (cut.epochTime[i] <= 50.0) {
-      fixedBefore += cut.epochFixed[i];
-      continue;
-    }
-    ++after;
-    EXPECT_FALSE(cut.epochFixed[i]) << "flight time " << cut.epochTime[i];
-    EXPECT_EQ(cut.epochDdcpRows[i], 0) << "flight time " << cut.epochTime[i];
-  }
-  EXPECT_GT(fixedBefore, 50);
-  EXPECT_GT(after, 50);
+  expectFixedUntilTheCutAndNoFixAfter(cut, 50.0);
 }
 
 // A fix needs DD integers of at least ar.min_satellites (4) satellites, three DD directions
@@ -1033,18 +1039,7 @@ TEST(GnssFusionSim, DdcpFixOfThreeSatellitesIsNoFix) {
   const std::vector<SatId> gps = highestGpsAtStart(scenario());
   ASSERT_GE(gps.size(), 3u);
   const RunResult cut = run<double>(mode(GnssFusionMode::kDoppDdcp), SatelliteCut{50.0, {gps[0], gps[1], gps[2]}});
-  int fixedBefore = 0, after = 0;
-  for (std::size_t i = 0; i < cut.epochFixed.size(); ++i) {
-    if (cut.epochTime[i] <= 50.0) {
-      fixedBefore += cut.epochFixed[i];
-      continue;
-    }
-    ++after;
-    EXPECT_FALSE(cut.epochFixed[i]) << "flight time " << cut.epochTime[i];
-    EXPECT_EQ(cut.epochDdcpRows[i], 0) << "flight time " << cut.epochTime[i];
-  }
-  EXPECT_GT(fixedBefore, 50);
-  EXPECT_GT(after, 50);
+  expectFixedUntilTheCutAndNoFixAfter(cut, 50.0);
 }
 
 }  // namespace
